@@ -1,0 +1,46 @@
+"""Configuration of the soft-T_P planner: one frozen dataclass."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Planner settings. Paper values where the paper gives them (T=3, Adam lr 0.1, 0.3)."""
+
+    horizon: int = 3  # T, moves per optimisation window
+    lr: float = 0.1  # Adam learning rate on the action logits
+    iters: int = 120  # Adam steps per window
+    tau: float = 0.5  # softmax temperature of the action logits
+    threshold: float = 0.3  # decoding confidence: a step's move mass must reach this
+    goal_loss: str = "towers"  # "atoms": the paper's goal CE; "towers": CE on well-placed blocks
+    lambda_move: float = 0.05  # weight of the move-count loss (shorter plans)
+    lambda_cycle: float = 1.0  # weight of the direct two-cycle loss
+    lambda_fp: float = 1.0  # weight of the fixed-point loss (before refinement)
+    fp_iters: int = 1  # T_P refinement applications between steps
+    init_noise: float = 0.5  # std of the Gaussian initial logits (differs per restart)
+    restarts: int = 16  # random restarts per problem, optimised in the same tensor program
+    lookahead: int = 6  # window length of the long-lookahead restarts (an extension, not paper)
+    lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
+    max_windows: int = 12  # replanning windows before giving up
+    batched: bool = True  # one tensor program for all problems; False: one problem at a time
+
+    def horizons(self) -> tuple[int, ...]:
+        """Window length of each restart: the long-lookahead restarts come last."""
+        n_long = round(self.restarts * self.lookahead_share)
+        return (self.horizon,) * (self.restarts - n_long) + (self.lookahead,) * n_long
+
+    def __post_init__(self) -> None:
+        from task.errors import TampError
+
+        for name in ("horizon", "iters", "restarts", "max_windows"):
+            if getattr(self, name) < 1:
+                raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")
+        if not 0.0 < self.threshold <= 1.0:
+            raise TampError(f"PlannerConfig.threshold must be in (0, 1], got {self.threshold}")
+        if not 0.0 <= self.lookahead_share <= 1.0:
+            share = self.lookahead_share
+            raise TampError(f"PlannerConfig.lookahead_share must be in [0, 1], got {share}")
+        if self.tau <= 0 or self.lr <= 0:
+            raise TampError("PlannerConfig.tau and PlannerConfig.lr must be > 0")

@@ -1,0 +1,111 @@
+"""Receding-window planning: optimise a window, decode, execute the legal moves, replan.
+
+``plan_batch`` plans many problems in one tensor program per window (problems of different
+sizes padded and masked, restarts as extra rows); problems that reach their goal leave the batch.
+With ``PlannerConfig(batched=False)`` the same code runs one problem at a time, so the speed-up
+of batching can be measured.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+
+import torch
+
+from task.config import PlannerConfig
+from task.decode import decode_best
+from task.domains import get_domain
+from task.domains.base import Domain, State
+from task.errors import TampError
+from task.optimize import optimise_window
+from task.problem import Plan, PlanResult, PlanStatus, Problem
+
+
+def _window(
+    domain: Domain,
+    problems: Sequence[Problem],
+    states: Sequence[State],
+    config: PlannerConfig,
+    generator: torch.Generator,
+):
+    batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
+    horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
+    steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
+    _, roll = optimise_window(domain, batch, steps, config, generator)
+    return decode_best(
+        domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold
+    )
+
+
+def _run(
+    domain: Domain,
+    problems: Sequence[Problem],
+    config: PlannerConfig,
+    generator: torch.Generator,
+    on_done: Callable[[int], None],
+) -> list[PlanResult]:
+    """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems."""
+    start = time.perf_counter()
+    states = [domain.initial_state(p) for p in problems]
+    moves: list[list] = [[] for _ in problems]
+    windows = [0] * len(problems)
+    active = [i for i, p in enumerate(problems) if not domain.is_goal(p, states[i])]
+    on_done(len(problems) - len(active))
+    for _ in range(config.max_windows):
+        if not active:
+            break
+        decoded = _window(
+            domain, [problems[i] for i in active], [states[i] for i in active], config, generator
+        )
+        still = []
+        for i, win in zip(active, decoded, strict=True):
+            windows[i] += 1
+            moves[i].extend(win.moves)
+            states[i] = win.state
+            if not win.reached:
+                still.append(i)
+        on_done(len(active) - len(still))
+        active = still
+    on_done(len(active))
+    elapsed = time.perf_counter() - start
+    results = []
+    for i, p in enumerate(problems):
+        reached = domain.is_goal(p, states[i])
+        stats = {
+            "windows": windows[i],
+            "time_s": elapsed / len(problems),
+            "batch_time_s": elapsed,
+        }
+        status = PlanStatus.SOLVED if reached else PlanStatus.NO_PLAN
+        results.append(PlanResult(status, Plan(tuple(moves[i])), p, None, stats))
+    return results
+
+
+def plan_batch(
+    problems: Sequence[Problem],
+    config: PlannerConfig = PlannerConfig(),
+    seed: int = 0,
+    progress: Callable[[int], None] | None = None,
+) -> list[PlanResult]:
+    """Plan every problem (all of one domain). ``progress(k)``: k more problems finished.
+
+    Returns one PlanResult per problem, in order; ``stats["time_s"]`` is the wall time per
+    problem (the batch's time divided among its problems when batched).
+    """
+    if not problems:
+        return []
+    names = {p.domain for p in problems}
+    if len(names) > 1:
+        raise TampError(f"plan_batch needs problems of one domain, got {sorted(names)}")
+    domain = get_domain(problems[0].domain)
+    generator = torch.Generator().manual_seed(seed)
+    report = progress or (lambda k: None)
+    if config.batched:
+        return _run(domain, problems, config, generator, report)
+    return [_run(domain, [p], config, generator, report)[0] for p in problems]
+
+
+def plan(problem: Problem, config: PlannerConfig = PlannerConfig(), seed: int = 0) -> PlanResult:
+    """Plan one problem."""
+    return plan_batch([problem], config, seed)[0]

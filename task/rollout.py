@@ -1,0 +1,64 @@
+"""Differentiable rollout of a window of action logits through the soft-T_P transition.
+
+Shared by every domain: the domain supplies soft legality and its T_P consistency operator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch import Tensor
+
+from task.config import PlannerConfig
+from task.domains.base import Domain, SoftBatch
+from task.soft import transition
+
+NEG = -1e9  # logit of a masked action
+
+
+@dataclass(frozen=True)
+class Rollout:
+    states: Tensor  # (B, T+1, N, Y) soft supports, refined
+    gates: Tensor  # (B, T, N, Y) move mass g_t(x, y) actually applied
+    loss: Tensor  # (B,) total objective per rollout
+    goal: Tensor  # (B,) goal cross-entropy at the window's end
+    moves: Tensor  # (B,) expected number of moves, sum_t sum_x m_t(x)
+
+
+def action_probs(logits: Tensor, batch: SoftBatch, tau: float, steps: Tensor) -> Tensor:
+    """M_t = softmax(a_t / tau) with invalid actions masked. (B, T, N, A) -> (B, T, N, A).
+
+    steps: (B, T) bool, False where a row's window is shorter than T (only STAY is allowed).
+    """
+    stay = torch.zeros_like(batch.action_mask[0, 0])  # (A,)
+    stay[-1] = True
+    live = steps[:, :, None, None] | stay  # (B, T, 1, A)
+    mask = batch.action_mask.unsqueeze(1) & live  # (B, T, N, A)
+    return torch.softmax(torch.where(mask, logits / tau, NEG), dim=-1)
+
+
+def rollout(
+    domain: Domain, logits: Tensor, batch: SoftBatch, steps: Tensor, config: PlannerConfig
+) -> Rollout:
+    """Roll the window out from ``batch.F0``; logits: (B, T, N, A); steps: (B, T) live steps."""
+    M = action_probs(logits, batch, config.tau, steps)  # (B, T, N, A)
+    F = batch.F0
+    states, gates = [F], []
+    fp = torch.zeros(F.shape[0], dtype=F.dtype, device=F.device)
+    cycle = domain.cycle_loss(F, batch)
+    for t in range(M.shape[1]):
+        F, g = transition(F, M[:, t], domain.soft_legality(F, batch))  # (B, N, Y)
+        refined = domain.consistency(F, batch)
+        fp = fp + (refined - F).pow(2).sum((-1, -2))  # fixed-point loss before refinement
+        F = refined
+        for _ in range(config.fp_iters - 1):
+            F = domain.consistency(F, batch)
+        cycle = cycle + domain.cycle_loss(F, batch)
+        states.append(F)
+        gates.append(g)
+    G = torch.stack(gates, dim=1)  # (B, T, N, Y)
+    moves = G.sum((1, 2, 3))
+    goal = domain.goal_loss(F, batch, config.goal_loss)
+    loss = goal + config.lambda_move * moves + config.lambda_cycle * cycle + config.lambda_fp * fp
+    return Rollout(torch.stack(states, dim=1), G, loss, goal, moves)

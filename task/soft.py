@@ -1,0 +1,77 @@
+"""Domain-independent soft-logic operators of the soft-T_P transition.
+
+Every function is batched (batch first) and differentiable. Products of ``(1 - p)`` terms run
+over at most N entities and are taken with ``torch.prod`` over a masked matrix, which is exact
+at 0 and 1 (one-hot states stay one-hot) and never divides.
+"""
+
+from __future__ import annotations
+
+import torch
+from torch import Tensor
+
+
+def prod_others(v: Tensor) -> Tensor:
+    """Exclusive product ``out[..., i] = prod_{j != i} v[..., j]``.
+
+    v: (..., N) -> (..., N). Used by the competition ``q(x) = prod_{x' != x} (1 - rho(x'))``.
+    """
+    n = v.shape[-1]
+    eye = torch.eye(n, dtype=torch.bool, device=v.device)
+    rows = v.unsqueeze(-2).expand(*v.shape[:-1], n, n)  # (..., N, N): row i holds v
+    return torch.where(eye, torch.ones_like(rows), rows).prod(-1)
+
+
+def column_free(F: Tensor, n: int) -> Tensor:
+    """Soft "nothing rests on column y" for the first ``n`` columns, excluding self-support.
+
+    Eq. clear: c(x) = prod_{z != x} (1 - F[z, x]).  F: (B, N, Y) -> (B, N).
+    """
+    occ = F[..., :n]  # (B, Z, X)
+    eye = torch.eye(n, dtype=torch.bool, device=F.device)
+    free = torch.where(eye, torch.ones_like(occ), 1.0 - occ)
+    return free.prod(-2)  # product over z -> (B, X)
+
+
+def exclusive_support(F: Tensor, n: int) -> Tensor:
+    """Target exclusivity on the first ``n`` (capacity-one) columns.
+
+    Eq. T_P: T_P(F)[z, y] = F[z, y] * prod_{z' != z} (1 - F[z', y]) for block targets y;
+    the remaining (unlimited-capacity) columns pass through. F: (B, N, Y) -> (B, N, Y).
+    """
+    cols = F[..., :n].transpose(-1, -2)  # (B, Y_blocks, Z)
+    others_free = prod_others(1.0 - cols).transpose(-1, -2)  # (B, Z, Y_blocks)
+    return torch.cat([F[..., :n] * others_free, F[..., n:]], dim=-1)
+
+
+def row_normalise(F: Tensor, eps: float = 1e-12) -> Tensor:
+    """Rows back to distributions; the denominator is clamped, never zero. (B, N, Y)."""
+    return F / F.sum(-1, keepdim=True).clamp_min(eps)
+
+
+def transition(F: Tensor, M: Tensor, legal: Tensor) -> tuple[Tensor, Tensor]:
+    """One soft-T_P step with legality-gated move mass and one-move-per-step competition.
+
+    F: (B, N, Y) support beliefs; M: (B, N, A) action distribution, A = Y + 1 (last = STAY);
+    legal: (B, N, Y) soft legality of move(x -> y) from the domain.
+
+    Eq. gate:        g~(x, y) = M(x, y) * legal(x, y)
+    Eq. competition: rho(x) = sum_y g~(x, y);  q(x) = prod_{x' != x} (1 - rho(x'));  g = g~ q
+    Eq. transition:  m(x) = sum_y g(x, y);  F' = (1 - m) F + g   (1 - m is the residual STAY mass)
+    Returns (F', g) with g: (B, N, Y).
+    """
+    g_raw = M[..., :-1] * legal  # (B, N, Y)
+    rho = g_raw.sum(-1)  # (B, N)
+    q = prod_others(1.0 - rho)  # (B, N)
+    g = g_raw * q.unsqueeze(-1)  # (B, N, Y)
+    m = g.sum(-1, keepdim=True)  # (B, N, 1)
+    return (1.0 - m) * F + g, g
+
+
+def goal_cross_entropy(F: Tensor, goal: Tensor) -> Tensor:
+    """Eq. goal: -sum over goal atoms of log F[x, y]; partial goals leave rows empty.
+
+    F, goal: (B, N, Y) with goal one-hot on the goal atoms -> (B,).
+    """
+    eps = torch.finfo(F.dtype).tiny
+    return -(goal * torch.log(F.clamp_min(eps))).sum((-1, -2))
