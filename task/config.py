@@ -11,7 +11,7 @@ class PlannerConfig:
 
     horizon: int = 3  # T, moves per optimisation window
     lr: float = 0.1  # Adam learning rate on the action logits
-    iters: int = 120  # Adam steps per window
+    iters: int = 60  # Adam steps per window
     tau: float = 0.5  # softmax temperature of the action logits
     threshold: float = 0.3  # decoding confidence: a step's move mass must reach this
     goal_loss: str = "towers"  # "atoms": the paper's goal CE; "towers": CE on well-placed blocks
@@ -21,7 +21,7 @@ class PlannerConfig:
     fp_iters: int = 1  # T_P refinement applications between steps
     init_noise: float = 0.5  # std of the Gaussian initial logits (differs per restart)
     restarts: int = 16  # random restarts per problem, optimised in the same tensor program
-    lookahead: int = 6  # window length of the long-lookahead restarts (an extension, not paper)
+    lookahead: int = 5  # window length of the long-lookahead restarts (an extension, not paper)
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
     max_windows: int = 12  # replanning windows before giving up
     batched: bool = True  # one tensor program for all problems; False: one problem at a time

@@ -23,3 +23,7 @@ def one_of(name: str, valid: object) -> str:
     """Format ``'x' (valid: a, b, c)`` for error messages."""
     items = ", ".join(str(v) for v in valid)
     return f"{name!r} (valid: {items})"
+
+
+class DataError(TampError):
+    """Benchmark data (e.g. the PlanBench checkout) is missing or does not match its manifest."""

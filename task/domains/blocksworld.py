@@ -291,19 +291,20 @@ def well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
     """Soft "x will never have to move again": w(x), (B, N, Y) -> (B, N).
 
     Goal blocks: w(x) = F[x, g(x)] * wbar(g(x)); blocks the goal leaves free:
-    w(x) = sum_y F[x, y] wbar(y); wbar(table) = 1. N sweeps of this recursion reach its fixed
-    point on every tower of at most N blocks.
+    w(x) = sum_y F[x, y] wbar(y); wbar(table) = 1. A problem of n blocks gets exactly n sweeps
+    of this recursion (its fixed point on crisp towers), whatever the padding.
     """
     n = batch.n
+    sweeps = batch.entity_mask.sum(-1, keepdim=True)  # (B, 1) real blocks per row
     has_goal = batch.goal.sum(-1)  # (B, N)
     on_goal = (F * batch.goal).sum(-1)  # F[x, g(x)], (B, N)
     w = torch.ones_like(has_goal)
     ones = torch.ones_like(F[:, 0, n:])  # (B, K)
-    for _ in range(n):
+    for k in range(n):
         wbar = torch.cat([w, ones], dim=-1).unsqueeze(-2)  # (B, 1, Y)
         goal_term = on_goal * (batch.goal * wbar).sum(-1)  # (B, N)
         free_term = (F * wbar).sum(-1)  # (B, N)
-        w = has_goal * goal_term + (1.0 - has_goal) * free_term
+        w = torch.where(k < sweeps, has_goal * goal_term + (1.0 - has_goal) * free_term, w)
     return w
 
 

@@ -1,0 +1,206 @@
+"""The ``tamp`` command line: argparse subcommands around `tamp.commands` and `tamp.bench_cli`.
+
+    tamp plan DOMAIN.pddl PROBLEM.pddl [--horizon 3 --restarts K --seed S --json --out plan.txt]
+    tamp validate DOMAIN.pddl PROBLEM.pddl PLAN [--json]
+    tamp demo [--json --out DIR]
+    tamp bench planbench [--data DIR --limit N --seeds 3 --horizon 1,3,5 --sequential N --out DIR]
+    tamp bench random [--blocks 6,8,10 --n 50 --seed 0 --max-nodes 20000 --out DIR]
+
+Exit codes: 0 success, 1 no plan or an invalid plan, 2 usage error or bad input (one line on
+stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Sequence
+
+from tamp import bench_cli, commands
+from task.config import PlannerConfig
+from task.domains.blocksworld import GOAL_LOSSES
+from task.errors import TampError
+from task.instances import DEFAULT_PLANBENCH
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (no usage block); subparsers inherit the class."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def _positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def _count(text: str) -> int:
+    return 0 if text.strip() == "0" else _positive(text)
+
+
+def _positive_list(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(t) for t in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated positive integers such as 1,3,5, got {text!r}"
+        ) from None
+    if not values or min(values) < 1:
+        raise argparse.ArgumentTypeError(f"expected positive integers, got {text!r}")
+    return tuple(dict.fromkeys(values))
+
+
+def _share(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}")
+    return value
+
+
+def _planner_options(horizon_list: bool) -> argparse.ArgumentParser:
+    """Options shared by every command that plans; they override `PlannerConfig` fields."""
+    d = PlannerConfig()
+    p = _Parser(add_help=False)
+    g = p.add_argument_group("planner (overrides PlannerConfig defaults)")
+    if horizon_list:
+        g.add_argument(
+            "--horizon",
+            dest="horizons",
+            type=_positive_list,
+            metavar="T[,T...]",
+            help=f"window lengths; several run the window ablation ({d.horizon})",
+        )
+    else:
+        g.add_argument(
+            "--horizon", type=_positive, metavar="T", help=f"window length ({d.horizon})"
+        )
+    g.add_argument(
+        "--restarts", type=_positive, metavar="K", help=f"random restarts ({d.restarts})"
+    )
+    g.add_argument(
+        "--iters", type=_positive, metavar="N", help=f"Adam steps per window ({d.iters})"
+    )
+    g.add_argument("--goal-loss", choices=GOAL_LOSSES, help=f"goal objective ({d.goal_loss})")
+    g.add_argument(
+        "--lookahead-share",
+        type=_share,
+        metavar="S",
+        help=f"share of restarts whose window is {d.lookahead} moves long "
+        f"({d.lookahead_share:g}; 0 = the paper's planner)",
+    )
+    return p
+
+
+def _output(p: argparse.ArgumentParser, out_help: str) -> None:
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    p.add_argument("--out", metavar="PATH", help=out_help)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="tamp", description="Differentiable soft-T_P task planning.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    plan_opts, bench_opts = _planner_options(False), _planner_options(True)
+
+    p = sub.add_parser("plan", parents=[plan_opts], help="plan a blocksworld PDDL problem")
+    p.add_argument("domain", metavar="DOMAIN.pddl")
+    p.add_argument("problem", metavar="PROBLEM.pddl")
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    _output(p, "write the plan file (VAL format) here")
+    p.set_defaults(func=commands.plan_command)
+
+    p = sub.add_parser("validate", help="validate a plan file against a domain and a problem")
+    p.add_argument("domain", metavar="DOMAIN.pddl")
+    p.add_argument("problem", metavar="PROBLEM.pddl")
+    p.add_argument("plan", metavar="PLAN")
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    p.set_defaults(func=commands.validate_command)
+
+    p = sub.add_parser("demo", parents=[plan_opts], help="plan the embedded 5-block example")
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    _output(p, "write the example's domain, problem and plan files into this folder")
+    p.set_defaults(func=commands.demo_command)
+
+    bench = sub.add_parser("bench", help="planning benchmarks").add_subparsers(
+        dest="suite", required=True, metavar="SUITE"
+    )
+    for name, what in (("planbench", "PlanBench Blocksworld-600"), ("random", "random problems")):
+        p = bench.add_parser(name, parents=[bench_opts], help=f"benchmark on {what}")
+        p.add_argument(
+            "--seeds", type=_positive, default=1, metavar="S", help="planner seeds 0..S-1 (1)"
+        )
+        p.add_argument(
+            "--sequential",
+            type=_count,
+            default=0,
+            metavar="N",
+            help="also time batched vs sequential planning on the first N instances",
+        )
+        p.add_argument(
+            "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
+        )
+        _output(p, "write instances.csv, results.json and steps.png into this folder")
+    planbench, random_ = bench.choices["planbench"], bench.choices["random"]
+    planbench.add_argument(
+        "--data",
+        default=str(DEFAULT_PLANBENCH),
+        metavar="DIR",
+        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+    )
+    planbench.add_argument(
+        "--limit",
+        type=_positive,
+        metavar="N",
+        help="a spread of N instances over the block counts (all 600)",
+    )
+    planbench.set_defaults(func=bench_cli.planbench_command)
+    random_.add_argument(
+        "--blocks",
+        type=_positive_list,
+        default=(6, 8, 10, 15, 20),
+        metavar="B[,B...]",
+        help="block counts (6,8,10,15,20)",
+    )
+    random_.add_argument("--n", type=_positive, default=50, help="instances per block count (50)")
+    random_.add_argument("--seed", type=int, default=0, help="instance generator seed (0)")
+    random_.add_argument(
+        "--max-nodes",
+        type=_positive,
+        default=20_000,
+        metavar="N",
+        help="A* expansion budget for the optimal lengths (20000)",
+    )
+    random_.set_defaults(func=bench_cli.random_command)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``tamp`` command line; returns the exit code."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: --help exits 0, usage errors 2
+        return exc.code if isinstance(exc.code, int) else 2
+    try:
+        return args.func(args)
+    except TampError as exc:
+        print(f"tamp: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # stdout closed early (e.g. piped into head): stop quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

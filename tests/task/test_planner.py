@@ -1,0 +1,130 @@
+"""The differentiable rollout, the optimiser, decoding and the replanning planner."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import pytest
+import torch
+
+from task.config import PlannerConfig
+from task.decode import decode_row
+from task.domains import get_domain
+from task.errors import ProblemError, TampError
+from task.generate import random_problem
+from task.planner import plan, plan_batch
+from task.problem import Problem
+from task.rollout import rollout
+
+BW = get_domain("blocksworld")
+FAST = PlannerConfig(restarts=4, iters=60)
+
+
+def _batch(problems, dtype=torch.float64):
+    return BW.encode(problems, [BW.initial_state(p) for p in problems], dtype)
+
+
+@pytest.mark.parametrize("goal_loss", ["atoms", "towers"])
+def test_rollout_gradcheck_float64(goal_loss):
+    problem = random_problem(3, 0)
+    batch = _batch([problem])
+    steps = torch.ones(1, 2, dtype=torch.bool)
+    config = replace(PlannerConfig(horizon=2), goal_loss=goal_loss)
+    gen = torch.Generator().manual_seed(0)
+    logits = torch.randn((1, 2, *batch.action_mask.shape[1:]), generator=gen, dtype=torch.float64)
+    logits.requires_grad_(True)
+
+    def f(a):
+        return rollout(BW, a, batch, steps, config).loss
+
+    assert torch.autograd.gradcheck(f, (logits,), eps=1e-6, atol=1e-5)
+
+
+def test_rows_of_a_batch_are_independent():
+    problems = [random_problem(3, 0), random_problem(5, 1)]
+    batch = _batch(problems)
+    steps = torch.ones(2, 3, dtype=torch.bool)
+    logits = torch.randn((2, 3, *batch.action_mask.shape[1:]), dtype=torch.float64)
+    logits.requires_grad_(True)
+    rollout(BW, logits, batch, steps, PlannerConfig()).loss[0].backward()
+    assert logits.grad[1].abs().sum() == 0.0
+    assert logits.grad[0].abs().sum() > 0.0
+
+
+@pytest.mark.parametrize("goal_loss", ["atoms", "towers"])
+def test_padded_problem_rolls_out_like_the_unpadded_one(goal_loss):
+    small, big = random_problem(3, 2), random_problem(6, 3)
+    steps = torch.ones(1, 3, dtype=torch.bool)
+    alone = _batch([small])
+    padded = _batch([small, big])
+    gen = torch.Generator().manual_seed(1)
+    a = torch.randn((1, 3, *alone.action_mask.shape[1:]), generator=gen, dtype=torch.float64)
+    # embed the small problem's logits into the padded layout: entity slots, table, STAY
+    n_big = padded.n
+    a_pad = torch.zeros((1, 3, n_big, n_big + 2), dtype=torch.float64)
+    a_pad[:, :, :3, :3] = a[:, :, :, :3]
+    a_pad[:, :, :3, n_big:] = a[:, :, :, 3:]
+    config = PlannerConfig(goal_loss=goal_loss)
+    one = rollout(BW, a, alone, steps, config)
+    sub = type(padded)(*(t[:1] for t in padded.astuple()))
+    two = rollout(BW, a_pad, sub, steps, config)
+    assert torch.allclose(one.loss, two.loss)
+
+
+def test_decoding_stops_at_the_first_illegal_move():
+    problem = Problem("p", "blocksworld", ("a", "b"), ("table", "a"), (("a", "b"),))
+    state = BW.initial_state(problem)  # b on a
+    gates = torch.zeros(2, 2, 3)
+    gates[0, 0, 1] = 0.9  # a -> b, illegal: a is covered
+    gates[1, 1, 2] = 0.9  # b -> table, legal but after an illegal step
+    win = decode_row(BW, problem, state, gates, 0.3, 0.0)
+    assert win.moves == () and not win.complete
+    gates[0] = 0.0
+    gates[0, 1, 2] = 0.2  # below the threshold: a STAY step
+    win = decode_row(BW, problem, state, gates, 0.3, 0.0)
+    assert [str(m) for m in win.moves] == ["move(b -> table)"]
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_small_problems_solved_with_legal_plans(seed):
+    problem = random_problem(3 + seed % 2, seed)
+    result = plan(problem, FAST, seed=seed)
+    assert result.solved
+    state = BW.initial_state(problem)
+    for move in result.plan:
+        assert BW.check_move(problem, state, move) is None
+        state = BW.apply_move(problem, state, move)
+    assert BW.is_goal(problem, state)
+
+
+def test_batched_and_sequential_paths_both_solve():
+    problems = [random_problem(4, s) for s in range(3)]
+    for batched in (True, False):
+        results = plan_batch(problems, replace(FAST, batched=batched), seed=0)
+        assert [r.solved for r in results] == [True] * 3
+
+
+def test_paper_configuration_plans_a_two_move_problem():
+    problem = Problem(
+        "p", "blocksworld", ("a", "b", "c"), ("b", "table", "table"), (("b", "c"), ("a", "b"))
+    )
+    config = PlannerConfig(goal_loss="atoms", lookahead_share=0.0, restarts=1)
+    result = plan(problem, config)
+    assert result.solved and len(result.plan) == 3
+
+
+def test_goal_already_true_gives_an_empty_plan():
+    problem = Problem("p", "blocksworld", ("a", "b"), ("b", "table"), (("a", "b"),))
+    result = plan(problem, FAST)
+    assert result.solved and len(result.plan) == 0
+
+
+def test_bad_inputs_raise_one_line_errors():
+    with pytest.raises(TampError, match="horizon"):
+        PlannerConfig(horizon=0)
+    with pytest.raises(TampError, match="threshold"):
+        PlannerConfig(threshold=1.5)
+    with pytest.raises(ProblemError, match="unknown domain 'sokobanx'"):
+        get_domain("sokobanx")
+    with pytest.raises(ProblemError, match="goal loss"):
+        plan(random_problem(3, 0), replace(FAST, goal_loss="bogus"))

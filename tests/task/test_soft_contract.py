@@ -1,0 +1,107 @@
+"""Contract tests run over every registered domain: soft transition vs crisp semantics."""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+import torch
+
+from task.domains import get_domain, names
+from task.generate import random_problem
+from task.problem import Move
+from task.soft import prod_others, transition
+
+DOMAINS = names()
+
+
+def _onehot_action(batch, x: int, y: int | None) -> torch.Tensor:
+    """(1, N, A) with move(x -> y) for entity x and STAY for everyone else."""
+    _, n, a = batch.action_mask.shape
+    M = torch.zeros(1, n, a, dtype=torch.float64)
+    M[0, :, -1] = 1.0
+    if y is not None:
+        M[0, x] = 0.0
+        M[0, x, y] = 1.0
+    return M
+
+
+def _cases(domain_name: str):
+    """Random problems with states reached by random legal moves."""
+    domain = get_domain(domain_name)
+    for seed in range(4):
+        problem = random_problem(3 + seed, seed)
+        state = domain.initial_state(problem)
+        yield problem, state
+
+
+@pytest.mark.parametrize("domain_name", DOMAINS)
+def test_soft_step_equals_crisp_apply_on_onehot_states(domain_name):
+    domain = get_domain(domain_name)
+    for problem, state in _cases(domain_name):
+        batch = domain.encode([problem], [state], torch.float64)
+        n = batch.n
+        for x, y in itertools.product(range(problem.n), range(n + len(problem.fixed))):
+            if y == x:
+                continue
+            target = problem.entities[y] if y < n else problem.fixed[y - n]
+            move = Move(problem.entities[x], target)
+            F = batch.F0
+            F1, g = transition(F, _onehot_action(batch, x, y), domain.soft_legality(F, batch))
+            if domain.check_move(problem, state, move) is None:
+                expected = domain.encode(
+                    [problem], [domain.apply_move(problem, state, move)], torch.float64
+                ).F0
+                assert torch.equal(F1, expected), move
+                assert g.sum().item() == 1.0
+            else:
+                assert g.abs().sum().item() == 0.0, f"illegal {move} carries mass"
+                assert torch.equal(F1, F)
+
+
+@pytest.mark.parametrize("domain_name", DOMAINS)
+def test_rows_stay_distributions_under_soft_actions(domain_name):
+    domain = get_domain(domain_name)
+    gen = torch.Generator().manual_seed(0)
+    for problem, state in _cases(domain_name):
+        batch = domain.encode([problem], [state], torch.float64)
+        F = batch.F0
+        for _ in range(5):
+            M = torch.softmax(torch.randn(batch.action_mask.shape, generator=gen), -1)
+            M = M.to(torch.float64) * batch.action_mask
+            M = M / M.sum(-1, keepdim=True)
+            F, g = transition(F, M, domain.soft_legality(F, batch))
+            assert torch.allclose(F.sum(-1), torch.ones_like(F[..., 0]))
+            assert (F >= 0).all() and (g >= 0).all()
+            F = domain.consistency(F, batch)
+            assert torch.allclose(F.sum(-1), torch.ones_like(F[..., 0]))
+
+
+@pytest.mark.parametrize("domain_name", DOMAINS)
+def test_consistency_is_identity_on_crisp_states(domain_name):
+    domain = get_domain(domain_name)
+    for problem, state in _cases(domain_name):
+        batch = domain.encode([problem], [state], torch.float64)
+        assert torch.equal(domain.consistency(batch.F0, batch), batch.F0)
+        assert domain.cycle_loss(batch.F0, batch).item() == 0.0
+
+
+def test_competition_lets_only_one_entity_move():
+    domain = get_domain("blocksworld")
+    problem = random_problem(4, 1)
+    batch = domain.encode([problem], [domain.initial_state(problem)], torch.float64)
+    clear = [i for i, e in enumerate(problem.entities) if e not in domain.initial_state(problem)]
+    M = _onehot_action(batch, clear[0], batch.n)  # clear block to the table
+    if len(clear) > 1:
+        M[0, clear[1]] = 0.0
+        M[0, clear[1], batch.n] = 1.0  # a second full move in the same step
+        _, g = transition(batch.F0, M, domain.soft_legality(batch.F0, batch))
+        assert g.sum().item() == 0.0  # two certain movers cancel each other out
+
+
+def test_prod_others_matches_loop():
+    v = torch.rand(3, 5, dtype=torch.float64)
+    out = prod_others(v)
+    for i in range(5):
+        others = torch.cat([v[:, :i], v[:, i + 1 :]], dim=1).prod(1)
+        assert torch.allclose(out[:, i], others)
