@@ -16,7 +16,7 @@ from pddl.core import Domain
 from tamp import report
 from task import data, pddl_io
 from task.config import PlannerConfig
-from task.domains import blocksworld
+from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.instances import Instance, example, from_files
 from task.planner import plan
@@ -48,7 +48,9 @@ def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     actions: tuple = ()
     validation = None
     if result.solved:
-        actions = blocksworld.moves_to_actions(instance.problem, result.plan.moves)
+        actions = get_domain(instance.problem.domain).to_actions(
+            instance.problem, result.plan.moves
+        )
         validation = validate(domain, instance.pddl, actions)
     return config, result, actions, validation
 

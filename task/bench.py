@@ -16,7 +16,7 @@ from dataclasses import dataclass, replace
 from pddl.core import Domain
 
 from task.config import PlannerConfig
-from task.domains import blocksworld
+from task.domains import get_domain
 from task.errors import ProblemError
 from task.instances import Instance, Suite
 from task.planner import plan_batch
@@ -94,7 +94,9 @@ def check(domain: Domain, instance: Instance, result: PlanResult) -> tuple[str, 
     if not result.solved:
         return "no_plan", None
     try:
-        actions = blocksworld.moves_to_actions(instance.problem, result.plan.moves)
+        actions = get_domain(instance.problem.domain).to_actions(
+            instance.problem, result.plan.moves
+        )
     except ProblemError:  # a move the planner claimed legal is not: report, do not crash
         return "inexecutable", 2 * len(result.plan)
     return validate(domain, instance.pddl, actions).status.value, len(actions)

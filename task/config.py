@@ -23,7 +23,7 @@ class PlannerConfig:
     restarts: int = 16  # random restarts per problem, optimised in the same tensor program
     lookahead: int = 5  # window length of the long-lookahead restarts (an extension, not paper)
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
-    max_windows: int = 12  # replanning windows before giving up
+    max_windows: int = 40  # replanning windows before giving up
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
 
     def horizons(self) -> tuple[int, ...]:

@@ -24,12 +24,15 @@ class DecodedWindow:
     reached: bool  # the goal holds in ``state``
     complete: bool  # every confident step decoded to a legal move
     loss: float  # the soft objective of the restart it came from
+    remaining: int  # the domain's admissible lower bound on moves still needed from ``state``
 
     def key(self) -> tuple:
-        """Sort key: goal reached with fewest moves, then progress, then the soft objective."""
+        """Sort key: the goal reached in fewest moves; else some progress, then the least
+        estimated total (moves + remaining), then the most moves, then the soft objective."""
+        g = len(self.moves)
         if self.reached:
-            return (0, len(self.moves), self.loss)
-        return (1, not self.moves, not self.complete, self.loss)
+            return (0, g, 0, 0, self.loss)
+        return (1, g == 0, g + self.remaining, -g, not self.complete, self.loss)
 
 
 def target_name(problem: Problem, column: int, n: int) -> str:
@@ -64,7 +67,9 @@ def decode_row(
         moves.append(move)
         if domain.is_goal(problem, state):
             break
-    return DecodedWindow(tuple(moves), state, domain.is_goal(problem, state), complete, loss)
+    reached = domain.is_goal(problem, state)
+    remaining = 0 if reached else domain.lower_bound(problem, state)
+    return DecodedWindow(tuple(moves), state, reached, complete, loss, remaining)
 
 
 def decode_best(

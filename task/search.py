@@ -51,6 +51,14 @@ def _heuristic(state: _Code, goal: dict[int, int], claimed: dict[int, int]) -> i
     return sum(moves(x) for x in range(n))
 
 
+def moves_lower_bound(problem: Problem, state: tuple[str, ...]) -> int:
+    """Admissible lower bound on the moves still needed from ``state`` (crisp supports)."""
+    names = {name: i for i, name in enumerate(problem.targets)}
+    code = tuple(names[s] for s in state)
+    goal = {names[x]: names[y] for x, y in problem.goal}
+    return _heuristic(code, goal, {y: x for x, y in goal.items() if y < len(code)})
+
+
 def _successors(state: _Code) -> list[tuple[int, int]]:
     n = len(state)
     clear = sorted(set(range(n)) - set(state))

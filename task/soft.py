@@ -1,8 +1,8 @@
 """Domain-independent soft-logic operators of the soft-T_P transition.
 
 Every function is batched (batch first) and differentiable. Products of ``(1 - p)`` terms run
-over at most N entities and are taken with ``torch.prod`` over a masked matrix, which is exact
-at 0 and 1 (one-hot states stay one-hot) and never divides.
+over at most N entities and are taken as plain (cumulative) products, which are exact at 0 and 1
+(one-hot states stay one-hot) and never divide; torch's product backward handles exact zeros.
 """
 
 from __future__ import annotations
@@ -12,14 +12,15 @@ from torch import Tensor
 
 
 def prod_others(v: Tensor) -> Tensor:
-    """Exclusive product ``out[..., i] = prod_{j != i} v[..., j]``.
+    """Exclusive product ``out[..., i] = prod_{j != i} v[..., j]``, without division.
 
-    v: (..., N) -> (..., N). Used by the competition ``q(x) = prod_{x' != x} (1 - rho(x'))``.
+    v: (..., N) -> (..., N), as prefix products times suffix products (O(N), exact at 0).
+    Used by the competition ``q(x) = prod_{x' != x} (1 - rho(x'))`` and by T_P.
     """
-    n = v.shape[-1]
-    eye = torch.eye(n, dtype=torch.bool, device=v.device)
-    rows = v.unsqueeze(-2).expand(*v.shape[:-1], n, n)  # (..., N, N): row i holds v
-    return torch.where(eye, torch.ones_like(rows), rows).prod(-1)
+    ones = torch.ones_like(v[..., :1])  # (..., 1)
+    before = torch.cat([ones, v[..., :-1]], dim=-1).cumprod(-1)  # prod_{j < i}
+    after = torch.cat([v[..., 1:], ones], dim=-1).flip(-1).cumprod(-1).flip(-1)  # prod_{j > i}
+    return before * after
 
 
 def column_free(F: Tensor, n: int) -> Tensor:

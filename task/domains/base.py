@@ -15,7 +15,7 @@ from typing import Protocol
 import torch
 from torch import Tensor
 
-from task.problem import Move, Problem
+from task.problem import Action, Move, Problem
 
 State = tuple[str, ...]  # crisp support of each entity, in problem.entities order
 
@@ -109,3 +109,11 @@ class Domain(Protocol):
     def apply_move(self, problem: Problem, state: State, move: Move) -> State: ...
 
     def is_goal(self, problem: Problem, state: State) -> bool: ...
+
+    def lower_bound(self, problem: Problem, state: State) -> int:
+        """An admissible lower bound on the moves still needed to reach the goal."""
+        ...
+
+    def to_actions(self, problem: Problem, moves: Sequence[Move]) -> tuple[Action, ...]:
+        """The domain's PDDL actions for a sequence of relational moves (its PDDL mapping)."""
+        ...

@@ -23,6 +23,7 @@ from task import pddl_io, strips
 from task.domains.base import SoftBatch, encode_supports
 from task.errors import PDDLError, ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
+from task.search import moves_lower_bound
 from task.soft import column_free, exclusive_support, goal_cross_entropy, row_normalise
 
 NAME = "blocksworld"
@@ -287,32 +288,33 @@ def cycle_loss(F: Tensor, batch: SoftBatch) -> Tensor:
     return 0.5 * (blocks * blocks.transpose(-1, -2)).sum((-1, -2))
 
 
-def well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
-    """Soft "x will never have to move again": w(x), (B, N, Y) -> (B, N).
+def log_well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
+    """Log of the soft "x will never have to move again", log w(x): (B, N, Y) -> (B, N).
 
     Goal blocks: w(x) = F[x, g(x)] * wbar(g(x)); blocks the goal leaves free:
-    w(x) = sum_y F[x, y] wbar(y); wbar(table) = 1. A problem of n blocks gets exactly n sweeps
-    of this recursion (its fixed point on crisp towers), whatever the padding.
+    w(x) = sum_y F[x, y] wbar(y); wbar(table) = 1. Computed in log space (products along a
+    tower of N blocks underflow otherwise). A problem of n blocks gets exactly n sweeps of the
+    recursion (its fixed point on crisp towers), whatever the padding.
     """
     n = batch.n
     sweeps = batch.entity_mask.sum(-1, keepdim=True)  # (B, 1) real blocks per row
-    has_goal = batch.goal.sum(-1)  # (B, N)
-    on_goal = (F * batch.goal).sum(-1)  # F[x, g(x)], (B, N)
-    w = torch.ones_like(has_goal)
-    ones = torch.ones_like(F[:, 0, n:])  # (B, K)
+    has_goal = batch.goal.sum(-1) > 0  # (B, N)
+    log_f = torch.log(F.clamp_min(torch.finfo(F.dtype).tiny))  # (B, N, Y)
+    log_on_goal = (log_f * batch.goal).sum(-1)  # log F[x, g(x)], (B, N)
+    lw = torch.zeros_like(log_on_goal)
+    zeros = torch.zeros_like(F[:, 0, n:])  # (B, K): log wbar(table) = 0
     for k in range(n):
-        wbar = torch.cat([w, ones], dim=-1).unsqueeze(-2)  # (B, 1, Y)
-        goal_term = on_goal * (batch.goal * wbar).sum(-1)  # (B, N)
-        free_term = (F * wbar).sum(-1)  # (B, N)
-        w = torch.where(k < sweeps, has_goal * goal_term + (1.0 - has_goal) * free_term, w)
-    return w
+        lwbar = torch.cat([lw, zeros], dim=-1).unsqueeze(-2)  # (B, 1, Y)
+        goal_term = log_on_goal + (batch.goal * lwbar).sum(-1)  # (B, N)
+        free_term = torch.logsumexp(log_f + lwbar, dim=-1)  # (B, N)
+        lw = torch.where(k < sweeps, torch.where(has_goal, goal_term, free_term), lw)
+    return lw
 
 
 def tower_cross_entropy(F: Tensor, batch: SoftBatch) -> Tensor:
     """Goal cross-entropy on well-placed goal blocks: -sum_{x in goal} log w(x). -> (B,)."""
-    w = well_placed(F, batch)
-    has_goal = batch.goal.sum(-1)
-    return -(has_goal * torch.log(w.clamp_min(torch.finfo(F.dtype).tiny))).sum(-1)
+    has_goal = batch.goal.sum(-1)  # (B, N)
+    return -(has_goal * log_well_placed(F, batch)).sum(-1)
 
 
 GOAL_LOSSES = ("atoms", "towers")
@@ -341,6 +343,7 @@ class Blocksworld:
     apply_move = staticmethod(apply_move)
     is_goal = staticmethod(is_goal)
     to_actions = staticmethod(moves_to_actions)
+    lower_bound = staticmethod(moves_lower_bound)
 
 
 DOMAIN = Blocksworld()
