@@ -13,6 +13,7 @@ class PlannerConfig:
     lr: float = 0.1  # Adam learning rate on the action logits
     iters: int = 60  # Adam steps per window
     tau: float = 0.5  # softmax temperature of the action logits
+    tau_end: float = 0.05  # temperature at the last Adam step (geometric annealing from tau)
     threshold: float = 0.3  # decoding confidence: a step's move mass must reach this
     goal_loss: str = "towers"  # "atoms": the paper's goal CE; "towers": CE on well-placed blocks
     lambda_move: float = 0.05  # weight of the move-count loss (shorter plans)
@@ -42,5 +43,5 @@ class PlannerConfig:
         if not 0.0 <= self.lookahead_share <= 1.0:
             share = self.lookahead_share
             raise TampError(f"PlannerConfig.lookahead_share must be in [0, 1], got {share}")
-        if self.tau <= 0 or self.lr <= 0:
-            raise TampError("PlannerConfig.tau and PlannerConfig.lr must be > 0")
+        if self.tau <= 0 or self.tau_end <= 0 or self.lr <= 0:
+            raise TampError("PlannerConfig.tau, tau_end and lr must be > 0")

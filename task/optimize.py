@@ -38,9 +38,17 @@ def optimise_window(
     """
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
     opt = torch.optim.Adam([logits], lr=config.lr)
-    for _ in range(config.iters):
+    for k in range(config.iters):
         opt.zero_grad(set_to_none=True)
-        rollout(domain, logits, batch, steps, config).loss.sum().backward()
+        tau = temperature(config, k)
+        rollout(domain, logits, batch, steps, config, tau).loss.sum().backward()
         opt.step()
     with torch.no_grad():
-        return logits.detach(), rollout(domain, logits, batch, steps, config)
+        tau = temperature(config, config.iters - 1)
+        return logits.detach(), rollout(domain, logits, batch, steps, config, tau)
+
+
+def temperature(config: PlannerConfig, k: int) -> float:
+    """Softmax temperature at Adam step k: geometric from ``tau`` to ``tau_end``."""
+    frac = k / max(config.iters - 1, 1)
+    return config.tau * (config.tau_end / config.tau) ** frac

@@ -39,10 +39,18 @@ def action_probs(logits: Tensor, batch: SoftBatch, tau: float, steps: Tensor) ->
 
 
 def rollout(
-    domain: Domain, logits: Tensor, batch: SoftBatch, steps: Tensor, config: PlannerConfig
+    domain: Domain,
+    logits: Tensor,
+    batch: SoftBatch,
+    steps: Tensor,
+    config: PlannerConfig,
+    tau: float | None = None,
 ) -> Rollout:
-    """Roll the window out from ``batch.F0``; logits: (B, T, N, A); steps: (B, T) live steps."""
-    M = action_probs(logits, batch, config.tau, steps)  # (B, T, N, A)
+    """Roll the window out from ``batch.F0``; logits: (B, T, N, A); steps: (B, T) live steps.
+
+    ``tau`` overrides ``config.tau`` (the optimiser anneals it).
+    """
+    M = action_probs(logits, batch, config.tau if tau is None else tau, steps)  # (B, T, N, A)
     F = batch.F0
     states, gates = [F], []
     fp = torch.zeros(F.shape[0], dtype=F.dtype, device=F.device)
