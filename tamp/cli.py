@@ -57,6 +57,16 @@ def _positive_list(text: str) -> tuple[int, ...]:
     return tuple(dict.fromkeys(values))
 
 
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value > 0.0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
 def _share(text: str) -> float:
     try:
         value = float(text)
@@ -97,6 +107,13 @@ def _planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         metavar="S",
         help=f"share of restarts whose window is {d.lookahead} moves long "
         f"({d.lookahead_share:g}; 0 = the paper's planner)",
+    )
+    g.add_argument(
+        "--tau-end",
+        type=_positive_float,
+        metavar="TAU",
+        help=f"softmax temperature at the last Adam step, annealed from {d.tau:g} "
+        f"({d.tau_end:g}; {d.tau:g} = no annealing, the paper's planner)",
     )
     return p
 

@@ -24,7 +24,7 @@ from task.problem import TABLE, PlanResult
 from task.search import optimal_moves
 from task.validate import Validation, validate, validate_files
 
-_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share")
+_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end")
 
 
 def planner_config(args: argparse.Namespace) -> PlannerConfig:

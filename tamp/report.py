@@ -127,7 +127,8 @@ def bench_report(bench: Bench) -> str:
     lines = [
         f"{bench.suite}: {bench.n} instances ({bench.source})",
         f"seeds {seeds}; restarts {c.restarts}, iters {c.iters}, goal loss {c.goal_loss}, "
-        f"lookahead {c.lookahead} x {c.lookahead_share:g} of restarts, max windows {c.max_windows}",
+        f"lookahead {c.lookahead} x {c.lookahead_share:g} of restarts, "
+        f"tau {c.tau:g}->{c.tau_end:g}, max windows {c.max_windows}",
         "",
     ]
     main = [_row(s, "mean" if s.seed is None else str(s.seed)) for s in main_rows(bench)]
