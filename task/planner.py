@@ -1,7 +1,8 @@
 """Receding-window planning: optimise a window, decode, execute the legal moves, replan.
 
-``plan_batch`` plans many problems in one tensor program per window (problems of different
-sizes padded and masked, restarts as extra rows); problems that reach their goal leave the batch.
+``plan_batch`` plans many problems in one tensor program per window and problem size (restarts
+as extra rows; the code pads and masks, so any mix of sizes also works in one program);
+problems that reach their goal leave the batch.
 With ``PlannerConfig(batched=False)`` the same code runs one problem at a time, so the speed-up
 of batching can be measured.
 """
@@ -101,9 +102,16 @@ def plan_batch(
     domain = get_domain(problems[0].domain)
     generator = torch.Generator().manual_seed(seed)
     report = progress or (lambda k: None)
-    if config.batched:
-        return _run(domain, problems, config, generator, report)
-    return [_run(domain, [p], config, generator, report)[0] for p in problems]
+    if not config.batched:
+        return [_run(domain, [p], config, generator, report)[0] for p in problems]
+    # one tensor program per problem size: no padding work, and per-size times in the stats
+    results: list[PlanResult | None] = [None] * len(problems)
+    for n in sorted({p.n for p in problems}):
+        group = [i for i, p in enumerate(problems) if p.n == n]
+        planned = _run(domain, [problems[i] for i in group], config, generator, report)
+        for i, result in zip(group, planned, strict=True):
+            results[i] = result
+    return results
 
 
 def plan(problem: Problem, config: PlannerConfig = PlannerConfig(), seed: int = 0) -> PlanResult:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
 import pytest
@@ -128,3 +129,53 @@ def test_bad_inputs_raise_one_line_errors():
         get_domain("sokobanx")
     with pytest.raises(ProblemError, match="goal loss"):
         plan(random_problem(3, 0), replace(FAST, goal_loss="bogus"))
+
+
+def test_temperature_anneals_geometrically_from_tau_to_tau_end():
+    from task.optimize import temperature
+
+    config = PlannerConfig(tau=0.5, tau_end=0.05, iters=11)
+    taus = [temperature(config, k) for k in range(11)]
+    assert taus[0] == pytest.approx(0.5) and taus[-1] == pytest.approx(0.05)
+    assert all(a > b for a, b in itertools.pairwise(taus))
+    assert temperature(replace(config, tau_end=0.5), 7) == pytest.approx(0.5)
+
+
+def test_restart_ranking_prefers_goal_then_estimated_total():
+    from task.decode import DecodedWindow
+    from task.problem import Move
+
+    m = Move("a", "table")
+    reached_long = DecodedWindow((m, m, m), (), True, True, 9.0, 0)
+    reached_short = DecodedWindow((m,), (), True, True, 9.0, 0)
+    stuck = DecodedWindow((), (), False, True, 0.0, 3)
+    detour = DecodedWindow((m, m), (), False, True, 0.0, 3)  # 2 moves, still 3 to go
+    progress = DecodedWindow((m, m), (), False, True, 5.0, 1)  # 2 moves, 1 to go
+    ranked = sorted([stuck, detour, progress, reached_long, reached_short], key=DecodedWindow.key)
+    assert ranked == [reached_short, reached_long, progress, detour, stuck]
+
+
+def test_lower_bound_is_zero_at_the_goal_and_admissible():
+    from task.search import optimal_moves
+
+    for seed in range(5):
+        problem = random_problem(5, seed)
+        state = BW.initial_state(problem)
+        optimum = optimal_moves(problem)
+        assert BW.lower_bound(problem, state) <= len(optimum)
+        for move in optimum:
+            state = BW.apply_move(problem, state, move)
+        assert BW.lower_bound(problem, state) == 0
+
+
+def test_deep_unstacking_needs_more_moves_than_the_lookahead():
+    # tower c-a-d-b; c must end on b: six moves, beyond the 5-move lookahead (PlanBench 330)
+    problem = Problem(
+        "deep",
+        "blocksworld",
+        ("a", "b", "c", "d"),
+        ("c", "d", "table", "a"),
+        (("b", "d"), ("c", "b"), ("d", "a")),
+    )
+    result = plan(problem, PlannerConfig(), seed=0)
+    assert result.solved and len(result.plan) >= 6
