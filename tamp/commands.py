@@ -79,9 +79,11 @@ def _plan_json(
 
 
 def _outcome(result: PlanResult, validation: Validation | None) -> str:
-    windows = result.stats.get("windows", 0)
-    plural = "" if windows == 1 else "s"
-    took = f"{len(result.plan)} moves, {windows} window{plural}, {result.stats['time_s']:.2f} s"
+    windows, moves = result.stats.get("windows", 0), len(result.plan)
+    took = (
+        f"{moves} move{'' if moves == 1 else 's'}, {windows} window{'' if windows == 1 else 's'}, "
+        f"{result.stats['time_s']:.2f} s"
+    )
     if validation is None:
         left = ", ".join(
             f"(ontable {x})" if y == TABLE else f"(on {x} {y})"
