@@ -5,6 +5,8 @@
     tamp demo [--json --out DIR]
     tamp bench planbench [--data DIR --limit N --seeds 3 --horizon 1,3,5 --sequential N --out DIR]
     tamp bench random [--blocks 6,8,10 --n 50 --seed 0 --max-nodes 20000 --out DIR]
+    tamp run [PROBLEM.pddl] [--sim pybullet|mujoco --inject drop:0.2 --seed S --out DIR]
+    tamp bench motion [--sim pybullet,mujoco --data DIR --n 100 --inject drop:0.2 --out DIR]
 
 Exit codes: 0 success, 1 no plan or an invalid plan, 2 usage error or bad input (one line on
 stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``).
@@ -18,6 +20,7 @@ import sys
 from collections.abc import Sequence
 
 from tamp import bench_cli, commands
+from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains.blocksworld import GOAL_LOSSES
 from task.errors import TampError
@@ -147,6 +150,19 @@ def build_parser() -> argparse.ArgumentParser:
     _output(p, "write the example's domain, problem and plan files into this folder")
     p.set_defaults(func=commands.demo_command)
 
+    p = sub.add_parser(
+        "run", parents=[plan_opts], help="plan and execute a problem with the simulated Panda"
+    )
+    p.add_argument(
+        "problem", nargs="?", metavar="PROBLEM.pddl", help="blocksworld problem (the example)"
+    )
+    _episode_options(p)
+    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    p.add_argument("--no-video", action="store_true", help="skip the camera video")
+    p.add_argument("--video-format", choices=("mp4", "gif"), default="mp4", help="(mp4)")
+    _output(p, "write the episode video and report.json into this folder")
+    p.set_defaults(func=_run_command)
+
     bench = sub.add_parser("bench", help="planning benchmarks").add_subparsers(
         dest="suite", required=True, metavar="SUITE"
     )
@@ -197,7 +213,56 @@ def build_parser() -> argparse.ArgumentParser:
         help="A* expansion budget for the optimal lengths (20000)",
     )
     random_.set_defaults(func=bench_cli.random_command)
+
+    p = bench.add_parser(
+        "motion", parents=[plan_opts], help="motion-level executability in the simulators"
+    )
+    _episode_options(p, multi_sim=True)
+    p.add_argument(
+        "--data",
+        default=str(DEFAULT_PLANBENCH),
+        metavar="DIR",
+        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+    )
+    p.add_argument("--n", type=_positive, default=100, help="instances, spread over sizes (100)")
+    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    p.add_argument(
+        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
+    )
+    _output(p, "write results.json and episodes.csv into this folder")
+    p.set_defaults(func=_motion_command)
     return parser
+
+
+def _episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None:
+    """Options of commands that run closed-loop episodes in a simulator."""
+    if multi_sim:
+        p.add_argument(
+            "--sim", default=",".join(SIMULATORS), metavar="SIM[,SIM]",
+            help=f"simulators, comma-separated ({','.join(SIMULATORS)})",
+        )  # fmt: skip
+    else:
+        p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="(pybullet)")
+    p.add_argument(
+        "--domain", metavar="DOMAIN.pddl", help="domain file (the embedded 4-op blocksworld)"
+    )
+    p.add_argument("--grasp", choices=("friction", "weld"), default="friction",
+                   help="physical friction grasp or a weld attach (friction)")  # fmt: skip
+    p.add_argument("--inject", metavar="KIND:P[,...]",
+                   help="faults with probabilities, e.g. drop:0.2,nudge:0.1,noise:0.1")  # fmt: skip
+    p.add_argument("--max-replans", type=_count, metavar="N", help="replanning budget (8)")
+
+
+def _run_command(args: argparse.Namespace) -> int:
+    from tamp.run_cmd import run_command  # imports the simulators only when needed
+
+    return run_command(args)
+
+
+def _motion_command(args: argparse.Namespace) -> int:
+    from tamp.motion_bench import motion_command
+
+    return motion_command(args)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -1,0 +1,216 @@
+"""One block move as eight phases: approach, descend, close, lift, transit, lower, open, retreat.
+
+Six top-down TCP waypoints (pre-grasp, grasp, lift, pre-place, place, retreat) are solved in one
+batched IK call. Consecutive solutions must be close in joint space (a wrist flip between two
+waypoints a few centimetres apart is a bug), so a waypoint whose solution jumps more than
+``max_joint_jump`` from the previous one is re-solved seeded with that previous solution, and the
+closer valid answer is kept. Each arm phase is a rest-to-rest straight joint segment
+(`motion.trajectory.straight_segment`); the gripper phases are standstills. An unreachable
+waypoint is a returned failure (``ik_infeasible``) with evidence, never an exception.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motion.errors import MotionError
+from motion.ik import IKSolver, grasp_yaw, pose_yaw, top_down_pose
+from motion.trajectory import JointTrajectory, SpeedLimits, polyline_segment, straight_segment
+
+WAYPOINTS = ("pre_grasp", "grasp", "lift", "pre_place", "place", "retreat")
+PHASES = ("approach", "descend", "close", "lift", "transit", "lower", "open", "retreat")
+
+
+@dataclass(frozen=True)
+class PickPlaceConfig:
+    """Geometry, timing and speeds of a pick-and-place (motion-research notes, sections 3-4)."""
+
+    approach_height: float = 0.10  # m, pre-grasp above the block top, retreat rise (at least:
+    # both also hover lift_clearance above the highest stack top)
+    lift_clearance: float = 0.06  # m, the held block's bottom clears the highest top by >= this
+    place_gap: float = 0.003  # m, release height of the block above its support
+    close_time: float = 0.5  # s, standstill while the gripper closes
+    open_time: float = 0.3  # s, standstill while the gripper opens
+    transit: SpeedLimits = SpeedLimits(velocity=0.5, acceleration=0.3, jerk=0.1)
+    approach: SpeedLimits = SpeedLimits(velocity=0.2, acceleration=0.1, jerk=0.1)
+    dt: float = 0.002  # s, trajectory sampling period
+    block_size: float = 0.05  # m, cube edge
+    max_joint_jump: float = 0.5  # rad, per-joint change between waypoints that triggers a re-solve
+    vertical_step: float = 0.02  # m, IK knot spacing on the vertical moves (straight in space)
+
+
+@dataclass(frozen=True)
+class PickPlaceRequest:
+    """Move the cube centred at ``pick`` so that its centre ends at ``place`` (base frame, m)."""
+
+    pick: tuple[float, float, float]  # block centre now
+    pick_yaw: float  # rad, block yaw now
+    place: tuple[float, float, float]  # block centre after placing (on top of the target)
+    place_yaw: float  # rad, block yaw after placing (modulo pi/2)
+    clear_z: float  # m, height of the highest stack top that transit must clear
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One segment of a move: ``name`` in PHASES, gripper command "open" or "closed" held."""
+
+    name: str
+    trajectory: JointTrajectory
+    gripper: str
+
+
+@dataclass(frozen=True)
+class MotionResult:
+    """Phases in execution order (empty unless ``ok``); ``failure`` is "ik_infeasible" or None."""
+
+    ok: bool
+    phases: tuple[Phase, ...]
+    failure: str | None
+    evidence: dict = field(default_factory=dict)
+    ik_time_s: float = 0.0
+
+
+def _xyz(value, name: str) -> np.ndarray:
+    a = np.asarray(value, dtype=np.float64)
+    if a.shape != (3,) or not np.isfinite(a).all():
+        raise MotionError(f"request.{name} = {value!r}; expected three finite floats (x, y, z)")
+    return a
+
+
+def waypoint_targets(
+    request: PickPlaceRequest, hand_yaw: float, config: PickPlaceConfig = PickPlaceConfig()
+) -> np.ndarray:
+    """The six top-down TCP targets (6, 4, 4), in WAYPOINTS order, for a hand now at hand_yaw."""
+    pick, place = _xyz(request.pick, "pick"), _xyz(request.place, "place")
+    for name in ("pick_yaw", "place_yaw", "clear_z"):
+        if not math.isfinite(getattr(request, name)):
+            raise MotionError(f"request.{name} = {getattr(request, name)}; expected a finite float")
+    half = config.block_size / 2
+    highest = max(request.clear_z, pick[2] + half, place[2] - half)  # stack tops to clear
+    z_transit = highest + config.lift_clearance + config.block_size  # TCP = held block centre
+    yaw_grasp = grasp_yaw(request.pick_yaw, hand_yaw)
+    yaw_place = grasp_yaw(request.place_yaw, yaw_grasp)
+    up = np.array([0.0, 0.0, 1.0])
+    place_tcp = place + config.place_gap * up
+    # the empty hand also hovers above every stack, so approach and retreat sweep nothing
+    z_hover = highest + config.lift_clearance
+    pre_grasp = pick + (half + config.approach_height) * up
+    retreat = place_tcp + config.approach_height * up
+    pre_grasp[2], retreat[2] = max(pre_grasp[2], z_hover), max(retreat[2], z_hover)
+    xyz_yaw = (
+        (pre_grasp, yaw_grasp),
+        (pick, yaw_grasp),
+        ((pick[0], pick[1], z_transit), yaw_grasp),
+        ((place[0], place[1], z_transit), yaw_place),
+        (place_tcp, yaw_place),
+        (retreat, yaw_place),
+    )
+    return np.stack([top_down_pose(xyz, yaw) for xyz, yaw in xyz_yaw])  # (6, 4, 4)
+
+
+def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, max_jump: float):
+    """Batched IK, then re-solve from the previous waypoint where the joint path jumps or fails."""
+    first = solver.solve(targets, q_now)
+    ok, q = first.ok.copy(), first.q.copy()  # (W,), (W, J)
+    pos_err, rot_err = first.pos_err.copy(), first.rot_err.copy()
+    resolved = []
+    for k in range(len(targets)):
+        prev = q_now if k == 0 else q[k - 1]
+        jump = float(np.abs(q[k] - prev).max())
+        if (ok[k] and jump <= max_jump) or (k > 0 and not ok[k - 1]):
+            continue  # fine as it is, or no valid previous solution to seed from
+        again = solver.solve(targets[k : k + 1], prev)
+        better = float(np.abs(again.q[0] - prev).max()) < jump
+        if again.ok[0] and (not ok[k] or better):
+            ok[k], q[k] = True, again.q[0]
+            pos_err[k], rot_err[k] = again.pos_err[0], again.rot_err[0]
+            resolved.append(WAYPOINTS[k])
+    return ok, q, pos_err, rot_err, resolved
+
+
+def _vertical_path(
+    solver: IKSolver, pose_a: np.ndarray, pose_b: np.ndarray, q_a, q_b, step: float
+) -> np.ndarray:
+    """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
+    one IK point every ``step`` m, so the tool moves straight instead of drifting sideways.
+    Falls back to the plain joint segment when an inner point fails or the knots jump."""
+    ends = np.stack([q_a, q_b])  # (2, J)
+    n = math.ceil(float(np.linalg.norm(pose_b[:3, 3] - pose_a[:3, 3])) / step)
+    if n < 2:
+        return ends
+    inner = np.repeat(pose_a[None], n - 1, axis=0)  # (n-1, 4, 4)
+    frac = np.arange(1, n)[:, None] / n  # (n-1, 1)
+    inner[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
+    found = solver.solve(inner, q_a)
+    path = np.vstack([q_a, found.q, q_b])  # (n+1, J)
+    if not found.ok.all() or np.abs(np.diff(path, axis=0)).max() > 0.3:
+        return ends
+    return path
+
+
+def plan_pick_place(
+    solver: IKSolver,
+    q_now,
+    request: PickPlaceRequest,
+    config: PickPlaceConfig = PickPlaceConfig(),
+) -> MotionResult:
+    """Plan one block move from the arm configuration ``q_now`` (J,); see the module docstring."""
+    q_now = np.asarray(q_now, dtype=np.float64)
+    if q_now.shape != (solver.dof,) or not np.isfinite(q_now).all():
+        raise MotionError(f"q_now has shape {q_now.shape}; expected finite ({solver.dof},)")
+    targets = waypoint_targets(request, pose_yaw(solver.fk(q_now)[0]), config)  # (6, 4, 4)
+    start = time.perf_counter()
+    ok, q, pos_err, rot_err, resolved = _solve_waypoints(
+        solver, targets, q_now, config.max_joint_jump
+    )
+    ik_time = time.perf_counter() - start
+    if not ok.all():
+        bad = [name for name, good in zip(WAYPOINTS, ok, strict=True) if not good]
+        k = WAYPOINTS.index(bad[0])
+        evidence = {
+            "waypoint": bad[0],
+            "target_xyz": tuple(float(v) for v in targets[k, :3, 3]),
+            "pos_err": float(pos_err[k]),
+            "rot_err": float(rot_err[k]),
+            "unreachable": tuple(bad),
+        }
+        return MotionResult(False, (), "ik_infeasible", evidence, ik_time)
+
+    w = {"now": q_now, **dict(zip(WAYPOINTS, q, strict=True))}  # name -> (J,)
+    plan = (  # phase, from, to (None: standstill), SpeedLimits or standstill seconds, gripper
+        ("approach", "now", "pre_grasp", config.transit, "open"),
+        ("descend", "pre_grasp", "grasp", config.approach, "open"),
+        ("close", "grasp", None, config.close_time, "closed"),
+        ("lift", "grasp", "lift", config.approach, "closed"),
+        ("transit", "lift", "pre_place", config.transit, "closed"),
+        ("lower", "pre_place", "place", config.approach, "closed"),
+        ("open", "place", None, config.open_time, "open"),
+        ("retreat", "place", "retreat", config.approach, "open"),
+    )
+    pose = dict(zip(WAYPOINTS, targets, strict=True))  # name -> (4, 4)
+    start = time.perf_counter()
+
+    def motion(src: str, dst: str | None, how) -> JointTrajectory:
+        if dst is None:
+            return JointTrajectory.hold(w[src], how, config.dt)
+        if src == "now" or dst == "pre_place":  # free-space moves: one straight joint segment
+            return straight_segment(w[src], w[dst], config.dt, solver.spec, how)
+        path = _vertical_path(solver, pose[src], pose[dst], w[src], w[dst], config.vertical_step)
+        return polyline_segment(path, config.dt, solver.spec, how)
+
+    phases = tuple(Phase(name, motion(src, dst, how), grip) for name, src, dst, how, grip in plan)
+    ik_time += time.perf_counter() - start
+    steps = np.abs(np.diff(np.vstack([q_now[None], q]), axis=0)).max(1)  # (6,) rad
+    evidence = {
+        "waypoints": {
+            n: tuple(float(v) for v in targets[i, :3, 3]) for i, n in enumerate(WAYPOINTS)
+        },
+        "yaws": {"grasp": pose_yaw(targets[1]), "place": pose_yaw(targets[4])},
+        "max_joint_step": {n: float(s) for n, s in zip(WAYPOINTS, steps, strict=True)},
+        "resolved": tuple(resolved),
+    }
+    return MotionResult(True, phases, None, evidence, ik_time)

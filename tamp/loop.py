@@ -1,0 +1,233 @@
+"""The closed loop: observe -> plan -> move -> check -> replan, in one simulator.
+
+An episode lays out the problem's initial state, plans with the soft-T_P planner, and executes
+the plan move by move. After each move it observes the block poses and reads the symbolic
+state. A failed move, or a state that differs from the one the plan expected, triggers a
+replan from the observed state (SS-Replan style: execute one action, observe, check); the
+number of replans is bounded. Ground truth is read only at the end, to score the episode.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from motion.ik import IKSolver
+from tamp.execute import ExecConfig, ExecutionResult, execute_move
+from tamp.faults import Injection, draw
+from tamp.scene import Pose, SceneConfig, layout, read_state
+from tamp.sim.base import Camera, Simulator, make_simulator
+from task.config import PlannerConfig
+from task.domains import get_domain
+from task.planner import plan
+from task.problem import Move, Problem
+
+SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation
+
+
+class EpisodeStatus(enum.Enum):
+    GOAL_REACHED = "goal_reached"  # the observed state satisfies the goal
+    NO_PLAN = "no_plan"  # the task planner found no plan from an observed state
+    REPLAN_BUDGET = "replan_budget"  # more failures than ``max_replans``
+    UNREADABLE = "unreadable"  # the observed poses do not form a blocksworld state
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """Settings of an episode. ``grasp``: 'friction' (physical) or 'weld' (attach)."""
+
+    sim: str = "pybullet"
+    grasp: str = "friction"
+    max_replans: int = 8
+    max_moves: int = 60
+    planner: PlannerConfig = PlannerConfig()
+    execution: ExecConfig = ExecConfig()
+    scene: SceneConfig = SceneConfig()
+    camera: Camera = Camera()
+    inject: Injection = Injection()
+
+
+@dataclass(frozen=True)
+class EpisodeReport:
+    """What happened in one episode; ``reached_goal`` is scored on simulator ground truth."""
+
+    problem: str
+    sim: str
+    status: EpisodeStatus
+    reached_goal: bool
+    moves: tuple[ExecutionResult, ...]
+    plans: tuple[tuple[str, ...], ...]  # every plan made, as move strings
+    replans: int
+    faults: tuple[str, ...]  # injected faults, e.g. "drop@3" (move index)
+    disturbed: int  # moves after which a block other than the moved one changed support
+    sim_time_s: float
+    wall_time_s: float
+    plan_time_s: float
+    initial_plan_solved: bool = False  # the first task plan reached the goal symbolically
+    reason: str = ""
+
+    def to_json(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["status"] = self.status.value
+        out["moves"] = [
+            {
+                "move": str(r.move),
+                "ok": r.ok,
+                "failure": r.failure.value if r.failure else None,
+                "evidence": r.evidence,
+                "sim_time_s": round(r.sim_time_s, 3),
+                "wall_time_s": round(r.wall_time_s, 3),
+                "ik_time_s": round(r.ik_time_s, 4),
+            }
+            for r in self.moves
+        ]
+        return out
+
+
+class Episode:
+    """One problem in one simulator. ``run()`` returns the EpisodeReport."""
+
+    def __init__(
+        self,
+        problem: Problem,
+        config: LoopConfig = LoopConfig(),
+        seed: int = 0,
+        on_frame: Callable[[Simulator], None] | None = None,
+        on_event: Callable[[str], None] | None = None,
+        solver: IKSolver | None = None,
+    ) -> None:
+        self.problem, self.config, self.seed = problem, config, seed
+        self.domain = get_domain(problem.domain)
+        self.rng = np.random.default_rng(seed)
+        self.on_frame = on_frame
+        self.say = on_event or (lambda text: None)
+        self.solver = solver or IKSolver()
+        poses = layout(problem.entities, problem.init, config.scene, seed)
+        self.sim = make_simulator(
+            config.sim, problem.entities, poses, config.scene, config.grasp, config.camera
+        )
+        self.status_text = ""
+
+    # --- observation -----------------------------------------------------------------------
+    def observe(self) -> dict[str, Pose]:
+        """Block poses as the robot sees them: true poses, plus injected noise."""
+        poses = self.sim.block_poses()
+        inj = self.config.inject
+        if draw(self.rng, inj.noise):
+            noise = self.rng.normal(0.0, inj.noise_sigma, size=(len(poses), 3))
+            poses = {
+                k: Pose(tuple(float(v) for v in np.add(p.xyz, n)), p.yaw)
+                for (k, p), n in zip(poses.items(), noise, strict=True)
+            }
+        return poses
+
+    def settle(self) -> None:
+        from motion.trajectory import JointTrajectory
+
+        hold = JointTrajectory.hold(self.sim.arm_q(), SETTLE_S, self.sim.dt)
+        self.sim.run(hold, "open", on_frame=self.on_frame)
+
+    def _true_state(self):
+        return read_state(self.problem.entities, self.sim.block_poses(), self.config.scene).state
+
+    # --- the loop --------------------------------------------------------------------------
+    def run(self) -> EpisodeReport:
+        cfg, problem = self.config, self.problem
+        wall0 = time.perf_counter()
+        moves: list[ExecutionResult] = []
+        plans: list[tuple[str, ...]] = []
+        faults: list[str] = []
+        replans = disturbed = 0
+        plan_time = 0.0
+        first_solved = self.domain.is_goal(problem, problem.init)
+        status, reason = EpisodeStatus.GOAL_REACHED, ""
+        state = problem.init
+        queue: list[Move] = []
+        try:
+            while True:
+                if self.domain.is_goal(problem, state):
+                    break
+                if not queue:
+                    t0 = time.perf_counter()
+                    current = dataclasses.replace(problem, init=state)
+                    result = plan(current, cfg.planner, seed=self.seed + len(plans))
+                    plan_time += time.perf_counter() - t0
+                    plans.append(tuple(str(m) for m in result.plan))
+                    first_solved = first_solved if len(plans) > 1 else result.solved
+                    if not result.solved:
+                        status, reason = EpisodeStatus.NO_PLAN, "the planner found no plan"
+                        break
+                    queue = list(result.plan)
+                    self.say(f"plan {len(plans)}: {len(queue)} moves")
+                if len(moves) >= cfg.max_moves:
+                    status, reason = EpisodeStatus.REPLAN_BUDGET, f"{cfg.max_moves} moves used"
+                    break
+                move = queue.pop(0)
+                expected = self.domain.apply_move(problem, state, move)
+                drop = draw(self.rng, cfg.inject.drop)
+                drop_at = float(self.rng.uniform(0.2, 0.8)) if drop else None
+                before = self._true_state()
+                self.status_text = f"{move}"
+                done = execute_move(
+                    self.sim, self.solver, move, self.observe, cfg.execution, cfg.scene,
+                    drop_at, self.on_frame,
+                )  # fmt: skip
+                if drop:
+                    faults.append(f"drop@{len(moves)}")
+                if done.ok and draw(self.rng, cfg.inject.nudge):
+                    self._nudge(move.entity)
+                    faults.append(f"nudge@{len(moves)}")
+                moves.append(done)
+                self.settle()
+                after = self._true_state()
+                if before is not None and after is not None:
+                    changed = [
+                        x
+                        for i, x in enumerate(problem.entities)
+                        if x != move.entity and before[i] != after[i]
+                    ]
+                    disturbed += bool(changed)
+                reading = read_state(problem.entities, self.observe(), cfg.scene)
+                self.say(f"{move}: " + ("ok" if done.ok else done.failure.value))
+                if reading.state is None:
+                    status, reason = EpisodeStatus.UNREADABLE, "; ".join(reading.issues)
+                    break
+                state = reading.state
+                if not done.ok or state != expected:
+                    queue = []
+                    replans += 1
+                    why = done.failure.value if done.failure else "state differs from the plan"
+                    self.say(f"replan {replans}: {why}")
+                    if replans > cfg.max_replans:
+                        status = EpisodeStatus.REPLAN_BUDGET
+                        reason = f"more than {cfg.max_replans} replans"
+                        break
+            truth = self._true_state()
+            reached = truth is not None and self.domain.is_goal(problem, truth)
+        finally:
+            self.sim.close()
+        return EpisodeReport(
+            problem.name, cfg.sim, status, reached, tuple(moves), tuple(plans), replans,
+            tuple(faults), disturbed, self.sim.time, time.perf_counter() - wall0, plan_time,
+            first_solved, reason,
+        )  # fmt: skip
+
+    def _nudge(self, block: str) -> None:
+        pose = self.sim.block_poses()[block]
+        angle = self.rng.uniform(0, 2 * np.pi)
+        d = self.config.inject.nudge_m
+        x, y, z = pose.xyz
+        # pushed off whatever it rests on: it falls to the table next to its support
+        self.sim.set_block_pose(
+            block, Pose((x + d * np.cos(angle) * 2, y + d * np.sin(angle) * 2, z), pose.yaw)
+        )
+
+
+def run_episode(problem: Problem, config: LoopConfig = LoopConfig(), seed: int = 0, **kw):
+    """Run one episode of ``problem`` (see `Episode`) and return its EpisodeReport."""
+    return Episode(problem, config, seed, **kw).run()

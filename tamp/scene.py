@@ -1,0 +1,201 @@
+"""The scene model: a symbolic Blocksworld state <-> block poses on a table, and back.
+
+Blocks are cubes (5 cm by default) with distinct colours. Each tower stands on a *table slot*,
+a fixed grid of positions in front of the robot; a block moved onto the table goes to a free
+slot. ``layout`` turns a state into poses (with small seeded jitter); ``read_state`` turns
+observed poses into a state, with tolerances, and says which block it cannot explain.
+
+World frame = the robot base frame (``panda_link0``); the table surface is z = 0.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from task.errors import ProblemError, TampError, one_of
+from task.problem import TABLE, Move
+
+# PlanBench renders a..e as red, blue, orange, yellow and white blocks; the rest follow.
+PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
+    ("red", (0.85, 0.1, 0.1)),
+    ("blue", (0.1, 0.25, 0.9)),
+    ("orange", (1.0, 0.55, 0.05)),
+    ("yellow", (0.95, 0.9, 0.1)),
+    ("white", (0.95, 0.95, 0.95)),
+    ("green", (0.1, 0.7, 0.2)),
+    ("purple", (0.55, 0.2, 0.75)),
+    ("cyan", (0.1, 0.8, 0.85)),
+    ("magenta", (0.95, 0.3, 0.75)),
+    ("brown", (0.5, 0.3, 0.1)),
+)
+
+
+class SceneError(TampError):
+    """A state cannot be laid out (too many blocks, too tall) or a pose is malformed."""
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A block pose: centre position (m) and yaw about the vertical (rad)."""
+
+    xyz: tuple[float, float, float]
+    yaw: float = 0.0
+
+    @property
+    def xy(self) -> np.ndarray:
+        return np.asarray(self.xyz[:2])
+
+
+@dataclass(frozen=True)
+class SceneConfig:
+    """Geometry of the table scene. Slots form a grid of ``slot_xs`` x ``slot_ys``."""
+
+    block_size: float = 0.05  # cube edge, m
+    block_mass: float = 0.1  # kg
+    # 16 cm apart: the open hand (about 20 cm across) clears a neighbouring tower
+    slot_xs: tuple[float, ...] = (0.40, 0.56)
+    slot_ys: tuple[float, ...] = (-0.32, -0.16, 0.0, 0.16, 0.32)
+    jitter_xy: float = 0.004  # uniform +-, m
+    jitter_yaw: float = 0.15  # uniform +-, rad
+    max_height: int = 7  # blocks per tower the arm can still clear
+    tol_xy: float = 0.02  # read_state: a block rests on another if centres are this close in xy
+    tol_z: float = 0.012  # ... and the heights differ by one block size within this
+    slot_radius: float = 0.05  # a slot is occupied when a block centre lies this close
+
+    @property
+    def slots(self) -> tuple[tuple[float, float], ...]:
+        return tuple((x, y) for x in self.slot_xs for y in self.slot_ys)
+
+
+def colour(index: int) -> tuple[float, float, float]:
+    """RGB in [0, 1] of the block at ``index`` in the problem's entity order."""
+    if index >= len(PALETTE):
+        raise SceneError(f"the scene has {len(PALETTE)} block colours, block #{index + 1} has none")
+    return PALETTE[index][1]
+
+
+def towers(entities: Sequence[str], state: Sequence[str]) -> list[list[str]]:
+    """Bottom-to-top towers of a crisp state (supports in ``entities`` order)."""
+    support = dict(zip(entities, state, strict=True))
+    above = {sup: x for x, sup in support.items() if sup != TABLE}
+    out = []
+    for base in (x for x in entities if support[x] == TABLE):
+        tower = [base]
+        while tower[-1] in above:
+            tower.append(above[tower[-1]])
+        out.append(tower)
+    if sum(len(t) for t in out) != len(entities):
+        raise ProblemError("the state has a support cycle or two blocks on one block")
+    return out
+
+
+def layout(
+    entities: Sequence[str],
+    state: Sequence[str],
+    config: SceneConfig = SceneConfig(),
+    seed: int = 0,
+) -> dict[str, Pose]:
+    """Poses for a crisp state: tower i on slot i, stacked exactly, jittered in xy and yaw."""
+    stacks = towers(entities, state)
+    if len(entities) > len(PALETTE):
+        raise SceneError(f"{len(entities)} blocks, but the scene has {len(PALETTE)} colours")
+    if len(stacks) > len(config.slots) - 1:
+        raise SceneError(f"{len(stacks)} towers need more than the {len(config.slots)} slots")
+    if max(len(t) for t in stacks) > config.max_height:
+        raise SceneError(f"a tower is taller than {config.max_height} blocks")
+    rng = np.random.default_rng(seed)
+    s = config.block_size
+    slots = [config.slots[i] for i in rng.permutation(len(config.slots))[: len(stacks)]]
+    poses = {}
+    for tower, (sx, sy) in zip(stacks, slots, strict=True):
+        for level, x in enumerate(tower):
+            dx, dy = rng.uniform(-config.jitter_xy, config.jitter_xy, size=2)
+            yaw = float(rng.uniform(-config.jitter_yaw, config.jitter_yaw))
+            poses[x] = Pose((sx + dx, sy + dy, s / 2 + level * s), yaw)
+    return poses
+
+
+@dataclass(frozen=True)
+class Reading:
+    """The state read from poses: supports in entity order, or None with the reasons."""
+
+    state: tuple[str, ...] | None
+    issues: tuple[str, ...] = ()
+
+
+def read_state(
+    entities: Sequence[str], poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()
+) -> Reading:
+    """Observed poses -> crisp supports. A block rests on the table when its centre is half a
+    block high, on block b when it sits one block above b's centre within the tolerances."""
+    missing = [x for x in entities if x not in poses]
+    if missing:
+        raise SceneError(f"no pose for blocks {missing} (poses given: {sorted(poses)})")
+    s = config.block_size
+    support, issues = {}, []
+    for x in entities:
+        px = poses[x]
+        if abs(px.xyz[2] - s / 2) <= config.tol_z:
+            support[x] = TABLE
+            continue
+        below = [
+            b
+            for b in entities
+            if b != x
+            and np.linalg.norm(px.xy - poses[b].xy) <= config.tol_xy
+            and abs(px.xyz[2] - poses[b].xyz[2] - s) <= config.tol_z
+        ]
+        if len(below) == 1:
+            support[x] = below[0]
+        else:
+            where = ", ".join(f"{v:.3f}" for v in px.xyz)
+            issues.append(f"block {x} at ({where}) rests on neither the table nor one block")
+    onto: dict[str, str] = {}
+    for x, sup in support.items():
+        if sup != TABLE and sup in onto:
+            issues.append(f"blocks {onto[sup]} and {x} both rest on {sup}")
+        onto[sup] = x
+    if issues:
+        return Reading(None, tuple(issues))
+    return Reading(tuple(support[x] for x in entities))
+
+
+def top_z(poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()) -> float:
+    """Height of the highest block top in the scene (0 for an empty table)."""
+    return max((p.xyz[2] + config.block_size / 2 for p in poses.values()), default=0.0)
+
+
+def free_slot(
+    poses: Mapping[str, Pose], near: Sequence[float], config: SceneConfig = SceneConfig()
+) -> tuple[float, float] | None:
+    """The unoccupied table slot nearest to ``near`` (x, y), or None when all are taken."""
+    free = [
+        slot
+        for slot in config.slots
+        if all(np.linalg.norm(p.xy - np.asarray(slot)) > config.slot_radius for p in poses.values())
+    ]
+    if not free:
+        return None
+    return min(free, key=lambda slot: math.dist(slot, near[:2]))
+
+
+def place_pose(
+    move: Move, poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()
+) -> Pose | None:
+    """Where the moved block's centre should end: on top of the target block, or on a free
+    table slot (None when the table is full)."""
+    if move.entity not in poses:
+        raise ProblemError(f"unknown block {one_of(move.entity, sorted(poses))}")
+    s = config.block_size
+    if move.target == TABLE:
+        others = {k: v for k, v in poses.items() if k != move.entity}
+        slot = free_slot(others, poses[move.entity].xyz, config)
+        return None if slot is None else Pose((slot[0], slot[1], s / 2), 0.0)
+    if move.target not in poses:
+        raise ProblemError(f"unknown target {one_of(move.target, [*sorted(poses), TABLE])}")
+    below = poses[move.target]
+    return Pose((below.xyz[0], below.xyz[1], below.xyz[2] + s), below.yaw)

@@ -1,0 +1,160 @@
+"""The one simulator interface both backends implement, and the shared control loop.
+
+A backend owns a world with the Panda, a table and the blocks of a scene. The same
+`motion.trajectory.JointTrajectory` (sampled at the simulator's ``dt`` = 2 ms in both
+backends) drives both: each physics step gets the trajectory's joint targets. What the loop
+may observe is what a real robot has: joint positions, finger width, finger contact forces and
+(in `tamp.observe`) block poses; ground-truth poses are used to score episodes.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from motion.trajectory import JointTrajectory
+from tamp.scene import Pose, SceneConfig
+from task.errors import TampError, one_of
+
+SIMULATORS = ("pybullet", "mujoco")
+DT = 0.002  # s, physics step of both backends
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A pinhole camera looking at ``target`` from ``eye``; ``fovy`` in degrees."""
+
+    eye: tuple[float, float, float] = (1.0, -0.55, 0.6)
+    target: tuple[float, float, float] = (0.48, 0.0, 0.1)
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    fovy: float = 50.0
+    width: int = 320
+    height: int = 240
+
+
+@dataclass(frozen=True)
+class GripperReading:
+    """Finger signals: opening between the fingers (m) and normal contact force (N) of each
+    finger on one block."""
+
+    width: float
+    left_force: float
+    right_force: float
+
+
+class Simulator(abc.ABC):
+    """A headless world: the Panda (at home, fingers open), a table, and cubes at ``poses``."""
+
+    name: str = ""
+    dt: float = DT
+
+    def __init__(
+        self,
+        entities: Sequence[str],
+        poses: Mapping[str, Pose],
+        scene: SceneConfig = SceneConfig(),
+        grasp: str = "friction",
+        camera: Camera = Camera(),
+    ) -> None:
+        if grasp not in ("friction", "weld"):
+            raise TampError(f"unknown grasp mode {one_of(grasp, ('friction', 'weld'))}")
+        self.entities = tuple(entities)
+        self.scene = scene
+        self.grasp = grasp
+        self.camera = camera
+        self.time = 0.0
+        self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
+
+    # --- what a backend implements -------------------------------------------------------
+    @abc.abstractmethod
+    def _command(self, q: np.ndarray, qd: np.ndarray, gripper: str) -> None:
+        """Set the arm joint targets (J,) and the gripper command for the next step."""
+
+    @abc.abstractmethod
+    def _step(self) -> None:
+        """Advance the physics by ``dt``."""
+
+    @abc.abstractmethod
+    def arm_q(self) -> np.ndarray:
+        """Measured arm joint positions (J,)."""
+
+    @abc.abstractmethod
+    def gripper(self, block: str) -> GripperReading:
+        """Finger width and the contact force of each finger on ``block``."""
+
+    @abc.abstractmethod
+    def block_poses(self) -> dict[str, Pose]:
+        """Ground-truth block poses (centre, yaw)."""
+
+    @abc.abstractmethod
+    def set_block_pose(self, block: str, pose: Pose) -> None:
+        """Teleport a block (fault injection); its velocity is zeroed."""
+
+    @abc.abstractmethod
+    def attach(self, block: str) -> None:
+        """Weld ``block`` to the hand where it is now (the ``weld`` grasp mode)."""
+
+    @abc.abstractmethod
+    def detach(self) -> None:
+        """Remove any weld."""
+
+    @abc.abstractmethod
+    def render(self) -> np.ndarray:
+        """An RGB image (H, W, 3) uint8 from ``camera``."""
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Free the simulator."""
+
+    # --- shared control ------------------------------------------------------------------
+    def run(
+        self,
+        trajectory: JointTrajectory,
+        gripper: str,
+        release_at: float | None = None,
+        on_frame: Callable[[Simulator], None] | None = None,
+    ) -> float:
+        """Track ``trajectory`` step by step with the gripper held at ``gripper``.
+
+        ``release_at`` (s into the trajectory) opens the gripper there (fault injection: a
+        drop). ``on_frame(self)`` is called every ``self.frame_period`` simulated seconds. Returns
+        the largest joint tracking error (rad) seen at the sample times.
+        """
+        worst = 0.0
+        next_frame = self.time
+        for k in range(len(trajectory.times)):
+            if release_at is not None and trajectory.times[k] >= release_at:
+                gripper = "open"
+                self.detach()
+            self._command(trajectory.positions[k], trajectory.velocities[k], gripper)
+            self._step()
+            self.time += self.dt
+            worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
+            if on_frame is not None and self.time >= next_frame:
+                on_frame(self)
+                next_frame = self.time + self.frame_period
+        return worst
+
+    def __enter__(self) -> Simulator:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def make_simulator(name: str, *args, **kwargs) -> Simulator:
+    """The backend called ``name`` ('pybullet' or 'mujoco'), built with the given scene."""
+    if name == "pybullet":
+        from tamp.sim.pybullet_sim import PyBulletSim
+
+        return PyBulletSim(*args, **kwargs)
+    if name == "mujoco":
+        from tamp.sim.mujoco_sim import MuJoCoSim
+
+        return MuJoCoSim(*args, **kwargs)
+    raise TampError(f"unknown simulator {one_of(name, SIMULATORS)}")

@@ -1,0 +1,168 @@
+"""MuJoCo backend: the Panda from `robots.mujoco_loader`, a table plane, free-joint cubes.
+
+Offscreen rendering goes through EGL by default (``MUJOCO_GL=egl``, Mesa llvmpipe on a CPU
+machine); set ``MUJOCO_GL`` yourself before anything imports mujoco to choose another backend.
+Friction grasps rely on the elliptic cones and impratio the loader sets; the weld grasp mode
+uses one inactive weld equality per block whose relative pose is set at attach time
+(shared/notes/motion-research.md, section 5.3).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+import mujoco
+import numpy as np
+
+from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
+from robots.panda import PANDA
+from tamp.scene import Pose, colour
+from tamp.sim.base import GripperReading, Simulator
+
+FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
+HAND_BODY = PANDA.tcp_link
+
+
+def _quat(yaw: float) -> list[float]:
+    return [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
+
+
+def _look_at(eye, target, up) -> list[float]:
+    """Quaternion of a MuJoCo camera at ``eye`` looking at ``target`` (camera looks along -z)."""
+    back = np.asarray(eye, float) - np.asarray(target, float)
+    back /= np.linalg.norm(back)
+    right = np.cross(np.asarray(up, float), back)
+    right /= np.linalg.norm(right)
+    upv = np.cross(back, right)
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, np.column_stack([right, upv, back]).ravel())
+    return list(quat)
+
+
+class MuJoCoSim(Simulator):
+    name = "mujoco"
+
+    def __init__(self, entities, poses, *args, **kwargs) -> None:
+        super().__init__(entities, poses, *args, **kwargs)
+        s = panda_spec(timestep=self.dt)
+        cam = self.camera
+        s.visual.global_.offwidth = max(cam.width, 640)
+        s.visual.global_.offheight = max(cam.height, 480)
+        world = s.worldbody
+        world.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01], rgba=[0.45, 0.45, 0.45, 1]
+        )
+        world.add_light(type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=[0.5, 0.3, 2.0],
+                        dir=[-0.2, -0.1, -1.0], diffuse=[0.8, 0.8, 0.8])  # fmt: skip
+        world.add_camera(name="scene", pos=list(cam.eye), quat=_look_at(cam.eye, cam.target,
+                         cam.up), fovy=cam.fovy)  # fmt: skip
+        half = self.scene.block_size / 2
+        for i, name in enumerate(self.entities):
+            pose = poses[name]
+            body = world.add_body(name=f"block_{name}", pos=list(pose.xyz), quat=_quat(pose.yaw))
+            body.add_freejoint(name=f"block_{name}")
+            body.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_BOX, size=[half] * 3, mass=self.scene.block_mass,
+                rgba=[*colour(i), 1], friction=[1.0, 0.005, 0.0001], condim=4,
+            )  # fmt: skip
+            s.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=f"weld_{name}", name1=HAND_BODY,
+                           name2=f"block_{name}", objtype=mujoco.mjtObj.mjOBJ_BODY,
+                           active=False)  # fmt: skip
+        self.model = m = s.compile()
+        self.data = d = mujoco.MjData(m)
+        self._arm_q = np.array([m.joint(j).qposadr[0] for j in PANDA.arm_joints])
+        self._fingers = np.array([m.joint(j).qposadr[0] for j in PANDA.finger_joints])
+        self._act = np.array([m.actuator(actuator_name(j)).id for j in PANDA.arm_joints])
+        self._grip = m.actuator(GRIP_ACTUATOR).id
+        self._finger_ids = [m.body(b).id for b in FINGER_BODIES]
+        self._hand = m.body(HAND_BODY).id
+        self._block_ids = {n: m.body(f"block_{n}").id for n in self.entities}
+        self._block_q = {n: m.joint(f"block_{n}").qposadr[0] for n in self.entities}
+        self._block_v = {n: m.joint(f"block_{n}").dofadr[0] for n in self.entities}
+        self._weld_ids = {n: m.equality(f"weld_{n}").id for n in self.entities}
+        d.qpos[self._arm_q] = PANDA.q_home
+        d.qpos[self._fingers] = PANDA.finger_open
+        self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+        mujoco.mj_forward(m, d)
+        self._renderer: mujoco.Renderer | None = None
+
+    def _command(self, q, qd, gripper) -> None:
+        self.data.ctrl[self._act] = q
+        self.data.ctrl[self._grip] = PANDA.finger_open if gripper == "open" else 0.0
+
+    def _step(self) -> None:
+        mujoco.mj_step(self.model, self.data)
+
+    def arm_q(self) -> np.ndarray:
+        return self.data.qpos[self._arm_q].copy()
+
+    def gripper(self, block: str) -> GripperReading:
+        m, d = self.model, self.data
+        target = self._block_ids[block]
+        forces = [0.0, 0.0]
+        f6 = np.zeros(6)
+        for i in range(d.ncon):
+            con = d.contact[i]
+            bodies = (m.geom_bodyid[con.geom1], m.geom_bodyid[con.geom2])
+            if target not in bodies:
+                continue
+            for k, finger in enumerate(self._finger_ids):
+                if finger in bodies:
+                    mujoco.mj_contactForce(m, d, i, f6)
+                    forces[k] += abs(f6[0])
+        width = float(d.qpos[self._fingers].sum())
+        return GripperReading(width, forces[0], forces[1])
+
+    def block_poses(self) -> dict[str, Pose]:
+        out = {}
+        for name, adr in self._block_q.items():
+            pos = self.data.qpos[adr : adr + 3]
+            w, x, y, z = self.data.qpos[adr + 3 : adr + 7]
+            yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+            out[name] = Pose(tuple(float(v) for v in pos), float(yaw))
+        return out
+
+    def tilt(self, block: str) -> float:
+        """Angle (rad) between the block's vertical axis and the world's."""
+        z = self.data.xmat[self._block_ids[block]][8]
+        return math.acos(max(-1.0, min(1.0, float(z))))
+
+    def set_block_pose(self, block: str, pose: Pose) -> None:
+        adr, vadr = self._block_q[block], self._block_v[block]
+        self.data.qpos[adr : adr + 3] = pose.xyz
+        self.data.qpos[adr + 3 : adr + 7] = _quat(pose.yaw)
+        self.data.qvel[vadr : vadr + 6] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+
+    def attach(self, block: str) -> None:
+        self.detach()
+        m, d = self.model, self.data
+        i = self._weld_ids[block]
+        hand_q, block_q, inv, rel = np.zeros(4), np.zeros(4), np.zeros(4), np.zeros(3)
+        mujoco.mju_mat2Quat(hand_q, d.xmat[self._hand])
+        mujoco.mju_mat2Quat(block_q, d.xmat[self._block_ids[block]])
+        mujoco.mju_negQuat(inv, hand_q)
+        mujoco.mju_rotVecQuat(rel, d.xpos[self._block_ids[block]] - d.xpos[self._hand], inv)
+        m.eq_data[i, 0:3] = 0.0  # anchor at the block origin
+        m.eq_data[i, 3:6] = rel  # the block's position in the hand frame
+        quat = np.zeros(4)
+        mujoco.mju_mulQuat(quat, inv, block_q)
+        m.eq_data[i, 6:10] = quat
+        d.eq_active[i] = 1
+
+    def detach(self) -> None:
+        self.data.eq_active[:] = 0
+
+    def render(self) -> np.ndarray:
+        if self._renderer is None:
+            self._renderer = mujoco.Renderer(self.model, self.camera.height, self.camera.width)
+        self._renderer.update_scene(self.data, camera="scene")
+        return self._renderer.render().copy()
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None

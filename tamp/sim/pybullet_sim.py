@@ -1,0 +1,150 @@
+"""PyBullet backend (``p.DIRECT``, no GUI): Panda, table plane, friction or weld grasps.
+
+Settings follow shared/notes/motion-research.md section 4: finger gear constraint (in the
+loader), position control of the arm with the trajectory's positions and velocities, 40 N per
+finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no GL needed).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as p
+
+from robots.panda import PANDA
+from robots.pybullet_loader import load_panda
+from tamp.scene import Pose, colour
+from tamp.sim.base import GripperReading, Simulator
+
+FINGER_FORCE = 40.0  # N per finger
+ARM_KP, ARM_KD = 0.3, 1.0  # PyBullet position-control gains
+
+
+def _quat(yaw: float) -> tuple[float, float, float, float]:
+    return p.getQuaternionFromEuler((0.0, 0.0, yaw))
+
+
+class PyBulletSim(Simulator):
+    name = "pybullet"
+
+    def __init__(self, entities, poses, *args, **kwargs) -> None:
+        super().__init__(entities, poses, *args, **kwargs)
+        self.client = c = p.connect(p.DIRECT)
+        p.setGravity(0, 0, -9.81, physicsClientId=c)
+        p.setTimeStep(self.dt, physicsClientId=c)
+        plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
+        look = p.createVisualShape(
+            p.GEOM_BOX, halfExtents=[3.0, 3.0, 0.001], rgbaColor=[0.45, 0.45, 0.45, 1],
+            physicsClientId=c,
+        )  # fmt: skip
+        self.table = p.createMultiBody(0, plane, look, [0, 0, 0], physicsClientId=c)
+        p.changeDynamics(self.table, -1, lateralFriction=1.0, physicsClientId=c)
+        self.robot = load_panda(c)
+        half = [self.scene.block_size / 2] * 3
+        self.blocks: dict[str, int] = {}
+        for i, name in enumerate(self.entities):
+            col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=c)
+            vis = p.createVisualShape(
+                p.GEOM_BOX, halfExtents=half, rgbaColor=[*colour(i), 1], physicsClientId=c
+            )
+            pose = poses[name]
+            body = p.createMultiBody(
+                self.scene.block_mass, col, vis, pose.xyz, _quat(pose.yaw), physicsClientId=c
+            )
+            p.changeDynamics(
+                body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=c
+            )
+            self.blocks[name] = body
+        self._weld: int | None = None
+        cam = self.camera
+        self._view = p.computeViewMatrix(cam.eye, cam.target, cam.up, physicsClientId=c)
+        self._proj = p.computeProjectionMatrixFOV(
+            cam.fovy, cam.width / cam.height, 0.05, 3.0, physicsClientId=c
+        )
+        self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+
+    def _command(self, q, qd, gripper) -> None:
+        r, c = self.robot, self.client
+        p.setJointMotorControlArray(
+            r.body, r.arm, p.POSITION_CONTROL, targetPositions=list(q),
+            targetVelocities=list(qd), forces=list(PANDA.effort),
+            positionGains=[ARM_KP] * 7, velocityGains=[ARM_KD] * 7, physicsClientId=c,
+        )  # fmt: skip
+        width = PANDA.finger_open if gripper == "open" else 0.0
+        p.setJointMotorControlArray(
+            r.body, r.fingers, p.POSITION_CONTROL, targetPositions=[width, width],
+            forces=[FINGER_FORCE] * 2, physicsClientId=c,
+        )  # fmt: skip
+
+    def _step(self) -> None:
+        p.stepSimulation(physicsClientId=self.client)
+
+    def arm_q(self) -> np.ndarray:
+        states = p.getJointStates(self.robot.body, self.robot.arm, physicsClientId=self.client)
+        return np.array([s[0] for s in states])
+
+    def gripper(self, block: str) -> GripperReading:
+        r, c = self.robot, self.client
+        width = sum(s[0] for s in p.getJointStates(r.body, r.fingers, physicsClientId=c))
+        forces = [
+            sum(
+                pt[9]
+                for pt in p.getContactPoints(
+                    r.body, self.blocks[block], linkIndexA=link, physicsClientId=c
+                )
+            )
+            for link in r.fingers
+        ]
+        return GripperReading(width, forces[0], forces[1])
+
+    def block_poses(self) -> dict[str, Pose]:
+        out = {}
+        for name, body in self.blocks.items():
+            pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
+            yaw = p.getEulerFromQuaternion(orn)[2]
+            out[name] = Pose(tuple(float(v) for v in pos), float(yaw))
+        return out
+
+    def tilt(self, block: str) -> float:
+        """Angle (rad) between the block's vertical axis and the world's."""
+        _, orn = p.getBasePositionAndOrientation(self.blocks[block], physicsClientId=self.client)
+        z = p.getMatrixFromQuaternion(orn)[8]
+        return math.acos(max(-1.0, min(1.0, z)))
+
+    def set_block_pose(self, block: str, pose: Pose) -> None:
+        body, c = self.blocks[block], self.client
+        p.resetBasePositionAndOrientation(body, pose.xyz, _quat(pose.yaw), physicsClientId=c)
+        p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=c)
+
+    def attach(self, block: str) -> None:
+        self.detach()
+        r, c = self.robot, self.client
+        link = p.getLinkState(r.body, r.tcp, computeForwardKinematics=True, physicsClientId=c)
+        b_pos, b_orn = p.getBasePositionAndOrientation(self.blocks[block], physicsClientId=c)
+        inv_pos, inv_orn = p.invertTransform(link[4], link[5])
+        rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, b_pos, b_orn)
+        # the TCP link is massless, so its inertial frame is its link frame
+        self._weld = p.createConstraint(
+            r.body, r.tcp, self.blocks[block], -1, p.JOINT_FIXED, [0, 0, 0],
+            parentFramePosition=rel_pos, childFramePosition=[0, 0, 0],
+            parentFrameOrientation=rel_orn, physicsClientId=c,
+        )  # fmt: skip
+
+    def detach(self) -> None:
+        if self._weld is not None:
+            p.removeConstraint(self._weld, physicsClientId=self.client)
+            self._weld = None
+
+    def render(self) -> np.ndarray:
+        cam = self.camera
+        _, _, rgb, _, _ = p.getCameraImage(
+            cam.width, cam.height, self._view, self._proj, renderer=p.ER_TINY_RENDERER,
+            physicsClientId=self.client,
+        )  # fmt: skip
+        return np.asarray(rgb, dtype=np.uint8).reshape(cam.height, cam.width, 4)[..., :3].copy()
+
+    def close(self) -> None:
+        if self.client is not None and p.isConnected(self.client):
+            p.disconnect(self.client)
+        self.client = None

@@ -1,0 +1,115 @@
+"""Pick-and-place planning: phase order, gripper commands, continuity, waypoints, failures."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from motion.errors import MotionError
+from motion.ik import pose_yaw
+from motion.pick_place import PHASES, PickPlaceConfig, PickPlaceRequest, plan_pick_place
+from robots.panda import PANDA
+
+CONFIG = PickPlaceConfig()
+HALF = CONFIG.block_size / 2
+REQUESTS = {
+    # pick a table block, put it on a one-block stack; a two-block tower stands elsewhere
+    "table_to_stack": PickPlaceRequest((0.45, -0.20, HALF), 0.3, (0.55, 0.15, 3 * HALF), 0.0, 0.10),
+    # unstack the top of a three-block tower onto the table, rotated
+    "tower_to_table": PickPlaceRequest(
+        (0.60, 0.25, 5 * HALF), -1.2, (0.40, -0.25, HALF), 2.0, 0.15
+    ),
+}
+GRIPPER = ("open", "open", "closed", "closed", "closed", "closed", "open", "open")
+
+
+@pytest.fixture(scope="module", params=sorted(REQUESTS))
+def planned(request, solver):
+    req = REQUESTS[request.param]
+    result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    assert result.ok, result.evidence
+    return req, result
+
+
+def _end_pose(solver, result, name: str) -> np.ndarray:
+    phase = next(p for p in result.phases if p.name == name)
+    return solver.fk(phase.trajectory.positions[-1])[0]
+
+
+def test_phases_and_gripper_commands_in_order(planned):
+    _, result = planned
+    assert tuple(p.name for p in result.phases) == PHASES
+    assert tuple(p.gripper for p in result.phases) == GRIPPER
+    assert result.failure is None
+    assert result.ik_time_s > 0.0
+
+
+def test_phases_are_continuous_and_rest_to_rest(planned):
+    _, result = planned
+    np.testing.assert_array_equal(result.phases[0].trajectory.positions[0], PANDA.q_home)
+    for before, after in zip(result.phases, result.phases[1:], strict=False):
+        np.testing.assert_array_equal(
+            after.trajectory.positions[0], before.trajectory.positions[-1]
+        )
+    for phase in result.phases:
+        assert np.abs(phase.trajectory.velocities[[0, -1]]).max() < 1e-12
+        assert all(PANDA.clamp_error(q) is None for q in phase.trajectory.positions)
+
+
+def test_descend_ends_at_the_block_and_lower_at_the_release_point(solver, planned):
+    req, result = planned
+    grasp = _end_pose(solver, result, "descend")
+    np.testing.assert_allclose(grasp[:3, 3], req.pick, atol=1e-3)
+    assert grasp[2, 2] < -0.999  # pointing down
+    assert abs(math.remainder(pose_yaw(grasp) - req.pick_yaw, math.pi / 2)) < 1e-3
+    place = _end_pose(solver, result, "lower")
+    np.testing.assert_allclose(place[:3, 3], np.add(req.place, (0, 0, CONFIG.place_gap)), atol=1e-3)
+    assert place[2, 2] < -0.999
+    assert abs(math.remainder(pose_yaw(place) - req.place_yaw, math.pi / 2)) < 1e-3
+    retreat = _end_pose(solver, result, "retreat")
+    rise = max(place[2, 3] + CONFIG.approach_height, req.clear_z + CONFIG.lift_clearance)
+    assert retreat[2, 3] >= rise - 1e-3
+
+
+def test_the_empty_hand_hovers_above_every_stack_before_descending(solver, planned):
+    req, result = planned
+    pre_grasp = _end_pose(solver, result, "approach")
+    np.testing.assert_allclose(pre_grasp[:2, 3], req.pick[:2], atol=1e-3)
+    assert pre_grasp[2, 3] >= req.clear_z + CONFIG.lift_clearance - 1e-3
+
+
+def test_transit_keeps_the_held_block_above_every_stack(solver, planned):
+    req, result = planned
+    transit = next(p for p in result.phases if p.name == "transit").trajectory
+    block_bottom = solver.fk(transit.positions)[:, 2, 3] - HALF  # (S,)
+    assert block_bottom.min() > req.clear_z + CONFIG.lift_clearance - 1e-3
+
+
+def test_no_joint_jumps_between_nearby_waypoints(planned):
+    _, result = planned
+    steps = result.evidence["max_joint_step"]
+    for name in ("grasp", "lift", "place", "retreat"):  # the short vertical moves
+        assert steps[name] < 1.0, (name, steps)
+
+
+def test_unreachable_place_is_ik_infeasible(solver):
+    req = dataclasses.replace(REQUESTS["table_to_stack"], place=(1.5, 0.0, 3 * HALF))
+    result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    assert not result.ok
+    assert result.failure == "ik_infeasible"
+    assert result.phases == ()
+    assert result.evidence["waypoint"] == "pre_place"
+    assert result.evidence["target_xyz"][0] == pytest.approx(1.5)
+    assert "place" in result.evidence["unreachable"]
+    assert result.evidence["pos_err"] > 0.1
+
+
+def test_malformed_request_raises(solver):
+    req = dataclasses.replace(REQUESTS["table_to_stack"], pick=(0.5, 0.0))
+    with pytest.raises(MotionError):
+        plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    with pytest.raises(MotionError):
+        plan_pick_place(solver, PANDA.q_home[:6], REQUESTS["table_to_stack"], CONFIG)
