@@ -1,12 +1,25 @@
 # Two commands on a fresh machine: `make demo` and `make test`.
-# Both create or reuse .venv and install everything needed. torch is pinned to 2.13.0, which
-# these machines serve as a local CPU build (no CUDA packages are pulled).
+# Both create or reuse .venv and install everything needed, system libraries included. torch is
+# pinned to 2.13.0, which these machines serve as a local CPU build (no CUDA packages are pulled).
 PYTHON ?= python3
+SIM ?= pybullet
+# Mesa EGL for MuJoCo's headless rendering (PyBullet's renderer needs no GL)
+SYSDEPS := libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint format bench clean
+.PHONY: demo test lint format bench sysdeps clean
+
+sysdeps:
+	@missing=$$(for p in $(SYSDEPS); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  if command -v apt-get >/dev/null 2>&1; then \
+	    sudo=$$([ "$$(id -u)" -eq 0 ] || echo sudo); \
+	    echo "installing $$missing"; \
+	    $$sudo apt-get update -qq && $$sudo apt-get install -y -qq $$missing; \
+	  else echo "warning: install the Mesa EGL libraries for MuJoCo rendering: $$missing"; fi; \
+	fi
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -17,14 +30,15 @@ $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install -q -e '.[dev]'
 	touch $(STAMP)
 
-demo: $(STAMP)
-	$(VENV)/bin/tamp demo
+# plan the embedded 5-block example and execute it with the simulated Panda (SIM=mujoco too)
+demo: $(STAMP) sysdeps
+	$(VENV)/bin/tamp run --sim $(SIM) --out out/demo
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .
 	$(VENV)/bin/ruff format --check .
 
-test: lint
+test: lint sysdeps
 	$(VENV)/bin/pytest -q
 
 format: $(STAMP)

@@ -15,7 +15,7 @@ import mujoco
 from robots.panda import PANDA, PandaSpec, urdf_path
 
 ARM_KP = (4500.0, 4500.0, 3500.0, 3500.0, 2000.0, 2000.0, 2000.0)  # as in MuJoCo Menagerie
-GRIP_KP = 500.0  # grip force on the tendon = kp * (target - width/2)
+GRIP_KP = 1000.0  # grip force on the tendon = kp * (target - width/2): about 12 N per finger
 TCP_SITE = "tcp"
 GRIP_ACTUATOR = "a_grip"
 

@@ -27,6 +27,7 @@ class Injection:
     noise: float = 0.0
     nudge_m: float = 0.03
     noise_sigma: float = 0.01
+    drop_moves: tuple[int, ...] = ()  # move indices that always drop (reproducible tests)
 
     @classmethod
     def parse(cls, text: str | None) -> Injection:
@@ -53,7 +54,7 @@ class Injection:
 
     @property
     def any(self) -> bool:
-        return any(getattr(self, k) > 0 for k in KINDS)
+        return bool(self.drop_moves) or any(getattr(self, k) > 0 for k in KINDS)
 
 
 def draw(rng: np.random.Generator, probability: float) -> bool:

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from motion.ik import IKSolver
-from tamp.execute import ExecConfig, ExecutionResult, execute_move
+from tamp.execute import ExecConfig, ExecutionResult, Failure, execute_move
 from tamp.faults import Injection, draw
 from tamp.scene import Pose, SceneConfig, layout, read_state
 from tamp.sim.base import Camera, Simulator, make_simulator
@@ -35,6 +35,7 @@ class EpisodeStatus(enum.Enum):
     NO_PLAN = "no_plan"  # the task planner found no plan from an observed state
     REPLAN_BUDGET = "replan_budget"  # more failures than ``max_replans``
     UNREADABLE = "unreadable"  # the observed poses do not form a blocksworld state
+    OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
 
 
 @dataclass(frozen=True)
@@ -169,7 +170,7 @@ class Episode:
                     break
                 move = queue.pop(0)
                 expected = self.domain.apply_move(problem, state, move)
-                drop = draw(self.rng, cfg.inject.drop)
+                drop = draw(self.rng, cfg.inject.drop) or len(moves) in cfg.inject.drop_moves
                 drop_at = float(self.rng.uniform(0.2, 0.8)) if drop else None
                 before = self._true_state()
                 self.status_text = f"{move}"
@@ -201,11 +202,14 @@ class Episode:
                 if not done.ok or state != expected:
                     queue = []
                     replans += 1
-                    why = done.failure.value if done.failure else "state differs from the plan"
+                    why = describe(done) if not done.ok else "the state differs from the plan"
                     self.say(f"replan {replans}: {why}")
+                    if _out_of_reach(moves):
+                        status, reason = EpisodeStatus.OUT_OF_REACH, why
+                        break
                     if replans > cfg.max_replans:
                         status = EpisodeStatus.REPLAN_BUDGET
-                        reason = f"more than {cfg.max_replans} replans"
+                        reason = f"more than {cfg.max_replans} replans; last: {why}"
                         break
             truth = self._true_state()
             reached = truth is not None and self.domain.is_goal(problem, truth)
@@ -226,6 +230,29 @@ class Episode:
         self.sim.set_block_pose(
             block, Pose((x + d * np.cos(angle) * 2, y + d * np.sin(angle) * 2, z), pose.yaw)
         )
+
+
+def describe(result: ExecutionResult) -> str:
+    """One line on why a move failed, e.g. ``move(a -> table): ik_infeasible (pre_grasp ...)``."""
+    if result.ok:
+        return f"{result.move}: ok"
+    ev = result.evidence
+    if result.failure is Failure.IK_INFEASIBLE:
+        xyz = ", ".join(f"{v:.3f}" for v in ev.get("target_xyz", ()))
+        detail = f"no IK solution for the {ev.get('waypoint')} waypoint at ({xyz}) m"
+    else:
+        detail = ", ".join(f"{k} {v}" for k, v in ev.items() if not isinstance(v, dict))
+    return f"{result.move}: {result.failure.value} ({detail})"
+
+
+def _out_of_reach(moves: list[ExecutionResult]) -> bool:
+    """The last two attempts were the same move and both found no IK solution."""
+    last = moves[-2:]
+    return (
+        len(last) == 2
+        and all(r.failure is Failure.IK_INFEASIBLE for r in last)
+        and last[0].move == last[1].move
+    )
 
 
 def run_episode(problem: Problem, config: LoopConfig = LoopConfig(), seed: int = 0, **kw):

@@ -32,11 +32,12 @@ def _imports(path: Path) -> set[str]:
     tree = ast.parse(path.read_text(), filename=str(path))
     found = set()
     for node in ast.walk(tree):
+        names = []
         if isinstance(node, ast.Import):
-            found |= {a.name.split(".")[0] for a in node.names if a.name not in SHARED}
+            names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            if node.module not in SHARED:
-                found.add(node.module.split(".")[0])
+            names = [node.module]
+        found |= {n.split(".")[0] for n in names if n not in SHARED}
     return found
 
 

@@ -66,7 +66,8 @@ class MuJoCoSim(Simulator):
             body.add_freejoint(name=f"block_{name}")
             body.add_geom(
                 type=mujoco.mjtGeom.mjGEOM_BOX, size=[half] * 3, mass=self.scene.block_mass,
-                rgba=[*colour(i), 1], friction=[1.0, 0.005, 0.0001], condim=4,
+                rgba=[*colour(i), 1], friction=[1.0, 0.03, 0.0001], condim=4,
+                solref=[0.004, 1.0],
             )  # fmt: skip
             s.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=f"weld_{name}", name1=HAND_BODY,
                            name2=f"block_{name}", objtype=mujoco.mjtObj.mjOBJ_BODY,

@@ -138,3 +138,20 @@ def test_bench_random_writes_artefacts(capsys, tmp_path):
         rows = list(csv.DictReader(handle))
     assert len(rows) == 3 and all(r["blocks"] == "3" and r["optimal"] for r in rows)
     assert all((tmp_path / name).stat().st_size > 0 for name in ARTEFACTS)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "--sim", "gazebo"],
+        ["run", "--inject", "drop:2"],
+        ["run", "--inject", "explode:0.1"],
+        ["run", "missing-problem.pddl", "--no-video"],
+        ["bench", "motion", "--sim", "gazebo"],
+        ["bench", "motion", "--data", "/nonexistent/planbench", "--n", "2"],
+    ],
+)
+def test_bad_run_and_motion_arguments_exit_2_with_one_line(argv, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error" in err[0]

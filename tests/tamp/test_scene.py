@@ -1,0 +1,83 @@
+"""The scene model: state -> poses -> state round trips, slots, placement targets, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tamp.faults import Injection
+from tamp.scene import (
+    Pose,
+    SceneConfig,
+    SceneError,
+    free_slot,
+    layout,
+    place_pose,
+    read_state,
+    towers,
+)
+from task.errors import ProblemError, TampError
+from task.problem import TABLE, Move
+
+ENTITIES = ("a", "b", "c", "d", "e")
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_layout_then_read_state_round_trips(seed):
+    rng = np.random.default_rng(seed)
+    order = list(rng.permutation(ENTITIES))
+    state, below = {}, TABLE
+    for x in order:  # random towers: each block on the table or on the previous one
+        below = TABLE if rng.random() < 0.4 else below
+        state[x] = below
+        below = x
+    crisp = tuple(state[x] for x in ENTITIES)
+    poses = layout(ENTITIES, crisp, seed=seed)
+    assert read_state(ENTITIES, poses).state == crisp
+
+
+def test_read_state_names_a_floating_block():
+    poses = layout(("a", "b"), (TABLE, TABLE))
+    poses["b"] = Pose((0.9, 0.9, 0.2))
+    reading = read_state(("a", "b"), poses)
+    assert reading.state is None
+    assert "block b" in reading.issues[0]
+
+
+def test_place_pose_on_a_block_and_on_a_free_slot():
+    poses = layout(("a", "b"), ("b", TABLE), seed=3)
+    on_b = place_pose(Move("a", "b"), poses)
+    assert on_b.xyz[2] == pytest.approx(poses["b"].xyz[2] + 0.05)
+    to_table = place_pose(Move("a", TABLE), poses)
+    assert to_table.xyz[2] == pytest.approx(0.025)
+    assert np.linalg.norm(to_table.xy - poses["b"].xy) > SceneConfig().slot_radius
+
+
+def test_full_table_has_no_free_slot():
+    config = SceneConfig(slot_xs=(0.5,), slot_ys=(0.0,))
+    poses = {"a": Pose((0.5, 0.0, 0.025))}
+    assert free_slot(poses, (0.5, 0.0), config) is None
+
+
+def test_bad_scene_inputs_are_clear_errors():
+    with pytest.raises(ProblemError, match="unknown target"):
+        place_pose(Move("a", "zz"), layout(("a",), (TABLE,)))
+    with pytest.raises(SceneError, match="colours"):
+        layout(tuple("abcdefghijk"), (TABLE,) * 11)
+    with pytest.raises(ProblemError, match="cycle"):
+        towers(("a", "b"), ("b", "a"))
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [(None, Injection()), ("drop:0.2", Injection(drop=0.2)),
+     ("drop:0.2,nudge:0.1,noise:0.5", Injection(drop=0.2, nudge=0.1, noise=0.5))],
+)  # fmt: skip
+def test_fault_specs_parse(text, expected):
+    assert Injection.parse(text) == expected
+
+
+@pytest.mark.parametrize("text", ["drop", "fall:0.2", "drop:x", "drop:1.5"])
+def test_bad_fault_specs_are_clear_errors(text):
+    with pytest.raises(TampError):
+        Injection.parse(text)
