@@ -155,7 +155,8 @@ class MuJoCoSim(Simulator):
         d.eq_active[i] = 1
 
     def detach(self) -> None:
-        self.data.eq_active[:] = 0
+        # only the grasp welds: the finger coupling (a joint equality) must stay active
+        self.data.eq_active[list(self._weld_ids.values())] = 0
 
     def render(self) -> np.ndarray:
         if self._renderer is None:
