@@ -136,17 +136,18 @@ def _vertical_path(
     solver: IKSolver, pose_a: np.ndarray, pose_b: np.ndarray, q_a, q_b, step: float
 ) -> np.ndarray:
     """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
-    one IK point every ``step`` m, so the tool moves straight instead of drifting sideways.
-    Falls back to the plain joint segment when an inner point fails or the knots jump."""
+    one IK point every ``step`` m, so the tool moves straight instead of drifting sideways. The
+    last knot solves pose_b on the same IK branch (it may differ from ``q_b``). Falls back to
+    the plain joint segment q_a -> q_b when a knot fails or the knots jump."""
     ends = np.stack([q_a, q_b])  # (2, J)
     n = math.ceil(float(np.linalg.norm(pose_b[:3, 3] - pose_a[:3, 3])) / step)
     if n < 2:
         return ends
-    inner = np.repeat(pose_a[None], n - 1, axis=0)  # (n-1, 4, 4)
-    frac = np.arange(1, n)[:, None] / n  # (n-1, 1)
-    inner[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
-    found = solver.solve(inner, q_a)
-    path = np.vstack([q_a, found.q, q_b])  # (n+1, J)
+    knots = np.repeat(pose_a[None], n, axis=0)  # (n, 4, 4), the end pose included
+    frac = np.arange(1, n + 1)[:, None] / n  # (n, 1)
+    knots[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
+    found = solver.solve(knots, q_a)  # each closest to q_a: one continuous IK branch
+    path = np.vstack([q_a, found.q])  # (n+1, J); it may end at another solution for pose_b
     if not found.ok.all() or np.abs(np.diff(path, axis=0)).max() > 0.3:
         return ends
     return path
@@ -200,6 +201,7 @@ def plan_pick_place(
         if src == "now" or dst == "pre_place":  # free-space moves: one straight joint segment
             return straight_segment(w[src], w[dst], config.dt, solver.spec, how)
         path = _vertical_path(solver, pose[src], pose[dst], w[src], w[dst], config.vertical_step)
+        w[dst] = path[-1]  # later phases start where this one ends (phases are built in order)
         return polyline_segment(path, config.dt, solver.spec, how)
 
     phases = tuple(Phase(name, motion(src, dst, how), grip) for name, src, dst, how, grip in plan)

@@ -113,3 +113,30 @@ def test_malformed_request_raises(solver):
         plan_pick_place(solver, PANDA.q_home, req, CONFIG)
     with pytest.raises(MotionError):
         plan_pick_place(solver, PANDA.q_home[:6], REQUESTS["table_to_stack"], CONFIG)
+
+
+@pytest.mark.parametrize("name", ["descend", "lift", "lower", "retreat"])
+def test_vertical_moves_follow_the_cartesian_line(solver, planned, name):
+    _, result = planned
+    path = next(p for p in result.phases if p.name == name).trajectory
+    xyz = solver.fk(path.positions[::10])[:, :3, 3]  # (S', 3)
+    drift = np.linalg.norm(xyz[:, :2] - xyz[-1, :2], axis=1)  # sideways from the end point
+    assert drift.max() < 0.003, (name, drift.max())
+
+
+def test_polyline_segment_respects_limits_and_passes_every_knot():
+    from motion.trajectory import SpeedLimits, polyline_segment
+    from robots.panda import PANDA
+
+    q0 = np.asarray(PANDA.q_home)
+    step = np.array([0.2, 0.1, 0.2, 0.1, 0.2, 0.1, 0.2])
+    knots = np.stack([q0, q0 + 0.1, q0 + step])  # (3, J)
+    limits = SpeedLimits(velocity=0.5, acceleration=0.3, jerk=0.1)
+    traj = polyline_segment(knots, 0.002, PANDA, limits)
+    v_max, a_max, _ = limits.scaled(PANDA)
+    assert (np.abs(traj.velocities) <= v_max * (1 + 1e-6)).all()
+    assert (np.abs(traj.accelerations) <= a_max * (1 + 1e-6)).all()
+    np.testing.assert_allclose(traj.positions[[0, -1]], knots[[0, -1]])
+    assert np.abs(traj.velocities[[0, -1]]).max() == 0.0
+    middle = np.linalg.norm(traj.positions - knots[1], axis=1).min()
+    assert middle < 1e-3  # the path goes through the middle knot
