@@ -28,6 +28,7 @@ class Injection:
     nudge_m: float = 0.03
     noise_sigma: float = 0.01
     drop_moves: tuple[int, ...] = ()  # move indices that always drop (reproducible tests)
+    nudge_moves: tuple[int, ...] = ()  # move indices whose placed block is always nudged
 
     @classmethod
     def parse(cls, text: str | None) -> Injection:
@@ -54,7 +55,8 @@ class Injection:
 
     @property
     def any(self) -> bool:
-        return bool(self.drop_moves) or any(getattr(self, k) > 0 for k in KINDS)
+        forced = self.drop_moves or self.nudge_moves
+        return bool(forced) or any(getattr(self, k) > 0 for k in KINDS)
 
 
 def draw(rng: np.random.Generator, probability: float) -> bool:

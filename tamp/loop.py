@@ -180,7 +180,8 @@ class Episode:
                 )  # fmt: skip
                 if drop:
                     faults.append(f"drop@{len(moves)}")
-                if done.ok and draw(self.rng, cfg.inject.nudge):
+                nudge = draw(self.rng, cfg.inject.nudge) or len(moves) in cfg.inject.nudge_moves
+                if done.ok and nudge:
                     self._nudge(move.entity)
                     faults.append(f"nudge@{len(moves)}")
                 moves.append(done)

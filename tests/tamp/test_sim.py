@@ -57,6 +57,36 @@ def test_a_dropped_block_triggers_a_replan_and_the_goal_is_still_reached(sim_nam
     assert report.reached_goal, report.reason
 
 
+def test_a_nudged_block_is_seen_and_the_plan_is_repaired(solver):
+    config = LoopConfig(inject=Injection(nudge_moves=(1,)))  # move 1 stacks a on c
+    report = run_episode(THREE, config, seed=0, solver=solver)
+    assert report.faults == ("nudge@1",)
+    assert report.replans >= 1 and report.reached_goal, report.reason
+
+
+def test_observation_noise_perturbs_the_observed_poses_only():
+    from tamp.loop import Episode
+
+    episode = Episode(THREE, LoopConfig(inject=Injection(noise=1.0, noise_sigma=0.01)), seed=0)
+    try:
+        truth, seen = episode.sim.block_poses(), episode.observe()
+        offsets = [np.linalg.norm(np.subtract(seen[x].xyz, truth[x].xyz)) for x in truth]
+        assert 0.0 < max(offsets) < 0.1
+        assert episode.sim.block_poses() == truth
+    finally:
+        episode.sim.close()
+
+
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_weld_grasp_mode_also_stacks_the_block(sim_name, solver):
+    entities = ("a", "b")
+    poses = layout(entities, (TABLE, TABLE), seed=4)
+    with make_simulator(sim_name, entities, poses, grasp="weld") as sim:
+        done = execute_move(sim, solver, Move("a", "b"), sim.block_poses)
+        assert done.ok, done.evidence
+        assert read_state(entities, sim.block_poses()).state == ("b", TABLE)
+
+
 def test_an_unreachable_block_is_an_ik_infeasible_failure(solver):
     entities = ("a",)
     with make_simulator("pybullet", entities, {"a": Pose((1.4, 0.0, 0.025))}) as sim:
