@@ -146,7 +146,7 @@ def _vertical_path(
     knots = np.repeat(pose_a[None], n, axis=0)  # (n, 4, 4), the end pose included
     frac = np.arange(1, n + 1)[:, None] / n  # (n, 1)
     knots[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
-    found = solver.solve(knots, q_a)  # each closest to q_a: one continuous IK branch
+    found = solver.follow(knots, q_a)  # Gauss-Newton from q_a: one continuous IK branch
     path = np.vstack([q_a, found.q])  # (n+1, J); it may end at another solution for pose_b
     if not found.ok.all() or np.abs(np.diff(path, axis=0)).max() > 0.3:
         return ends

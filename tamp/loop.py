@@ -13,6 +13,7 @@ import dataclasses
 import enum
 import time
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -138,6 +139,11 @@ class Episode:
 
     # --- the loop --------------------------------------------------------------------------
     def run(self) -> EpisodeReport:
+        """Run the episode to the goal or a stop; closes the simulator."""
+        with _torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+            return self._run()
+
+    def _run(self) -> EpisodeReport:
         cfg, problem = self.config, self.problem
         wall0 = time.perf_counter()
         moves: list[ExecutionResult] = []
@@ -231,6 +237,19 @@ class Episode:
         self.sim.set_block_pose(
             block, Pose((x + d * np.cos(angle) * 2, y + d * np.sin(angle) * 2, z), pose.yaw)
         )
+
+
+@contextmanager
+def _torch_threads(n: int):
+    """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def describe(result: ExecutionResult) -> str:

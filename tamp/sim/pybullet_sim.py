@@ -57,6 +57,7 @@ class PyBulletSim(Simulator):
             )
             self.blocks[name] = body
         self._weld: int | None = None
+        self._finger_command = ""
         cam = self.camera
         self._view = p.computeViewMatrix(cam.eye, cam.target, cam.up, physicsClientId=c)
         self._proj = p.computeProjectionMatrixFOV(
@@ -71,6 +72,9 @@ class PyBulletSim(Simulator):
             targetVelocities=list(qd), forces=list(PANDA.effort),
             positionGains=[ARM_KP] * 7, velocityGains=[ARM_KD] * 7, physicsClientId=c,
         )  # fmt: skip
+        if gripper == self._finger_command:
+            return
+        self._finger_command = gripper
         width = PANDA.finger_open if gripper == "open" else 0.0
         p.setJointMotorControlArray(
             r.body, r.fingers, p.POSITION_CONTROL, targetPositions=[width, width],

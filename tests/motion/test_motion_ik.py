@@ -140,3 +140,19 @@ def test_ik_refine_rejects_bad_shapes(solver):
         ik_refine(solver, q_star[0], targets)
     with pytest.raises(MotionError):
         ik_refine(solver, q_star, targets[:1])
+
+
+def test_follow_tracks_a_vertical_line_on_one_branch(solver):
+    start = solver.solve(top_down_pose((0.5, 0.1, 0.05), 0.3)[None], np.asarray(PANDA.q_home))
+    assert start.ok[0]
+    line = np.stack([top_down_pose((0.5, 0.1, 0.05 + 0.02 * k), 0.3) for k in range(1, 11)])
+    out = solver.follow(line, start.q[0])
+    assert out.ok.all()
+    np.testing.assert_allclose(solver.fk(out.q)[:, :3, 3], line[:, :3, 3], atol=1e-4)
+    knots = np.vstack([start.q, out.q])  # (11, J)
+    assert np.abs(np.diff(knots, axis=0)).max() < 0.2  # no branch switch between 2 cm knots
+
+
+def test_follow_reports_targets_it_cannot_reach(solver):
+    far = top_down_pose((2.0, 0.0, 0.1), 0.0)[None]
+    assert not solver.follow(far, np.asarray(PANDA.q_home)).ok[0]
