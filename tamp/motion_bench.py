@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
 import json
 import platform
 import sys
@@ -112,9 +113,10 @@ def motion_command(args: argparse.Namespace) -> int:
         reports = []
         bar = tqdm(suite.instances, desc=f"motion {name}", unit="episode", file=sys.stderr,
                    disable=not args.progress)  # fmt: skip
-        for inst in bar:
-            report = run_episode(inst.problem, config, seed=args.seed, solver=solver)
-            reports.append(report)
+        for k, inst in enumerate(bar):
+            # each episode its own layout and fault draws, reproducible from --seed
+            report = run_episode(inst.problem, config, seed=args.seed * 100_003 + k, solver=solver)
+            reports.append(dataclasses.replace(report, problem=inst.name))
             bar.set_postfix(goal=sum(r.reached_goal for r in reports))
         rows[name] = summarise(reports)
         all_reports += reports

@@ -71,6 +71,25 @@ class SceneConfig:
         return tuple((x, y) for x in self.slot_xs for y in self.slot_ys)
 
 
+def cube_yaw(rotation) -> float:
+    """Yaw of a cube's side faces from its rotation matrix (3, 3), in [-pi/4, pi/4).
+
+    Whichever block axis points most nearly up, the next axis projected on the table gives the
+    yaw; a cube that fell on its side gets the right grasp angle (Euler yaw would not).
+    """
+    r = np.asarray(rotation, dtype=float).reshape(3, 3)  # columns: block axes in the world
+    up = int(np.argmax(np.abs(r[2])))
+    side = r[:, (up + 1) % 3]
+    quarter = math.pi / 2
+    return (math.atan2(side[1], side[0]) + quarter / 2) % quarter - quarter / 2
+
+
+def cube_tilt(rotation) -> float:
+    """Angle (rad) between the world's vertical and the block axis nearest to it."""
+    r = np.asarray(rotation, dtype=float).reshape(3, 3)
+    return math.acos(min(1.0, float(np.abs(r[2]).max())))
+
+
 def colour(index: int) -> tuple[float, float, float]:
     """RGB in [0, 1] of the block at ``index`` in the problem's entity order."""
     if index >= len(PALETTE):

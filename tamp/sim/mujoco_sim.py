@@ -19,7 +19,7 @@ import numpy as np
 
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
-from tamp.scene import Pose, colour
+from tamp.scene import Pose, colour, cube_tilt, cube_yaw
 from tamp.sim.base import GripperReading, Simulator
 
 FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
@@ -121,15 +121,13 @@ class MuJoCoSim(Simulator):
         out = {}
         for name, adr in self._block_q.items():
             pos = self.data.qpos[adr : adr + 3]
-            w, x, y, z = self.data.qpos[adr + 3 : adr + 7]
-            yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
-            out[name] = Pose(tuple(float(v) for v in pos), float(yaw))
+            yaw = cube_yaw(self.data.xmat[self._block_ids[name]])
+            out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
 
     def tilt(self, block: str) -> float:
-        """Angle (rad) between the block's vertical axis and the world's."""
-        z = self.data.xmat[self._block_ids[block]][8]
-        return math.acos(max(-1.0, min(1.0, float(z))))
+        """Angle (rad) between the world's vertical and the block axis nearest to it."""
+        return cube_tilt(self.data.xmat[self._block_ids[block]])
 
     def set_block_pose(self, block: str, pose: Pose) -> None:
         adr, vadr = self._block_q[block], self._block_v[block]

@@ -7,14 +7,12 @@ finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pybullet as p
 
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
-from tamp.scene import Pose, colour
+from tamp.scene import Pose, colour, cube_tilt, cube_yaw
 from tamp.sim.base import GripperReading, Simulator
 
 FINGER_FORCE = 40.0  # N per finger
@@ -106,15 +104,14 @@ class PyBulletSim(Simulator):
         out = {}
         for name, body in self.blocks.items():
             pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
-            yaw = p.getEulerFromQuaternion(orn)[2]
-            out[name] = Pose(tuple(float(v) for v in pos), float(yaw))
+            yaw = cube_yaw(p.getMatrixFromQuaternion(orn))
+            out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
 
     def tilt(self, block: str) -> float:
-        """Angle (rad) between the block's vertical axis and the world's."""
+        """Angle (rad) between the world's vertical and the block axis nearest to it."""
         _, orn = p.getBasePositionAndOrientation(self.blocks[block], physicsClientId=self.client)
-        z = p.getMatrixFromQuaternion(orn)[8]
-        return math.acos(max(-1.0, min(1.0, z)))
+        return cube_tilt(p.getMatrixFromQuaternion(orn))
 
     def set_block_pose(self, block: str, pose: Pose) -> None:
         body, c = self.blocks[block], self.client

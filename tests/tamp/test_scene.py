@@ -10,6 +10,8 @@ from tamp.scene import (
     Pose,
     SceneConfig,
     SceneError,
+    cube_tilt,
+    cube_yaw,
     free_slot,
     layout,
     place_pose,
@@ -81,3 +83,17 @@ def test_fault_specs_parse(text, expected):
 def test_bad_fault_specs_are_clear_errors(text):
     with pytest.raises(TampError):
         Injection.parse(text)
+
+
+def test_cube_yaw_reads_a_cube_lying_on_its_side():
+    def rz(a):
+        return np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+
+    ry90 = np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]])  # tipped over about y
+    for yaw in (-0.7, -0.2, 0.0, 0.3, 0.7):
+        got = cube_yaw(rz(yaw) @ ry90)
+        assert abs(np.remainder(got - yaw + np.pi / 4, np.pi / 2) - np.pi / 4) < 1e-9
+        assert cube_tilt(rz(yaw) @ ry90) < 1e-9
+    assert cube_tilt(
+        np.array([[1.0, 0, 0], [0, np.cos(0.3), -np.sin(0.3)], [0, np.sin(0.3), np.cos(0.3)]])
+    ) == pytest.approx(0.3)
