@@ -65,6 +65,7 @@ class SceneConfig:
     tol_xy: float = 0.02  # read_state: a block rests on another if centres are this close in xy
     tol_z: float = 0.012  # ... and the heights differ by one block size within this
     slot_radius: float = 0.05  # a slot is occupied when a block centre lies this close
+    isolation: float = 0.3  # free_slot prefers slots with this much room to every block
 
     @property
     def slots(self) -> tuple[tuple[float, float], ...]:
@@ -191,15 +192,20 @@ def top_z(poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()) -> flo
 def free_slot(
     poses: Mapping[str, Pose], near: Sequence[float], config: SceneConfig = SceneConfig()
 ) -> tuple[float, float] | None:
-    """The unoccupied table slot nearest to ``near`` (x, y), or None when all are taken."""
-    free = [
-        slot
-        for slot in config.slots
-        if all(np.linalg.norm(p.xy - np.asarray(slot)) > config.slot_radius for p in poses.values())
-    ]
+    """An unoccupied table slot, or None when all are taken.
+
+    Slots away from every block come first (a slot next to a tower puts the arm's wrist beside
+    that tower, which it can knock over); among those with ``isolation`` m of room, the one
+    nearest to ``near`` (x, y).
+    """
+
+    def room(slot) -> float:
+        return min((math.dist(slot, p.xy) for p in poses.values()), default=math.inf)
+
+    free = [slot for slot in config.slots if room(slot) > config.slot_radius]
     if not free:
         return None
-    return min(free, key=lambda slot: math.dist(slot, near[:2]))
+    return min(free, key=lambda s: (-min(room(s), config.isolation), math.dist(s, near[:2])))
 
 
 def place_pose(

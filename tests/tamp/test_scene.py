@@ -97,3 +97,11 @@ def test_cube_yaw_reads_a_cube_lying_on_its_side():
     assert cube_tilt(
         np.array([[1.0, 0, 0], [0, np.cos(0.3), -np.sin(0.3)], [0, np.sin(0.3), np.cos(0.3)]])
     ) == pytest.approx(0.3)
+
+
+def test_free_slot_prefers_room_away_from_towers_then_nearness():
+    config = SceneConfig(slot_xs=(0.5,), slot_ys=(-0.32, -0.16, 0.0, 0.16, 0.32))
+    poses = {"a": Pose((0.5, 0.0, 0.025)), "b": Pose((0.5, 0.0, 0.075))}
+    # -0.16 and 0.16 are free and nearest, but right beside the tower
+    assert free_slot(poses, (0.5, 0.0), config) in ((0.5, -0.32), (0.5, 0.32))
+    assert free_slot(poses, (0.5, 0.3), config) == (0.5, 0.32)
