@@ -10,6 +10,11 @@ with a high impratio (needed for friction grasps). Callers add the scene, then `
 
 from __future__ import annotations
 
+import os
+
+# MuJoCo picks its GL backend at import: default to headless EGL unless the user chose one
+os.environ.setdefault("MUJOCO_GL", "egl")
+
 import mujoco
 
 from robots.panda import PANDA, PandaSpec, urdf_path
