@@ -26,7 +26,7 @@ from tamp.sim.base import Camera, Simulator, make_simulator
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.planner import plan
-from task.problem import Move, Problem
+from task.problem import TABLE, Move, Problem
 
 SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation
 
@@ -46,6 +46,7 @@ class LoopConfig:
     sim: str = "pybullet"
     grasp: str = "friction"
     max_replans: int = 8
+    max_tidies: int = 2  # attempts to put loose (leaning) blocks back on the table
     max_moves: int = 60
     planner: PlannerConfig = PlannerConfig()
     execution: ExecConfig = ExecConfig()
@@ -149,7 +150,7 @@ class Episode:
         moves: list[ExecutionResult] = []
         plans: list[tuple[str, ...]] = []
         faults: list[str] = []
-        replans = disturbed = 0
+        replans = disturbed = tidies = 0
         plan_time = 0.0
         first_solved = self.domain.is_goal(problem, problem.init)
         status, reason = EpisodeStatus.GOAL_REACHED, ""
@@ -202,6 +203,9 @@ class Episode:
                     disturbed += bool(changed)
                 reading = read_state(problem.entities, self.observe(), cfg.scene)
                 self.say(f"{move}: " + ("ok" if done.ok else done.failure.value))
+                if reading.state is None and tidies < cfg.max_tidies:
+                    tidies += 1
+                    reading = self._tidy(reading, moves)
                 if reading.state is None:
                     status, reason = EpisodeStatus.UNREADABLE, "; ".join(reading.issues)
                     break
@@ -227,6 +231,20 @@ class Episode:
             tuple(faults), disturbed, self.sim.time, time.perf_counter() - wall0, plan_time,
             first_solved, reason,
         )  # fmt: skip
+
+    def _tidy(self, reading, moves: list[ExecutionResult]):
+        """Recovery from an unreadable scene: put each loose block (leaning, on an edge) on a
+        free table slot with an ordinary pick-and-place, then observe again."""
+        for block in reading.loose:
+            self.status_text = f"tidy {block}"
+            done = execute_move(
+                self.sim, self.solver, Move(block, TABLE), self.observe,
+                self.config.execution, self.config.scene, None, self.on_frame,
+            )  # fmt: skip
+            moves.append(done)
+            self.say(f"tidy {block} onto the table: " + describe(done))
+            self.settle()
+        return read_state(self.problem.entities, self.observe(), self.config.scene)
 
     def _nudge(self, block: str) -> None:
         pose = self.sim.block_poses()[block]

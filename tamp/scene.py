@@ -145,6 +145,7 @@ class Reading:
 
     state: tuple[str, ...] | None
     issues: tuple[str, ...] = ()
+    loose: tuple[str, ...] = ()  # blocks resting on neither the table nor one block
 
 
 def read_state(
@@ -156,7 +157,7 @@ def read_state(
     if missing:
         raise SceneError(f"no pose for blocks {missing} (poses given: {sorted(poses)})")
     s = config.block_size
-    support, issues = {}, []
+    support, issues, loose = {}, [], []
     for x in entities:
         px = poses[x]
         if abs(px.xyz[2] - s / 2) <= config.tol_z:
@@ -174,13 +175,14 @@ def read_state(
         else:
             where = ", ".join(f"{v:.3f}" for v in px.xyz)
             issues.append(f"block {x} at ({where}) rests on neither the table nor one block")
+            loose.append(x)
     onto: dict[str, str] = {}
     for x, sup in support.items():
         if sup != TABLE and sup in onto:
             issues.append(f"blocks {onto[sup]} and {x} both rest on {sup}")
         onto[sup] = x
     if issues:
-        return Reading(None, tuple(issues))
+        return Reading(None, tuple(issues), tuple(loose))
     return Reading(tuple(support[x] for x in entities))
 
 

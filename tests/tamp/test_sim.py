@@ -129,3 +129,21 @@ def test_tamp_run_writes_video_and_report(tmp_path):
     assert code == (0 if report["reached_goal"] else 1)
     assert report["status"] == "goal_reached" and report["config"]["sim"] == "pybullet"
     assert (tmp_path / "episode.mp4").stat().st_size > 10_000
+
+
+def test_a_loose_block_is_tidied_onto_the_table_and_the_episode_goes_on(solver, monkeypatch):
+    import tamp.loop as loop
+    from tamp.scene import Reading
+
+    real, calls = loop.read_state, []
+
+    def once_loose(entities, poses, config):
+        calls.append(1)
+        if len(calls) == 3:  # true state before, after, then the observation: c "leans"
+            return Reading(None, ("block c leans",), ("c",))
+        return real(entities, poses, config)
+
+    monkeypatch.setattr(loop, "read_state", once_loose)
+    report = run_episode(THREE, LoopConfig(), seed=0, solver=solver)
+    assert any(str(m.move) == "move(c -> table)" and m.ok for m in report.moves)
+    assert report.reached_goal, report.reason
