@@ -53,11 +53,6 @@ class Injection:
         parts = [f"{k}:{getattr(self, k):g}" for k in KINDS if getattr(self, k) > 0]
         return ",".join(parts) or "none"
 
-    @property
-    def any(self) -> bool:
-        forced = self.drop_moves or self.nudge_moves
-        return bool(forced) or any(getattr(self, k) > 0 for k in KINDS)
-
 
 def draw(rng: np.random.Generator, probability: float) -> bool:
     """One Bernoulli draw; always consumes a number so episodes stay aligned across settings."""
