@@ -12,6 +12,7 @@ import argparse
 import csv
 import dataclasses
 import json
+import os
 import platform
 import sys
 import time
@@ -124,7 +125,7 @@ def motion_command(args: argparse.Namespace) -> int:
     results = {
         "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
                    "grasp": base.grasp, "seed": args.seed, "data": str(args.data)},
-        "machine": {"cpus": __import__("os").cpu_count(), "python": platform.python_version(),
+        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "processor": platform.processor() or platform.machine()},
         "ik_batch": ik,
         "summary": rows,
