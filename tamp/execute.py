@@ -79,13 +79,13 @@ def _holding(sim: Simulator, block: str, config: ExecConfig, fresh: bool) -> dic
     }
 
 
-def _back_off(sim: Simulator, phases: tuple[Phase, ...], name: str, on_frame) -> None:
-    """After a failure: open the gripper and undo ``name``'s motion upward (a safe pose)."""
+def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
+    """After a failure at the block: open the gripper and undo the descent (a safe pose)."""
     sim.detach()
     q = sim.arm_q()
     hold = JointTrajectory.hold(q, 0.3, sim.dt)
     sim.run(hold, "open", on_frame=on_frame)
-    phase = next(ph for ph in phases if ph.name == name)
+    phase = next(ph for ph in phases if ph.name == "descend")
     up = phase.trajectory
     back = JointTrajectory(
         up.times, up.positions[::-1].copy(), -up.velocities[::-1], up.accelerations[::-1]
@@ -136,12 +136,12 @@ def execute_move(
             sim.detach()
         worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame))
         if worst > config.max_tracking:
-            _back_off(sim, planned.phases, "descend", on_frame)
+            _back_off(sim, planned.phases, on_frame)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
             missed = _holding(sim, move.entity, config, fresh=True)
             if missed is not None:
-                _back_off(sim, planned.phases, "descend", on_frame)
+                _back_off(sim, planned.phases, on_frame)
                 return result(Failure.GRASP_MISSED, ik, **missed)
             if sim.grasp == "weld":
                 sim.attach(move.entity)
@@ -150,7 +150,8 @@ def execute_move(
             if gone is not None:
                 sim.detach()
                 sim.run(JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt), "open", on_frame=on_frame)
-                return result(Failure.DROPPED, ik, after=phase.name, **gone)
+                injected = release is not None  # the fault injection opened the gripper
+                return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **gone)
     seen = observe()[move.entity]
     dxy = float(np.linalg.norm(seen.xy - np.asarray(target.xyz[:2])))
     dz = abs(seen.xyz[2] - target.xyz[2])

@@ -25,7 +25,7 @@ class Injection:
     drop: float = 0.0
     nudge: float = 0.0
     noise: float = 0.0
-    nudge_m: float = 0.03
+    nudge_m: float = 0.06
     noise_sigma: float = 0.01
     drop_moves: tuple[int, ...] = ()  # move indices that always drop (reproducible tests)
     nudge_moves: tuple[int, ...] = ()  # move indices whose placed block is always nudged

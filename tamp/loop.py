@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from motion.ik import IKSolver
+from motion.trajectory import JointTrajectory
 from tamp.execute import ExecConfig, ExecutionResult, Failure, execute_move
 from tamp.faults import Injection, draw
 from tamp.scene import Pose, SceneConfig, layout, read_state
@@ -130,8 +131,6 @@ class Episode:
         return poses
 
     def settle(self) -> None:
-        from motion.trajectory import JointTrajectory
-
         hold = JointTrajectory.hold(self.sim.arm_q(), SETTLE_S, self.sim.dt)
         self.sim.run(hold, "open", on_frame=self.on_frame)
 
@@ -166,7 +165,8 @@ class Episode:
                     result = plan(current, cfg.planner, seed=self.seed + len(plans))
                     plan_time += time.perf_counter() - t0
                     plans.append(tuple(str(m) for m in result.plan))
-                    first_solved = first_solved if len(plans) > 1 else result.solved
+                    if len(plans) == 1:
+                        first_solved = result.solved
                     if not result.solved:
                         status, reason = EpisodeStatus.NO_PLAN, "the planner found no plan"
                         break
@@ -185,7 +185,7 @@ class Episode:
                     self.sim, self.solver, move, self.observe, cfg.execution, cfg.scene,
                     drop_at, self.on_frame,
                 )  # fmt: skip
-                if drop:
+                if done.evidence.get("injected"):  # drawn, and the move reached its transit
                     faults.append(f"drop@{len(moves)}")
                 nudge = draw(self.rng, cfg.inject.nudge) or len(moves) in cfg.inject.nudge_moves
                 if done.ok and nudge:
@@ -253,7 +253,7 @@ class Episode:
         x, y, z = pose.xyz
         # pushed off whatever it rests on: it falls to the table next to its support
         self.sim.set_block_pose(
-            block, Pose((x + d * np.cos(angle) * 2, y + d * np.sin(angle) * 2, z), pose.yaw)
+            block, Pose((x + d * np.cos(angle), y + d * np.sin(angle), z), pose.yaw)
         )
 
 

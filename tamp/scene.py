@@ -85,12 +85,6 @@ def cube_yaw(rotation) -> float:
     return (math.atan2(side[1], side[0]) + quarter / 2) % quarter - quarter / 2
 
 
-def cube_tilt(rotation) -> float:
-    """Angle (rad) between the world's vertical and the block axis nearest to it."""
-    r = np.asarray(rotation, dtype=float).reshape(3, 3)
-    return math.acos(min(1.0, float(np.abs(r[2]).max())))
-
-
 def colour(index: int) -> tuple[float, float, float]:
     """RGB in [0, 1] of the block at ``index`` in the problem's entity order."""
     if index >= len(PALETTE):

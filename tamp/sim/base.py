@@ -93,10 +93,6 @@ class Simulator(abc.ABC):
         """Ground-truth block poses (centre, yaw)."""
 
     @abc.abstractmethod
-    def tilt(self, block: str) -> float:
-        """Angle (rad) between the world's vertical and the block axis nearest to it."""
-
-    @abc.abstractmethod
     def set_block_pose(self, block: str, pose: Pose) -> None:
         """Teleport a block (fault injection); its velocity is zeroed."""
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
-from tamp.scene import Pose, colour, cube_tilt, cube_yaw
+from tamp.scene import Pose, colour, cube_yaw
 from tamp.sim.base import GripperReading, Simulator
 
 FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
@@ -124,10 +124,6 @@ class MuJoCoSim(Simulator):
             yaw = cube_yaw(self.data.xmat[self._block_ids[name]])
             out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
-
-    def tilt(self, block: str) -> float:
-        """Angle (rad) between the world's vertical and the block axis nearest to it."""
-        return cube_tilt(self.data.xmat[self._block_ids[block]])
 
     def set_block_pose(self, block: str, pose: Pose) -> None:
         adr, vadr = self._block_q[block], self._block_v[block]

@@ -12,7 +12,7 @@ import pybullet as p
 
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
-from tamp.scene import Pose, colour, cube_tilt, cube_yaw
+from tamp.scene import Pose, colour, cube_yaw
 from tamp.sim.base import GripperReading, Simulator
 
 FINGER_FORCE = 40.0  # N per finger
@@ -107,11 +107,6 @@ class PyBulletSim(Simulator):
             yaw = cube_yaw(p.getMatrixFromQuaternion(orn))
             out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
-
-    def tilt(self, block: str) -> float:
-        """Angle (rad) between the world's vertical and the block axis nearest to it."""
-        _, orn = p.getBasePositionAndOrientation(self.blocks[block], physicsClientId=self.client)
-        return cube_tilt(p.getMatrixFromQuaternion(orn))
 
     def set_block_pose(self, block: str, pose: Pose) -> None:
         body, c = self.blocks[block], self.client

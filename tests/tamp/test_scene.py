@@ -10,7 +10,6 @@ from tamp.scene import (
     Pose,
     SceneConfig,
     SceneError,
-    cube_tilt,
     cube_yaw,
     free_slot,
     layout,
@@ -93,10 +92,6 @@ def test_cube_yaw_reads_a_cube_lying_on_its_side():
     for yaw in (-0.7, -0.2, 0.0, 0.3, 0.7):
         got = cube_yaw(rz(yaw) @ ry90)
         assert abs(np.remainder(got - yaw + np.pi / 4, np.pi / 2) - np.pi / 4) < 1e-9
-        assert cube_tilt(rz(yaw) @ ry90) < 1e-9
-    assert cube_tilt(
-        np.array([[1.0, 0, 0], [0, np.cos(0.3), -np.sin(0.3)], [0, np.sin(0.3), np.cos(0.3)]])
-    ) == pytest.approx(0.3)
 
 
 def test_free_slot_prefers_room_away_from_towers_then_nearness():
