@@ -71,7 +71,7 @@ class MotionResult:
     phases: tuple[Phase, ...]
     failure: str | None
     evidence: dict = field(default_factory=dict)
-    ik_time_s: float = 0.0
+    ik_time_s: float = 0.0  # IK for all waypoints and knots, plus the ruckig timing
 
 
 def _xyz(value, name: str) -> np.ndarray:
@@ -206,7 +206,8 @@ def plan_pick_place(
 
     phases = tuple(Phase(name, motion(src, dst, how), grip) for name, src, dst, how, grip in plan)
     ik_time += time.perf_counter() - start
-    steps = np.abs(np.diff(np.vstack([q_now[None], q]), axis=0)).max(1)  # (6,) rad
+    final = np.stack([w[n] for n in WAYPOINTS])  # (6, J), after the vertical re-solves
+    steps = np.abs(np.diff(np.vstack([q_now[None], final]), axis=0)).max(1)  # (6,) rad
     evidence = {
         "waypoints": {
             n: tuple(float(v) for v in targets[i, :3, 3]) for i, n in enumerate(WAYPOINTS)
