@@ -5,3 +5,7 @@ support matrix F (B, N, N+K) with a CNN backbone, ROI pooling and the directiona
 of the paper. Data generation, training, checkpoints and planning from images come next (see
 the open perception issue). ``import perception`` stays light: no torch until a submodule needs it.
 """
+
+from pathlib import Path
+
+CHECKPOINT = Path(__file__).with_name("support.pt")  # the shipped weights (see its meta)

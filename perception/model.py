@@ -34,6 +34,7 @@ class ModelConfig:
     roi: int = 4  # ROI pooling grid, roi x roi samples per entity
     dim: int = 64  # D, entity embedding size
     fixed: int = 1  # K, fixed targets (the table)
+    bands: int = 6  # Fourier bands of the box geometry (0: the raw geometry only)
 
 
 def roi_pool(features: Tensor, boxes: Tensor, image_hw: tuple[int, int], size: int) -> Tensor:
@@ -57,6 +58,19 @@ def roi_pool(features: Tensor, boxes: Tensor, image_hw: tuple[int, int], size: i
     return pooled.reshape(b, r, d * size * size)
 
 
+def fourier(g: Tensor, bands: int) -> Tensor:
+    """g and its Fourier features sin/cos(2^j pi g), j < bands: (..., G) -> (..., G(1 + 2 bands)).
+
+    With them the bilinear head can score *offsets* between two boxes (cos(a - b) is bilinear
+    in the sin/cos of a and b), such as "y sits one block below x".
+    """
+    if bands == 0:
+        return g
+    freq = torch.pi * 2.0 ** torch.arange(bands, dtype=g.dtype, device=g.device)  # (F,)
+    angles = (g[..., None] * freq).flatten(-2)  # (..., G * F)
+    return torch.cat([g, angles.sin(), angles.cos()], dim=-1)
+
+
 class SupportModel(nn.Module):
     """Images (B, 3, H, W) in [0, 1] + entity boxes (B, N, 4) -> soft supports (B, N, N+K)."""
 
@@ -69,7 +83,7 @@ class SupportModel(nn.Module):
             c_in = c_out
         self.backbone = nn.Sequential(*layers)
         self.project = nn.Sequential(
-            nn.Linear(c_in * config.roi * config.roi + 4, config.dim),
+            nn.Linear(c_in * config.roi * config.roi + 4 * (1 + 2 * config.bands), config.dim),
             nn.ReLU(),
             nn.Linear(config.dim, config.dim),
         )
@@ -77,22 +91,26 @@ class SupportModel(nn.Module):
         self.W = nn.Parameter(torch.eye(config.dim) / config.dim**0.5)  # (D, D)
         self.b = nn.Parameter(torch.zeros(()))
 
-    def embed(self, images: Tensor, boxes: Tensor) -> Tensor:
-        """Entity embeddings r_x, (B, N, D)."""
-        h, w = images.shape[-2:]
-        feats = self.backbone(images)  # (B, D', H', W')
-        pooled = roi_pool(feats, boxes, (h, w), self.config.roi)  # (B, N, D' S S)
-        scale = boxes.new_tensor([w, h, w, h])
-        x0, y0, x1, y1 = (boxes / scale).unbind(-1)  # each (B, N), normalised
-        geometry = torch.stack([(x0 + x1) / 2, (y0 + y1) / 2, x1 - x0, y1 - y0], dim=-1)
-        return self.project(torch.cat([pooled, geometry], dim=-1))  # (B, N, D)
-
     def forward(self, images: Tensor, boxes: Tensor, entity_mask: Tensor) -> Tensor:
         """Soft support matrix F (B, N, N+K); each row is a distribution over targets."""
         check_inputs(images, boxes, entity_mask)
+        return self.head(self.backbone(images), boxes, entity_mask, images.shape[-2:])
+
+    def head(
+        self, features: Tensor, boxes: Tensor, entity_mask: Tensor, image_hw: tuple[int, int]
+    ) -> Tensor:
+        """Everything after the backbone: ROI pooling, embeddings, the bilinear head.
+
+        features: (B, D', H', W') backbone output of images of size ``image_hw``.
+        """
         b, n = entity_mask.shape
         k = self.config.fixed
-        r = self.embed(images, boxes)  # (B, N, D)
+        h, w = image_hw
+        pooled = roi_pool(features, boxes, (h, w), self.config.roi)  # (B, N, D' S S)
+        scale = boxes.new_tensor([w, h, w, h])
+        x0, y0, x1, y1 = (boxes / scale).unbind(-1)  # each (B, N), normalised
+        geometry = torch.stack([(x0 + x1) / 2, (y0 + y1) / 2, x1 - x0, y1 - y0], dim=-1)
+        r = self.project(torch.cat([pooled, fourier(geometry, self.config.bands)], dim=-1))
         targets = torch.cat([r, self.fixed.expand(b, k, -1)], dim=1)  # (B, Y, D)
         scores = r @ self.W @ targets.transpose(1, 2) + self.b  # (B, N, Y), Eq. bilinear
         valid_target = torch.cat([entity_mask, entity_mask.new_ones(b, k)], dim=1)  # (B, Y)
@@ -103,6 +121,10 @@ class SupportModel(nn.Module):
         table = torch.zeros_like(support)
         table[..., n] = 1.0  # padded entities rest on the first fixed target
         return torch.where(entity_mask[..., None], support, table)
+
+    def head_parameters(self) -> list[nn.Parameter]:
+        """The weights after the backbone (projection, table embedding, W, b)."""
+        return [*self.project.parameters(), self.fixed, self.W, self.b]
 
 
 def check_inputs(images: Tensor, boxes: Tensor, entity_mask: Tensor) -> None:

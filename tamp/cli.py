@@ -19,7 +19,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from tamp import bench_cli, commands
+from tamp import bench_cli, commands, perception_cmd
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains.blocksworld import GOAL_LOSSES
@@ -57,6 +57,16 @@ def _positive_list(text: str) -> tuple[int, ...]:
         ) from None
     if not values or min(values) < 1:
         raise argparse.ArgumentTypeError(f"expected positive integers, got {text!r}")
+    return tuple(dict.fromkeys(values))
+
+
+def _radius_list(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(t) for t in text.split(","))
+    except ValueError:
+        values = (-1,)
+    if not values or min(values) < 0:
+        raise argparse.ArgumentTypeError(f"expected radii >= 0 such as 0,6, got {text!r}")
     return tuple(dict.fromkeys(values))
 
 
@@ -231,6 +241,35 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _output(p, "write results.json and episodes.csv into this folder")
     p.set_defaults(func=_motion_command)
+    p = bench.add_parser(
+        "perception", parents=[bench_opts], help="planning PlanBench instances from rendered images"
+    )
+    p.add_argument(
+        "--data",
+        default=str(DEFAULT_PLANBENCH),
+        metavar="DIR",
+        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+    )
+    p.add_argument(
+        "--n", type=_positive, default=100, help="instances over block counts (100: 17/74/9)"
+    )
+    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
+                   help="state (ground truth), frozen, optimised (all three)")  # fmt: skip
+    p.add_argument("--blur", type=_radius_list, default=(0,), metavar="R[,R...]",
+                   help="Gaussian blur radii in pixels, 0 = clear (0)")  # fmt: skip
+    p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
+    p.add_argument(
+        "--checkpoint", default=str(perception_cmd.DEFAULT_CHECKPOINT), metavar="FILE.pt",
+        help="perception weights (the shipped checkpoint)",
+    )  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
+    p.add_argument("--threads", type=_positive, default=2, help="torch threads (2)")
+    p.add_argument(
+        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
+    )
+    _output(p, "write results.json, instances.csv and example.png into this folder")
+    p.set_defaults(func=_perception_bench_command)
+    perception_cmd.add_parser(sub, _positive)
     return parser
 
 
@@ -251,12 +290,26 @@ def _episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> Non
     p.add_argument("--inject", metavar="KIND:P[,...]",
                    help="faults with probabilities, e.g. drop:0.2,nudge:0.1,noise:0.1")  # fmt: skip
     p.add_argument("--max-replans", type=_count, metavar="N", help="replanning budget (8)")
+    p.add_argument("--observe", choices=("state", "camera"), default="state",
+                   help="state from block poses or from the camera image (state)")  # fmt: skip
+    p.add_argument("--perception", choices=("frozen", "optimised"), default="frozen",
+                   help="camera: frozen or planning-optimised perception (frozen)")  # fmt: skip
+    p.add_argument("--blur", type=int, default=0, metavar="R",
+                   help="camera: Gaussian blur radius in pixels (0)")  # fmt: skip
+    p.add_argument("--checkpoint", metavar="FILE.pt",
+                   help="camera: perception weights (perception/support.pt)")  # fmt: skip
 
 
 def _run_command(args: argparse.Namespace) -> int:
     from tamp.run_cmd import run_command  # imports the simulators only when needed
 
     return run_command(args)
+
+
+def _perception_bench_command(args: argparse.Namespace) -> int:
+    from tamp.perception_bench import perception_bench_command
+
+    return perception_bench_command(args)
 
 
 def _motion_command(args: argparse.Namespace) -> int:

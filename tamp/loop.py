@@ -5,6 +5,13 @@ the plan move by move. After each move it observes the block poses and reads the
 state. A failed move, or a state that differs from the one the plan expected, triggers a
 replan from the observed state (SS-Replan style: execute one action, observe, check); the
 number of replans is bounded. Ground truth is read only at the end, to score the episode.
+
+``observe="state"`` reads the symbolic state from block poses. ``observe="camera"`` reads it
+from the simulator's camera image with the trained perception model (`tamp.from_images`): the
+goal is the perceived goal scene, a rendered completion of the problem's goal; each planning
+window starts from the soft state perceived in the current image (frozen or
+planning-optimised perception), only that window's moves are executed, and the next window
+starts from a new image.
 """
 
 from __future__ import annotations
@@ -22,13 +29,17 @@ from motion.ik import IKSolver
 from motion.trajectory import JointTrajectory
 from tamp.execute import ExecConfig, ExecutionResult, Failure, execute_move
 from tamp.faults import Injection, draw
-from tamp.scene import Pose, SceneConfig, layout, read_state
+from tamp.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
+from tamp.scene import PALETTE, Pose, Reading, SceneConfig, layout, read_state
 from tamp.sim.base import Camera, Simulator, make_simulator
 from task.config import PlannerConfig
 from task.domains import get_domain
+from task.domains.blocksworld import complete_goal
+from task.errors import TampError, one_of
 from task.planner import plan
 from task.problem import TABLE, Move, Problem
 
+OBSERVE = ("state", "camera")
 SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation
 
 
@@ -42,7 +53,8 @@ class EpisodeStatus(enum.Enum):
 
 @dataclass(frozen=True)
 class LoopConfig:
-    """Settings of an episode. ``grasp``: 'friction' (physical) or 'weld' (attach)."""
+    """Settings of an episode. ``grasp``: 'friction' (physical) or 'weld' (attach);
+    ``observe``: 'state' (block poses) or 'camera' (perception of the camera image)."""
 
     sim: str = "pybullet"
     grasp: str = "friction"
@@ -54,6 +66,15 @@ class LoopConfig:
     scene: SceneConfig = SceneConfig()
     camera: Camera = Camera()
     inject: Injection = Injection()
+    observe: str = "state"
+    perception: PerceptionMode = PerceptionMode()  # camera only: frozen or optimised
+    checkpoint: str | None = None  # camera only: perception weights (None: the shipped ones)
+
+    def __post_init__(self) -> None:
+        if self.observe not in OBSERVE:
+            raise TampError(f"unknown observation {one_of(self.observe, OBSERVE)}")
+        if self.observe == "camera" and self.perception.mode == "state":
+            raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")
 
 
 @dataclass(frozen=True)
@@ -112,10 +133,28 @@ class Episode:
         self.say = on_event or (lambda text: None)
         self.solver = solver or IKSolver()
         poses = layout(problem.entities, problem.init, config.scene, seed)
+        self.status_text = ""
+        self.target = problem  # what the robot plans for and tests: the goal it perceives
+        self.perceived: tuple[tuple[str, ...], object] | None = None  # last (state, F)
+        if config.observe == "camera":
+            self._setup_camera()
         self.sim = make_simulator(
             config.sim, problem.entities, poses, config.scene, config.grasp, config.camera
         )
-        self.status_text = ""
+
+    def _setup_camera(self) -> None:
+        """Load perception, render the goal scene and read the goal from it."""
+        from perception import CHECKPOINT
+        from perception.perceive import Perceiver
+        from tamp.render import StateRenderer
+
+        cfg, problem = self.config, self.problem
+        self.perceiver = Perceiver.load(cfg.checkpoint or CHECKPOINT)
+        goal_state = complete_goal(problem)
+        with StateRenderer(cfg.sim, cfg.scene, cfg.camera) as renderer:
+            self.goal_image = renderer.render(problem.entities, goal_state, self.seed + 1)
+        self.target = perceived_goal(problem, self.perceiver, self.goal_image, cfg.perception.blur)
+        self.image = None
 
     # --- observation -----------------------------------------------------------------------
     def observe(self) -> dict[str, Pose]:
@@ -134,6 +173,48 @@ class Episode:
         hold = JointTrajectory.hold(self.sim.arm_q(), SETTLE_S, self.sim.dt)
         self.sim.run(hold, "open", on_frame=self.on_frame)
 
+    def read(self) -> Reading:
+        """The symbolic state the robot observes: from block poses, or from the camera."""
+        if self.config.observe == "state":
+            return read_state(self.problem.entities, self.observe(), self.config.scene)
+        from perception.errors import PerceptionError
+
+        self.image = self.sim.render()
+        try:
+            state, F = perceived_state(
+                self.target, self.perceiver, self.image, self.config.perception.blur
+            )
+        except PerceptionError as err:
+            return Reading(None, (str(err),))
+        self.perceived = (state, F)
+        return Reading(state)
+
+    def belief_lines(self) -> list[str]:
+        """The last perceived soft state, one line per block: its most likely support and that
+        support's probability, by colour (empty when observing block poses)."""
+        if self.perceived is None:
+            return []
+        _, F = self.perceived  # (N, N + 1): blocks, then the table
+        names = [PALETTE[i][0] for i in range(self.target.n)] + [TABLE]
+        lines = []
+        for x, row in enumerate(F):
+            p, col = row.max(0)
+            lines.append(f"{names[x]} on {names[int(col)]} {float(p):.2f}")
+        return lines
+
+    def _plan(self, state, seed: int):
+        """Plan from ``state``; with the camera, one window from the current image."""
+        current = dataclasses.replace(self.target, init=state)
+        if self.config.observe == "state":
+            return plan(current, self.config.planner, seed=seed)
+        image = self.image
+        beliefs = ImageBeliefs(
+            [current], self.perceiver, lambda i, s: image, [self.goal_image],
+            self.config.perception,
+        )  # fmt: skip
+        window = dataclasses.replace(self.config.planner, max_windows=1)
+        return plan(current, window, seed=seed, beliefs=beliefs)
+
     def _true_state(self):
         return read_state(self.problem.entities, self.sim.block_poses(), self.config.scene).state
 
@@ -151,25 +232,35 @@ class Episode:
         faults: list[str] = []
         replans = disturbed = tidies = 0
         plan_time = 0.0
-        first_solved = self.domain.is_goal(problem, problem.init)
+        target = self.target
+        first_solved = self.domain.is_goal(target, problem.init)
         status, reason = EpisodeStatus.GOAL_REACHED, ""
         state = problem.init
+        stalls = 0  # camera: windows in a row that decoded no move
         queue: list[Move] = []
         try:
-            while True:
-                if self.domain.is_goal(problem, state):
+            if cfg.observe == "camera":
+                reading = self.read()
+                state = reading.state
+                if state is None:
+                    status, reason = EpisodeStatus.UNREADABLE, "; ".join(reading.issues)
+            while state is not None:
+                if self.domain.is_goal(target, state):
                     break
                 if not queue:
                     t0 = time.perf_counter()
-                    current = dataclasses.replace(problem, init=state)
-                    result = plan(current, cfg.planner, seed=self.seed + len(plans))
+                    result = self._plan(state, self.seed + len(plans))
                     plan_time += time.perf_counter() - t0
                     plans.append(tuple(str(m) for m in result.plan))
                     if len(plans) == 1:
                         first_solved = result.solved
-                    if not result.solved:
-                        status, reason = EpisodeStatus.NO_PLAN, "the planner found no plan"
-                        break
+                    window = cfg.observe == "camera" and len(result.plan) > 0
+                    stalls = 0 if window or result.solved else stalls + 1
+                    if not (result.solved or window):
+                        if cfg.observe == "state" or stalls > cfg.max_replans:
+                            status, reason = EpisodeStatus.NO_PLAN, "the planner found no plan"
+                            break
+                        continue
                     queue = list(result.plan)
                     self.say(f"plan {len(plans)}: {len(queue)} moves")
                 if len(moves) >= cfg.max_moves:
@@ -201,7 +292,7 @@ class Episode:
                         if x != move.entity and before[i] != after[i]
                     ]
                     disturbed += bool(changed)
-                reading = read_state(problem.entities, self.observe(), cfg.scene)
+                reading = self.read()
                 self.say(f"{move}: " + ("ok" if done.ok else done.failure.value))
                 if reading.state is None and tidies < cfg.max_tidies:
                     tidies += 1
@@ -244,7 +335,7 @@ class Episode:
             moves.append(done)
             self.say(f"tidy {block} onto the table: " + describe(done))
             self.settle()
-        return read_state(self.problem.entities, self.observe(), self.config.scene)
+        return self.read()
 
     def _nudge(self, block: str) -> None:
         pose = self.sim.block_poses()[block]

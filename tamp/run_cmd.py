@@ -14,6 +14,7 @@ from pathlib import Path
 
 from tamp.commands import planner_config
 from tamp.faults import Injection
+from tamp.from_images import PerceptionMode
 from tamp.loop import Episode, EpisodeReport, LoopConfig
 from tamp.video import VideoWriter
 from task import data, pddl_io
@@ -40,6 +41,9 @@ def loop_config(args: argparse.Namespace) -> LoopConfig:
         grasp=args.grasp,
         planner=planner_config(args),
         inject=Injection.parse(args.inject),
+        observe=args.observe,
+        perception=PerceptionMode(args.perception, blur=args.blur),
+        checkpoint=args.checkpoint,
     )
     if args.max_replans is not None:
         config = replace(config, max_replans=args.max_replans)
@@ -85,13 +89,16 @@ def run_command(args: argparse.Namespace) -> int:
 
         def frame(sim) -> None:
             caption = f"{sim.name} t={sim.time:5.1f}s  {episode.status_text}"
-            video.write(sim.render(), caption)
+            video.write(sim.render(), caption, episode.belief_lines())
 
         episode.on_frame = frame
         episode.sim.frame_period = FRAME_PERIOD
     if not quiet:
         head = f"running {problem.name} ({problem.n} blocks) in {config.sim}, grasp {config.grasp}"
-        print(f"{head}, faults {config.inject}, seed {args.seed}", file=sys.stderr)
+        seen = config.observe
+        if seen == "camera":
+            seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
+        print(f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}", file=sys.stderr)
     report = episode.run()
     written = []
     if video is not None and video.close() is not None:
@@ -99,7 +106,8 @@ def run_command(args: argparse.Namespace) -> int:
     body = report.to_json()
     body["config"] = {
         "sim": config.sim, "grasp": config.grasp, "inject": str(config.inject),
-        "seed": args.seed, "max_replans": config.max_replans,
+        "seed": args.seed, "max_replans": config.max_replans, "observe": config.observe,
+        "perception": config.perception.mode, "blur": config.perception.blur,
     }  # fmt: skip
     if out is not None:
         (out / "report.json").write_text(json.dumps(body, indent=2))

@@ -19,19 +19,23 @@ import numpy as np
 from task.errors import ProblemError, TampError, one_of
 from task.problem import TABLE, Move
 
-# PlanBench renders a..e as red, blue, orange, yellow and white blocks; the rest follow.
+# PlanBench names a..e after red, blue, orange, yellow and white blocks; white is replaced by
+# green here, because a white block cannot be told from the light-grey Panda by colour. The
+# first ``CAMERA_COLOURS`` have hues at least 24 degrees apart, so camera perception can find
+# them by colour; brown (an orange hue) and white are for larger state-observed scenes only.
 PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
     ("red", (0.85, 0.1, 0.1)),
     ("blue", (0.1, 0.25, 0.9)),
     ("orange", (1.0, 0.55, 0.05)),
     ("yellow", (0.95, 0.9, 0.1)),
-    ("white", (0.95, 0.95, 0.95)),
     ("green", (0.1, 0.7, 0.2)),
     ("purple", (0.55, 0.2, 0.75)),
     ("cyan", (0.1, 0.8, 0.85)),
     ("magenta", (0.95, 0.3, 0.75)),
     ("brown", (0.5, 0.3, 0.1)),
+    ("white", (0.95, 0.95, 0.95)),
 )
+CAMERA_COLOURS = 8  # blocks that camera perception can tell apart by colour
 
 
 class SceneError(TampError):

@@ -5,6 +5,7 @@ Frames are written as they are rendered, so a long episode never holds its video
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import cv2
@@ -27,13 +28,20 @@ class VideoWriter:
         self._mp4: cv2.VideoWriter | None = None
         self._gif: list = []
 
-    def write(self, rgb: np.ndarray, caption: str = "") -> None:
+    def write(self, rgb: np.ndarray, caption: str = "", notes: Sequence[str] = ()) -> None:
+        """Append a frame; ``caption`` on a band at the top, ``notes`` (short lines, e.g. the
+        perceived soft state) at the bottom left."""
         if rgb.ndim != 3 or rgb.shape[2] != 3 or rgb.dtype != np.uint8:
             raise TampError(f"a video frame must be (H, W, 3) uint8, got {rgb.shape} {rgb.dtype}")
         bgr = cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR)
         if caption:
             cv2.rectangle(bgr, (0, 0), (bgr.shape[1], 18), (0, 0, 0), -1)
             cv2.putText(bgr, caption, (4, 13), cv2.FONT_HERSHEY_SIMPLEX, 0.4, (255, 255, 255), 1)
+        h = bgr.shape[0]
+        for k, line in enumerate(reversed(list(notes))):
+            y = h - 6 - 13 * k
+            cv2.rectangle(bgr, (0, y - 10), (8 + 6 * len(line), y + 3), (0, 0, 0), -1)
+            cv2.putText(bgr, line, (4, y), cv2.FONT_HERSHEY_SIMPLEX, 0.35, (255, 255, 255), 1)
         if self.path.suffix == ".gif":
             self._gif.append(bgr[..., ::-1].copy())
         else:

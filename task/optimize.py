@@ -7,11 +7,15 @@ be alone.
 
 from __future__ import annotations
 
+import dataclasses
+
 import torch
 from torch import Tensor
 
+from task.beliefs import WindowBeliefs
 from task.config import PlannerConfig
 from task.domains.base import Domain, SoftBatch
+from task.errors import TampError
 from task.rollout import Rollout, rollout
 
 
@@ -31,21 +35,49 @@ def optimise_window(
     steps: Tensor,
     config: PlannerConfig,
     generator: torch.Generator,
+    beliefs: WindowBeliefs | None = None,
 ) -> tuple[Tensor, Rollout]:
     """Optimise the window's logits; returns them and the final rollout (no grad).
 
     steps: (B, T) bool, the live steps of each row (rows may have shorter windows).
+    ``beliefs`` (see `task.beliefs`) replaces the batch's F0 and goal by soft ones, recomputed
+    at every step; their parameters, if any, are optimised too, at their own learning rate.
     """
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
-    opt = torch.optim.Adam([logits], lr=config.lr)
+    groups = [{"params": [logits], "lr": config.lr}]
+    extra = beliefs.parameters() if beliefs is not None else []
+    if extra:
+        groups.append({"params": extra, "lr": beliefs.lr})
+    opt = torch.optim.Adam(groups)
     for k in range(config.iters):
         opt.zero_grad(set_to_none=True)
         tau = temperature(config, k)
-        rollout(domain, logits, batch, steps, config, tau).loss.sum().backward()
+        live, penalty = with_beliefs(batch, beliefs)
+        (rollout(domain, logits, live, steps, config, tau).loss.sum() + penalty).backward()
         opt.step()
     with torch.no_grad():
         tau = temperature(config, config.iters - 1)
-        return logits.detach(), rollout(domain, logits, batch, steps, config, tau)
+        live, _ = with_beliefs(batch, beliefs)
+        return logits.detach(), rollout(domain, logits, live, steps, config, tau)
+
+
+def with_beliefs(batch: SoftBatch, beliefs: WindowBeliefs | None) -> tuple[SoftBatch, Tensor]:
+    """The batch with the beliefs' soft F0 and goal (each problem's restarts share them), and
+    the beliefs' penalty counted once per restart row, as the planning loss is."""
+    if beliefs is None:
+        return batch, batch.F0.new_zeros(())
+    F0, goal, penalty = beliefs.compute()  # (P, N, Y), (P, N, Y), (P,)
+    rows = batch.F0.shape[0]
+    if F0.shape[1:] != batch.F0.shape[1:] or goal.shape != F0.shape or rows % F0.shape[0]:
+        raise TampError(
+            f"beliefs of shape {tuple(F0.shape)} / {tuple(goal.shape)} do not fit a batch of "
+            f"{tuple(batch.F0.shape)}"
+        )
+    r = rows // F0.shape[0]
+    soft = dataclasses.replace(
+        batch, F0=F0.repeat_interleave(r, dim=0), goal=goal.repeat_interleave(r, dim=0)
+    )
+    return soft, r * penalty.sum()
 
 
 def temperature(config: PlannerConfig, k: int) -> float:

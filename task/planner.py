@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 
 import torch
 
+from task.beliefs import BeliefSource
 from task.config import PlannerConfig
 from task.decode import decode_best
 from task.domains import get_domain
@@ -29,11 +30,12 @@ def _window(
     states: Sequence[State],
     config: PlannerConfig,
     generator: torch.Generator,
+    beliefs=None,
 ):
     batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
     horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
     steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
-    _, roll = optimise_window(domain, batch, steps, config, generator)
+    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs)
     return decode_best(
         domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold
     )
@@ -45,8 +47,12 @@ def _run(
     config: PlannerConfig,
     generator: torch.Generator,
     on_done: Callable[[int], None],
+    source: BeliefSource | None = None,
+    indices: Sequence[int] = (),
 ) -> list[PlanResult]:
-    """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems."""
+    """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems.
+
+    ``indices``: the problems' positions in the caller's list (what ``source`` is told)."""
     start = time.perf_counter()
     states = [domain.initial_state(p) for p in problems]
     moves: list[list] = [[] for _ in problems]
@@ -56,9 +62,9 @@ def _run(
     for _ in range(config.max_windows):
         if not active:
             break
-        decoded = _window(
-            domain, [problems[i] for i in active], [states[i] for i in active], config, generator
-        )
+        now = [states[i] for i in active]
+        beliefs = None if source is None else source([indices[i] for i in active], now)
+        decoded = _window(domain, [problems[i] for i in active], now, config, generator, beliefs)
         still = []
         for i, win in zip(active, decoded, strict=True):
             windows[i] += 1
@@ -88,11 +94,13 @@ def plan_batch(
     config: PlannerConfig = PlannerConfig(),
     seed: int = 0,
     progress: Callable[[int], None] | None = None,
+    beliefs: BeliefSource | None = None,
 ) -> list[PlanResult]:
     """Plan every problem (all of one domain). ``progress(k)``: k more problems finished.
 
     Returns one PlanResult per problem, in order; ``stats["time_s"]`` is the wall time per
-    problem (the batch's time divided among its problems when batched).
+    problem (the batch's time divided among its problems when batched). ``beliefs`` gives
+    every window soft initial and goal supports (planning from perception, `task.beliefs`).
     """
     if not problems:
         return []
@@ -103,17 +111,26 @@ def plan_batch(
     generator = torch.Generator().manual_seed(seed)
     report = progress or (lambda k: None)
     if not config.batched:
-        return [_run(domain, [p], config, generator, report)[0] for p in problems]
+        return [
+            _run(domain, [p], config, generator, report, beliefs, [i])[0]
+            for i, p in enumerate(problems)
+        ]
     # one tensor program per problem size: no padding work, and per-size times in the stats
     results: list[PlanResult | None] = [None] * len(problems)
     for n in sorted({p.n for p in problems}):
         group = [i for i, p in enumerate(problems) if p.n == n]
-        planned = _run(domain, [problems[i] for i in group], config, generator, report)
+        subset = [problems[i] for i in group]
+        planned = _run(domain, subset, config, generator, report, beliefs, group)
         for i, result in zip(group, planned, strict=True):
             results[i] = result
     return results
 
 
-def plan(problem: Problem, config: PlannerConfig = PlannerConfig(), seed: int = 0) -> PlanResult:
-    """Plan one problem."""
-    return plan_batch([problem], config, seed)[0]
+def plan(
+    problem: Problem,
+    config: PlannerConfig = PlannerConfig(),
+    seed: int = 0,
+    beliefs: BeliefSource | None = None,
+) -> PlanResult:
+    """Plan one problem (``beliefs``: soft inputs from perception, see `plan_batch`)."""
+    return plan_batch([problem], config, seed, beliefs=beliefs)[0]

@@ -28,14 +28,29 @@ TRACK_EVERY = 5  # steps between tracking-error samples
 
 @dataclass(frozen=True)
 class Camera:
-    """A pinhole camera looking at ``target`` from ``eye``; ``fovy`` in degrees."""
+    """A pinhole camera looking at ``target`` from ``eye``; ``fovy`` in degrees.
 
-    eye: tuple[float, float, float] = (1.0, -0.55, 0.6)
-    target: tuple[float, float, float] = (0.48, 0.0, 0.1)
+    The default looks at the slot grid from the front right, 40 degrees above the table, along
+    an azimuth (x : y = 2 : 1) that lines up with no diagonal of the grid, so a tower rarely
+    hides a block behind it.
+    """
+
+    eye: tuple[float, float, float] = (1.22, -0.38, 0.81)
+    target: tuple[float, float, float] = (0.47, 0.0, 0.1)
     up: tuple[float, float, float] = (0.0, 0.0, 1.0)
-    fovy: float = 50.0
+    fovy: float = 40.0
     width: int = 320
     height: int = 240
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """One directional light: ``direction`` it shines along (world frame), diffuse and ambient
+    intensities in [0, 1]. Both backends map these onto their own lighting models."""
+
+    direction: tuple[float, float, float] = (-0.2, -0.1, -1.0)
+    diffuse: float = 0.8
+    ambient: float = 0.4
 
 
 @dataclass(frozen=True)
@@ -68,6 +83,7 @@ class Simulator(abc.ABC):
         self.scene = scene
         self.grasp = grasp
         self.camera = camera
+        self.lighting = Lighting()
         self.time = 0.0
         self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
 
@@ -107,6 +123,10 @@ class Simulator(abc.ABC):
     @abc.abstractmethod
     def render(self) -> np.ndarray:
         """An RGB image (H, W, 3) uint8 from ``camera``."""
+
+    @abc.abstractmethod
+    def set_view(self, camera: Camera, lighting: Lighting) -> None:
+        """Move the camera and change the light for the next ``render``."""
 
     @abc.abstractmethod
     def close(self) -> None:

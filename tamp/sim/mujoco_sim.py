@@ -20,7 +20,8 @@ import numpy as np
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import GripperReading, Simulator
+from tamp.sim.base import Camera, GripperReading, Lighting, Simulator
+from task.errors import TampError
 
 FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
 HAND_BODY = PANDA.tcp_link
@@ -55,8 +56,9 @@ class MuJoCoSim(Simulator):
         world.add_geom(
             type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01], rgba=[0.45, 0.45, 0.45, 1]
         )
-        world.add_light(type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL, pos=[0.5, 0.3, 2.0],
-                        dir=[-0.2, -0.1, -1.0], diffuse=[0.8, 0.8, 0.8])  # fmt: skip
+        world.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+                        pos=[0.5, 0.3, 2.0], dir=[-0.2, -0.1, -1.0],
+                        diffuse=[0.8, 0.8, 0.8])  # fmt: skip
         world.add_camera(name="scene", pos=list(cam.eye), quat=_look_at(cam.eye, cam.target,
                          cam.up), fovy=cam.fovy)  # fmt: skip
         half = self.scene.block_size / 2
@@ -89,6 +91,7 @@ class MuJoCoSim(Simulator):
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
         mujoco.mj_forward(m, d)
         self._renderer: mujoco.Renderer | None = None
+        self.set_view(self.camera, self.lighting)
 
     def _command(self, q, qd, gripper) -> None:
         self.data.ctrl[self._act] = q
@@ -151,6 +154,20 @@ class MuJoCoSim(Simulator):
     def detach(self) -> None:
         # only the grasp welds: the finger coupling (a joint equality) must stay active
         self.data.eq_active[list(self._weld_ids.values())] = 0
+
+    def set_view(self, camera: Camera, lighting: Lighting) -> None:
+        if (camera.width, camera.height) != (self.camera.width, self.camera.height):
+            raise TampError("set_view cannot change the image size of a MuJoCo simulator")
+        m, cam, sun = self.model, self.model.camera("scene"), self.model.light("sun")
+        self.camera, self.lighting = camera, lighting
+        cam.pos[:] = camera.eye
+        cam.quat[:] = _look_at(camera.eye, camera.target, camera.up)
+        cam.fovy[:] = camera.fovy
+        direction = np.asarray(lighting.direction, float)
+        sun.dir[:] = direction / np.linalg.norm(direction)
+        sun.diffuse[:] = lighting.diffuse
+        m.vis.headlight.ambient[:] = lighting.ambient
+        m.vis.headlight.diffuse[:] = 0.1
 
     def render(self) -> np.ndarray:
         if self._renderer is None:

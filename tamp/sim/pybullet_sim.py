@@ -13,7 +13,7 @@ import pybullet as p
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import GripperReading, Simulator
+from tamp.sim.base import Camera, GripperReading, Lighting, Simulator
 
 FINGER_FORCE = 40.0  # N per finger
 ARM_KP, ARM_KD = 0.3, 1.0  # PyBullet position-control gains
@@ -56,11 +56,7 @@ class PyBulletSim(Simulator):
             self.blocks[name] = body
         self._weld: int | None = None
         self._finger_command = ""
-        cam = self.camera
-        self._view = p.computeViewMatrix(cam.eye, cam.target, cam.up, physicsClientId=c)
-        self._proj = p.computeProjectionMatrixFOV(
-            cam.fovy, cam.width / cam.height, 0.05, 3.0, physicsClientId=c
-        )
+        self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
 
     def _command(self, q, qd, gripper) -> None:
@@ -132,11 +128,21 @@ class PyBulletSim(Simulator):
             p.removeConstraint(self._weld, physicsClientId=self.client)
             self._weld = None
 
+    def set_view(self, camera: Camera, lighting: Lighting) -> None:
+        c = self.client
+        self.camera, self.lighting = camera, lighting
+        self._view = p.computeViewMatrix(camera.eye, camera.target, camera.up, physicsClientId=c)
+        self._proj = p.computeProjectionMatrixFOV(
+            camera.fovy, camera.width / camera.height, 0.05, 3.0, physicsClientId=c
+        )
+
     def render(self) -> np.ndarray:
-        cam = self.camera
+        cam, light = self.camera, self.lighting
         _, _, rgb, _, _ = p.getCameraImage(
             cam.width, cam.height, self._view, self._proj, renderer=p.ER_TINY_RENDERER,
-            physicsClientId=self.client,
+            lightDirection=[-v for v in light.direction], lightColor=[1.0, 1.0, 1.0],
+            lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
+            lightSpecularCoeff=0.05, shadow=0, physicsClientId=self.client,
         )  # fmt: skip
         return np.asarray(rgb, dtype=np.uint8).reshape(cam.height, cam.width, 4)[..., :3].copy()
 

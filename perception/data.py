@@ -1,0 +1,109 @@
+"""Rendered support datasets on disk, and the tensors the model trains on.
+
+One compressed ``.npz`` file holds M samples:
+
+- ``images`` (M, H, W, 3) uint8 RGB;
+- ``colours`` (M, S) int8: palette index of each block of the sample, -1 after its last block;
+- ``supports`` (M, S) int8: what each block rests on, as the block's position in the sample
+  (0..n-1), ``TABLE`` (-1) for the table, ``PAD`` (-2) after the last block;
+- ``palette`` (P, 3) float32 RGB in [0, 1], the colours the blocks may have;
+- ``meta``: a JSON string saying how the file was made (command, seed, simulators).
+
+Entity boxes are not stored: they come from `perception.segment` at load time, exactly as at
+test time.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from perception.errors import PerceptionError
+from perception.segment import find_boxes
+
+TABLE = -1
+PAD = -2
+
+
+@dataclass(frozen=True)
+class SupportData:
+    """A loaded dataset (see the module docstring for the arrays)."""
+
+    images: np.ndarray
+    colours: np.ndarray
+    supports: np.ndarray
+    palette: np.ndarray
+    meta: dict
+
+    def __len__(self) -> int:
+        return len(self.images)
+
+    @property
+    def slots(self) -> int:
+        """S, the most blocks a sample may have."""
+        return self.colours.shape[1]
+
+
+def save(path: str | Path, data: SupportData) -> Path:
+    """Write ``data`` to ``path`` (``.npz``, compressed); returns the path."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(
+        path,
+        images=data.images,
+        colours=data.colours,
+        supports=data.supports,
+        palette=data.palette,
+        meta=np.asarray(json.dumps(data.meta)),
+    )
+    return path
+
+
+def load(path: str | Path) -> SupportData:
+    """Read a dataset written by `save`; one-line PerceptionError if missing or malformed."""
+    path = Path(path)
+    if not path.is_file():
+        raise PerceptionError(f"no dataset at {path} (make one with `tamp perception dataset`)")
+    try:
+        with np.load(path) as z:
+            data = SupportData(
+                z["images"], z["colours"], z["supports"], z["palette"], json.loads(str(z["meta"]))
+            )
+    except (KeyError, ValueError, OSError) as err:
+        raise PerceptionError(f"{path} is not a support dataset: {err}") from None
+    if data.images.ndim != 4 or data.colours.shape != data.supports.shape:
+        raise PerceptionError(f"{path}: arrays of inconsistent shapes")
+    return data
+
+
+def label_matrix(supports: np.ndarray, slots: int) -> np.ndarray:
+    """Target column per block, (M, S) int64 in 0..S (S = the table column); padding -> S."""
+    out = supports.astype(np.int64)
+    return np.where(out < 0, slots, out)
+
+
+def tensors(data: SupportData, indices: np.ndarray | None = None) -> dict[str, Tensor]:
+    """Model inputs and labels of the chosen samples (all by default).
+
+    images (M, 3, H, W) float in [0, 1]; boxes (M, S, 4); mask (M, S) bool; target (M, S) long
+    with the table at column S. Boxes of padded slots are a dummy 1-pixel box.
+    """
+    idx = np.arange(len(data)) if indices is None else np.asarray(indices)
+    s = data.slots
+    boxes = np.zeros((len(idx), s, 4), dtype=np.float32)
+    boxes[..., 2:] = 1.0
+    for row, i in enumerate(idx):
+        n = int((data.colours[i] >= 0).sum())
+        boxes[row, :n] = find_boxes(data.images[i], data.palette[data.colours[i, :n]])
+    images = torch.from_numpy(data.images[idx]).permute(0, 3, 1, 2)  # (M, 3, H, W) uint8
+    return {
+        "images": images,
+        "boxes": torch.from_numpy(boxes),
+        "mask": torch.from_numpy(data.colours[idx] >= 0),
+        "target": torch.from_numpy(label_matrix(data.supports[idx], s)),
+    }

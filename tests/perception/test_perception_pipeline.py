@@ -1,0 +1,132 @@
+"""Segmentation, dataset files, training, checkpoints and soft beliefs for the planner.
+
+Images here are drawn with OpenCV (coloured squares on grey), so no simulator is needed.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+import torch
+
+from perception import data as pdata
+from perception.errors import PerceptionError
+from perception.model import ModelConfig, SupportModel
+from perception.perceive import Perceiver, blur, kl_rows
+from perception.segment import find_boxes
+from perception.train import TrainConfig, evaluate, load_checkpoint, save_checkpoint, train
+
+RGB = [(0.85, 0.1, 0.1), (0.1, 0.25, 0.9), (1.0, 0.55, 0.05)]  # red, blue, orange
+
+
+def _image(squares) -> np.ndarray:
+    """Grey (H=120, W=160) image with filled squares: [(rgb, x0, y0, size)]."""
+    img = np.full((120, 160, 3), 110, np.uint8)
+    for rgb, x, y, s in squares:
+        colour = tuple(int(255 * c) for c in rgb)
+        cv2.rectangle(img, (x, y), (x + s - 1, y + s - 1), colour, -1)
+    return img
+
+
+def _tower_image():
+    # blue on red (stacked), orange alone on the table
+    return _image([(RGB[0], 40, 70, 16), (RGB[1], 40, 54, 16), (RGB[2], 100, 70, 16)])
+
+
+def test_colour_boxes_are_found_where_the_blocks_are():
+    boxes = find_boxes(_tower_image(), RGB)  # within the 2x2 opening's one-pixel shift
+    np.testing.assert_allclose(boxes[0], [40, 70, 56, 86], atol=1)
+    np.testing.assert_allclose(boxes[1], [40, 54, 56, 70], atol=1)
+    np.testing.assert_allclose(boxes[2], [100, 70, 116, 86], atol=1)
+
+
+def test_a_missing_block_is_named_in_one_line():
+    img = _image([(RGB[0], 40, 70, 16), (RGB[2], 100, 70, 16)])  # blue hidden
+    with pytest.raises(PerceptionError, match=r"block\(s\) b not found") as err:
+        find_boxes(img, RGB, names=["a", "b", "c"])
+    assert "\n" not in str(err.value)
+
+
+def test_a_grey_robot_and_table_are_never_blocks():
+    img = _image([])
+    cv2.rectangle(img, (10, 10), (60, 60), (235, 235, 235), -1)  # light grey, like the Panda
+    with pytest.raises(PerceptionError):
+        find_boxes(img, RGB[:1])
+
+
+@pytest.mark.parametrize("bad", [np.zeros((10, 10)), np.zeros((10, 10, 3), np.float32)])
+def test_bad_images_raise_one_line_errors(bad):
+    with pytest.raises(PerceptionError, match="image must be"):
+        find_boxes(bad, RGB)
+
+
+def test_blur_keeps_shape_and_type_and_widens_boxes():
+    img = _tower_image()
+    soft = blur(img, 6)
+    assert soft.shape == img.shape and soft.dtype == np.uint8
+    assert blur(img, 0) is img
+    wide, sharp = find_boxes(soft, RGB), find_boxes(img, RGB)
+    assert (wide[:, 2:] - wide[:, :2] >= sharp[:, 2:] - sharp[:, :2]).all()
+
+
+def _dataset(m: int = 8) -> pdata.SupportData:
+    images = np.stack([_tower_image()] * m)
+    colours = np.tile(np.array([[0, 1, 2, -1]], np.int8), (m, 1))
+    # block 0 (red) on the table, block 1 (blue) on block 0, block 2 (orange) on the table
+    supports = np.tile(np.array([[pdata.TABLE, 0, pdata.TABLE, pdata.PAD]], np.int8), (m, 1))
+    return pdata.SupportData(images, colours, supports, np.asarray(RGB, np.float32), {"x": 1})
+
+
+def test_dataset_round_trip_and_tensors(tmp_path):
+    path = pdata.save(tmp_path / "d.npz", _dataset())
+    back = pdata.load(path)
+    assert back.meta == {"x": 1} and len(back) == 8 and back.slots == 4
+    t = pdata.tensors(back)
+    assert t["images"].shape == (8, 3, 120, 160) and t["images"].dtype == torch.uint8
+    assert t["boxes"].shape == (8, 4, 4)
+    assert t["mask"][0].tolist() == [True, True, True, False]
+    assert t["target"][0].tolist() == [4, 0, 4, 4]  # the table is column S = 4
+
+
+def test_a_missing_dataset_or_checkpoint_is_a_one_line_error(tmp_path):
+    with pytest.raises(PerceptionError, match="no dataset at"):
+        pdata.load(tmp_path / "none.npz")
+    with pytest.raises(PerceptionError, match="no perception checkpoint"):
+        load_checkpoint(tmp_path / "none.pt")
+    (tmp_path / "junk.pt").write_bytes(b"not a checkpoint")
+    with pytest.raises(PerceptionError, match="is not a support-model checkpoint"):
+        load_checkpoint(tmp_path / "junk.pt")
+
+
+def test_training_fits_a_tiny_dataset_and_the_checkpoint_round_trips(tmp_path):
+    t = pdata.tensors(_dataset())
+    small = ModelConfig(channels=(8, 8), dim=16, bands=2)
+    model = train(t, TrainConfig(epochs=30, batch=8, lr=1e-2), small)
+    scores = evaluate(model, t)
+    assert scores["relation_accuracy"] == 1.0 and scores["blocks"] == 24
+    path = save_checkpoint(tmp_path / "m.pt", model, {"seed": 0})
+    again, meta = load_checkpoint(path)
+    assert meta == {"seed": 0} and again.config == small
+    x = (t["images"].float() / 255, t["boxes"], t["mask"])
+    torch.testing.assert_close(again(*x), model(*x))
+
+
+def test_kl_anchor_is_zero_at_the_anchor_and_positive_elsewhere():
+    F = torch.softmax(torch.randn(2, 3, 4), -1)
+    mask = torch.ones(2, 3, dtype=torch.bool)
+    torch.testing.assert_close(kl_rows(F, F, mask), torch.zeros(2))
+    G = torch.softmax(torch.randn(2, 3, 4), -1)
+    assert (kl_rows(F, G, mask) > 0).all()
+
+
+def test_perceiver_inputs_pad_to_the_largest_scene():
+    torch.manual_seed(0)
+    perceiver = Perceiver(SupportModel(ModelConfig(channels=(8,), dim=8)))
+    images, boxes, mask = perceiver.inputs([_tower_image()] * 2, [RGB, RGB[:2]])
+    assert images.shape == (2, 3, 120, 160) and boxes.shape == (2, 3, 4)
+    assert mask.tolist() == [[True, True, True], [True, True, False]]
+    F = perceiver.support((images, boxes, mask))
+    assert F.shape == (2, 3, 4)
+    with pytest.raises(PerceptionError, match="images differ in size"):
+        perceiver.inputs([_tower_image(), _tower_image()[:100]], [RGB, RGB])
