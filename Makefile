@@ -30,9 +30,10 @@ $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install -q -e '.[dev]'
 	touch $(STAMP)
 
-# plan the embedded 5-block example and execute it with the simulated Panda (SIM=mujoco too)
+# the embedded 5-block example from camera images: perception, planning and the simulated Panda
+# (SIM=mujoco for MuJoCo)
 demo: $(STAMP) sysdeps
-	$(VENV)/bin/tamp run --sim $(SIM) --out out/demo
+	$(VENV)/bin/tamp run --sim $(SIM) --observe camera --out out/demo
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

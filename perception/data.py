@@ -90,20 +90,31 @@ def label_matrix(supports: np.ndarray, slots: int) -> np.ndarray:
 def tensors(data: SupportData, indices: np.ndarray | None = None) -> dict[str, Tensor]:
     """Model inputs and labels of the chosen samples (all by default).
 
-    images (M, 3, H, W) float in [0, 1]; boxes (M, S, 4); mask (M, S) bool; target (M, S) long
-    with the table at column S. Boxes of padded slots are a dummy 1-pixel box.
+    images (M, 3, H, W) uint8; boxes (M, S, 4); mask (M, S) bool; target (M, S) long with the
+    table at column S; ``kept`` (M,) the sample indices used. A sample in which segmentation
+    cannot find every block is left out (``dropped`` counts them). Boxes of padded slots are a
+    dummy 1-pixel box.
     """
     idx = np.arange(len(data)) if indices is None else np.asarray(indices)
     s = data.slots
-    boxes = np.zeros((len(idx), s, 4), dtype=np.float32)
-    boxes[..., 2:] = 1.0
-    for row, i in enumerate(idx):
+    kept, boxes = [], []
+    for i in idx:
         n = int((data.colours[i] >= 0).sum())
-        boxes[row, :n] = find_boxes(data.images[i], data.palette[data.colours[i, :n]])
-    images = torch.from_numpy(data.images[idx]).permute(0, 3, 1, 2)  # (M, 3, H, W) uint8
+        row = np.zeros((s, 4), dtype=np.float32)
+        row[:, 2:] = 1.0
+        try:
+            row[:n] = find_boxes(data.images[i], data.palette[data.colours[i, :n]])
+        except PerceptionError:
+            continue
+        kept.append(i)
+        boxes.append(row)
+    kept = np.asarray(kept, dtype=np.int64)
+    images = torch.from_numpy(data.images[kept]).permute(0, 3, 1, 2)  # (M, 3, H, W) uint8
     return {
         "images": images,
-        "boxes": torch.from_numpy(boxes),
-        "mask": torch.from_numpy(data.colours[idx] >= 0),
-        "target": torch.from_numpy(label_matrix(data.supports[idx], s)),
+        "boxes": torch.from_numpy(np.stack(boxes).reshape(len(kept), s, 4)),
+        "mask": torch.from_numpy(data.colours[kept] >= 0),
+        "target": torch.from_numpy(label_matrix(data.supports[kept], s)),
+        "kept": torch.from_numpy(kept),
+        "dropped": len(idx) - len(kept),
     }

@@ -1,9 +1,11 @@
 """Entity regions from an image by colour: one bounding box per block, found with OpenCV.
 
 Each block has its own saturated colour. A pixel belongs to a block when it is saturated and
-bright enough (the grey table and the light-grey robot are not) and its hue lies within
-``hue_tol`` of the block's hue; the block's region is the largest connected component of those
-pixels after a small morphological opening. Nothing is read from a simulator.
+bright enough (the grey table and the light-grey robot are not) and, among the colours looked
+for, the block's hue is the nearest to the pixel's, within ``hue_tol`` (nearest, so that
+neighbouring hues such as orange and yellow never share a pixel); the block's region is the
+largest connected component of those pixels after a small morphological opening. Nothing is
+read from a simulator.
 """
 
 from __future__ import annotations
@@ -55,14 +57,20 @@ def find_boxes(
     """
     check_image(image)
     names = [f"#{i}" for i in range(len(colours))] if names is None else list(names)
+    if len(names) != len(colours):
+        raise PerceptionError(f"{len(names)} block names for {len(colours)} colours")
     hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
     h = hsv[..., 0].astype(np.int16)
     vivid = (hsv[..., 1] >= config.min_saturation) & (hsv[..., 2] >= config.min_value)
+    hues = np.asarray([hue_of(rgb) for rgb in colours], dtype=np.int16)  # (N,)
+    d = np.abs(h[..., None] - hues)  # (H, W, N)
+    d = np.minimum(d, 180 - d)  # hue is circular
+    nearest = d.argmin(-1) if len(hues) else np.zeros(h.shape, int)  # (H, W)
+    close = vivid & (d.min(-1, initial=255) <= config.hue_tol)
     kernel = np.ones((2, 2), np.uint8)
     boxes, missing = [], []
-    for name, rgb in zip(names, colours, strict=True):
-        d = np.abs(h - hue_of(rgb))
-        mask = (vivid & (np.minimum(d, 180 - d) <= config.hue_tol)).astype(np.uint8)
+    for k, name in enumerate(names):
+        mask = (close & (nearest == k)).astype(np.uint8)
         mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
         count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
         if count < 2:

@@ -69,6 +69,7 @@ def evaluate(model: SupportModel, data: dict[str, Tensor], batch: int = 64) -> d
         "nll": loss / max(m, 1),
         "blocks": blocks,
         "scenes": m,
+        "unreadable": int(data.get("dropped", 0)),  # scenes segmentation could not read
     }
 
 

@@ -262,6 +262,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--checkpoint", default=str(perception_cmd.DEFAULT_CHECKPOINT), metavar="FILE.pt",
         help="perception weights (the shipped checkpoint)",
     )  # fmt: skip
+    # defaults of tamp.from_images.PerceptionMode (not imported here: it pulls in torch)
+    p.add_argument("--kl-weight", type=float, default=1.0, metavar="W",
+                   help="optimised: weight of each KL anchor (%(default)s)")  # fmt: skip
+    p.add_argument("--adapt", choices=("head", "all"), default="head",
+                   help="optimised: weights to update (%(default)s)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
     p.add_argument("--threads", type=_positive, default=2, help="torch threads (2)")
     p.add_argument(

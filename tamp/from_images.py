@@ -8,8 +8,9 @@ Three modes, for every planning entry point that takes a ``PerceptionMode``:
 - ``optimised``: as frozen, but the planning loss also updates a per-problem copy of the
   perception weights (Adam, lr 1e-4) with KL anchors to the initial predictions on both the
   initial and the goal image; the soft states are recomputed from the images at every gradient
-  step (`task.optimize.with_beliefs`). The adapted weights carry over to the problem's next
-  window. ``adapt="head"`` (the default) updates the weights after the CNN backbone (ROI
+  step (`task.optimize.with_beliefs`). Every window adapts a fresh copy of the trained
+  weights (carried over, the adaptation drifts and the planner stalls). ``adapt="head"`` (the
+  default) updates the weights after the CNN backbone (ROI
   projection, table embedding, bilinear W and b) and computes the backbone's features of the two
   images once per window; ``adapt="all"`` also updates the backbone and reruns it every step
   (about 40 times slower on a CPU).
@@ -32,7 +33,6 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from perception.model import SupportModel
 from perception.perceive import Perceiver, blur, kl_rows
 from tamp.render import block_colours
 from task.domains.base import State
@@ -132,7 +132,6 @@ class ImageBeliefs:
             raise TampError("ImageBeliefs needs mode 'frozen' or 'optimised'")
         self.problems, self.perceiver, self.observe, self.mode = problems, perceiver, observe, mode
         self.goal_images = [blur(im, mode.blur) for im in goal_images]
-        self.models: dict[int, SupportModel] = {}
         self.perception_s = 0.0  # time spent reading images (segmentation and the model)
 
     def _inputs(self, i: int, image: np.ndarray):
@@ -158,16 +157,12 @@ class ImageBeliefs:
                 torch.stack([a[0] for a in anchors]), torch.stack([a[1] for a in anchors])
             )
         models = []
-        for i in indices:
-            if i not in self.models:
-                model = copy.deepcopy(self.perceiver.model)
-                trained = (
-                    model.head_parameters() if self.mode.adapt == "head" else model.parameters()
-                )
-                for param in trained:
-                    param.requires_grad_(True)
-                self.models[i] = model
-            models.append(self.models[i])
+        for _ in indices:  # a fresh copy of the trained weights for every problem and window
+            model = copy.deepcopy(self.perceiver.model)
+            trained = model.head_parameters() if self.mode.adapt == "head" else model.parameters()
+            for param in trained:
+                param.requires_grad_(True)
+            models.append(model)
         return _Adapted(models, inputs, features, anchors, self.mode)
 
 

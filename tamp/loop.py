@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from motion.ik import IKSolver
-from motion.trajectory import JointTrajectory
+from motion.trajectory import JointTrajectory, straight_segment
+from robots.panda import PANDA
 from tamp.execute import ExecConfig, ExecutionResult, Failure, execute_move
 from tamp.faults import Injection, draw
 from tamp.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
@@ -185,7 +186,14 @@ class Episode:
                 self.target, self.perceiver, self.image, self.config.perception.blur
             )
         except PerceptionError as err:
-            return Reading(None, (str(err),))
+            home = np.asarray(PANDA.q_home)
+            if np.abs(self.sim.arm_q() - home).max() < 0.05:
+                return Reading(None, (str(err),))
+            # the arm may hide a block: take it home (high above the table) and look again
+            self.status_text = "home to look again"
+            self.sim.run(straight_segment(self.sim.arm_q(), home, self.sim.dt), "open",
+                         on_frame=self.on_frame)  # fmt: skip
+            return self.read()
         self.perceived = (state, F)
         return Reading(state)
 

@@ -124,7 +124,9 @@ def motion_command(args: argparse.Namespace) -> int:
     inject = str(base.inject)
     results = {
         "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
-                   "grasp": base.grasp, "seed": args.seed, "data": str(args.data)},
+                   "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
+                   "observe": base.observe, "perception": base.perception.mode,
+                   "blur": base.perception.blur},
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "processor": platform.processor() or platform.machine()},
         "ik_batch": ik,
@@ -145,8 +147,10 @@ def motion_command(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(results, indent=2))
         return 0
+    seen = base.observe + (f" ({base.perception.mode} perception)" if base.observe == "camera"
+                           else "")  # fmt: skip
     print(f"motion benchmark: {len(suite.instances)} PlanBench instances, grasp {base.grasp}, "
-          f"faults {inject}, seed {args.seed}")  # fmt: skip
+          f"observe {seen}, faults {inject}, seed {args.seed}")  # fmt: skip
     print(table(rows, inject))
     print(f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
           f"({ik['converged']}/{ik['n']} converged)")  # fmt: skip

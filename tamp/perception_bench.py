@@ -47,7 +47,7 @@ from task.planner import plan_batch
 REDRAWS = 8  # layout seeds tried before a render counts as hiding a block
 
 
-class Camera:
+class Renders:
     """Renders instance images, redrawing layouts that hide a block; keeps time and counts."""
 
     def __init__(self, renderer: StateRenderer, problems, seed: int) -> None:
@@ -90,7 +90,8 @@ def run_row(suite, chosen, mode: str, radius: int, horizon: int, args, perceiver
                 failed_goal[i] = str(err)
         beliefs = ImageBeliefs(
             planned, perceiver, lambda i, s: camera.image(i, s),
-            goal_images, PerceptionMode(mode, blur=radius),
+            goal_images, PerceptionMode(mode, kl_weight=args.kl_weight, blur=radius,
+                                        adapt=args.adapt),
         )  # fmt: skip
     keep = [i for i in range(len(problems)) if i not in failed_goal]
     results = dict.fromkeys(range(len(problems)))
@@ -172,7 +173,7 @@ def perception_bench_command(args: argparse.Namespace) -> int:
     combos = [(r, m, t) for r, m, t in combos if not (m == "state" and r != args.blur[0])]
     rows, summaries = [], []
     with StateRenderer(args.sim) as renderer:
-        camera = Camera(renderer, [i.problem for i in chosen], args.seed)
+        camera = Renders(renderer, [i.problem for i in chosen], args.seed)
         bar = tqdm(combos, desc="perception bench", unit="row", file=sys.stderr,
                    disable=not args.progress)  # fmt: skip
         for radius, mode, horizon in bar:

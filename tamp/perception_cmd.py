@@ -44,8 +44,8 @@ def train_command(args: argparse.Namespace) -> int:
 
     torch.set_num_threads(args.threads)
     t0 = time.perf_counter()
-    train_data = pdata.tensors(pdata.load(args.train))
-    test_data = pdata.tensors(pdata.load(args.test))
+    train_raw, test_raw = pdata.load(args.train), pdata.load(args.test)
+    train_data, test_data = pdata.tensors(train_raw), pdata.tensors(test_raw)
     config = TrainConfig(epochs=args.epochs, seed=args.seed)
     with tqdm(total=config.epochs, desc="train", unit="epoch", file=sys.stderr,
               disable=not args.progress) as bar:  # fmt: skip
@@ -59,8 +59,19 @@ def train_command(args: argparse.Namespace) -> int:
     meta = {
         "command": _command_line(),
         "seed": args.seed,
-        "train": {"file": str(args.train), "images": len(train_data["images"])},
-        "test": {"file": str(args.test), **scores},
+        "train": {
+            "file": str(args.train),
+            "images": len(train_raw),
+            "unreadable": train_data["dropped"],  # left out: segmentation could not read them
+            "made_by": train_raw.meta.get("command"),
+            "data_seed": train_raw.meta.get("seed"),
+        },
+        "test": {
+            "file": str(args.test),
+            "made_by": test_raw.meta.get("command"),
+            "data_seed": test_raw.meta.get("seed"),
+            **scores,
+        },
         "train_config": config.__dict__,
         "train_time_s": round(time.perf_counter() - t0, 1),
         "threads": args.threads,
@@ -68,8 +79,8 @@ def train_command(args: argparse.Namespace) -> int:
     save_checkpoint(args.out, model, meta)
     print(
         f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
-        f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images) "
-        f"-> {args.out}"
+        f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
+        f"{scores['unreadable']} unreadable, left out) -> {args.out}"
     )
     return 0
 
@@ -92,7 +103,8 @@ def eval_command(args: argparse.Namespace) -> int:
     else:
         print(
             f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
-            f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images)"
+            f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
+            f"{scores['unreadable']} unreadable, left out)"
         )
     return 0
 

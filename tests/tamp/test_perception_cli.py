@@ -1,0 +1,52 @@
+"""``tamp perception ...`` and ``tamp bench perception`` through ``main(argv)``."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from perception import data as pdata
+from tamp.cli import main
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err, err
+    assert err.startswith("tamp") and "error:" in err, err
+    return err
+
+
+@pytest.mark.sim
+def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
+    path = tmp_path / "d.npz"
+    args = ["perception", "dataset", "--n", "4", "--seed", "3", "--out", str(path)]
+    assert main([*args, "--no-progress"]) == 0
+    data = pdata.load(path)
+    assert len(data) == 4 and data.images.shape[1:] == (240, 320, 3)
+    assert data.meta["sims"] == ["pybullet", "mujoco"] and data.meta["seed"] == 3
+    assert ((data.colours >= 0).sum(1) >= 3).all()
+    capsys.readouterr()
+    assert main(["perception", "eval", str(path), "--json"]) == 0
+    scores = json.loads(capsys.readouterr().out)
+    assert scores["scenes"] == 4 and 0.0 <= scores["relation_accuracy"] <= 1.0
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["perception", "eval", "missing.npz"], "no dataset at missing.npz"),
+        (["perception", "train", "--train", "a.npz", "--test", "b.npz"], "no dataset at a.npz"),
+        (["bench", "perception", "--data", "nowhere"], "PlanBench data not found"),
+        (["bench", "perception", "--modes", "psychic"], "unknown mode 'psychic'"),
+        (["run", "--observe", "camera", "--checkpoint", "none.pt"], "no perception checkpoint"),
+    ],
+)
+def test_bad_input_is_one_line(capsys, argv, needle):
+    assert main(argv) == 2
+    assert needle in _one_line_error(capsys)
+
+
+def test_bad_blur_is_a_usage_error(capsys):
+    assert main(["bench", "perception", "--blur", "-3"]) == 2
+    assert "radii >= 0" in capsys.readouterr().err
