@@ -263,7 +263,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="perception weights (the shipped checkpoint)",
     )  # fmt: skip
     # defaults of tamp.from_images.PerceptionMode (not imported here: it pulls in torch)
-    p.add_argument("--kl-weight", type=float, default=1.0, metavar="W",
+    p.add_argument("--kl-weight", type=float, default=10.0, metavar="W",
                    help="optimised: weight of each KL anchor (%(default)s)")  # fmt: skip
     p.add_argument("--adapt", choices=("head", "all"), default="head",
                    help="optimised: weights to update (%(default)s)")  # fmt: skip

@@ -10,10 +10,10 @@ Three modes, for every planning entry point that takes a ``PerceptionMode``:
   initial and the goal image; the soft states are recomputed from the images at every gradient
   step (`task.optimize.with_beliefs`). Every window adapts a fresh copy of the trained
   weights (carried over, the adaptation drifts and the planner stalls). ``adapt="head"`` (the
-  default) updates the weights after the CNN backbone (ROI
-  projection, table embedding, bilinear W and b) and computes the backbone's features of the two
-  images once per window; ``adapt="all"`` also updates the backbone and reruns it every step
-  (about 40 times slower on a CPU).
+  default) updates the weights after the CNN backbone (ROI projection, table embedding,
+  bilinear W and b) and computes the backbone's features of the two images once per window;
+  ``adapt="all"`` also updates the backbone and reruns it on both images at every step (see
+  BENCHMARKS.md for what that costs).
 
 The crisp side is the paper's: decoded moves are checked against the true symbolic state. The
 goal the planner stops at is the *perceived* goal scene (the most likely valid state under the
@@ -52,7 +52,7 @@ class PerceptionMode:
 
     mode: str = "frozen"
     lr: float = 1e-4  # Adam learning rate of the perception weights (the paper's value)
-    kl_weight: float = 1.0  # weight of each KL anchor
+    kl_weight: float = 10.0  # weight of each KL anchor (chosen on the 100-subset, BENCHMARKS.md)
     blur: int = 0  # Gaussian blur radius (pixels) applied to every image; 0 = clear
     adapt: str = "head"  # which weights ``optimised`` updates: "head" or "all"
 
