@@ -1,9 +1,14 @@
 """perception: the rendering-independent image -> soft support model.
 
-``perception.model.SupportModel`` maps images (B, 3, H, W) and entity boxes (B, N, 4) to a soft
-support matrix F (B, N, N+K) with a CNN backbone, ROI pooling and the directional bilinear head
-of the paper. Data generation, training, checkpoints and planning from images come next (see
-the open perception issue). ``import perception`` stays light: no torch until a submodule needs it.
+- ``perception.segment``: entity boxes by colour (OpenCV), with one-line errors for hidden blocks;
+- ``perception.model.SupportModel``: images (B, 3, H, W) and entity boxes (B, N, 4) -> a soft
+  support matrix F (B, N, N+K) (CNN backbone, ROI pooling, the directional bilinear head);
+- ``perception.data`` / ``perception.train``: dataset files, training, evaluation, checkpoints;
+- ``perception.perceive.Perceiver``: segmentation + model, blur, KL anchors.
+
+``CHECKPOINT`` is the shipped model (its meta says which commands and seeds made it). Rendering
+lives in ``tamp`` (``tamp.render``, ``tamp.dataset``); this package never imports a simulator.
+``import perception`` stays light: no torch until a submodule needs it.
 """
 
 from pathlib import Path

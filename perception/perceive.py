@@ -80,6 +80,6 @@ class Perceiver:
         stack = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # (B, 3, H, W) uint8
         return as_float(stack), torch.from_numpy(boxes), torch.from_numpy(mask)
 
-    def support(self, inputs: tuple[Tensor, Tensor, Tensor], model: SupportModel | None = None):
-        """Soft supports F (B, N, N+K) of `inputs` by ``model`` (default: this perceiver's)."""
-        return (model or self.model)(*inputs)
+    def support(self, inputs: tuple[Tensor, Tensor, Tensor]) -> Tensor:
+        """Soft supports F (B, N, N+K) of `inputs` (see `inputs`) by this perceiver's model."""
+        return self.model(*inputs)

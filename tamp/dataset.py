@@ -12,7 +12,6 @@ from __future__ import annotations
 import random
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -94,8 +93,3 @@ def generate(
     return pdata.SupportData(
         np.stack(images), np.stack(colours_out), np.stack(supports_out), palette, info
     )
-
-
-def write(path: str | Path, data: pdata.SupportData) -> Path:
-    """Save ``data`` (`perception.data.save`)."""
-    return pdata.save(path, data)
