@@ -131,6 +131,21 @@ def _planner_options(horizon_list: bool) -> argparse.ArgumentParser:
     return p
 
 
+def _data_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--data",
+        default=str(DEFAULT_PLANBENCH),
+        metavar="DIR",
+        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+    )
+
+
+def _progress_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
+    )
+
+
 def _output(p: argparse.ArgumentParser, out_help: str) -> None:
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--out", metavar="PATH", help=out_help)
@@ -188,17 +203,10 @@ def build_parser() -> argparse.ArgumentParser:
             metavar="N",
             help="also time batched vs sequential planning on the first N instances",
         )
-        p.add_argument(
-            "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
-        )
+        _progress_option(p)
         _output(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
-    planbench.add_argument(
-        "--data",
-        default=str(DEFAULT_PLANBENCH),
-        metavar="DIR",
-        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
-    )
+    _data_option(planbench)
     planbench.add_argument(
         "--limit",
         type=_positive,
@@ -228,28 +236,16 @@ def build_parser() -> argparse.ArgumentParser:
         "motion", parents=[plan_opts], help="motion-level executability in the simulators"
     )
     _episode_options(p, multi_sim=True)
-    p.add_argument(
-        "--data",
-        default=str(DEFAULT_PLANBENCH),
-        metavar="DIR",
-        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
-    )
+    _data_option(p)
     p.add_argument("--n", type=_positive, default=100, help="instances, spread over sizes (100)")
     p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
-    p.add_argument(
-        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
-    )
+    _progress_option(p)
     _output(p, "write results.json and episodes.csv into this folder")
     p.set_defaults(func=_motion_command)
     p = bench.add_parser(
         "perception", parents=[bench_opts], help="planning PlanBench instances from rendered images"
     )
-    p.add_argument(
-        "--data",
-        default=str(DEFAULT_PLANBENCH),
-        metavar="DIR",
-        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
-    )
+    _data_option(p)
     p.add_argument(
         "--n", type=_positive, default=100, help="instances over block counts (100: 17/74/9)"
     )
@@ -269,9 +265,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="optimised: weights to update (%(default)s)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
     p.add_argument("--threads", type=_positive, default=2, help="torch threads (2)")
-    p.add_argument(
-        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
-    )
+    _progress_option(p)
     _output(p, "write results.json, instances.csv and example.png into this folder")
     p.set_defaults(func=_perception_bench_command)
     perception_cmd.add_parser(sub, _positive)
