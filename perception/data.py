@@ -91,8 +91,8 @@ def tensors(data: SupportData, indices: np.ndarray | None = None) -> dict[str, T
     """Model inputs and labels of the chosen samples (all by default).
 
     images (M, 3, H, W) uint8; boxes (M, S, 4); mask (M, S) bool; target (M, S) long with the
-    table at column S; ``kept`` (M,) the sample indices used. A sample in which segmentation
-    cannot find every block is left out (``dropped`` counts them). Boxes of padded slots are a
+    table at column S. A sample in which segmentation cannot find every block is left out
+    (``dropped`` counts them). Boxes of padded slots are a
     dummy 1-pixel box.
     """
     idx = np.arange(len(data)) if indices is None else np.asarray(indices)
@@ -112,9 +112,8 @@ def tensors(data: SupportData, indices: np.ndarray | None = None) -> dict[str, T
     images = torch.from_numpy(data.images[kept]).permute(0, 3, 1, 2)  # (M, 3, H, W) uint8
     return {
         "images": images,
-        "boxes": torch.from_numpy(np.stack(boxes).reshape(len(kept), s, 4)),
+        "boxes": torch.from_numpy(np.asarray(boxes, dtype=np.float32).reshape(len(kept), s, 4)),
         "mask": torch.from_numpy(data.colours[kept] >= 0),
         "target": torch.from_numpy(label_matrix(data.supports[kept], s)),
-        "kept": torch.from_numpy(kept),
         "dropped": len(idx) - len(kept),
     }

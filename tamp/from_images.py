@@ -145,11 +145,12 @@ class ImageBeliefs:
     def __call__(self, indices: Sequence[int], states: Sequence[State]):
         t0 = time.perf_counter()
         inputs = [self._inputs(i, self.observe(i, s)) for i, s in zip(indices, states, strict=True)]
-        with torch.no_grad():
-            anchors = [self.perceiver.support(x) for x in inputs]  # (2, N, Y) each
-            features = [
-                self.perceiver.model.backbone(x[0]) if self.mode.adapt == "head" else None
-                for x in inputs
+        model = self.perceiver.model
+        with torch.no_grad():  # one backbone pass per image pair: the anchors and the features
+            features = [model.backbone(images) for images, _, _ in inputs]
+            anchors = [  # (2, N, Y) each
+                model.head(f, boxes, mask, images.shape[-2:])
+                for f, (images, boxes, mask) in zip(features, inputs, strict=True)
             ]
         self.perception_s += time.perf_counter() - t0
         if self.mode.mode == "frozen":
@@ -163,6 +164,8 @@ class ImageBeliefs:
             for param in trained:
                 param.requires_grad_(True)
             models.append(model)
+        if self.mode.adapt == "all":
+            features = [None] * len(inputs)  # each step reruns the adapted backbone
         return _Adapted(models, inputs, features, anchors, self.mode)
 
 
@@ -171,11 +174,7 @@ def perceived_goal(
 ) -> Problem:
     """``problem`` whose goal is the perceived goal scene: every block's most likely support
     under the trained model's reading of ``goal_image`` (a valid state by construction)."""
-    colours = block_colours(problem.n)
-    x = perceiver.inputs([blur(goal_image, radius)], [colours], [problem.entities])
-    with torch.no_grad():
-        F = perceiver.support(x)[0]  # (N, Y)
-    state = most_likely_state(problem, F)
+    state, _ = perceived_state(problem, perceiver, goal_image, radius)
     return dataclasses.replace(problem, goal=tuple(zip(problem.entities, state, strict=True)))
 
 
@@ -186,5 +185,5 @@ def perceived_state(
     colours = block_colours(problem.n)
     x = perceiver.inputs([blur(image, radius)], [colours], [problem.entities])
     with torch.no_grad():
-        F = perceiver.support(x)[0]
+        F = perceiver.support(x)[0]  # (N, Y)
     return most_likely_state(problem, F), F

@@ -27,10 +27,14 @@ import numpy as np
 
 from motion.ik import IKSolver
 from motion.trajectory import JointTrajectory, straight_segment
+from perception import CHECKPOINT
+from perception.errors import PerceptionError
+from perception.perceive import Perceiver
 from robots.panda import PANDA
 from tamp.execute import ExecConfig, ExecutionResult, Failure, execute_move
 from tamp.faults import Injection, draw
 from tamp.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
+from tamp.render import StateRenderer
 from tamp.scene import PALETTE, Pose, Reading, SceneConfig, layout, read_state
 from tamp.sim.base import Camera, Simulator, make_simulator
 from task.config import PlannerConfig
@@ -136,7 +140,8 @@ class Episode:
         poses = layout(problem.entities, problem.init, config.scene, seed)
         self.status_text = ""
         self.target = problem  # what the robot plans for and tests: the goal it perceives
-        self.perceived: tuple[tuple[str, ...], object] | None = None  # last (state, F)
+        self.perceived = None  # camera: the last perceived soft supports F (N, N + 1)
+        self.image = None  # camera: the last camera image
         if config.observe == "camera":
             self._setup_camera()
         self.sim = make_simulator(
@@ -145,17 +150,12 @@ class Episode:
 
     def _setup_camera(self) -> None:
         """Load perception, render the goal scene and read the goal from it."""
-        from perception import CHECKPOINT
-        from perception.perceive import Perceiver
-        from tamp.render import StateRenderer
-
         cfg, problem = self.config, self.problem
         self.perceiver = Perceiver.load(cfg.checkpoint or CHECKPOINT)
         goal_state = complete_goal(problem)
         with StateRenderer(cfg.sim, cfg.scene, cfg.camera) as renderer:
             self.goal_image = renderer.render(problem.entities, goal_state, self.seed + 1)
         self.target = perceived_goal(problem, self.perceiver, self.goal_image, cfg.perception.blur)
-        self.image = None
 
     # --- observation -----------------------------------------------------------------------
     def observe(self) -> dict[str, Pose]:
@@ -178,8 +178,6 @@ class Episode:
         """The symbolic state the robot observes: from block poses, or from the camera."""
         if self.config.observe == "state":
             return read_state(self.problem.entities, self.observe(), self.config.scene)
-        from perception.errors import PerceptionError
-
         self.image = self.sim.render()
         try:
             state, F = perceived_state(
@@ -194,7 +192,7 @@ class Episode:
             self.sim.run(straight_segment(self.sim.arm_q(), home, self.sim.dt), "open",
                          on_frame=self.on_frame)  # fmt: skip
             return self.read()
-        self.perceived = (state, F)
+        self.perceived = F
         return Reading(state)
 
     def belief_lines(self) -> list[str]:
@@ -202,7 +200,7 @@ class Episode:
         support's probability, by colour (empty when observing block poses)."""
         if self.perceived is None:
             return []
-        _, F = self.perceived  # (N, N + 1): blocks, then the table
+        F = self.perceived  # (N, N + 1): blocks, then the table
         names = [PALETTE[i][0] for i in range(self.target.n)] + [TABLE]
         lines = []
         for x, row in enumerate(F):

@@ -54,6 +54,13 @@ class Renders:
         self.renderer, self.problems, self.seed = renderer, problems, seed
         self.render_s = 0.0
         self.redrawn = 0
+        self._goals: dict[int, np.ndarray] = {}  # every row uses the same goal images
+
+    def goal(self, i: int) -> np.ndarray:
+        """The goal image of problem i: its completed goal scene, rendered once."""
+        if i not in self._goals:
+            self._goals[i] = self.image(i, complete_goal(self.problems[i]), "goal")
+        return self._goals[i]
 
     def image(self, i: int, state, kind: str = "init") -> np.ndarray:
         p = self.problems[i]
@@ -78,16 +85,16 @@ def run_row(suite, chosen, mode: str, radius: int, horizon: int, args, perceiver
     config = replace(planner_config(args), horizon=horizon)
     problems = [inst.problem for inst in chosen]
     planned = list(problems)
-    failed_goal: dict[int, str] = {}
+    failed_goal: set[int] = set()  # goal images in which a block could not be found
     render0, t0 = camera.render_s, time.perf_counter()
     beliefs = None
     if mode != "state":
-        goal_images = [camera.image(i, complete_goal(p), "goal") for i, p in enumerate(problems)]
+        goal_images = [camera.goal(i) for i in range(len(problems))]
         for i, p in enumerate(problems):
             try:
                 planned[i] = perceived_goal(p, perceiver, goal_images[i], radius)
-            except PerceptionError as err:
-                failed_goal[i] = str(err)
+            except PerceptionError:
+                failed_goal.add(i)
         beliefs = ImageBeliefs(
             planned, perceiver, lambda i, s: camera.image(i, s),
             goal_images, PerceptionMode(mode, kl_weight=args.kl_weight, blur=radius,
@@ -182,7 +189,7 @@ def perception_bench_command(args: argparse.Namespace) -> int:
             rows += r
             summaries.append(s)
         sample = chosen[0].problem
-        views = [camera.image(0, sample.init), camera.image(0, complete_goal(sample), "goal")]
+        views = [camera.image(0, sample.init), camera.goal(0)]
         if args.blur[-1]:
             views += [blur(im, args.blur[-1]) for im in views]
         example = np.hstack(views)  # initial and goal images, then blurred

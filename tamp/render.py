@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tamp.scene import CAMERA_COLOURS, PALETTE, Pose, SceneConfig, SceneError, layout
+from tamp.scene import CAMERA_COLOURS, PALETTE, Pose, SceneConfig, SceneError, colour, layout
 from tamp.sim.base import Camera, Lighting, make_simulator
 
 PARK = (5.0, 5.0)  # xy (m) where unused blocks wait, far outside every camera view
@@ -119,4 +119,4 @@ class StateRenderer:
 
 def block_colours(n: int) -> list[tuple[float, float, float]]:
     """RGB in [0, 1] of the first ``n`` palette colours (what perception looks for)."""
-    return [PALETTE[i][1] for i in range(n)]
+    return [colour(i) for i in range(n)]

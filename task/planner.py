@@ -14,7 +14,7 @@ from collections.abc import Callable, Sequence
 
 import torch
 
-from task.beliefs import BeliefSource
+from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig
 from task.decode import decode_best
 from task.domains import get_domain
@@ -30,7 +30,7 @@ def _window(
     states: Sequence[State],
     config: PlannerConfig,
     generator: torch.Generator,
-    beliefs=None,
+    beliefs: WindowBeliefs | None = None,
 ):
     batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
     horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)

@@ -395,18 +395,15 @@ def most_likely_state(problem: Problem, F: Tensor) -> tuple[str, ...]:
         raise ProblemError(f"soft state of shape {tuple(F.shape)} does not fit {n} blocks")
     logf = torch.log(F.detach().double().clamp_min(1e-300))  # (N, Y)
     blocks = torch.cat([logf[:n, :n], logf[:n, rows:]], dim=1)  # (n, n+1), table last
+    names = [*problem.entities, TABLE]
     if n <= ENUMERATE_UP_TO:
         states = all_states(n)  # (S, n)
         score = blocks.gather(1, states.T).sum(0)  # (S,)
-        best = states[int(score.argmax())].tolist()
-    else:
-        best = blocks.argmax(1).tolist()
-    names = [*problem.entities, TABLE]
-    state = tuple(names[c] for c in best)
-    if n > ENUMERATE_UP_TO:
-        reason = _support_error([(x, y) for x, y in zip(problem.entities, state, strict=True)])
-        if reason is not None:
-            raise ProblemError(f"the most likely supports are not a state: {reason}")
+        return tuple(names[c] for c in states[int(score.argmax())].tolist())
+    state = tuple(names[c] for c in blocks.argmax(1).tolist())
+    reason = _support_error(list(zip(problem.entities, state, strict=True)))
+    if reason is not None:
+        raise ProblemError(f"the most likely supports are not a state: {reason}")
     return state
 
 

@@ -96,6 +96,30 @@ def test_beliefs_drive_the_window_and_only_learnable_ones_change(learn):
     assert changed is learn
 
 
+def test_moves_that_only_the_beliefs_allow_are_never_decoded():
+    # truth: b sits on a. The beliefs say b is on the table, so move(a -> c) looks legal and
+    # reaches the goal in one step; in the true state it is illegal and must not be returned.
+    problem = Problem("p", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("a", "c"),))
+    wrong = _onehot(problem, (TABLE, TABLE, TABLE))
+    goal = _onehot(problem, ("c", TABLE, TABLE))
+
+    class Wrong:
+        lr = 0.1
+
+        def compute(self):
+            return wrong[None], goal[None], torch.zeros(1)
+
+        def parameters(self):
+            return []
+
+    config = PlannerConfig(iters=30, restarts=4, max_windows=2)
+    result = plan(problem, config, seed=0, beliefs=lambda i, s: Wrong())
+    assert not result.solved and result.plan.moves == ()
+    assert result.stats["windows"] == 2
+    # the same planner on the true state solves it (the beliefs, not the planner, failed)
+    assert plan(problem, config, seed=0).solved
+
+
 def test_beliefs_of_the_wrong_shape_are_refused():
     class Bad:
         lr = 0.1
