@@ -7,8 +7,8 @@
 - ``perception.perceive.Perceiver``: segmentation + model, blur, KL anchors.
 
 ``CHECKPOINT`` is the shipped model (its meta says which commands and seeds made it). Rendering
-lives in ``tamp`` (``tamp.render``, ``tamp.dataset``); this package never imports a simulator.
-``import perception`` stays light: no torch until a submodule needs it.
+lives in ``tamp`` (``tamp.camera.render``, ``tamp.camera.dataset``); this package never
+imports a simulator. ``import perception`` stays light: no torch until a submodule needs it.
 """
 
 from pathlib import Path

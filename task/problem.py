@@ -94,7 +94,7 @@ class PlanResult:
     status: PlanStatus
     plan: Plan
     problem: Problem
-    validation: object | None = None  # task.validate.Validation of the 4-op plan
+    validation: object | None = None  # task.symbolic.validate.Validation of the 4-op plan
     stats: dict = field(default_factory=dict)
 
     @property

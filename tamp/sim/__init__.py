@@ -6,6 +6,7 @@ choosing PyBullet never imports MuJoCo and vice versa.
 
 from __future__ import annotations
 
-from tamp.sim.base import SIMULATORS, Camera, GripperReading, Simulator, make_simulator
+from tamp.sim.base import SIMULATORS, Camera, GripperReading, Simulator
+from tamp.sim.factory import make_simulator
 
 __all__ = ["SIMULATORS", "Camera", "GripperReading", "Simulator", "make_simulator"]

@@ -167,16 +167,3 @@ class Simulator(abc.ABC):
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-
-def make_simulator(name: str, *args, **kwargs) -> Simulator:
-    """The backend called ``name`` ('pybullet' or 'mujoco'), built with the given scene."""
-    if name == "pybullet":
-        from tamp.sim.pybullet_sim import PyBulletSim
-
-        return PyBulletSim(*args, **kwargs)
-    if name == "mujoco":
-        from tamp.sim.mujoco_sim import MuJoCoSim
-
-        return MuJoCoSim(*args, **kwargs)
-    raise TampError(f"unknown simulator {one_of(name, SIMULATORS)}")

@@ -11,8 +11,8 @@ from importlib import resources
 
 from pddl.core import Domain
 
-from task import pddl_io
 from task.errors import PDDLError, one_of
+from task.symbolic import pddl_io
 
 DOMAIN_FILE = "blocksworld-4ops.pddl"
 EXAMPLE_FILE = "example-5.pddl"

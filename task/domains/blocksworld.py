@@ -20,12 +20,12 @@ from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 from torch import Tensor
 
-from task import pddl_io, strips
 from task.domains.base import SoftBatch, encode_supports
 from task.errors import PDDLError, ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
-from task.search import moves_lower_bound
 from task.soft import column_free, exclusive_support, goal_cross_entropy, row_normalise
+from task.symbolic import pddl_io, strips
+from task.symbolic.search import moves_lower_bound
 
 NAME = "blocksworld"
 PDDL_DOMAIN = "blocksworld-4ops"

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tamp.faults import Injection
+from tamp.loop.faults import Injection
 from tamp.scene import (
     Pose,
     SceneConfig,

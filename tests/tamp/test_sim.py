@@ -10,9 +10,9 @@ import pytest
 
 from motion.ik import IKSolver
 from tamp.cli import main
-from tamp.execute import Failure, execute_move
-from tamp.faults import Injection
-from tamp.loop import EpisodeStatus, LoopConfig, run_episode
+from tamp.loop.episode import EpisodeStatus, LoopConfig, run_episode
+from tamp.loop.execute import Failure, execute_move
+from tamp.loop.faults import Injection
 from tamp.scene import Pose, layout, read_state
 from tamp.sim import SIMULATORS, make_simulator
 from task.problem import TABLE, Move, Problem
@@ -65,7 +65,7 @@ def test_a_nudged_block_is_seen_and_the_plan_is_repaired(solver):
 
 
 def test_observation_noise_perturbs_the_observed_poses_only():
-    from tamp.loop import Episode
+    from tamp.loop.episode import Episode
 
     episode = Episode(THREE, LoopConfig(inject=Injection(noise=1.0, noise_sigma=0.01)), seed=0)
     try:
@@ -96,7 +96,7 @@ def test_an_unreachable_block_is_an_ik_infeasible_failure(solver):
 
 
 def test_an_out_of_reach_episode_stops_with_a_clear_reason(solver, monkeypatch):
-    import tamp.loop as loop
+    import tamp.loop.episode as loop
 
     far = {"a": Pose((1.4, 0.0, 0.025)), "b": Pose((0.5, 0.0, 0.025))}
     monkeypatch.setattr(loop, "layout", lambda *a, **k: far)
@@ -132,7 +132,7 @@ def test_tamp_run_writes_video_and_report(tmp_path):
 
 
 def test_a_loose_block_is_tidied_onto_the_table_and_the_episode_goes_on(solver, monkeypatch):
-    import tamp.loop as loop
+    import tamp.loop.episode as loop
     from tamp.scene import Reading
 
     real, calls = loop.read_state, []

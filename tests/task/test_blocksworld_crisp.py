@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from task import generate, pddl_io
 from task.domains import blocksworld as bw
 from task.errors import PDDLError, ProblemError
 from task.problem import TABLE, Action, Move, Problem
+from task.symbolic import generate, pddl_io
 
 # c on b on a; d on the table. Objects deliberately not in alphabetical order.
 PROBLEM = """(define (problem tiny)

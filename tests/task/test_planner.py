@@ -12,10 +12,10 @@ from task.config import PlannerConfig
 from task.decode import decode_row
 from task.domains import get_domain
 from task.errors import ProblemError, TampError
-from task.generate import random_problem
 from task.planner import plan, plan_batch
 from task.problem import Problem
 from task.rollout import rollout
+from task.symbolic.generate import random_problem
 
 BW = get_domain("blocksworld")
 FAST = PlannerConfig(restarts=4, iters=60)
@@ -156,7 +156,7 @@ def test_restart_ranking_prefers_goal_then_estimated_total():
 
 
 def test_lower_bound_is_zero_at_the_goal_and_admissible():
-    from task.search import optimal_moves
+    from task.symbolic.search import optimal_moves
 
     for seed in range(5):
         problem = random_problem(5, seed)

@@ -8,9 +8,9 @@ import pytest
 import torch
 
 from task.domains import get_domain, names
-from task.generate import random_problem
 from task.problem import Move
 from task.soft import prod_others, transition
+from task.symbolic.generate import random_problem
 
 DOMAINS = names()
 

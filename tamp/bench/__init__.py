@@ -1,0 +1,12 @@
+"""tamp.bench: every benchmark of the project, one home.
+
+- ``suites``: what is benchmarked (PlanBench Blocksworld-600, seeded random problems);
+- ``planning``: plan a suite per (horizon, seed) and validate every plan (``bench planbench``,
+  ``bench random``); ``summary``: its rows in the paper's format;
+- ``motion``: closed-loop episodes in the simulators (``bench motion``);
+- ``perception``: planning from rendered images (``bench perception``);
+- ``results``: the one results writer (output folder, machine record, JSON, CSV, plots);
+- ``tables``: the one table printer.
+
+The command-line handlers that call these live in `tamp.cli.bench`.
+"""

@@ -1,0 +1,174 @@
+"""Planning benchmarks: plan a suite per (horizon, seed), validate every plan, summarise.
+
+Each plan is converted to 4-op PDDL actions and checked by `task.symbolic.validate.validate`
+against the instance's parsed PDDL problem (the official check, independent of the planner's own crisp
+replay). Summaries follow the paper's table: valid out of N, optimal as a share of the valid
+plans, inexecutable, non-goal-reaching, mean time per instance and total wall time, one row per
+(horizon, seed), a mean over seeds, and rows per block count.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+
+from pddl.core import Domain
+
+from tamp.bench.suites import Suite
+from task.config import PlannerConfig
+from task.domains import get_domain
+from task.errors import ProblemError
+from task.planner import plan_batch
+from task.problem import PlanResult
+from task.symbolic.instances import Instance
+from task.symbolic.validate import validate
+
+STATUSES = ("valid", "inexecutable", "non_goal_reaching", "no_plan")
+
+
+@dataclass(frozen=True)
+class Row:
+    """One instance planned with one (horizon, seed). ``length``: our 4-op actions or None."""
+
+    instance: str
+    blocks: int
+    optimal: int | None
+    horizon: int
+    seed: int
+    length: int | None
+    status: str
+    time_s: float
+    windows: int
+
+
+@dataclass(frozen=True)
+class Run:
+    """A whole suite planned in one `plan_batch` call; ``wall_s`` is that call's wall time."""
+
+    horizon: int
+    seed: int
+    wall_s: float
+    rows: tuple[Row, ...]
+
+    def valid(self) -> int:
+        return sum(r.status == "valid" for r in self.rows)
+
+
+@dataclass(frozen=True)
+class Speed:
+    """The batched and the sequential path on the same first ``n`` instances."""
+
+    n: int
+    horizon: int
+    seed: int
+    batched_s: float
+    sequential_s: float
+    batched_valid: int
+    sequential_valid: int
+
+    @property
+    def speedup(self) -> float | None:
+        """How many times faster the batched path ran (sequential / batched wall time)."""
+        return self.sequential_s / self.batched_s if self.batched_s > 0 else None
+
+
+@dataclass(frozen=True)
+class Bench:
+    """Everything one benchmark invocation measured."""
+
+    suite: str
+    source: str
+    n: int
+    config: PlannerConfig
+    seeds: tuple[int, ...]
+    horizons: tuple[int, ...]
+    runs: tuple[Run, ...]
+    speed: Speed | None = None
+
+    def rows(self) -> tuple[Row, ...]:
+        return tuple(r for run in self.runs for r in run.rows)
+
+
+def check(domain: Domain, instance: Instance, result: PlanResult) -> tuple[str, int | None]:
+    """``(status, 4-op length)`` of a planner result, validated against the instance's PDDL."""
+    if not result.solved:
+        return "no_plan", None
+    try:
+        actions = get_domain(instance.problem.domain).to_actions(
+            instance.problem, result.plan.moves
+        )
+    except ProblemError:  # a move the planner claimed legal is not: report, do not crash
+        return "inexecutable", 2 * len(result.plan)
+    return validate(domain, instance.pddl, actions).status.value, len(actions)
+
+
+def run_once(
+    suite: Suite,
+    config: PlannerConfig,
+    seed: int,
+    progress: Callable[[int], None] | None = None,
+    instances: Sequence[Instance] | None = None,
+) -> Run:
+    """Plan ``instances`` (default: the whole suite) with one config and seed; validate all."""
+    chosen = tuple(suite.instances if instances is None else instances)
+    start = time.perf_counter()
+    results = plan_batch([i.problem for i in chosen], config, seed, progress)
+    wall = time.perf_counter() - start
+    rows = []
+    for instance, result in zip(chosen, results, strict=True):
+        status, length = check(suite.domain, instance, result)
+        rows.append(
+            Row(
+                instance.name,
+                instance.blocks,
+                instance.optimal,
+                config.horizon,
+                seed,
+                length,
+                status,
+                float(result.stats.get("time_s", wall / max(len(chosen), 1))),
+                int(result.stats.get("windows", 0)),
+            )
+        )
+    return Run(config.horizon, seed, wall, tuple(rows))
+
+
+def run(
+    suite: Suite,
+    config: PlannerConfig,
+    seeds: Sequence[int] = (0,),
+    horizons: Sequence[int] | None = None,
+    sequential: int = 0,
+    progress: Callable[[int], None] | None = None,
+) -> Bench:
+    """Plan the suite for every horizon and seed (horizons default to ``config.horizon``).
+
+    With ``sequential > 0`` the first ``sequential`` instances are also planned once batched and
+    once with ``PlannerConfig(batched=False)`` (first horizon, first seed) to time batching.
+    A one-window, one-step plan of the first instance runs untimed first (torch warm-up).
+    """
+    horizons = tuple(horizons or (config.horizon,))
+    seeds = tuple(seeds)
+    if suite.instances:  # untimed warm-up: torch's one-time start-up cost
+        warm = replace(config, iters=1, max_windows=1)
+        plan_batch([suite.instances[0].problem], warm, seeds[0])
+    runs = tuple(
+        run_once(suite, replace(config, horizon=h), s, progress) for h in horizons for s in seeds
+    )
+    speed = None
+    if sequential > 0:
+        subset = suite.instances[:sequential]
+        cfg = replace(config, horizon=horizons[0])
+        fast = run_once(suite, replace(cfg, batched=True), seeds[0], progress, subset)
+        slow = run_once(suite, replace(cfg, batched=False), seeds[0], progress, subset)
+        speed = Speed(
+            len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s, fast.valid(), slow.valid()
+        )
+    n = len(suite.instances)
+    return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed)
+
+
+def total(n: int, seeds: int, horizons: int, sequential: int = 0) -> int:
+    """How many plans `run` makes: a progress bar's total (``progress`` counts them)."""
+    return n * seeds * horizons + 2 * min(sequential, n)

@@ -1,0 +1,106 @@
+"""Summary rows of a benchmark in the paper's format, computed from its per-instance rows.
+
+A `Summary` covers one horizon and either one seed or the mean over seeds (``seed`` None), over
+all instances or one block count. Counts of a mean row are means over seeds (e.g. 598.3 valid).
+"Optimal" counts valid plans no longer than the known optimum; its percentage is taken over the
+valid plans whose instance has a known optimum (``known`` says how many instances have one).
+"""
+
+from __future__ import annotations
+
+import statistics
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, fields
+
+from tamp.bench.planning import STATUSES, Bench, Row
+
+
+@dataclass(frozen=True)
+class Summary:
+    horizon: int
+    seed: int | None  # None: mean over seeds
+    blocks: int | None  # None: every block count
+    n: int  # instances
+    known: int  # instances with a known optimal length
+    valid: float
+    optimal: float  # valid plans of optimal length (among instances with a known optimum)
+    optimal_pct: float | None  # 100 * optimal / valid plans with a known optimum
+    inexecutable: float
+    non_goal_reaching: float
+    no_plan: float
+    time_s: float  # mean planning time per instance
+    wall_s: float | None  # wall time of the whole batch (None for a block-count row)
+    windows: float  # mean replanning windows per instance
+
+    def asdict(self) -> dict:
+        return asdict(self)
+
+
+def _fmean(values: Sequence[float]) -> float:
+    return statistics.fmean(values) if values else 0.0
+
+
+def summarise(
+    rows: Sequence[Row], horizon: int, seed: int | None, blocks: int | None, wall: float | None
+) -> Summary:
+    """The summary of one seed's ``rows``."""
+    count = {s: sum(r.status == s for r in rows) for s in STATUSES}
+    scored = [r for r in rows if r.status == "valid" and r.optimal is not None]
+    optimal = sum(r.length is not None and r.length <= r.optimal for r in scored)
+    return Summary(
+        horizon=horizon,
+        seed=seed,
+        blocks=blocks,
+        n=len(rows),
+        known=sum(r.optimal is not None for r in rows),
+        valid=count["valid"],
+        optimal=optimal,
+        optimal_pct=100.0 * optimal / len(scored) if scored else None,
+        inexecutable=count["inexecutable"],
+        non_goal_reaching=count["non_goal_reaching"],
+        no_plan=count["no_plan"],
+        time_s=_fmean([r.time_s for r in rows]),
+        wall_s=wall,
+        windows=_fmean([r.windows for r in rows]),
+    )
+
+
+def mean_over_seeds(per_seed: Sequence[Summary]) -> Summary:
+    """Field-wise mean of the summaries of several seeds (same horizon and instances)."""
+    first = per_seed[0]
+    values = {}
+    for f in fields(Summary):
+        if f.name in ("horizon", "blocks", "n", "known"):
+            values[f.name] = getattr(first, f.name)
+        elif f.name == "seed":
+            values[f.name] = None
+        else:
+            present = [getattr(s, f.name) for s in per_seed if getattr(s, f.name) is not None]
+            values[f.name] = _fmean(present) if present else None
+    return Summary(**values)
+
+
+def main_rows(bench: Bench) -> list[Summary]:
+    """A row per (horizon, seed) over all instances, then their mean when there are seeds > 1."""
+    out = []
+    for h in bench.horizons:
+        runs = [r for r in bench.runs if r.horizon == h]
+        per_seed = [summarise(r.rows, h, r.seed, None, r.wall_s) for r in runs]
+        out += per_seed
+        if len(per_seed) > 1:
+            out.append(mean_over_seeds(per_seed))
+    return out
+
+
+def block_rows(bench: Bench) -> list[Summary]:
+    """A row per (horizon, block count), each the mean over seeds."""
+    counts = sorted({r.blocks for r in bench.rows()})
+    out = []
+    for h in bench.horizons:
+        runs = [r for r in bench.runs if r.horizon == h]
+        for b in counts:
+            per_seed = [
+                summarise([x for x in r.rows if x.blocks == b], h, r.seed, b, None) for r in runs
+            ]
+            out.append(mean_over_seeds(per_seed))
+    return out

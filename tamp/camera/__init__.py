@@ -1,0 +1,9 @@
+"""tamp.camera: images of simulated scenes and planning from them.
+
+- ``render``: `StateRenderer`, a symbolic state rendered by a simulator camera;
+- ``dataset``: randomised rendered scenes labelled with their supports (perception training data);
+- ``from_images``: soft beliefs for the planner from camera images (frozen or
+  planning-optimised perception).
+
+The image -> soft-state model itself lives in `perception` and never sees a simulator.
+"""

@@ -1,0 +1,189 @@
+"""Planning from camera images: perception gives the planner its soft initial and goal states.
+
+Three modes, for every planning entry point that takes a ``PerceptionMode``:
+
+- ``state``: the ground-truth symbolic state (no images; the planner's own one-hot encoding);
+- ``frozen``: every window starts from F0 = perception of the current image and aims at
+  perception of the goal image, with the trained weights fixed;
+- ``optimised``: as frozen, but the planning loss also updates a per-problem copy of the
+  perception weights (Adam, lr 1e-4) with KL anchors to the initial predictions on both the
+  initial and the goal image; the soft states are recomputed from the images at every gradient
+  step (`task.optimize.with_beliefs`). Every window adapts a fresh copy of the trained
+  weights (carried over, the adaptation drifts and the planner stalls). ``adapt="head"`` (the
+  default) updates the weights after the CNN backbone (ROI projection, table embedding,
+  bilinear W and b) and computes the backbone's features of the two images once per window;
+  ``adapt="all"`` also updates the backbone and reruns it on both images at every step (see
+  BENCHMARKS.md for what that costs).
+
+The crisp side is the paper's: decoded moves are checked against the true symbolic state. The
+goal the planner stops at is the *perceived* goal scene (the most likely valid state under the
+trained model's reading of the goal image, every block's support), so a misread goal image
+gives a plan that fails validation against the PDDL goal; it is never corrected from the PDDL.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from perception.perceive import Perceiver, blur, kl_rows
+from tamp.camera.render import block_colours
+from task.domains.base import State
+from task.domains.blocksworld import most_likely_state
+from task.errors import TampError, one_of
+from task.problem import Problem
+
+MODES = ("state", "frozen", "optimised")
+ADAPT = ("head", "all")
+
+Observe = Callable[[int, State], np.ndarray]  # (problem index, true state) -> RGB image
+
+
+@dataclass(frozen=True)
+class PerceptionMode:
+    """How the planner gets its states. ``lr`` and ``kl_weight`` matter in ``optimised`` only."""
+
+    mode: str = "frozen"
+    lr: float = 1e-4  # Adam learning rate of the perception weights (the paper's value)
+    kl_weight: float = 10.0  # weight of each KL anchor (chosen on the 100-subset, BENCHMARKS.md)
+    blur: int = 0  # Gaussian blur radius (pixels) applied to every image; 0 = clear
+    adapt: str = "head"  # which weights ``optimised`` updates: "head" or "all"
+
+    def __post_init__(self) -> None:
+        if self.mode not in MODES:
+            raise TampError(f"unknown perception mode {one_of(self.mode, MODES)}")
+        if self.adapt not in ADAPT:
+            raise TampError(f"unknown adapt setting {one_of(self.adapt, ADAPT)}")
+        if self.lr <= 0 or self.kl_weight < 0 or self.blur < 0:
+            raise TampError("PerceptionMode needs lr > 0, kl_weight >= 0 and blur >= 0")
+
+
+class _Frozen:
+    """Soft inputs computed once, no parameters."""
+
+    lr = 0.0
+
+    def __init__(self, F0: Tensor, goal: Tensor) -> None:
+        self.F0, self.goal = F0, goal
+
+    def compute(self):
+        return self.F0, self.goal, self.F0.new_zeros(self.F0.shape[0])
+
+    def parameters(self) -> list[Tensor]:
+        return []
+
+
+class _Adapted:
+    """Soft inputs recomputed from the images by per-problem models at every step.
+
+    ``features[i]``: the frozen backbone's features of problem i's two images, or None to run
+    the problem's own (adapted) backbone every step.
+    """
+
+    def __init__(self, models, inputs, features, anchors, mode: PerceptionMode) -> None:
+        self.models, self.inputs, self.features, self.anchors = models, inputs, features, anchors
+        self.mode = mode
+        self.lr, self.kl_weight = mode.lr, mode.kl_weight
+
+    def compute(self):
+        F0s, goals, penalties = [], [], []
+        for model, (images, boxes, mask), feats, anchor in zip(
+            self.models, self.inputs, self.features, self.anchors, strict=True
+        ):
+            if feats is None:
+                F = model(images, boxes, mask)  # (2, N, Y): the current image, the goal image
+            else:
+                F = model.head(feats, boxes, mask, images.shape[-2:])  # (2, N, Y)
+            kl = kl_rows(anchor, F, mask)  # (2,)
+            F0s.append(F[0])
+            goals.append(F[1])
+            penalties.append(self.kl_weight * kl.sum())
+        return torch.stack(F0s), torch.stack(goals), torch.stack(penalties)
+
+    def parameters(self) -> list[Tensor]:
+        if self.mode.adapt == "head":
+            return [p for m in self.models for p in m.head_parameters()]
+        return [p for m in self.models for p in m.parameters()]
+
+
+class ImageBeliefs:
+    """A `task.beliefs.BeliefSource` that reads every window's states from images.
+
+    ``observe(i, state)`` returns the current camera image of problem i (whose true state is
+    ``state``); ``goal_images[i]`` is its goal image. Images are blurred per ``mode.blur``.
+    """
+
+    def __init__(
+        self,
+        problems: Sequence[Problem],
+        perceiver: Perceiver,
+        observe: Observe,
+        goal_images: Sequence[np.ndarray],
+        mode: PerceptionMode,
+    ) -> None:
+        if mode.mode == "state":
+            raise TampError("ImageBeliefs needs mode 'frozen' or 'optimised'")
+        self.problems, self.perceiver, self.observe, self.mode = problems, perceiver, observe, mode
+        self.goal_images = [blur(im, mode.blur) for im in goal_images]
+        self.perception_s = 0.0  # time spent reading images (segmentation and the model)
+
+    def _inputs(self, i: int, image: np.ndarray):
+        p = self.problems[i]
+        colours = block_colours(p.n)
+        return self.perceiver.inputs(
+            [blur(image, self.mode.blur), self.goal_images[i]], [colours, colours],
+            [p.entities, p.entities],
+        )  # fmt: skip
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State]):
+        t0 = time.perf_counter()
+        inputs = [self._inputs(i, self.observe(i, s)) for i, s in zip(indices, states, strict=True)]
+        model = self.perceiver.model
+        with torch.no_grad():  # one backbone pass per image pair: the anchors and the features
+            features = [model.backbone(images) for images, _, _ in inputs]
+            anchors = [  # (2, N, Y) each
+                model.head(f, boxes, mask, images.shape[-2:])
+                for f, (images, boxes, mask) in zip(features, inputs, strict=True)
+            ]
+        self.perception_s += time.perf_counter() - t0
+        if self.mode.mode == "frozen":
+            return _Frozen(
+                torch.stack([a[0] for a in anchors]), torch.stack([a[1] for a in anchors])
+            )
+        models = []
+        for _ in indices:  # a fresh copy of the trained weights for every problem and window
+            model = copy.deepcopy(self.perceiver.model)
+            trained = model.head_parameters() if self.mode.adapt == "head" else model.parameters()
+            for param in trained:
+                param.requires_grad_(True)
+            models.append(model)
+        if self.mode.adapt == "all":
+            features = [None] * len(inputs)  # each step reruns the adapted backbone
+        return _Adapted(models, inputs, features, anchors, self.mode)
+
+
+def perceived_goal(
+    problem: Problem, perceiver: Perceiver, goal_image: np.ndarray, radius: int = 0
+) -> Problem:
+    """``problem`` whose goal is the perceived goal scene: every block's most likely support
+    under the trained model's reading of ``goal_image`` (a valid state by construction)."""
+    state, _ = perceived_state(problem, perceiver, goal_image, radius)
+    return dataclasses.replace(problem, goal=tuple(zip(problem.entities, state, strict=True)))
+
+
+def perceived_state(
+    problem: Problem, perceiver: Perceiver, image: np.ndarray, radius: int = 0
+) -> tuple[State, Tensor]:
+    """The most likely valid state of ``image`` and the soft supports F (N, Y) behind it."""
+    colours = block_colours(problem.n)
+    x = perceiver.inputs([blur(image, radius)], [colours], [problem.entities])
+    with torch.no_grad():
+        F = perceiver.support(x)[0]  # (N, Y)
+    return most_likely_state(problem, F), F

@@ -1,0 +1,144 @@
+"""``tamp perception dataset|train|eval``: make rendered data, train and score the support model."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+import time
+
+from tqdm import tqdm
+
+from perception import CHECKPOINT
+
+EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
+DEFAULT_CHECKPOINT = CHECKPOINT
+
+
+def _command_line() -> str:
+    return "tamp " + " ".join(shlex.quote(a) for a in sys.argv[1:])
+
+
+def dataset_command(args: argparse.Namespace) -> int:
+    from perception import data as pdata
+    from tamp.camera.dataset import generate
+
+    sims = tuple(s for s in args.sim.split(",") if s)
+    with tqdm(total=args.n, desc="render", unit="image", file=sys.stderr,
+              disable=not args.progress) as bar:  # fmt: skip
+        data = generate(
+            args.n, args.seed, sims, args.min_blocks, args.max_blocks,
+            progress=bar.update, meta={"command": _command_line()},
+        )  # fmt: skip
+    path = pdata.save(args.out, data)
+    print(f"{len(data)} images ({data.meta['redrawn']} redrawn for occlusion) -> {path}")
+    return 0
+
+
+def train_command(args: argparse.Namespace) -> int:
+    import torch
+
+    from perception import data as pdata
+    from perception.train import TrainConfig, evaluate, save_checkpoint, train
+
+    torch.set_num_threads(args.threads)
+    t0 = time.perf_counter()
+    train_raw, test_raw = pdata.load(args.train), pdata.load(args.test)
+    train_data, test_data = pdata.tensors(train_raw), pdata.tensors(test_raw)
+    config = TrainConfig(epochs=args.epochs, seed=args.seed)
+    with tqdm(total=config.epochs, desc="train", unit="epoch", file=sys.stderr,
+              disable=not args.progress) as bar:  # fmt: skip
+
+        def on_epoch(k: int, loss: float) -> None:
+            bar.set_postfix(nll=f"{loss:.4f}")
+            bar.update(1)
+
+        model = train(train_data, config, on_epoch=on_epoch)
+    scores = evaluate(model, test_data)
+    meta = {
+        "command": _command_line(),
+        "seed": args.seed,
+        "train": {
+            "file": str(args.train),
+            "images": len(train_raw),
+            "unreadable": train_data["dropped"],  # left out: segmentation could not read them
+            "made_by": train_raw.meta.get("command"),
+            "data_seed": train_raw.meta.get("seed"),
+        },
+        "test": {
+            "file": str(args.test),
+            "made_by": test_raw.meta.get("command"),
+            "data_seed": test_raw.meta.get("seed"),
+            **scores,
+        },
+        "train_config": config.__dict__,
+        "train_time_s": round(time.perf_counter() - t0, 1),
+        "threads": args.threads,
+    }
+    save_checkpoint(args.out, model, meta)
+    print(
+        f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
+        f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
+        f"{scores['unreadable']} unreadable, left out) -> {args.out}"
+    )
+    return 0
+
+
+def eval_command(args: argparse.Namespace) -> int:
+    from perception import data as pdata
+    from perception.train import evaluate, load_checkpoint
+
+    model, _ = load_checkpoint(args.checkpoint)
+    data = pdata.load(args.data)
+    if args.blur:
+        from perception.perceive import blur
+
+        data = pdata.SupportData(
+            blur(data.images, args.blur), data.colours, data.supports, data.palette, data.meta
+        )
+    scores = evaluate(model, pdata.tensors(data))
+    if args.json:
+        print(json.dumps(scores))
+    else:
+        print(
+            f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
+            f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
+            f"{scores['unreadable']} unreadable, left out)"
+        )
+    return 0
+
+
+def add_parser(sub, positive) -> None:
+    """The ``perception`` subcommands on the ``tamp`` parser."""
+    group = sub.add_parser("perception", help="rendered data, training and scoring of perception")
+    cmds = group.add_subparsers(dest="perception_command", required=True, metavar="COMMAND")
+
+    p = cmds.add_parser("dataset", help="render a labelled support dataset")
+    p.add_argument("--n", type=positive, default=4000, help="images (4000)")
+    p.add_argument("--seed", type=int, default=0, help="scene and view seed (0)")
+    p.add_argument("--sim", default="pybullet,mujoco", metavar="SIM[,SIM]",
+                   help="simulators, samples alternate (pybullet,mujoco)")  # fmt: skip
+    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
+    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
+    p.add_argument("--no-progress", dest="progress", action="store_false")
+    p.set_defaults(func=dataset_command)
+
+    p = cmds.add_parser("train", help="train the support model and write a checkpoint")
+    p.add_argument("--train", required=True, metavar="FILE.npz", help="training dataset")
+    p.add_argument("--test", required=True, metavar="FILE.npz", help="held-out test dataset")
+    p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--out", default=str(DEFAULT_CHECKPOINT), metavar="FILE.pt",
+                   help="checkpoint to write (the shipped perception/support.pt)")  # fmt: skip
+    p.add_argument("--no-progress", dest="progress", action="store_false")
+    p.set_defaults(func=train_command)
+
+    p = cmds.add_parser("eval", help="relation accuracy of a checkpoint on a dataset")
+    p.add_argument("data", metavar="FILE.npz")
+    p.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), metavar="FILE.pt")
+    p.add_argument("--blur", type=positive, metavar="R", help="Gaussian blur radius, pixels")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=eval_command)

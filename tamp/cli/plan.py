@@ -1,0 +1,164 @@
+"""What the ``tamp`` subcommands do: plan, validate, demo. Each returns the exit code.
+
+0: success (a valid plan); 1: no plan or an invalid plan. Bad input raises `TampError`, which
+`tamp.cli.main` turns into one ``tamp: error:`` line and exit code 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import asdict, replace
+from pathlib import Path
+
+from pddl.core import Domain
+
+from tamp.cli import report
+from task import data
+from task.config import PlannerConfig
+from task.domains import blocksworld, get_domain
+from task.errors import TampError
+from task.planner import plan
+from task.problem import TABLE, PlanResult
+from task.symbolic import pddl_io
+from task.symbolic.instances import Instance, example, from_files
+from task.symbolic.search import optimal_moves
+from task.symbolic.validate import Validation, validate, validate_files
+
+_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end")
+
+
+def planner_config(args: argparse.Namespace) -> PlannerConfig:
+    """PlannerConfig defaults with the options the user gave (None: not given)."""
+    given = {k: getattr(args, k) for k in _OVERRIDES if getattr(args, k, None) is not None}
+    return replace(PlannerConfig(), **given)
+
+
+def _write(path: Path, text: str) -> None:
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise TampError(f"cannot write {path} ({exc.strerror or exc})") from None
+
+
+def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
+    """Plan ``instance`` and validate the 4-op plan against its PDDL (None without a plan)."""
+    config = planner_config(args)
+    result = plan(instance.problem, config, args.seed)
+    actions: tuple = ()
+    validation = None
+    if result.solved:
+        actions = get_domain(instance.problem.domain).to_actions(
+            instance.problem, result.plan.moves
+        )
+        validation = validate(domain, instance.pddl, actions)
+    return config, result, actions, validation
+
+
+def _plan_json(
+    config: PlannerConfig,
+    result: PlanResult,
+    actions: tuple,
+    validation: Validation | None,
+    seed: int,
+) -> str:
+    return json.dumps(
+        {
+            "problem": result.problem.name,
+            "status": result.status.value,
+            "valid": validation is not None and validation.valid,
+            "moves": [[m.entity, m.target] for m in result.plan.moves],
+            "actions": [str(a).lower() for a in actions],
+            "validation": None if validation is None else report.validation_dict(validation),
+            "stats": result.stats,
+            "seed": seed,
+            "config": asdict(config),
+        },
+        indent=2,
+    )
+
+
+def _outcome(result: PlanResult, validation: Validation | None) -> str:
+    windows, moves = result.stats.get("windows", 0), len(result.plan)
+    took = (
+        f"{moves} move{'' if moves == 1 else 's'}, {windows} window{'' if windows == 1 else 's'}, "
+        f"{result.stats['time_s']:.2f} s"
+    )
+    if validation is None:
+        left = ", ".join(
+            f"(ontable {x})" if y == TABLE else f"(on {x} {y})"
+            for x, y in blocksworld.unsatisfied_goals(result.problem, _final_state(result))
+        )
+        return f"NO PLAN: goal not reached after {took}; unmet: {left}"
+    return f"{report.validation_line(validation)} ({took})"
+
+
+def _final_state(result: PlanResult) -> tuple[str, ...]:
+    state = blocksworld.initial_state(result.problem)
+    for move in result.plan.moves:
+        state = blocksworld.apply_move(result.problem, state, move)
+    return state
+
+
+def plan_command(args: argparse.Namespace) -> int:
+    """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line."""
+    domain, instance = from_files(args.domain, args.problem)
+    config, result, actions, validation = _solve(domain, instance, args)
+    if args.out is not None and validation is not None:
+        _write(Path(args.out), pddl_io.format_plan(actions))
+    if args.json:
+        print(_plan_json(config, result, actions, validation, args.seed))
+    else:
+        if actions:
+            print(pddl_io.format_plan(actions), end="")
+        print(_outcome(result, validation))
+    return 0 if validation is not None and validation.valid else 1
+
+
+def validate_command(args: argparse.Namespace) -> int:
+    """``tamp validate DOMAIN PROBLEM PLAN``: VALID or the first failing step."""
+    validation = validate_files(args.domain, args.problem, args.plan)
+    if args.json:
+        print(json.dumps(report.validation_dict(validation), indent=2))
+    else:
+        print(report.validation_line(validation))
+    return 0 if validation.valid else 1
+
+
+def demo_command(args: argparse.Namespace) -> int:
+    """``tamp demo``: plan the embedded 5-block example and show every stage."""
+    domain, instance = example()
+    config, result, actions, validation = _solve(domain, instance, args)
+    written = []
+    if args.out is not None:
+        out = Path(args.out)
+        for name in (data.DOMAIN_FILE, data.EXAMPLE_FILE):
+            _write(out / name, data.read_text(name))
+            written.append(name)
+        if validation is not None:
+            _write(out / "example-5.plan", pddl_io.format_plan(actions))
+            written.append("example-5.plan")
+    if args.json:
+        print(_plan_json(config, result, actions, validation, args.seed))
+        return 0 if validation is not None and validation.valid else 1
+    problem = instance.problem
+    best = optimal_moves(problem)
+    lines = [
+        f"soft-tamp demo: {data.source(data.EXAMPLE_FILE)}, {problem.n} blocks, "
+        f"optimal plan {'?' if best is None else len(best)} moves (A*)",
+        "",
+        *report.problem_picture(problem),
+        "",
+        f"soft-T_P planner (T={config.horizon}, {config.restarts} restarts, seed {args.seed}):",
+        *(f"  {k}. {m}" for k, m in enumerate(result.plan.moves, start=1)),
+        "",
+        f"PDDL plan ({blocksworld.PDDL_DOMAIN}):",
+        pddl_io.format_plan(actions).rstrip(),
+        "",
+        _outcome(result, validation),
+    ]
+    print("\n".join(lines))
+    if written:
+        print(f"wrote {', '.join(written)} to {args.out}")
+    return 0 if validation is not None and validation.valid else 1

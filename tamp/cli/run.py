@@ -1,0 +1,122 @@
+"""``tamp run``: plan a problem, execute it with the simulated Panda, write video and report.
+
+Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from tamp.camera.from_images import PerceptionMode
+from tamp.cli.plan import planner_config
+from tamp.loop.episode import Episode, EpisodeReport, LoopConfig
+from tamp.loop.faults import Injection
+from tamp.video import VideoWriter
+from task import data
+from task.errors import TampError
+from task.problem import Problem
+from task.symbolic import pddl_io
+from task.symbolic.instances import example, from_files, from_text
+
+FRAME_PERIOD = 0.2  # simulated seconds between video frames
+VIDEO_FPS = 20.0  # playback: 4x real time
+
+
+def load_problem(problem: str | None, domain: str | None) -> Problem:
+    """The problem file (with ``domain`` or the embedded 4-op domain), or the embedded example."""
+    if problem is None:
+        return example()[1].problem
+    if domain is None:
+        return from_text(data.domain(), pddl_io.read_text(problem), str(problem)).problem
+    return from_files(domain, problem)[1].problem
+
+
+def loop_config(args: argparse.Namespace) -> LoopConfig:
+    config = LoopConfig(
+        sim=args.sim,
+        grasp=args.grasp,
+        planner=planner_config(args),
+        inject=Injection.parse(args.inject),
+        observe=args.observe,
+        perception=PerceptionMode(args.perception, blur=args.blur),
+        checkpoint=args.checkpoint,
+    )
+    if args.max_replans is not None:
+        config = replace(config, max_replans=args.max_replans)
+    return config
+
+
+def summary_lines(report: EpisodeReport) -> list[str]:
+    moves = report.moves
+    ok = sum(r.ok for r in moves)
+    per_move = report.wall_time_s / max(len(moves), 1)
+    return [
+        f"{report.problem} in {report.sim}: {report.status.value}"
+        f"{' (' + report.reason + ')' if report.reason else ''}; goal reached (ground truth): "
+        f"{'yes' if report.reached_goal else 'no'}",
+        f"moves {ok}/{len(moves)} ok, {report.replans} replans, faults injected: "
+        f"{', '.join(report.faults) or 'none'}",
+        f"sim {report.sim_time_s:.1f} s, wall {report.wall_time_s:.1f} s "
+        f"({per_move:.2f} s per move, {report.sim_time_s / max(report.wall_time_s, 1e-9):.1f}x "
+        f"real time), planning {report.plan_time_s:.2f} s",
+    ]
+
+
+def run_command(args: argparse.Namespace) -> int:
+    problem = load_problem(args.problem, args.domain)
+    config = loop_config(args)
+    out = Path(args.out) if args.out else None
+    video = None
+    if out is not None and not args.no_video:
+        video = VideoWriter(out / f"episode.{args.video_format}", VIDEO_FPS)
+    if out is not None:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise TampError(f"cannot create {out} ({exc.strerror or exc})") from None
+    quiet = args.json
+
+    def say(text: str) -> None:
+        if not quiet:
+            print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
+
+    episode = Episode(problem, config, args.seed, on_event=say)
+    if video is not None:
+
+        def frame(sim) -> None:
+            caption = f"{sim.name} t={sim.time:5.1f}s  {episode.status_text}"
+            video.write(sim.render(), caption, episode.belief_lines())
+
+        episode.on_frame = frame
+        episode.sim.frame_period = FRAME_PERIOD
+    if not quiet:
+        head = f"running {problem.name} ({problem.n} blocks) in {config.sim}, grasp {config.grasp}"
+        seen = config.observe
+        if seen == "camera":
+            seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
+        print(f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}", file=sys.stderr)
+    report = episode.run()
+    written = []
+    if video is not None and video.close() is not None:
+        written.append(video.path.name)
+    body = report.to_json()
+    body["config"] = {
+        "sim": config.sim, "grasp": config.grasp, "inject": str(config.inject),
+        "seed": args.seed, "max_replans": config.max_replans, "observe": config.observe,
+        "perception": config.perception.mode, "blur": config.perception.blur,
+    }  # fmt: skip
+    if out is not None:
+        (out / "report.json").write_text(json.dumps(body, indent=2))
+        written.append("report.json")
+    if args.json:
+        print(json.dumps(body, indent=2))
+    else:
+        print("\n".join(summary_lines(report)))
+        if written:
+            print(f"wrote {', '.join(written)} to {out}")
+    return 0 if report.reached_goal else 1

@@ -1,0 +1,163 @@
+"""Execute one relational move as a pick-and-place and detect how it failed.
+
+Failure detection uses signals a real robot has: the finger width against the block width,
+contact on both fingers, a check after the lift and after the transit (is the block still
+between the fingers?), and a post-place check of the observed block pose. The simulator's
+ground truth is not used here; `tamp.loop.episode` uses it only to score episodes.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motion.ik import IKSolver
+from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
+from motion.trajectory import JointTrajectory
+from tamp.scene import Pose, SceneConfig, place_pose, top_z
+from tamp.sim.base import Simulator
+from task.problem import Move
+
+
+class Failure(enum.Enum):
+    """Why a move failed; each is a replanning trigger for the loop."""
+
+    IK_INFEASIBLE = "ik_infeasible"  # a waypoint of the pick-and-place has no IK solution
+    NO_FREE_SLOT = "no_free_slot"  # a move to the table found every table slot taken
+    GRASP_MISSED = "grasp_missed"  # after closing, the fingers do not hold a block-wide object
+    DROPPED = "dropped"  # the block left the fingers after the lift
+    MISPLACED = "misplaced"  # after release the block is not where it was to be placed
+    TRACKING = "tracking_error"  # the arm could not follow its trajectory (blocked)
+
+
+@dataclass(frozen=True)
+class ExecConfig:
+    """Thresholds of the failure checks, and the pick-and-place settings."""
+
+    motion: PickPlaceConfig = PickPlaceConfig()
+    width_tol: float = 0.007  # m: a held block keeps the fingers at its width +- this
+    min_force: float = 0.2  # N: both fingers must push at least this on a freshly closed grasp
+    place_tol_xy: float = 0.015  # m: post-place check
+    place_tol_z: float = 0.008  # m
+    max_tracking: float = 0.3  # rad: beyond this the arm is blocked
+
+
+@dataclass(frozen=True)
+class ExecutionResult:
+    """The outcome of one move: ok, or the failure kind and the evidence behind it."""
+
+    move: Move
+    ok: bool
+    failure: Failure | None = None
+    evidence: dict = field(default_factory=dict)
+    sim_time_s: float = 0.0
+    wall_time_s: float = 0.0
+    ik_time_s: float = 0.0
+
+
+Observe = Callable[[], dict[str, Pose]]
+
+
+def _holding(sim: Simulator, block: str, config: ExecConfig, fresh: bool) -> dict | None:
+    """None when the fingers hold ``block``; otherwise the evidence that they do not."""
+    r = sim.gripper(block)
+    size = config.motion.block_size
+    wide = abs(r.width - size) <= config.width_tol
+    floor = config.min_force if fresh else 0.0
+    both = r.left_force > floor and r.right_force > floor
+    if wide and (both or (sim.grasp == "weld" and not fresh)):
+        return None
+    return {
+        "finger_width": round(r.width, 4),
+        "block_width": size,
+        "left_force": round(r.left_force, 3),
+        "right_force": round(r.right_force, 3),
+    }
+
+
+def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
+    """After a failure at the block: open the gripper and undo the descent (a safe pose)."""
+    sim.detach()
+    q = sim.arm_q()
+    hold = JointTrajectory.hold(q, 0.3, sim.dt)
+    sim.run(hold, "open", on_frame=on_frame)
+    phase = next(ph for ph in phases if ph.name == "descend")
+    up = phase.trajectory
+    back = JointTrajectory(
+        up.times, up.positions[::-1].copy(), -up.velocities[::-1], up.accelerations[::-1]
+    )
+    if np.abs(back.positions[0] - q).max() < 0.05:
+        sim.run(back, "open", on_frame=on_frame)
+
+
+def execute_move(
+    sim: Simulator,
+    solver: IKSolver,
+    move: Move,
+    observe: Observe,
+    config: ExecConfig = ExecConfig(),
+    scene: SceneConfig = SceneConfig(),
+    drop_at: float | None = None,
+    on_frame: Callable[[Simulator], None] | None = None,
+) -> ExecutionResult:
+    """Pick ``move.entity`` where it is observed and place it on ``move.target``.
+
+    ``drop_at`` in [0, 1] opens the gripper at that fraction of the transit (fault injection).
+    """
+    wall0, sim0 = time.perf_counter(), sim.time
+
+    def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
+        return ExecutionResult(
+            move, failure is None, failure, evidence, sim.time - sim0,
+            time.perf_counter() - wall0, ik_time,
+        )  # fmt: skip
+
+    poses = observe()
+    target = place_pose(move, poses, scene)
+    if target is None:
+        return result(Failure.NO_FREE_SLOT, slots=len(scene.slots))
+    pick = poses[move.entity]
+    others = {k: v for k, v in poses.items() if k != move.entity}
+    request = PickPlaceRequest(pick.xyz, pick.yaw, target.xyz, target.yaw, top_z(others, scene))
+    planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
+    if not planned.ok:
+        return result(Failure.IK_INFEASIBLE, planned.ik_time_s, **planned.evidence)
+    ik = planned.ik_time_s
+    worst = 0.0
+    for phase in planned.phases:
+        release = None
+        if phase.name == "transit" and drop_at is not None:
+            release = drop_at * phase.trajectory.duration
+        if phase.name == "open":
+            sim.detach()
+        worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame))
+        if worst > config.max_tracking:
+            _back_off(sim, planned.phases, on_frame)
+            return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
+        if phase.name == "close":
+            missed = _holding(sim, move.entity, config, fresh=True)
+            if missed is not None:
+                _back_off(sim, planned.phases, on_frame)
+                return result(Failure.GRASP_MISSED, ik, **missed)
+            if sim.grasp == "weld":
+                sim.attach(move.entity)
+        elif phase.name in ("lift", "transit"):
+            gone = _holding(sim, move.entity, config, fresh=False)
+            if gone is not None:
+                sim.detach()
+                sim.run(JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt), "open", on_frame=on_frame)
+                injected = release is not None  # the fault injection opened the gripper
+                return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **gone)
+    seen = observe()[move.entity]
+    dxy = float(np.linalg.norm(seen.xy - np.asarray(target.xyz[:2])))
+    dz = abs(seen.xyz[2] - target.xyz[2])
+    if dxy > config.place_tol_xy or dz > config.place_tol_z:
+        return result(
+            Failure.MISPLACED, ik, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4),
+            target=[round(v, 4) for v in target.xyz],
+        )  # fmt: skip
+    return result(None, ik, tracking_rad=round(worst, 4))

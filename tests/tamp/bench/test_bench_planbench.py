@@ -1,0 +1,102 @@
+"""Benchmark machinery: instance sources, plan checking, summaries, artefacts."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tamp.bench import planning as bench
+from tamp.bench import results as bench_io
+from tamp.bench import suites
+from tamp.bench.planning import Row
+from tamp.bench.summary import block_rows, main_rows, summarise
+from task.config import PlannerConfig
+from task.errors import DataError
+from task.problem import Move, Plan, PlanResult, PlanStatus
+from task.symbolic import instances
+from task.symbolic.search import optimal_moves
+
+
+def _result(instance, moves, status=PlanStatus.SOLVED):
+    return PlanResult(status, Plan(tuple(moves)), instance.problem, None, {})
+
+
+def test_check_uses_the_pddl_validator():
+    domain, inst = instances.example()
+    best = optimal_moves(inst.problem)
+    assert bench.check(domain, inst, _result(inst, best)) == ("valid", 2 * len(best))
+    assert bench.check(domain, inst, _result(inst, best[:2])) == ("non_goal_reaching", 4)
+    assert bench.check(domain, inst, _result(inst, [Move("a", "c")])) == ("inexecutable", 2)
+    assert bench.check(domain, inst, _result(inst, [], PlanStatus.NO_PLAN)) == ("no_plan", None)
+
+
+@pytest.mark.parametrize("limit", [1, 4, 7, 10, None])
+def test_spread_is_stratified_and_deterministic(limit):
+    items = [3] * 10 + [4] * 40 + [5] * 10
+    chosen = suites.spread(list(enumerate(items)), limit, key=lambda x: x[1])
+    assert len(chosen) == (limit or len(items))
+    assert chosen == suites.spread(list(enumerate(items)), limit, key=lambda x: x[1])
+    if limit and limit >= 4:
+        assert {b for _, b in chosen} == {3, 4, 5}
+
+
+def test_summaries_follow_the_paper_format():
+    def row(seed, status, length, optimal=4, blocks=3):
+        return Row("i", blocks, optimal, 3, seed, length, status, 0.5, 1)
+
+    seed0 = (row(0, "valid", 4), row(0, "valid", 6), row(0, "no_plan", None, blocks=4))
+    seed1 = (row(1, "valid", 4), row(1, "valid", 4), row(1, "inexecutable", 8, None, 4))
+    runs = (bench.Run(3, 0, 1.5, seed0), bench.Run(3, 1, 2.5, seed1))
+    result = bench.Bench("t", "synthetic", 3, PlannerConfig(), (0, 1), (3,), runs)
+    first, second, mean = main_rows(result)
+    assert (first.valid, first.optimal, first.optimal_pct, first.no_plan) == (2, 1, 50.0, 1)
+    assert (second.known, second.optimal_pct, second.inexecutable) == (2, 100.0, 1)
+    assert (mean.seed, mean.valid, mean.optimal_pct, mean.wall_s) == (None, 2.0, 75.0, 2.0)
+    by_blocks = {s.blocks: s for s in block_rows(result)}
+    assert by_blocks[3].valid == 2 and by_blocks[4].valid == 0 and by_blocks[4].optimal_pct is None
+    assert summarise((), 3, 0, None, None).optimal_pct is None
+
+
+def test_run_ablation_sequential_and_artefacts(tmp_path):
+    suite = suites.generated([3, 4], n=2, seed=1)
+    assert [i.name for i in suite.instances] == [
+        i.name for i in suites.generated([3, 4], 2, seed=1).instances
+    ]
+    assert all(i.optimal is not None for i in suite.instances)
+    done = []
+    config = PlannerConfig(restarts=4, iters=40)
+    result = bench.run(suite, config, (0, 1), (1, 3), sequential=2, progress=done.append)
+    assert sum(done) == bench.total(4, 2, 2, 2) == 20
+    assert [(r.horizon, r.seed) for r in result.runs] == [(1, 0), (1, 1), (3, 0), (3, 1)]
+    assert len(main_rows(result)) == 6 and len(block_rows(result)) == 4
+    assert result.speed is not None and result.speed.n == 2 and result.speed.speedup > 0
+    paths = bench_io.write(result, tmp_path / "out")
+    report = json.loads(paths[1].read_text())
+    assert report["config"]["restarts"] == 4 and report["horizons"] == [1, 3]
+    assert report["machine"]["cores"] and report["speed"]["n"] == 2
+    assert len(paths[0].read_text().splitlines()) == 1 + 4 * 4
+    assert paths[2].read_bytes().startswith(b"\x89PNG")
+
+
+def test_missing_planbench_data_is_one_line(tmp_path):
+    with pytest.raises(DataError, match=r"PlanBench data not found at .*karthikv792"):
+        suites.planbench(tmp_path / "missing")
+
+
+def test_manifest_without_columns_is_named(tmp_path):
+    for name in ("domain.pddl", "manifest.csv"):
+        (tmp_path / name).write_text("file,n_blocks\n")
+    (tmp_path / "instances").mkdir()
+    with pytest.raises(DataError, match="missing column"):
+        suites.planbench(tmp_path)
+
+
+@pytest.mark.shared
+def test_planbench_official_600(planbench_dir):
+    suite = suites.planbench(planbench_dir / "blocksworld")
+    counts = {b: sum(i.blocks == b for i in suite.instances) for b in (3, 4, 5)}
+    assert counts == {3: 100, 4: 445, 5: 55}
+    assert all(i.optimal is not None and i.optimal % 2 == 0 for i in suite.instances)
+    limited = suites.planbench(planbench_dir / "blocksworld", limit=6)
+    assert [i.blocks for i in limited.instances] == [3, 4, 4, 4, 4, 5]

@@ -1,0 +1,84 @@
+"""Perception on simulator renders: the shipped checkpoint, hidden blocks, a camera episode.
+
+Uses the checkpoint shipped in ``perception/support.pt``; each test takes seconds.
+"""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+
+from perception import CHECKPOINT
+from perception.errors import PerceptionError
+from perception.perceive import Perceiver
+from tamp.camera.from_images import perceived_goal, perceived_state
+from tamp.camera.render import StateRenderer
+from tamp.loop.episode import EpisodeStatus, LoopConfig, run_episode
+from tamp.scene import Pose
+from tamp.sim import SIMULATORS
+from task.domains.blocksworld import complete_goal
+from task.problem import TABLE, Problem
+from task.symbolic.generate import block_names, random_towers
+
+pytestmark = pytest.mark.sim
+
+
+@pytest.fixture(scope="module")
+def perceiver() -> Perceiver:
+    return Perceiver.load(CHECKPOINT)
+
+
+def test_the_shipped_checkpoint_says_how_it_was_made():
+    from perception.train import load_checkpoint
+
+    _, meta = load_checkpoint(CHECKPOINT)
+    assert meta["command"].startswith("tamp perception train")
+    assert meta["test"]["relation_accuracy"] >= 0.995
+    assert "seed" in meta
+
+
+@pytest.mark.parametrize("sim", SIMULATORS)
+def test_the_shipped_checkpoint_reads_fresh_renders(sim, perceiver):
+    with StateRenderer(sim) as renderer:
+        for k in range(4):
+            names = block_names(3 + k)
+            state = random_towers(names, random.Random(100 + k))
+            problem = Problem("p", "blocksworld", names, state, ())
+            image = renderer.render(names, state, seed=1000 + k)
+            read, F = perceived_state(problem, perceiver, image)
+            assert read == state
+            assert F.shape == (len(names), len(names) + 1)
+            np.testing.assert_allclose(F.sum(-1).numpy(), 1.0, rtol=1e-5)
+
+
+def test_a_block_out_of_view_is_named(perceiver):
+    names = ("a", "b", "c")
+    problem = Problem("p", "blocksworld", names, (TABLE, "a", TABLE), ())
+    with StateRenderer("pybullet") as renderer:
+        renderer.render(names, problem.init, seed=0)
+        renderer.sim.set_block_pose(renderer.names[2], Pose((3.0, 3.0, 0.025)))  # c, far away
+        image = renderer.sim.render()
+    with pytest.raises(PerceptionError, match=r"block\(s\) c not found"):
+        perceived_state(problem, perceiver, image)
+
+
+def test_the_perceived_goal_is_the_completed_goal_scene(perceiver):
+    problem = Problem(
+        "p", "blocksworld", ("a", "b", "c", "d"), (TABLE, "a", TABLE, "c"), (("a", "d"),)
+    )
+    full = complete_goal(problem)
+    with StateRenderer("pybullet") as renderer:
+        image = renderer.render(problem.entities, full, seed=3)
+    seen = perceived_goal(problem, perceiver, image)
+    assert seen.goal == tuple(zip(problem.entities, full, strict=True))
+
+
+def test_an_image_driven_episode_reaches_its_goal():
+    problem = Problem(
+        "three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("a", "c"), ("b", "a"))
+    )
+    report = run_episode(problem, LoopConfig(sim="pybullet", observe="camera"), seed=0)
+    assert report.status is EpisodeStatus.GOAL_REACHED, report.reason
+    assert report.reached_goal  # scored on simulator ground truth

@@ -1,0 +1,157 @@
+"""The ``tamp`` command line through ``main(argv)``: plan, validate, demo, bench, bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from tamp.cli import main
+from tamp.cli import plan as commands
+from task import data
+from task.domains import blocksworld
+from task.problem import Plan, PlanResult, PlanStatus
+from task.symbolic.generate import random_problem
+
+FAST = ["--restarts", "8", "--iters", "60"]
+ARTEFACTS = ("instances.csv", "results.json", "steps.png")
+
+
+def _one_line_error(capsys) -> str:
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "Traceback" not in err, err
+    assert err.startswith("tamp") and "error:" in err, err
+    return err
+
+
+@pytest.fixture
+def files(tmp_path):
+    """The embedded domain and a generated 5-block problem written as PDDL."""
+    domain = tmp_path / "domain.pddl"
+    domain.write_text(data.read_text(data.DOMAIN_FILE))
+    problem = tmp_path / "problem.pddl"
+    problem.write_text(blocksworld.to_pddl(random_problem(5, seed=3)))
+    return domain, problem
+
+
+def test_demo_plans_validates_and_writes_files(capsys, tmp_path):
+    assert main(["demo", *FAST, "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    for text in ("initial", "goal", "move(", "PDDL plan", "; cost = ", "VALID: valid plan of"):
+        assert text in out
+    names = (data.DOMAIN_FILE, data.EXAMPLE_FILE, "example-5.plan")
+    assert main(["validate", *(str(tmp_path / n) for n in names)]) == 0
+    assert capsys.readouterr().out.startswith("VALID")
+
+
+def test_plan_generated_problem_writes_a_valid_plan_file(capsys, files, tmp_path):
+    plan_file = tmp_path / "out" / "plan.txt"
+    assert main(["plan", *map(str, files), *FAST, "--out", str(plan_file)]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[-1].startswith("VALID: valid plan of")
+    assert plan_file.read_text() in out
+    assert main(["validate", *map(str, files), str(plan_file)]) == 0
+
+
+def test_plan_json_parses(capsys, files):
+    assert main(["plan", *map(str, files), *FAST, "--horizon", "2", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["status"] == "solved" and report["valid"]
+    assert len(report["actions"]) == 2 * len(report["moves"]) == report["validation"]["length"]
+    assert report["config"]["horizon"] == 2 and report["config"]["restarts"] == 8
+
+
+def test_plan_without_a_plan_exits_1(capsys, files, monkeypatch):
+    def no_plan(problem, config, seed):
+        return PlanResult(PlanStatus.NO_PLAN, Plan(), problem, None, {"windows": 12, "time_s": 1})
+
+    monkeypatch.setattr(commands, "plan", no_plan)
+    assert main(["plan", *map(str, files)]) == 1
+    assert capsys.readouterr().out.startswith("NO PLAN: goal not reached after 0 moves")
+
+
+def test_validate_names_the_first_failing_step(capsys, files, tmp_path):
+    plan = tmp_path / "bad.plan"
+    plan.write_text("(stack a b)\n")
+    assert main(["validate", *map(str, files), str(plan)]) == 1
+    assert capsys.readouterr().out.startswith("INEXECUTABLE: step 1 (stack a b): precondition")
+    plan.write_text("")
+    assert main(["validate", *map(str, files), str(plan), "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert report["status"] == "non_goal_reaching" and not report["valid"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["plan", "{domain}", "{missing}"], "no such file"),
+        (["plan", "{domain}", "{malformed}"], "parse error"),
+        (["validate", "{domain}", "{problem}", "{missing}"], "no such file"),
+        (["frobnicate"], "invalid choice: 'frobnicate'"),
+        ([], "required: COMMAND"),
+        (["plan", "{domain}", "{problem}", "--horizon", "x"], "--horizon"),
+        (["plan", "{domain}", "{problem}", "--horizon", "0"], "positive integer"),
+        (["plan", "{domain}", "{problem}", "--goal-loss", "l2"], "invalid choice: 'l2'"),
+        (["bench", "planbench", "--horizon", "1,x"], "comma-separated"),
+        (["bench", "planbench", "--data", "{missing}"], "PlanBench data not found"),
+        (["bench", "random", "--blocks", "1"], "at least 2 blocks"),
+        (["bench"], "required: SUITE"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(capsys, files, tmp_path, argv, expected):
+    malformed = tmp_path / "malformed.pddl"
+    malformed.write_text("(define (problem x")
+    paths = {
+        "domain": files[0],
+        "problem": files[1],
+        "missing": tmp_path / "nope",
+        "malformed": malformed,
+    }
+    assert main([a.format(**paths) for a in argv]) == 2
+    assert expected in _one_line_error(capsys)
+
+
+def test_help_exits_0(capsys):
+    assert main(["--help"]) == 0
+    assert "plan" in capsys.readouterr().out
+
+
+@pytest.mark.shared
+def test_bench_planbench_writes_artefacts(capsys, planbench_dir, tmp_path):
+    argv = ["bench", "planbench", "--data", str(planbench_dir / "blocksworld"), "--limit", "6"]
+    argv += ["--seeds", "1", *FAST, "--out", str(tmp_path), "--json", "--no-progress"]
+    assert main(argv) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["instances"] == 6 and report["summary"][0]["n"] == 6
+    assert {row["blocks"] for row in report["by_blocks"]} == {3, 4, 5}
+    assert all((tmp_path / name).stat().st_size > 0 for name in ARTEFACTS)
+    assert json.loads((tmp_path / "results.json").read_text())["summary"] == report["summary"]
+
+
+def test_bench_random_writes_artefacts(capsys, tmp_path):
+    argv = ["bench", "random", "--blocks", "3", "--n", "3", *FAST, "--out", str(tmp_path)]
+    assert main([*argv, "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("random: 3 instances") and "by block count" in out
+    with (tmp_path / "instances.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 3 and all(r["blocks"] == "3" and r["optimal"] for r in rows)
+    assert all((tmp_path / name).stat().st_size > 0 for name in ARTEFACTS)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["run", "--sim", "gazebo"],
+        ["run", "--inject", "drop:2"],
+        ["run", "--inject", "explode:0.1"],
+        ["run", "missing-problem.pddl", "--no-video"],
+        ["bench", "motion", "--sim", "gazebo"],
+        ["bench", "motion", "--data", "/nonexistent/planbench", "--n", "2"],
+    ],
+)
+def test_bad_run_and_motion_arguments_exit_2_with_one_line(argv, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "error" in err[0]

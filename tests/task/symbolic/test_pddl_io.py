@@ -1,0 +1,129 @@
+"""PDDL reading and writing: one-line errors that name the file, and the VAL plan format."""
+
+from __future__ import annotations
+
+import pytest
+
+from task.errors import PDDLError, TampError
+from task.problem import Action
+from task.symbolic import pddl_io
+
+PROBLEM = """; a comment before the problem
+(define (problem tiny)
+(:domain blocksworld-4ops)
+(:objects c a b )
+(:init (handempty) (ontable a) (on b a) (ontable c) (clear b) (clear c))
+(:goal (and (on a b)))
+)
+"""
+
+
+def _error(excinfo: pytest.ExceptionInfo, *parts: str) -> str:
+    message = str(excinfo.value)
+    assert "\n" not in message
+    for part in parts:
+        assert part in message
+    return message
+
+
+def test_load_domain_and_problem(bw_domain_path, tmp_path):
+    domain = pddl_io.load_domain(bw_domain_path)
+    path = tmp_path / "p.pddl"
+    path.write_text(PROBLEM)
+    problem = pddl_io.load_problem(path, domain)
+    assert str(problem.name) == "tiny"
+    assert pddl_io.load_object_order(path) == ("c", "a", "b")
+
+
+def test_missing_file_names_the_file(tmp_path):
+    missing = tmp_path / "nope.pddl"
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.load_domain(missing)
+    _error(excinfo, str(missing), "no such file")
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.read_plan(tmp_path)
+    _error(excinfo, str(tmp_path), "cannot read")
+
+
+@pytest.mark.parametrize(
+    ("text", "where"),
+    [
+        (PROBLEM.replace("(on b a)", "(on b a]"), "line 5, column"),
+        (PROBLEM[:-3], "end of file"),
+        ("(define (problem x) (:domain d) (:init) (:goal (and (on a b)))", "end of file"),
+        ("(defin (problem x))", "line 1, column 2"),
+    ],
+)
+def test_malformed_problem_is_one_line_with_position(tmp_path, text, where):
+    path = tmp_path / "broken.pddl"
+    path.write_text(text)
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.load_problem(path)
+    _error(excinfo, str(path), "parse error", where)
+
+
+def test_malformed_domain(bw_domain_path, tmp_path):
+    text = bw_domain_path.read_text().replace(":effect", ":efect", 1)
+    path = tmp_path / "domain.pddl"
+    path.write_text(text)
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.load_domain(path)
+    _error(excinfo, str(path), "parse error at line", "unexpected")
+
+
+def test_library_validation_error_is_one_line(bw_domain_path):
+    text = bw_domain_path.read_text().replace("(?x ?y)", "(?x - block ?y)", 1)
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_domain(text, "typed.pddl")
+    _error(excinfo, "typed.pddl", "typing")
+
+
+def test_problem_for_another_domain(bw_domain_path):
+    domain = pddl_io.load_domain(bw_domain_path)
+    text = PROBLEM.replace("blocksworld-4ops", "logistics-strips")
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_problem(text, "other.pddl", domain)
+    _error(excinfo, "other.pddl", "'logistics-strips'", "'blocksworld-4ops'")
+
+
+def test_errors_are_one_family():
+    assert issubclass(PDDLError, TampError)
+
+
+def test_plan_round_trip(tmp_path):
+    plan = (Action("unstack", ("b", "a")), Action("put-down", ("b",)), Action("pick-up", ("a",)))
+    text = pddl_io.format_plan(plan)
+    assert text == "(unstack b a)\n(put-down b)\n(pick-up a)\n; cost = 3 (unit cost)\n"
+    path = pddl_io.write_plan(plan, tmp_path / "sub" / "plan.txt")
+    assert pddl_io.read_plan(path) == plan
+    assert pddl_io.format_plan(()) == "; cost = 0 (unit cost)\n"
+
+
+def test_plan_reader_skips_comments_and_lowercases():
+    text = "; header\n\n  (UNSTACK B A)  ; inline\n(put-down   b)\n\n; cost = 2 (unit cost)\n"
+    assert pddl_io.parse_plan(text) == (Action("unstack", ("b", "a")), Action("put-down", ("b",)))
+
+
+@pytest.mark.parametrize("line", ["stack a b", "(stack a (b))", "(stack a b", "()", "(a) (b)"])
+def test_malformed_plan_line(line):
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_plan(f"(pick-up a)\n; ok\n{line}\n", "plan.txt")
+    _error(excinfo, "plan.txt", "line 3", "malformed plan line")
+
+
+def test_object_order_with_types_and_comments():
+    text = "(define (problem p) (:domain d) (:objects ; x y\n up down - DIR b0 - BOX f1 f0 - LOC)"
+    assert pddl_io.object_order(text) == ("up", "down", "b0", "f1", "f0")
+    assert pddl_io.object_order("(define (problem p) (:domain d) (:init))") == ()
+
+
+@pytest.mark.shared
+@pytest.mark.parametrize("name", ["blocksworld", "logistics", "sokoban"])
+def test_planbench_domains_parse(planbench_dir, name):
+    domain = pddl_io.load_domain(planbench_dir / name / "domain.pddl")
+    instances = sorted((planbench_dir / name / "instances").rglob("*.pddl"))[:5]
+    for path in instances:
+        problem = pddl_io.load_problem(path, domain)
+        assert {str(o.name).lower() for o in problem.objects} == set(
+            pddl_io.load_object_order(path)
+        )
