@@ -9,7 +9,7 @@ Tensor axis glossary (batch first, always):
     J  joints                               D  features
 
 Public entry points: ``task.planner.plan`` / ``plan_batch``, ``task.config.PlannerConfig``,
-``task.symbolic.validate.validate``, ``task.domains.get_domain``;
-``task.beliefs`` for planning from soft (perceived) states. ``import task`` stays light: it pulls in no simulator and no torch until a
+``task.symbolic.validate.validate``, ``task.domains.get_domain``; ``task.beliefs`` for planning from
+soft (perceived) states. ``import task`` stays light: it pulls in no simulator and no torch until a
 submodule that needs it is imported.
 """

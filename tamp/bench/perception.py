@@ -8,9 +8,9 @@ instances with the same seed:
 - ``state``: ground-truth symbolic states (no images);
 - ``frozen`` / ``optimised``: see `tamp.camera.from_images`.
 
-Every plan is validated against the instance's own PDDL goal (`tamp.bench.planning.check`).
-Each window's image is a fresh render of the current true state (new slots, new jitter); a render in which a
-block is hidden is redrawn with the next layout seed and counted. Times per instance exclude
+Every plan is validated against the instance's own PDDL goal (`tamp.bench.planning.check`). Each
+window's image is a fresh render of the current true state (new slots, new jitter); a render in
+which a block is hidden is redrawn with the next layout seed and counted. Times per instance exclude
 rendering (a camera's job) but include segmentation, the model and planning.
 """
 

@@ -1,9 +1,9 @@
 """Planning benchmarks: plan a suite per (horizon, seed), validate every plan, summarise.
 
-Each plan is converted to 4-op PDDL actions and checked by `task.symbolic.validate.validate`
-against the instance's parsed PDDL problem (the official check, independent of the planner's own crisp
-replay). Summaries follow the paper's table: valid out of N, optimal as a share of the valid
-plans, inexecutable, non-goal-reaching, mean time per instance and total wall time, one row per
+Each plan is converted to 4-op PDDL actions and checked by `task.symbolic.validate.validate` against
+the instance's parsed PDDL problem (the official check, independent of the planner's own crisp
+replay). Summaries follow the paper's table: valid out of N, optimal as a share of the valid plans,
+inexecutable, non-goal-reaching, mean time per instance and total wall time, one row per
 (horizon, seed), a mean over seeds, and rows per block count.
 """
 
