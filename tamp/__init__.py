@@ -1,6 +1,15 @@
-"""tamp: the loop observe -> perceive -> plan -> move -> execute -> check, and the CLI.
+"""tamp: the loop observe -> perceive -> plan -> execute -> check -> replan, and the CLI.
 
-Today it holds the ``tamp`` command line (`tamp.cli`): planning, validating and benchmarking
-PDDL blocksworld problems with the soft-T_P planner of `task`. Simulator backends and the
-perception-to-motion loop are upcoming.
+The one package that sees every other one. Its rooms:
+
+- ``tamp.loop``: closed-loop episodes in a simulator (observe, plan a window, execute a move,
+  check, recover or replan), fault injection;
+- ``tamp.sim``: the `Simulator` interface, the PyBullet and MuJoCo backends, the factory;
+- ``tamp.camera``: rendering symbolic states, rendered perception datasets, planning beliefs
+  from camera images;
+- ``tamp.bench``: every benchmark (PlanBench, random, motion, perception), one results writer,
+  one table printer;
+- ``tamp.cli``: the ``tamp`` command (parsing and printing only);
+- ``tamp.scene``: the table, its slots and block poses <-> symbolic states;
+  ``tamp.video``: episode videos.
 """

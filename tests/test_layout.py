@@ -28,17 +28,42 @@ FORBIDDEN = {
 SHARED = {"task.errors"}
 
 
-def _imports(path: Path) -> set[str]:
+# rooms inside a package -> modules (dotted prefixes) they must never import. The direction
+# inside tamp: cli -> bench -> loop -> camera -> sim; inside task: the crisp side and the domains
+# never reach into the optimiser.
+OPTIMISER = ("task.planner", "task.optimize", "task.rollout", "task.decode", "task.beliefs")
+ROOM_FORBIDDEN = {
+    "tamp/sim": ("tamp.loop", "tamp.camera", "tamp.bench", "tamp.cli"),
+    "tamp/camera": ("tamp.loop", "tamp.bench", "tamp.cli"),
+    "tamp/loop": ("tamp.bench", "tamp.cli"),
+    "tamp/bench": ("tamp.cli",),
+    "task/symbolic": OPTIMISER,
+    "task/domains": OPTIMISER,
+}
+ROOMS = {
+    "tamp": ("bench", "camera", "cli", "loop", "sim"),
+    "task": ("data", "domains", "symbolic"),
+}
+
+
+def _modules(path: Path) -> set[str]:
+    """Every module ``path`` imports, dotted (``from a.b import c`` gives ``a.b`` and ``a.b.c``)."""
     tree = ast.parse(path.read_text(), filename=str(path))
     found = set()
     for node in ast.walk(tree):
-        names = []
         if isinstance(node, ast.Import):
-            names = [a.name for a in node.names]
+            found |= {a.name for a in node.names}
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            names = [node.module]
-        found |= {n.split(".")[0] for n in names if n not in SHARED}
+            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
     return found
+
+
+def _imports(path: Path) -> set[str]:
+    return {n.split(".")[0] for n in _modules(path) if n not in SHARED and not _shared_child(n)}
+
+
+def _shared_child(name: str) -> bool:
+    return any(name.startswith(s + ".") for s in SHARED)
 
 
 @pytest.mark.parametrize("package", PACKAGES)
@@ -61,3 +86,52 @@ def test_import_task_stays_light():
     code = "import sys, task; print(sorted(m for m in ('torch', 'pddl') if m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.parametrize("room", sorted(ROOM_FORBIDDEN))
+def test_rooms_respect_their_import_direction(room):
+    bad = {
+        f"{path.relative_to(ROOT)} imports {name}"
+        for path in (ROOT / room).rglob("*.py")
+        for name in _modules(path)
+        if name.startswith(ROOM_FORBIDDEN[room])
+    }
+    assert not bad, sorted(bad)
+
+
+def test_simulator_base_imports_no_backend():
+    """The factory picks a backend; the interface never imports one (no import circle)."""
+    names = _modules(ROOT / "tamp" / "sim" / "base.py")
+    assert not {n for n in names if n.startswith(("tamp.sim.pybullet", "tamp.sim.mujoco"))}
+
+
+@pytest.mark.parametrize("package", sorted(ROOMS))
+def test_rooms_are_packages_with_a_docstring(package):
+    for room in ROOMS[package]:
+        init = ROOT / package / room / "__init__.py"
+        assert init.is_file(), init
+        assert ast.get_docstring(ast.parse(init.read_text())), f"{init} says nothing of its room"
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_package_says_what_it_owns(package):
+    doc = ast.get_docstring(ast.parse((ROOT / package / "__init__.py").read_text())) or ""
+    assert len(doc.split()) > 10 and "TODO" not in doc
+
+
+def test_no_flat_folder_of_many_modules():
+    """More than about ten modules in one folder is a sign that rooms are missing."""
+    for package in PACKAGES:
+        for folder in [ROOT / package, *(p for p in (ROOT / package).rglob("*") if p.is_dir())]:
+            modules = [p for p in folder.glob("*.py") if p.name != "__init__.py"]
+            assert len(modules) <= 11, f"{folder.relative_to(ROOT)}: {len(modules)} modules"
+
+
+def test_no_module_is_long():
+    long = {
+        f"{p.relative_to(ROOT)}: {n} lines"
+        for package in PACKAGES
+        for p in (ROOT / package).rglob("*.py")
+        if (n := len(p.read_text().splitlines())) > 300
+    }
+    assert not long, sorted(long)

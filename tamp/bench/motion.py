@@ -1,33 +1,50 @@
-"""``tamp bench motion``: how executable task plans are at motion level, per simulator.
+"""The motion benchmark (``tamp bench motion``): how executable task plans are at motion level.
 
-Runs closed-loop episodes (`tamp.loop.episode`) on a spread of PlanBench instances in each simulator
-and prints the executability table: task plans valid, moves executed, episodes reaching the
-goal (simulator ground truth), failures by kind, replans, disturbed stacks, time per move; with
-fault injection also the recovery rate. Writes ``episodes.csv`` and ``results.json``.
+`run` plays closed-loop episodes (`tamp.loop`) on a suite in each simulator; `summarise` gives
+the executability figures per simulator: task plans valid, moves executed, episodes reaching
+the goal (simulator ground truth), failures by kind, replans, disturbed stacks, time per move,
+and with fault injection the recovery rate. `tamp.bench.tables.motion_table` prints them.
 """
 
 from __future__ import annotations
 
-import argparse
-import csv
 import dataclasses
-import json
-import os
-import platform
-import sys
 import time
 from collections import Counter
-from dataclasses import replace
-from pathlib import Path
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
-from tqdm import tqdm
 
 from motion.ik import IKSolver, top_down_pose
-from tamp.bench import suites
-from tamp.cli.run import loop_config
-from tamp.loop.episode import EpisodeReport, run_episode
+from tamp.bench.suites import Suite
+from tamp.loop import EpisodeReport, LoopConfig, run_episode
 from task.errors import TampError
+
+SIMS = ("pybullet", "mujoco")
+EPISODE_COLUMNS = (
+    "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
+    "disturbed", "sim_time_s", "wall_time_s",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class MotionBench:
+    """Every episode of one motion benchmark, its summary per simulator and the IK timing."""
+
+    sims: tuple[str, ...]
+    reports: tuple[EpisodeReport, ...]
+    summary: dict[str, dict]
+    ik: dict
+
+
+def parse_sims(text: str) -> tuple[str, ...]:
+    """``pybullet,mujoco`` as a tuple; TampError naming an unknown simulator."""
+    sims = tuple(dict.fromkeys(text.split(",")))
+    for name in sims:
+        if name not in SIMS:
+            raise TampError(f"unknown simulator {name!r} (valid: {', '.join(SIMS)})")
+    return sims
 
 
 def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
@@ -72,88 +89,47 @@ def summarise(reports: list[EpisodeReport]) -> dict:
     }
 
 
-def table(rows: dict[str, dict], inject: str) -> str:
-    head = (
-        f"{'sim':9} {'episodes':>8} {'plans valid':>11} {'goal':>9} {'moves ok':>13} "
-        f"{'replans':>7} "
-        f"{'disturbed':>9} {'wall/move':>9} {'sim/move':>8} {'x real':>6}"
-    )
-    lines = [head]
-    for sim, s in rows.items():
-        e = s["episodes"]
-        lines.append(
-            f"{sim:9} {e:>8} {s['plans_valid']:>7}/{e:<3} {s['goal_reached']:>4}/{e:<4} "
-            f"{s['moves_ok']:>6}/{s['moves']:<6} {s['replans']:>7} {s['disturbed']:>9} "
-            f"{s['wall_per_move_s']:>8.2f}s {s['sim_per_move_s']:>7.2f}s "
-            f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):>6.1f}"
-        )
-    lines.append("")
-    for sim, s in rows.items():
-        kinds = ", ".join(f"{k} {v}" for k, v in sorted(s["failures"].items())) or "none"
-        lines.append(f"{sim}: failures by kind: {kinds}; episode outcomes: {s['statuses']}")
-        if inject != "none":
-            lines.append(
-                f"{sim}: faults ({inject}) hit {s['with_faults']} episodes, "
-                f"{s['recovered']} of them still reached the goal"
-            )
-    return "\n".join(lines)
-
-
-def motion_command(args: argparse.Namespace) -> int:
-    sims = tuple(dict.fromkeys(args.sim.split(",")))
-    for name in sims:
-        if name not in ("pybullet", "mujoco"):
-            raise TampError(f"unknown simulator {name!r} (valid: pybullet, mujoco)")
-    suite = suites.planbench(args.data, args.n)
-    base = loop_config(args)
+def run(
+    suite: Suite,
+    base: LoopConfig,
+    sims: Sequence[str],
+    seed: int,
+    progress: Callable[[str, EpisodeReport], None] | None = None,
+) -> MotionBench:
+    """One closed-loop episode per instance in each simulator; ``progress(sim, report)`` after
+    each. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
+    reproducible from ``seed``."""
     solver = IKSolver()
     ik = time_ik(solver)
-    rows, all_reports = {}, []
+    summary, every = {}, []
     for name in sims:
         config = replace(base, sim=name)
         reports = []
-        bar = tqdm(suite.instances, desc=f"motion {name}", unit="episode", file=sys.stderr,
-                   disable=not args.progress)  # fmt: skip
-        for k, inst in enumerate(bar):
-            # each episode its own layout and fault draws, reproducible from --seed
-            report = run_episode(inst.problem, config, seed=args.seed * 100_003 + k, solver=solver)
+        for k, inst in enumerate(suite.instances):
+            report = run_episode(inst.problem, config, seed=seed * 100_003 + k, solver=solver)
             reports.append(dataclasses.replace(report, problem=inst.name))
-            bar.set_postfix(goal=sum(r.reached_goal for r in reports))
-        rows[name] = summarise(reports)
-        all_reports += reports
-    inject = str(base.inject)
-    results = {
-        "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
-                   "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
-                   "observe": base.observe, "perception": base.perception.mode,
-                   "blur": base.perception.blur},
-        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                    "processor": platform.processor() or platform.machine()},
-        "ik_batch": ik,
-        "summary": rows,
-    }  # fmt: skip
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "results.json").write_text(json.dumps(results, indent=2))
-        with open(out / "episodes.csv", "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["sim", "problem", "status", "reached_goal", "moves", "moves_ok",
-                        "replans", "faults", "disturbed", "sim_time_s", "wall_time_s"])  # fmt: skip
-            for r in all_reports:
-                row = [r.sim, r.problem, r.status.value, r.reached_goal, len(r.moves)]
-                row += [sum(m.ok for m in r.moves), r.replans, " ".join(r.faults), r.disturbed]
-                w.writerow([*row, round(r.sim_time_s, 2), round(r.wall_time_s, 2)])
-    if args.json:
-        print(json.dumps(results, indent=2))
-        return 0
-    seen = base.observe + (f" ({base.perception.mode} perception)" if base.observe == "camera"
-                           else "")  # fmt: skip
-    print(f"motion benchmark: {len(suite.instances)} PlanBench instances, grasp {base.grasp}, "
-          f"observe {seen}, faults {inject}, seed {args.seed}")  # fmt: skip
-    print(table(rows, inject))
-    print(f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
-          f"({ik['converged']}/{ik['n']} converged)")  # fmt: skip
-    if args.out:
-        print(f"wrote results.json, episodes.csv to {args.out}")
-    return 0
+            if progress is not None:
+                progress(name, reports[-1])
+        summary[name] = summarise(reports)
+        every += reports
+    return MotionBench(tuple(sims), tuple(every), summary, ik)
+
+
+def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
+    """One ``episodes.csv`` row per episode (columns `EPISODE_COLUMNS`)."""
+    return [
+        {
+            "sim": r.sim,
+            "problem": r.problem,
+            "status": r.status.value,
+            "reached_goal": r.reached_goal,
+            "moves": len(r.moves),
+            "moves_ok": sum(m.ok for m in r.moves),
+            "replans": r.replans,
+            "faults": " ".join(r.faults),
+            "disturbed": r.disturbed,
+            "sim_time_s": round(r.sim_time_s, 2),
+            "wall_time_s": round(r.wall_time_s, 2),
+        }
+        for r in reports
+    ]

@@ -1,7 +1,7 @@
-"""``tamp bench perception``: planning PlanBench instances from rendered images.
+"""The perception benchmark (``tamp bench perception``): planning from rendered images.
 
 For each instance the initial state and a goal scene (the PDDL goal completed by
-`task.domains.blocksworld.complete_goal`: blocks the goal leaves free keep their support when
+`task.domains.blocksworld_states.complete_goal`: blocks the goal leaves free keep their support when
 they can) are rendered by a simulator camera. Every (blur, mode, horizon) row plans the same
 instances with the same seed:
 
@@ -16,31 +16,21 @@ rendering (a camera's job) but include segmentation, the model and planning.
 
 from __future__ import annotations
 
-import argparse
-import csv
-import json
-import os
-import platform
-import sys
 import time
 import zlib
-from dataclasses import replace
-from pathlib import Path
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 
-import cv2
 import numpy as np
-import torch
-from tqdm import tqdm
 
 from perception.errors import PerceptionError
 from perception.perceive import Perceiver, blur
 from perception.segment import find_boxes
-from tamp.bench import suites
 from tamp.bench.planning import check
 from tamp.camera.from_images import MODES, ImageBeliefs, PerceptionMode, perceived_goal
 from tamp.camera.render import StateRenderer, block_colours
-from tamp.cli.plan import planner_config
-from task.domains.blocksworld import complete_goal
+from task.config import PlannerConfig
+from task.domains.blocksworld_states import complete_goal
 from task.errors import TampError
 from task.planner import plan_batch
 
@@ -80,57 +70,81 @@ class Renders:
             self.render_s += time.perf_counter() - t0
 
 
-def run_row(suite, chosen, mode: str, radius: int, horizon: int, args, perceiver, camera):
+@dataclass(frozen=True)
+class PerceptionBench:
+    """Every row of one perception benchmark: per-instance rows, one summary per (blur, mode,
+    horizon), renders redrawn because a block was hidden, and an example image strip."""
+
+    rows: tuple[dict, ...]
+    summaries: tuple[dict, ...]
+    redrawn: int
+    example: np.ndarray
+
+
+def parse_modes(text: str) -> tuple[str, ...]:
+    """``state,frozen,optimised`` as a tuple; TampError naming an unknown mode."""
+    modes = tuple(m for m in text.split(",") if m)
+    for m in modes:
+        if m not in MODES:
+            raise TampError(f"--modes: unknown mode {m!r}; expected some of {', '.join(MODES)}")
+    return modes
+
+
+def _goals(problems, mode: PerceptionMode, perceiver, camera) -> tuple[list, set[int]]:
+    """The goals the planner sees (perceived from goal images unless ``state``), and the
+    problems whose goal image hides a block."""
+    planned, failed = list(problems), set()
+    if mode.mode == "state":
+        return planned, failed
+    for i, p in enumerate(problems):
+        try:
+            planned[i] = perceived_goal(p, perceiver, camera.goal(i), mode.blur)
+        except PerceptionError:
+            failed.add(i)
+    return planned, failed
+
+
+def _plan(planned, keep, config, seed, beliefs) -> dict:
+    """Plan the problems ``keep`` (indices into ``planned``); index -> PlanResult."""
+    if not keep:
+        return {}
+    source = None
+    if beliefs is not None:
+
+        def source(indices, states):
+            return beliefs([keep[j] for j in indices], states)
+
+    out = plan_batch([planned[i] for i in keep], config, seed, beliefs=source)
+    return dict(zip(keep, out, strict=True))
+
+
+def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, perceiver, camera):
     """Plan ``chosen`` once in one mode; returns per-instance rows and the row summary."""
-    config = replace(planner_config(args), horizon=horizon)
+    config = replace(config, horizon=horizon)
     problems = [inst.problem for inst in chosen]
-    planned = list(problems)
-    failed_goal: set[int] = set()  # goal images in which a block could not be found
     render0, t0 = camera.render_s, time.perf_counter()
+    planned, failed_goal = _goals(problems, mode, perceiver, camera)
     beliefs = None
-    if mode != "state":
+    if mode.mode != "state":
         goal_images = [camera.goal(i) for i in range(len(problems))]
-        for i, p in enumerate(problems):
-            try:
-                planned[i] = perceived_goal(p, perceiver, goal_images[i], radius)
-            except PerceptionError:
-                failed_goal.add(i)
-        beliefs = ImageBeliefs(
-            planned, perceiver, lambda i, s: camera.image(i, s),
-            goal_images, PerceptionMode(mode, kl_weight=args.kl_weight, blur=radius,
-                                        adapt=args.adapt),
-        )  # fmt: skip
+        beliefs = ImageBeliefs(planned, perceiver, camera.image, goal_images, mode)
     keep = [i for i in range(len(problems)) if i not in failed_goal]
-    results = dict.fromkeys(range(len(problems)))
-    if keep:
-        sub = [planned[i] for i in keep]
-        source = None
-        if beliefs is not None:
-
-            def source(indices, states):
-                return beliefs([keep[j] for j in indices], states)
-
-        out = plan_batch(sub, config, args.seed, beliefs=source)
-        for i, r in zip(keep, out, strict=True):
-            results[i] = r
+    results = _plan(planned, keep, config, seed, beliefs)
     wall = time.perf_counter() - t0 - (camera.render_s - render0)
     rows = []
     for i, inst in enumerate(chosen):
-        r = results[i]
-        if r is None:
-            status, length = "perception_error", None
-        else:
-            status, length = check(suite.domain, inst, r)
+        r = results.get(i)
+        status, length = ("perception_error", None) if r is None else check(suite.domain, inst, r)
         rows.append({
             "instance": inst.name, "blocks": inst.blocks, "optimal": inst.optimal,
-            "mode": mode, "blur": radius, "horizon": horizon, "status": status,
+            "mode": mode.mode, "blur": mode.blur, "horizon": horizon, "status": status,
             "length": length, "windows": None if r is None else r.stats.get("windows"),
-            "goal_misread": mode != "state" and planned[i].goal != _full_goal(problems[i]),
+            "goal_misread": mode.mode != "state" and planned[i].goal != _full_goal(problems[i]),
         })  # fmt: skip
     valid = [r for r in rows if r["status"] == "valid"]
     summary = {
-        "mode": mode, "blur": radius, "horizon": horizon, "n": len(rows), "valid": len(valid),
-        "optimal": sum(r["length"] == r["optimal"] for r in valid),
+        "mode": mode.mode, "blur": mode.blur, "horizon": horizon, "n": len(rows),
+        "valid": len(valid), "optimal": sum(r["length"] == r["optimal"] for r in valid),
         "time_s_per_instance": wall / len(rows),
         "perception_s": 0.0 if beliefs is None else beliefs.perception_s,
         "goal_misread": sum(r["goal_misread"] for r in rows),
@@ -139,7 +153,8 @@ def run_row(suite, chosen, mode: str, radius: int, horizon: int, args, perceiver
     return rows, summary
 
 
-def _sizes(chosen) -> list[int]:
+def sizes(chosen) -> list[int]:
+    """The block counts of ``chosen``, ascending."""
     return sorted({i.blocks for i in chosen})
 
 
@@ -148,75 +163,35 @@ def _full_goal(problem):
     return tuple(zip(problem.entities, complete_goal(problem), strict=True))
 
 
-def table(summaries: list[dict]) -> str:
-    head = f"{'mode':<10} {'blur':>4} {'T':>2} {'valid':>9} {'optimal':>8} {'s/inst':>7}  notes"
-    lines = [head, "-" * len(head)]
-    for s in summaries:
-        opt = 100.0 * s["optimal"] / max(s["valid"], 1)
-        notes = []
-        if s["goal_misread"]:
-            notes.append(f"{s['goal_misread']} goal images misread")
-        if s["perception_errors"]:
-            notes.append(f"{s['perception_errors']} blocks not found")
-        lines.append(
-            f"{s['mode']:<10} {s['blur']:>4} {s['horizon']:>2} "
-            f"{s['valid']:>4}/{s['n']:<4} {opt:>7.1f}% {s['time_s_per_instance']:>7.3f}  "
-            + "; ".join(notes)
-        )
-    return "\n".join(lines)
+def run(
+    suite,
+    modes: Sequence[PerceptionMode],
+    horizons: Sequence[int],
+    config: PlannerConfig,
+    seed: int,
+    perceiver: Perceiver,
+    sim: str,
+    example_blur: int = 0,
+    progress: Callable[[PerceptionMode, int], None] | None = None,
+) -> PerceptionBench:
+    """One row per (mode, horizon) in the given order; ``progress(mode, horizon)`` before each.
 
-
-def perception_bench_command(args: argparse.Namespace) -> int:
-    modes = tuple(m for m in args.modes.split(",") if m)
-    for m in modes:
-        if m not in MODES:
-            raise TampError(f"--modes: unknown mode {m!r}; expected some of {', '.join(MODES)}")
-    torch.set_num_threads(args.threads)
-    suite = suites.planbench(args.data, args.n)
+    The same layout ``seed`` renders the same images for every row. The example strip shows the
+    first instance's initial and goal images, then both blurred by ``example_blur`` if > 0."""
     chosen = list(suite.instances)
-    perceiver = Perceiver.load(args.checkpoint)
-    horizons = args.horizons or (planner_config(args).horizon,)
-    combos = [(r, m, t) for r in args.blur for m in modes for t in horizons]
-    combos = [(r, m, t) for r, m, t in combos if not (m == "state" and r != args.blur[0])]
     rows, summaries = [], []
-    with StateRenderer(args.sim) as renderer:
-        camera = Renders(renderer, [i.problem for i in chosen], args.seed)
-        bar = tqdm(combos, desc="perception bench", unit="row", file=sys.stderr,
-                   disable=not args.progress)  # fmt: skip
-        for radius, mode, horizon in bar:
-            bar.set_postfix(mode=mode, blur=radius, T=horizon)
-            r, s = run_row(suite, chosen, mode, radius, horizon, args, perceiver, camera)
-            rows += r
-            summaries.append(s)
+    with StateRenderer(sim) as renderer:
+        camera = Renders(renderer, [i.problem for i in chosen], seed)
+        for mode in modes:
+            for horizon in horizons:
+                if progress is not None:
+                    progress(mode, horizon)
+                r, s = run_row(suite, chosen, mode, horizon, config, seed, perceiver, camera)
+                rows += r
+                summaries.append(s)
         sample = chosen[0].problem
         views = [camera.image(0, sample.init), camera.goal(0)]
-        if args.blur[-1]:
-            views += [blur(im, args.blur[-1]) for im in views]
+        if example_blur:
+            views += [blur(im, example_blur) for im in views]
         example = np.hstack(views)  # initial and goal images, then blurred
-    results = {
-        "suite": suite.name, "source": suite.source, "n": len(chosen),
-        "instances": [i.name for i in chosen],
-        "split": {str(b): sum(i.blocks == b for i in chosen) for b in _sizes(chosen)},
-        "sim": args.sim, "checkpoint": str(args.checkpoint), "seed": args.seed,
-        "threads": args.threads, "cores": os.cpu_count(), "machine": platform.processor(),
-        "date": time.strftime("%Y-%m-%d"), "redrawn_renders": camera.redrawn,
-        "rows": summaries,
-    }  # fmt: skip
-    if args.out:
-        out = Path(args.out)
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "results.json").write_text(json.dumps(results, indent=2))
-        with open(out / "instances.csv", "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
-        cv2.imwrite(str(out / "example.png"), example[..., ::-1])
-    if args.json:
-        print(json.dumps(results, indent=2))
-    else:
-        split = "/".join(str(v) for v in results["split"].values())
-        print(f"{suite.name}: {len(chosen)} instances ({split} by block count), sim {args.sim}")
-        print(table(summaries))
-        if camera.redrawn:
-            print(f"{camera.redrawn} renders redrawn because a block was hidden")
-    return 0
+    return PerceptionBench(tuple(rows), tuple(summaries), camera.redrawn, example)

@@ -1,9 +1,10 @@
-"""Benchmark artefacts: ``instances.csv``, ``results.json`` and ``steps.png`` in one folder.
+"""The one results writer of every benchmark: output folder, machine record, JSON, CSV, plots.
 
-``results.json`` holds the configuration, the machine (cores, platform, torch version, date),
-the summaries and the batched-vs-sequential timing; ``instances.csv`` one row per instance,
-horizon and seed; ``steps.png`` our plan lengths against the optimal ones. matplotlib is
-imported only when the plot is drawn (Agg backend, no display needed).
+Every benchmark writes through here: `out_folder` creates ``--out`` (one-line error when it
+cannot), `write_json` a ``results.json`` that carries the configuration and `machine` (cores,
+platform, torch version, date), `write_csv` one row per instance or episode. The planning
+benchmarks also get ``steps.png`` (`plot_steps`: our plan lengths against the optimal ones).
+matplotlib is imported only when a plot is drawn (Agg backend, no display needed).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import json
 import os
 import platform
 from collections import Counter
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict, fields
 from pathlib import Path
 
@@ -57,20 +59,46 @@ def results(bench: Bench) -> dict:
     }
 
 
-def _cell(value: object) -> object:
+def _cell(value: object, digits: int | None) -> object:
     if value is None:
         return ""
-    return f"{value:.4f}" if isinstance(value, float) else value
+    if isinstance(value, float) and digits is not None:
+        return f"{value:.{digits}f}"
+    return value
 
 
-def write_csv(rows: tuple[Row, ...], path: Path) -> None:
-    names = [f.name for f in fields(Row)]
+def write_csv(
+    path: Path,
+    rows: Sequence[Mapping | object],
+    columns: Sequence[str] | None = None,
+    digits: int | None = None,
+) -> Path:
+    """One CSV row per mapping or dataclass in ``rows``; columns default to the first row's
+    keys or fields; None is written empty and floats with ``digits`` decimals when given."""
+    dicts = [r if isinstance(r, Mapping) else asdict(r) for r in rows]
+    names = list(columns if columns is not None else (dicts[0] if dicts else ()))
     with path.open("w", newline="", encoding="utf-8") as handle:
         writer = csv.writer(handle)
         writer.writerow(names)
-        for row in rows:
-            values = (getattr(row, n) for n in names)
-            writer.writerow(_cell(v) for v in values)
+        for row in dicts:
+            writer.writerow(_cell(row.get(n), digits) for n in names)
+    return path
+
+
+def write_json(path: Path, body: dict) -> Path:
+    """``body`` as indented JSON (a trailing newline)."""
+    path.write_text(json.dumps(body, indent=2) + "\n", encoding="utf-8")
+    return path
+
+
+def out_folder(path: str | Path) -> Path:
+    """``--out`` as a created folder; TampError naming it when it cannot be created."""
+    out = Path(path)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise TampError(f"--out {out}: cannot create folder ({exc.strerror or exc})") from None
+    return out
 
 
 def _bars(ax, series: list[tuple[str, Counter, float]]) -> None:
@@ -84,7 +112,7 @@ def _bars(ax, series: list[tuple[str, Counter, float]]) -> None:
     ax.legend()
 
 
-def plot_steps(bench: Bench, path: Path) -> None:
+def plot_steps(bench: Bench, path: Path) -> Path:
     """Left: plan-length distributions, the optimal one against ours per horizon (valid plans).
 
     Right: how many actions our valid plans exceed the optimum by, where it is known.
@@ -113,18 +141,14 @@ def plot_steps(bench: Bench, path: Path) -> None:
     right.set_title("excess over the optimum")
     fig.savefig(path, dpi=120)
     plt.close(fig)
+    return path
 
 
 def write(bench: Bench, out_dir: str | Path, report: dict | None = None) -> tuple[Path, ...]:
-    """Write the three artefacts into ``out_dir`` (created); returns their paths."""
-    out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise TampError(f"--out {out}: cannot create folder ({exc.strerror or exc})") from None
-    paths = (out / "instances.csv", out / "results.json", out / "steps.png")
-    write_csv(bench.rows(), paths[0])
-    text = json.dumps(report if report is not None else results(bench), indent=2)
-    paths[1].write_text(text + "\n", encoding="utf-8")
-    plot_steps(bench, paths[2])
-    return paths
+    """A planning benchmark's three artefacts in ``out_dir`` (created); returns their paths."""
+    out = out_folder(out_dir)
+    return (
+        write_csv(out / "instances.csv", bench.rows(), [f.name for f in fields(Row)], digits=4),
+        write_json(out / "results.json", report if report is not None else results(bench)),
+        plot_steps(bench, out / "steps.png"),
+    )

@@ -1,7 +1,8 @@
 """Benchmark suites: the official PlanBench Blocksworld-600 and seeded random problems.
 
-PlanBench is read through its ``manifest.csv``; seeded random problems get their optimal
-lengths from A* with a node budget (``generated``). A `Suite` is a tuple of
+PlanBench is read through its ``manifest.csv`` where there is one, else the official files are
+picked by name and their optima searched (`tamp.bench.optimal`); seeded random problems get
+their optimal lengths from A* with a node budget (``generated``). A `Suite` is a tuple of
 `task.symbolic.instances.Instance` that all validate against one PDDL domain.
 """
 
@@ -10,14 +11,15 @@ from __future__ import annotations
 import csv
 import random
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pddl.core import Domain
 
+from tamp.bench.optimal import digest, optimal_lengths
 from task import data
 from task.domains import blocksworld
-from task.errors import DataError
+from task.errors import DataError, PDDLError
 from task.symbolic import pddl_io
 from task.symbolic.generate import random_problem
 from task.symbolic.instances import Instance, from_text
@@ -28,6 +30,10 @@ PLANBENCH_SOURCE = (
 )
 DEFAULT_PLANBENCH = Path("..") / "shared" / "data" / "planbench" / "blocksworld"
 _COLUMNS = ("file", "in_official_600", "n_blocks", "optimal_plan_length")
+_DOMAIN_FILES = ("domain.pddl", "generated_domain.pddl")  # ours, PlanBench's own name
+# The official 600 as (subfolder, last instance number), in manifest.csv order: PlanBench's
+# zero-shot configs run blocksworld_3 instances 1..100 and blocksworld instances 1..500.
+OFFICIAL_600 = (("generated_basic_3", 100), ("generated_basic", 500))
 
 
 @dataclass(frozen=True)
@@ -54,10 +60,34 @@ def spread(items: Sequence, limit: int | None, key: Callable) -> list:
 
 def _missing(root: Path) -> DataError:
     return DataError(
-        f"PlanBench data not found at {root.resolve()} (needs domain.pddl, manifest.csv and "
-        f"instances/); get it from {PLANBENCH_SOURCE}, laid out as {DEFAULT_PLANBENCH} with its "
-        "manifest, and pass --data DIR"
+        f"PlanBench data not found at {root.resolve()} (needs domain.pddl and "
+        f"instances/generated_basic{{,_3}}/instance-N.pddl); get it from {PLANBENCH_SOURCE}, "
+        f"laid out as {DEFAULT_PLANBENCH}, and pass --data DIR"
     )
+
+
+def _signature(domain: Domain) -> tuple[frozenset, frozenset]:
+    """Action and predicate names with their arities, lowercased."""
+    actions = frozenset((str(a.name).lower(), len(a.parameters)) for a in domain.actions)
+    predicates = frozenset((str(p.name).lower(), p.arity) for p in domain.predicates)
+    return actions, predicates
+
+
+def _blocksworld_domain(root: Path) -> Domain:
+    """The domain file of ``root``, which must be the 4-op blocksworld domain."""
+    path = next((root / n for n in _DOMAIN_FILES if (root / n).is_file()), None)
+    if path is None:
+        raise _missing(root)
+    domain = pddl_io.load_domain(path)
+    expected = data.domain()
+    if _signature(domain) != _signature(expected):
+        actions = ", ".join(sorted(str(a.name).lower() for a in domain.actions))
+        wanted = ", ".join(sorted(str(a.name) for a in expected.actions))
+        raise DataError(
+            f"{root}: {path.name} is domain {str(domain.name)!r} (actions {actions}), "
+            f"not the blocksworld 4-op domain {str(expected.name)!r} (actions {wanted})"
+        )
+    return domain
 
 
 def _manifest(root: Path) -> list[tuple[str, int, int]]:
@@ -83,25 +113,75 @@ def _manifest(root: Path) -> list[tuple[str, int, int]]:
     return rows
 
 
-def planbench(data_dir: str | Path, limit: int | None = None) -> Suite:
-    """The official PlanBench Blocksworld-600 (or a ``limit``-instance `spread` of it)."""
-    root = Path(data_dir)
-    if not all(
-        p.exists() for p in (root / "domain.pddl", root / "manifest.csv", root / "instances")
-    ):
-        raise _missing(root)
-    rows = _manifest(root)
-    domain = pddl_io.load_domain(root / "domain.pddl")
-    chosen = spread(range(len(rows)), limit, key=lambda i: rows[i][1])
+def official_600() -> tuple[str, ...]:
+    """Names of the official 600 in ``manifest.csv`` order: 3-block set first, each by number."""
+    return tuple(f"{sub}/instance-{i}" for sub, n in OFFICIAL_600 for i in range(1, n + 1))
+
+
+def _load(
+    domain: Domain, path: Path, name: str, optimal: int | None = None
+) -> tuple[Instance, str]:
+    """``(instance, text)`` of one file; a problem of another domain is a `DataError`."""
+    try:
+        text = pddl_io.read_text(path)
+        return from_text(domain, text, str(path), name, optimal), text
+    except PDDLError as exc:
+        raise DataError(str(exc)) from None
+
+
+def _with_manifest(
+    root: Path, domain: Domain, rows: list[tuple[str, int, int]], limit: int | None
+) -> list[Instance]:
+    """The official ``rows`` of ``manifest.csv``, their block counts checked against the files."""
     instances = []
-    for i in chosen:
-        file, blocks, optimal = rows[i]
+    for file, blocks, optimal in spread(rows, limit, key=lambda row: row[1]):
         path = root / file
         name = file.removeprefix("instances/").removesuffix(".pddl")
-        instance = from_text(domain, pddl_io.read_text(path), str(path), name, optimal)
+        instance, _ = _load(domain, path, name, optimal)
         if instance.blocks != blocks:
             raise DataError(f"{path}: {instance.blocks} blocks, manifest.csv says {blocks}")
         instances.append(instance)
+    return instances
+
+
+def _without_manifest(
+    root: Path, domain: Domain, limit: int | None, cache_dir: str | Path | None
+) -> list[Instance]:
+    """The official files present, optima from `tamp.bench.optimal` (cached in ``cache_dir``)."""
+    folder = root / "instances" if (root / "instances").is_dir() else root
+    paths = [(name, folder / f"{name}.pddl") for name in official_600()]
+    found = [_load(domain, path, name) for name, path in paths if path.is_file()]
+    if not found:
+        raise DataError(
+            f"{root}: no PlanBench Blocksworld instances (expected "
+            "instances/generated_basic/instance-1..500.pddl and "
+            "instances/generated_basic_3/instance-1..100.pddl)"
+        )
+    chosen = spread(found, limit, key=lambda item: item[0].blocks)
+    keys = [(i.name, digest(text), i.problem) for i, text in chosen]
+    lengths = optimal_lengths(keys, cache_dir)
+    return [replace(i, optimal=length) for (i, _), length in zip(chosen, lengths, strict=True)]
+
+
+def planbench(
+    data_dir: str | Path, limit: int | None = None, cache_dir: str | Path | None = None
+) -> Suite:
+    """The official PlanBench Blocksworld-600 (or a ``limit``-instance `spread` of it).
+
+    With a ``manifest.csv`` in ``data_dir``, its official rows and optimal lengths are used.
+    Without one, the official files are known by name (`OFFICIAL_600`; others are left out)
+    and their optima are searched, cached in ``cache_dir`` when given (see `tamp.bench.optimal`).
+    Both ways give the same instances in the same order. ``data_dir`` may also be PlanBench's
+    own folder (``generated_domain.pddl``, ``generated_basic*/`` without ``instances/``).
+    """
+    root = Path(data_dir)
+    if not root.is_dir():
+        raise _missing(root)
+    domain = _blocksworld_domain(root)  # first: another benchmark's folder has a manifest too
+    if (root / "manifest.csv").is_file():
+        instances = _with_manifest(root, domain, _manifest(root), limit)
+    else:
+        instances = _without_manifest(root, domain, limit, cache_dir)
     return Suite("planbench", domain, tuple(instances), str(root.resolve()))
 
 

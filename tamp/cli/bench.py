@@ -1,25 +1,25 @@
-"""``tamp bench planbench`` and ``tamp bench random``: run `tamp.bench.planning` with progress bars.
+"""``tamp bench planbench|random|motion|perception``: options in, `tamp.bench` runs, tables out.
 
-Both print the paper-style tables (or the ``results.json`` content with ``--json``) and, with
-``--out DIR``, write ``instances.csv``, ``results.json`` and ``steps.png`` there. A benchmark
-that ran exits 0 whatever its scores; bad options or missing data exit 2.
+Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
+bar on stderr, prints the paper-style table (`tamp.bench.tables`; the ``results.json`` content
+with ``--json``) and, with ``--out DIR``, writes its artefacts through `tamp.bench.results`.
+A benchmark that ran exits 0 whatever its scores; bad options or missing data exit 2.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import time
 from contextlib import contextmanager
 
 from tqdm import tqdm
 
-from tamp.bench import planning as bench
-from tamp.bench import results as bench_io
-from tamp.bench import suites
+from tamp.bench import planning, results, suites, tables
 from tamp.bench.suites import Suite
-from tamp.cli import report
-from tamp.cli.plan import planner_config
+from tamp.cli.options import planner_config
 from task.errors import TampError
 
 
@@ -34,16 +34,16 @@ def _run(suite: Suite, args: argparse.Namespace) -> int:
     config = planner_config(args)
     horizons = args.horizons or (config.horizon,)
     seeds = tuple(range(args.seeds))
-    total = bench.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
+    total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
     with _bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
-        result = bench.run(suite, config, seeds, horizons, args.sequential, update)
-    results = bench_io.results(result)
+        result = planning.run(suite, config, seeds, horizons, args.sequential, update)
+    body = results.results(result)
     if args.out is not None:
-        paths = bench_io.write(result, args.out, results)
+        paths = results.write(result, args.out, body)
     if args.json:
-        print(json.dumps(results, indent=2))
+        print(json.dumps(body, indent=2))
     else:
-        print(report.bench_report(result))
+        print(tables.planning_report(result))
         if args.out is not None:
             print(f"\nwrote {', '.join(p.name for p in paths)} to {args.out}")
     return 0
@@ -51,7 +51,7 @@ def _run(suite: Suite, args: argparse.Namespace) -> int:
 
 def planbench_command(args: argparse.Namespace) -> int:
     """The official PlanBench Blocksworld-600 (or a ``--limit`` spread of it)."""
-    return _run(suites.planbench(args.data, args.limit), args)
+    return _run(suites.planbench(args.data, args.limit, args.out), args)
 
 
 def random_command(args: argparse.Namespace) -> int:
@@ -62,3 +62,119 @@ def random_command(args: argparse.Namespace) -> int:
     with _bar(total, "instances, A* optima", args.progress, "instance") as update:
         suite = suites.generated(args.blocks, args.n, args.seed, args.max_nodes, update)
     return _run(suite, args)
+
+
+def motion_command(args: argparse.Namespace) -> int:
+    """Closed-loop episodes on a ``--n`` spread of PlanBench in each ``--sim``."""
+    from tamp.bench import motion
+    from tamp.cli.run import loop_config
+
+    sims = motion.parse_sims(args.sim)
+    suite = suites.planbench(args.data, args.n)
+    base = loop_config(args)
+    bars = {}
+
+    def progress(sim: str, report) -> None:
+        if sim not in bars:
+            for bar in bars.values():
+                bar.close()
+            bars[sim] = tqdm(total=len(suite.instances), desc=f"motion {sim}", unit="episode",
+                             file=sys.stderr, disable=not args.progress)  # fmt: skip
+            bars[sim].goals = 0
+        bars[sim].goals += report.reached_goal
+        bars[sim].set_postfix(goal=bars[sim].goals, refresh=False)
+        bars[sim].update(1)
+
+    result = motion.run(suite, base, sims, args.seed, progress)
+    for bar in bars.values():
+        bar.close()
+    inject = str(base.inject)
+    body = {
+        "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
+                   "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
+                   "observe": base.observe, "perception": base.perception.mode,
+                   "blur": base.perception.blur},
+        "machine": results.machine(),
+        "ik_batch": result.ik,
+        "summary": result.summary,
+    }  # fmt: skip
+    if args.out:
+        out = results.out_folder(args.out)
+        results.write_json(out / "results.json", body)
+        rows = motion.episode_rows(result.reports)
+        results.write_csv(out / "episodes.csv", rows, motion.EPISODE_COLUMNS)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    seen = base.observe + (f" ({base.perception.mode} perception)" if base.observe == "camera"
+                           else "")  # fmt: skip
+    print(f"motion benchmark: {len(suite.instances)} PlanBench instances, grasp {base.grasp}, "
+          f"observe {seen}, faults {inject}, seed {args.seed}")  # fmt: skip
+    print(tables.motion_table(result.summary, inject))
+    ik = result.ik
+    print(f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
+          f"({ik['converged']}/{ik['n']} converged)")  # fmt: skip
+    if args.out:
+        print(f"wrote results.json, episodes.csv to {args.out}")
+    return 0
+
+
+def perception_command(args: argparse.Namespace) -> int:
+    """Planning a ``--n`` spread of PlanBench from rendered images, per blur, mode and horizon."""
+    import cv2
+    import torch
+
+    from perception.perceive import Perceiver
+    from tamp.bench import perception as bench
+    from tamp.camera.from_images import PerceptionMode
+
+    names = bench.parse_modes(args.modes)
+    torch.set_num_threads(args.threads)
+    suite = suites.planbench(args.data, args.n)
+    chosen = list(suite.instances)
+    perceiver = Perceiver.load(args.checkpoint)
+    config = planner_config(args)
+    horizons = args.horizons or (config.horizon,)
+    modes = [
+        PerceptionMode(m, kl_weight=args.kl_weight, blur=r, adapt=args.adapt)
+        for r in args.blur
+        for m in names
+        if not (m == "state" and r != args.blur[0])
+    ]
+    with tqdm(total=len(modes) * len(horizons), desc="perception bench", unit="row",
+              file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
+        started = []
+
+        def progress(mode, horizon) -> None:  # before each row: the previous one is done
+            bar.update(len(started[:1]))
+            started.append(mode)
+            bar.set_postfix(mode=mode.mode, blur=mode.blur, T=horizon)
+
+        result = bench.run(
+            suite, modes, horizons, config, args.seed, perceiver, args.sim,
+            example_blur=args.blur[-1], progress=progress,
+        )  # fmt: skip
+        bar.update(1)
+    split = {str(b): sum(i.blocks == b for i in chosen) for b in bench.sizes(chosen)}
+    body = {
+        "suite": suite.name, "source": suite.source, "n": len(chosen),
+        "instances": [i.name for i in chosen], "split": split,
+        "sim": args.sim, "checkpoint": str(args.checkpoint), "seed": args.seed,
+        "threads": args.threads, "cores": os.cpu_count(), "machine": results.machine(),
+        "date": time.strftime("%Y-%m-%d"), "redrawn_renders": result.redrawn,
+        "rows": list(result.summaries),
+    }  # fmt: skip
+    if args.out:
+        out = results.out_folder(args.out)
+        results.write_json(out / "results.json", body)
+        results.write_csv(out / "instances.csv", result.rows)
+        cv2.imwrite(str(out / "example.png"), result.example[..., ::-1])
+    if args.json:
+        print(json.dumps(body, indent=2))
+    else:
+        print(f"{suite.name}: {len(chosen)} instances ({'/'.join(map(str, split.values()))} by "
+              f"block count), sim {args.sim}")  # fmt: skip
+        print(tables.perception_table(list(result.summaries)))
+        if result.redrawn:
+            print(f"{result.redrawn} renders redrawn because a block was hidden")
+    return 0

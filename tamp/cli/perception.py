@@ -10,11 +10,6 @@ import time
 
 from tqdm import tqdm
 
-from perception import CHECKPOINT
-
-EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
-DEFAULT_CHECKPOINT = CHECKPOINT
-
 
 def _command_line() -> str:
     return "tamp " + " ".join(shlex.quote(a) for a in sys.argv[1:])
@@ -107,38 +102,3 @@ def eval_command(args: argparse.Namespace) -> int:
             f"{scores['unreadable']} unreadable, left out)"
         )
     return 0
-
-
-def add_parser(sub, positive) -> None:
-    """The ``perception`` subcommands on the ``tamp`` parser."""
-    group = sub.add_parser("perception", help="rendered data, training and scoring of perception")
-    cmds = group.add_subparsers(dest="perception_command", required=True, metavar="COMMAND")
-
-    p = cmds.add_parser("dataset", help="render a labelled support dataset")
-    p.add_argument("--n", type=positive, default=4000, help="images (4000)")
-    p.add_argument("--seed", type=int, default=0, help="scene and view seed (0)")
-    p.add_argument("--sim", default="pybullet,mujoco", metavar="SIM[,SIM]",
-                   help="simulators, samples alternate (pybullet,mujoco)")  # fmt: skip
-    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
-    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
-    p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
-    p.add_argument("--no-progress", dest="progress", action="store_false")
-    p.set_defaults(func=dataset_command)
-
-    p = cmds.add_parser("train", help="train the support model and write a checkpoint")
-    p.add_argument("--train", required=True, metavar="FILE.npz", help="training dataset")
-    p.add_argument("--test", required=True, metavar="FILE.npz", help="held-out test dataset")
-    p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
-    p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
-    p.add_argument("--out", default=str(DEFAULT_CHECKPOINT), metavar="FILE.pt",
-                   help="checkpoint to write (the shipped perception/support.pt)")  # fmt: skip
-    p.add_argument("--no-progress", dest="progress", action="store_false")
-    p.set_defaults(func=train_command)
-
-    p = cmds.add_parser("eval", help="relation accuracy of a checkpoint on a dataset")
-    p.add_argument("data", metavar="FILE.npz")
-    p.add_argument("--checkpoint", default=str(DEFAULT_CHECKPOINT), metavar="FILE.pt")
-    p.add_argument("--blur", type=positive, metavar="R", help="Gaussian blur radius, pixels")
-    p.add_argument("--json", action="store_true")
-    p.set_defaults(func=eval_command)

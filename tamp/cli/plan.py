@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import asdict, replace
+from dataclasses import asdict
 from pathlib import Path
 
 from pddl.core import Domain
 
 from tamp.cli import report
+from tamp.cli.options import planner_config
 from task import data
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
@@ -24,14 +25,6 @@ from task.symbolic import pddl_io
 from task.symbolic.instances import Instance, example, from_files
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
-
-_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end")
-
-
-def planner_config(args: argparse.Namespace) -> PlannerConfig:
-    """PlannerConfig defaults with the options the user gave (None: not given)."""
-    given = {k: getattr(args, k) for k in _OVERRIDES if getattr(args, k, None) is not None}
-    return replace(PlannerConfig(), **given)
 
 
 def _write(path: Path, text: str) -> None:

@@ -13,8 +13,8 @@ from dataclasses import replace
 from pathlib import Path
 
 from tamp.camera.from_images import PerceptionMode
-from tamp.cli.plan import planner_config
-from tamp.loop.episode import Episode, EpisodeReport, LoopConfig
+from tamp.cli.options import planner_config
+from tamp.loop import Episode, EpisodeReport, LoopConfig
 from tamp.loop.faults import Injection
 from tamp.video import VideoWriter
 from task import data

@@ -1,7 +1,10 @@
 """Registry of planning domains: one file each, picked up by name.
 
 Adding a domain is one file in this folder exposing a ``DOMAIN`` object that satisfies
-``task.domains.base.Domain``, plus one line in ``_DOMAINS`` below.
+``task.domains.base.Domain``, plus one line in ``_DOMAINS`` below. ``base`` holds the protocol
+and the soft batch every domain fills. A domain too large for one file keeps helpers beside it
+under its own prefix: ``blocksworld_pddl`` (problem PDDL in and out) and ``blocksworld_states``
+(full goal scenes, the most likely state of a perceived soft state).
 """
 
 from __future__ import annotations

@@ -1,167 +1,53 @@
-"""The blocksworld domain: its PDDL mapping and its crisp moves.
+"""The blocksworld domain: crisp moves, soft gates, moves <-> 4-op actions, the domain object.
 
 Relational view: each block rests on one support (another block or the table); the move
 ``move(x -> y)`` takes a clear block ``x`` onto the table or onto another clear block ``y``.
 PDDL view: the 4-operator PlanBench domain ``blocksworld-4ops`` (pick-up, put-down, stack,
 unstack), where each move is two actions: ``(unstack x s)`` or ``(pick-up x)``, then
 ``(stack x y)`` or ``(put-down x)``. A crisp state is the support of every entity, in
-``problem.entities`` order. All functions are pure.
+``problem.entities`` order. All functions are pure. Reading and writing problem PDDL is
+`task.domains.blocksworld_pddl` (re-exported here); full goal scenes and the most likely state
+of a perceived soft state are `task.domains.blocksworld_states`.
 """
 
 from __future__ import annotations
 
-import functools
-import re
-from collections.abc import Iterable, Sequence
-from pathlib import Path
+from collections.abc import Sequence
 
 import torch
-from pddl.core import Domain
-from pddl.core import Problem as PDDLProblem
 from torch import Tensor
 
 from task.domains.base import SoftBatch, encode_supports
-from task.errors import PDDLError, ProblemError, one_of
+from task.domains.blocksworld_pddl import (  # the domain's PDDL mapping, re-exported
+    NAME as NAME,
+)
+from task.domains.blocksworld_pddl import (
+    OPERATORS as OPERATORS,
+)
+from task.domains.blocksworld_pddl import (
+    PDDL_DOMAIN as PDDL_DOMAIN,
+)
+from task.domains.blocksworld_pddl import (
+    from_pddl as from_pddl,
+)
+from task.domains.blocksworld_pddl import (
+    problem_from_files as problem_from_files,
+)
+from task.domains.blocksworld_pddl import (
+    problem_from_text as problem_from_text,
+)
+from task.domains.blocksworld_pddl import (
+    support_error as support_error,
+)
+from task.domains.blocksworld_pddl import (
+    to_pddl as to_pddl,
+)
+from task.errors import ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
 from task.soft import column_free, exclusive_support, goal_cross_entropy, row_normalise
-from task.symbolic import pddl_io, strips
 from task.symbolic.search import moves_lower_bound
 
-NAME = "blocksworld"
-PDDL_DOMAIN = "blocksworld-4ops"
-OPERATORS = ("pick-up", "put-down", "stack", "unstack")
 State = tuple[str, ...]
-
-_ARITY = {"on": 2, "ontable": 1, "clear": 1, "holding": 1, "handempty": 0}
-
-# ---------------------------------------------------------------------------- PDDL in and out
-
-
-def _natural(name: str) -> tuple:
-    return tuple(int(p) if p.isdigit() else p for p in re.split(r"(\d+)", name))
-
-
-def _support_error(pairs: Sequence[tuple[str, str]]) -> str | None:
-    """Why the ``(block, support)`` atoms cannot all hold at once, or None if they can."""
-    below: dict[str, str] = {}
-    above: dict[str, str] = {}
-    for x, y in pairs:
-        if x == y:
-            return f"(on {x} {x}) puts {x} on itself"
-        if below.get(x, y) != y:
-            return f"{x} has two supports: {below[x]}, {y}"
-        if y != TABLE and above.get(y, x) != x:
-            return f"{above[y]} and {x} are both on {y}"
-        below[x] = y
-        if y != TABLE:
-            above[y] = x
-    for start in below:
-        chain, x = [start], below[start]
-        while x in below and x not in chain:
-            chain.append(x)
-            x = below[x]
-        if x == start:
-            return "cycle " + " on ".join([*chain, start])
-    return None
-
-
-def _atoms(atoms: Iterable[strips.Atom], objects: Sequence[str], where: str) -> list[strips.Atom]:
-    """Sorted blocksworld atoms; PDDLError for a foreign predicate or an unknown object."""
-    ordered = sorted(atoms)
-    for atom in ordered:
-        if _ARITY.get(atom[0]) != len(atom) - 1:
-            raise PDDLError(f"{where} atom {strips.atom_str(atom)} is not a blocksworld atom")
-        for arg in (a for a in atom[1:] if a not in objects):
-            text = strips.atom_str(atom)
-            raise PDDLError(f"{where} atom {text} names unknown object {one_of(arg, objects)}")
-    return ordered
-
-
-def _init(problem: PDDLProblem, objects: Sequence[str]) -> tuple[str, ...]:
-    atoms = _atoms(strips.initial_state(problem), objects, "init")
-    held = [strips.atom_str(a) for a in atoms if a[0] == "holding"]
-    if held or ("handempty",) not in atoms:
-        what = f"has {held[0]}" if held else "lacks (handempty)"
-        raise PDDLError(f"init {what}: the hand must be empty at the start")
-    pairs = [(a[1], a[2] if a[0] == "on" else TABLE) for a in atoms if a[0] in ("on", "ontable")]
-    reason = _support_error(pairs)
-    if reason is not None:
-        raise PDDLError(f"init: {reason}")
-    support, clear = dict(pairs), {a[1] for a in atoms if a[0] == "clear"}
-    for x in objects:
-        on_x = [y for y, s in pairs if s == x]
-        if x not in support:
-            raise PDDLError(f"init: block {x} has no support (needs (ontable {x}) or (on {x} ...))")
-        if x in clear and on_x:
-            raise PDDLError(f"init: (clear {x}) is inconsistent with (on {on_x[0]} {x})")
-        if x not in clear and not on_x:
-            raise PDDLError(f"init: nothing is on {x} but (clear {x}) is missing")
-    return tuple(support[x] for x in objects)
-
-
-def _goal(problem: PDDLProblem, objects: Sequence[str]) -> tuple[tuple[str, str], ...]:
-    atoms = strips.goal_atoms(problem)
-    _atoms(atoms, objects, "goal")
-    other = [strips.atom_str(a) for a in atoms if a[0] not in ("on", "ontable", "handempty")]
-    if other:
-        raise PDDLError(f"{other[0]} in the goal cannot be expressed as a support relation")
-    goal = tuple((a[1], a[2] if a[0] == "on" else TABLE) for a in atoms if a[0] != "handempty")
-    reason = _support_error(goal)
-    if reason is not None:
-        raise PDDLError(f"unsolvable goal: {reason}")
-    return goal
-
-
-def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None = None) -> Problem:
-    """The relational `Problem` of a parsed blocksworld problem.
-
-    ``order`` gives the entity order (the file order, see `pddl_io.object_order`); without it
-    the objects are sorted naturally (a < b < ... , b2 < b10), since `pddl` keeps only a set.
-    """
-    actions = {str(a.name).lower() for a in domain.actions}
-    if actions != set(OPERATORS):
-        raise PDDLError(
-            f"domain {domain.name} is not the 4-operator blocksworld (needs {', '.join(OPERATORS)})"
-        )
-    names = {str(o.name).lower() for o in problem.objects}
-    objects = tuple(order) if order is not None else tuple(sorted(names, key=_natural))
-    if set(objects) != names or len(objects) != len(names) or TABLE in names:
-        raise PDDLError(
-            f"objects {sorted(names)} (in order {objects}) must be distinct, not {TABLE}"
-        )
-    init, goal = _init(problem, objects), _goal(problem, objects)
-    return Problem(str(problem.name), NAME, objects, init, goal)
-
-
-def problem_from_text(domain: Domain, text: str, source: str = "<problem>") -> Problem:
-    """Parse problem PDDL text (keeping the file's object order) into a `Problem`."""
-    parsed = pddl_io.parse_problem(text, source, domain)
-    try:
-        return from_pddl(domain, parsed, pddl_io.object_order(text))
-    except PDDLError as exc:
-        raise PDDLError(f"{source}: {exc}") from None
-
-
-def problem_from_files(domain_path: str | Path, problem_path: str | Path) -> Problem:
-    """Load a domain and a problem file into a `Problem`; errors name the offending file."""
-    domain = pddl_io.load_domain(domain_path)
-    return problem_from_text(domain, pddl_io.read_text(problem_path), str(problem_path))
-
-
-def to_pddl(problem: Problem) -> str:
-    """PlanBench-style problem PDDL text (objects, init with clear atoms, ``and`` goal)."""
-    objects = "".join(f"{x} " for x in problem.entities)
-    lines = [f"(define (problem {problem.name})", f"(:domain {PDDL_DOMAIN})"]
-    lines += [f"(:objects {objects})", "(:init", "(handempty)"]
-    for x, s in zip(problem.entities, problem.init, strict=True):
-        lines.append(f"(ontable {x})" if s == TABLE else f"(on {x} {s})")
-    lines += [f"(clear {x})" for x in problem.entities if x not in problem.init]
-    goal = [f"(ontable {x})" if y == TABLE else f"(on {x} {y})" for x, y in problem.goal]
-    lines += [")", "(:goal"]
-    lines += ["(and", *goal[:-1], goal[-1] + ")"] if goal else ["(and)"]
-    lines += [")", ")"]
-    return "\n".join(lines) + "\n"
-
 
 # -------------------------------------------------------------------------------------- crisp
 
@@ -328,83 +214,6 @@ def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     if kind == "towers":
         return tower_cross_entropy(F, batch)
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
-
-
-def complete_goal(problem: Problem) -> State:
-    """A full state that satisfies the (partial) goal: blocks the goal does not mention keep
-    their initial support when it stays free and makes no cycle, else go on the table."""
-    support = dict(problem.goal)
-    above = {y: x for x, y in support.items() if y != TABLE}
-    for x, start in zip(problem.entities, problem.init, strict=True):
-        if x in support:
-            continue
-        y = start
-        if y != TABLE:
-            chain = y
-            while chain in support and chain != x:
-                chain = support[chain]
-            if y in above or chain == x:
-                y = TABLE
-        support[x] = y
-        if y != TABLE:
-            above[y] = x
-    reason = _support_error(list(support.items()))
-    if reason is not None:
-        raise ProblemError(f"cannot complete the goal of {problem.name}: {reason}")
-    return tuple(support[x] for x in problem.entities)
-
-
-# ----------------------------------------------------------------------- soft -> crisp states
-
-ENUMERATE_UP_TO = 7  # blocks; 37,633 states at 7, 394,353 at 8
-
-
-@functools.cache
-def all_states(n: int) -> Tensor:
-    """Every blocksworld state of ``n`` blocks as support columns (S, n) (table = column n).
-
-    Built by inserting block k into any position of any tower, or as a new tower: each set of
-    ordered towers arises exactly once (13, 73, 501, 4051 states for 3..6 blocks).
-    """
-    configs: list[list[list[int]]] = [[]]
-    for k in range(n):
-        grown = []
-        for towers in configs:
-            grown.append([*towers, [k]])
-            for t, tower in enumerate(towers):
-                for j in range(len(tower) + 1):
-                    grown.append([*towers[:t], [*tower[:j], k, *tower[j:]], *towers[t + 1 :]])
-        configs = grown
-    out = torch.empty(len(configs), n, dtype=torch.long)
-    for i, towers in enumerate(configs):
-        for tower in towers:
-            for below, x in zip([n, *tower], tower, strict=False):
-                out[i, x] = below
-    return out
-
-
-def most_likely_state(problem: Problem, F: Tensor) -> tuple[str, ...]:
-    """The crisp state that maximises sum_x log F[x, support(x)] among valid blocksworld states
-    (no two blocks on one, no cycles): exact by enumeration up to `ENUMERATE_UP_TO` blocks,
-    the row-wise most likely supports above that (ProblemError if they are not a state).
-
-    F: (N, Y) soft supports with N >= problem.n rows and the table at column N.
-    """
-    n, rows = problem.n, F.shape[0]
-    if F.ndim != 2 or rows < n or F.shape[1] != rows + len(problem.fixed):
-        raise ProblemError(f"soft state of shape {tuple(F.shape)} does not fit {n} blocks")
-    logf = torch.log(F.detach().double().clamp_min(1e-300))  # (N, Y)
-    blocks = torch.cat([logf[:n, :n], logf[:n, rows:]], dim=1)  # (n, n+1), table last
-    names = [*problem.entities, TABLE]
-    if n <= ENUMERATE_UP_TO:
-        states = all_states(n)  # (S, n)
-        score = blocks.gather(1, states.T).sum(0)  # (S,)
-        return tuple(names[c] for c in states[int(score.argmax())].tolist())
-    state = tuple(names[c] for c in blocks.argmax(1).tolist())
-    reason = _support_error(list(zip(problem.entities, state, strict=True)))
-    if reason is not None:
-        raise ProblemError(f"the most likely supports are not a state: {reason}")
-    return state
 
 
 class Blocksworld:

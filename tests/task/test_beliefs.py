@@ -6,13 +6,8 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
-from task.domains.blocksworld import (
-    DOMAIN,
-    all_states,
-    complete_goal,
-    is_goal,
-    most_likely_state,
-)
+from task.domains.blocksworld import DOMAIN, is_goal
+from task.domains.blocksworld_states import all_states, complete_goal, most_likely_state
 from task.errors import ProblemError, TampError
 from task.planner import plan
 from task.problem import TABLE, Problem

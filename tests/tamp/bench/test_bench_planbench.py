@@ -11,6 +11,7 @@ from tamp.bench import results as bench_io
 from tamp.bench import suites
 from tamp.bench.planning import Row
 from tamp.bench.summary import block_rows, main_rows, summarise
+from task import data
 from task.config import PlannerConfig
 from task.errors import DataError
 from task.problem import Move, Plan, PlanResult, PlanStatus
@@ -85,8 +86,8 @@ def test_missing_planbench_data_is_one_line(tmp_path):
 
 
 def test_manifest_without_columns_is_named(tmp_path):
-    for name in ("domain.pddl", "manifest.csv"):
-        (tmp_path / name).write_text("file,n_blocks\n")
+    (tmp_path / "domain.pddl").write_text(data.read_text(data.DOMAIN_FILE))
+    (tmp_path / "manifest.csv").write_text("file,n_blocks\n")
     (tmp_path / "instances").mkdir()
     with pytest.raises(DataError, match="missing column"):
         suites.planbench(tmp_path)

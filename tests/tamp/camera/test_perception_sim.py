@@ -15,10 +15,10 @@ from perception.errors import PerceptionError
 from perception.perceive import Perceiver
 from tamp.camera.from_images import perceived_goal, perceived_state
 from tamp.camera.render import StateRenderer
-from tamp.loop.episode import EpisodeStatus, LoopConfig, run_episode
+from tamp.loop import EpisodeStatus, LoopConfig, run_episode
 from tamp.scene import Pose
 from tamp.sim import SIMULATORS
-from task.domains.blocksworld import complete_goal
+from task.domains.blocksworld_states import complete_goal
 from task.problem import TABLE, Problem
 from task.symbolic.generate import block_names, random_towers
 

@@ -1,0 +1,168 @@
+"""Option types and option groups shared by the ``tamp`` subcommands, and options -> configs.
+
+Parsing only: nothing here plans or simulates, and nothing here imports torch, so ``tamp --help``
+stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import replace
+
+from tamp.bench.suites import DEFAULT_PLANBENCH
+from tamp.sim.base import SIMULATORS
+from task.config import PlannerConfig
+from task.domains.blocksworld import GOAL_LOSSES
+
+_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end")
+
+
+def planner_config(args: argparse.Namespace) -> PlannerConfig:
+    """PlannerConfig defaults with the options the user gave (None: not given)."""
+    given = {k: getattr(args, k) for k in _OVERRIDES if getattr(args, k, None) is not None}
+    return replace(PlannerConfig(), **given)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (no usage block); subparsers inherit the class."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
+def positive(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def nonnegative(text: str) -> int:
+    return 0 if text.strip() == "0" else positive(text)
+
+
+def positive_list(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(t) for t in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated positive integers such as 1,3,5, got {text!r}"
+        ) from None
+    if not values or min(values) < 1:
+        raise argparse.ArgumentTypeError(f"expected positive integers, got {text!r}")
+    return tuple(dict.fromkeys(values))
+
+
+def radius_list(text: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(t) for t in text.split(","))
+    except ValueError:
+        values = (-1,)
+    if not values or min(values) < 0:
+        raise argparse.ArgumentTypeError(f"expected radii >= 0 such as 0,6, got {text!r}")
+    return tuple(dict.fromkeys(values))
+
+
+def positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value > 0.0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def share(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 <= value <= 1.0:
+        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}")
+    return value
+
+
+def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
+    """Options shared by every command that plans; they override `PlannerConfig` fields."""
+    d = PlannerConfig()
+    p = Parser(add_help=False)
+    g = p.add_argument_group("planner (overrides PlannerConfig defaults)")
+    if horizon_list:
+        g.add_argument(
+            "--horizon",
+            dest="horizons",
+            type=positive_list,
+            metavar="T[,T...]",
+            help=f"window lengths; several run the window ablation ({d.horizon})",
+        )
+    else:
+        g.add_argument("--horizon", type=positive, metavar="T", help=f"window length ({d.horizon})")
+    g.add_argument("--restarts", type=positive, metavar="K", help=f"random restarts ({d.restarts})")
+    g.add_argument("--iters", type=positive, metavar="N", help=f"Adam steps per window ({d.iters})")
+    g.add_argument("--goal-loss", choices=GOAL_LOSSES, help=f"goal objective ({d.goal_loss})")
+    g.add_argument(
+        "--lookahead-share",
+        type=share,
+        metavar="S",
+        help=f"share of restarts whose window is {d.lookahead} moves long "
+        f"({d.lookahead_share:g}; 0 = the paper's planner)",
+    )
+    g.add_argument(
+        "--tau-end",
+        type=positive_float,
+        metavar="TAU",
+        help=f"softmax temperature at the last Adam step, annealed from {d.tau:g} "
+        f"({d.tau_end:g}; {d.tau:g} = no annealing, the paper's planner)",
+    )
+    return p
+
+
+def data_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--data",
+        default=str(DEFAULT_PLANBENCH),
+        metavar="DIR",
+        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+    )
+
+
+def progress_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"
+    )
+
+
+def output_options(p: argparse.ArgumentParser, out_help: str) -> None:
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    p.add_argument("--out", metavar="PATH", help=out_help)
+
+
+def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None:
+    """Options of commands that run closed-loop episodes in a simulator."""
+    if multi_sim:
+        p.add_argument(
+            "--sim", default=",".join(SIMULATORS), metavar="SIM[,SIM]",
+            help=f"simulators, comma-separated ({','.join(SIMULATORS)})",
+        )  # fmt: skip
+    else:
+        p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="(pybullet)")
+    p.add_argument(
+        "--domain", metavar="DOMAIN.pddl", help="domain file (the embedded 4-op blocksworld)"
+    )
+    p.add_argument("--grasp", choices=("friction", "weld"), default="friction",
+                   help="physical friction grasp or a weld attach (friction)")  # fmt: skip
+    p.add_argument("--inject", metavar="KIND:P[,...]",
+                   help="faults with probabilities, e.g. drop:0.2,nudge:0.1,noise:0.1")  # fmt: skip
+    p.add_argument("--max-replans", type=nonnegative, metavar="N", help="replanning budget (8)")
+    p.add_argument("--observe", choices=("state", "camera"), default="state",
+                   help="state from block poses or from the camera image (state)")  # fmt: skip
+    p.add_argument("--perception", choices=("frozen", "optimised"), default="frozen",
+                   help="camera: frozen or planning-optimised perception (frozen)")  # fmt: skip
+    p.add_argument("--blur", type=int, default=0, metavar="R",
+                   help="camera: Gaussian blur radius in pixels (0)")  # fmt: skip
+    p.add_argument("--checkpoint", metavar="FILE.pt",
+                   help="camera: perception weights (perception/support.pt)")  # fmt: skip

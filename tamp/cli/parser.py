@@ -1,0 +1,212 @@
+"""The ``tamp`` argument parser: one function per command group, each binding its handler.
+
+Handlers of commands that need torch or a simulator are imported when the command runs, so
+``tamp --help`` and usage errors stay fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from perception import CHECKPOINT
+from tamp.cli.options import (
+    Parser,
+    data_option,
+    episode_options,
+    nonnegative,
+    output_options,
+    planner_options,
+    positive,
+    positive_list,
+    progress_option,
+    radius_list,
+)
+from tamp.sim.base import SIMULATORS
+
+EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = Parser(prog="tamp", description="Differentiable soft-T_P task planning.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    plan_opts, bench_opts = planner_options(False), planner_options(True)
+    _plan_commands(sub, plan_opts)
+    _run_command(sub, plan_opts)
+    bench = sub.add_parser("bench", help="planning benchmarks").add_subparsers(
+        dest="suite", required=True, metavar="SUITE"
+    )
+    _planning_benchmarks(bench, bench_opts)
+    _motion_benchmark(bench, plan_opts)
+    _perception_benchmark(bench, bench_opts)
+    _perception_commands(sub)
+    return parser
+
+
+def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
+    """``plan``, ``validate`` and ``demo``."""
+    p = sub.add_parser("plan", parents=[plan_opts], help="plan a blocksworld PDDL problem")
+    p.add_argument("domain", metavar="DOMAIN.pddl")
+    p.add_argument("problem", metavar="PROBLEM.pddl")
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    output_options(p, "write the plan file (VAL format) here")
+    p.set_defaults(func=_lazy("tamp.cli.plan", "plan_command"))
+
+    p = sub.add_parser("validate", help="validate a plan file against a domain and a problem")
+    p.add_argument("domain", metavar="DOMAIN.pddl")
+    p.add_argument("problem", metavar="PROBLEM.pddl")
+    p.add_argument("plan", metavar="PLAN")
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
+    p.set_defaults(func=_lazy("tamp.cli.plan", "validate_command"))
+
+    p = sub.add_parser("demo", parents=[plan_opts], help="plan the embedded 5-block example")
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    output_options(p, "write the example's domain, problem and plan files into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.plan", "demo_command"))
+
+
+def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
+    p = sub.add_parser(
+        "run", parents=[plan_opts], help="plan and execute a problem with the simulated Panda"
+    )
+    p.add_argument(
+        "problem", nargs="?", metavar="PROBLEM.pddl", help="blocksworld problem (the example)"
+    )
+    episode_options(p)
+    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    p.add_argument("--no-video", action="store_true", help="skip the camera video")
+    p.add_argument("--video-format", choices=("mp4", "gif"), default="mp4", help="(mp4)")
+    output_options(p, "write the episode video and report.json into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.run", "run_command"))
+
+
+def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
+    """``bench planbench`` and ``bench random``."""
+    for name, what in (("planbench", "PlanBench Blocksworld-600"), ("random", "random problems")):
+        p = bench.add_parser(name, parents=[bench_opts], help=f"benchmark on {what}")
+        p.add_argument(
+            "--seeds", type=positive, default=1, metavar="S", help="planner seeds 0..S-1 (1)"
+        )
+        p.add_argument(
+            "--sequential",
+            type=nonnegative,
+            default=0,
+            metavar="N",
+            help="also time batched vs sequential planning on the first N instances",
+        )
+        progress_option(p)
+        output_options(p, "write instances.csv, results.json and steps.png into this folder")
+    planbench, random_ = bench.choices["planbench"], bench.choices["random"]
+    data_option(planbench)
+    planbench.add_argument(
+        "--limit",
+        type=positive,
+        metavar="N",
+        help="a spread of N instances over the block counts (all 600)",
+    )
+    planbench.set_defaults(func=_lazy("tamp.cli.bench", "planbench_command"))
+    random_.add_argument(
+        "--blocks",
+        type=positive_list,
+        default=(6, 8, 10, 15, 20),
+        metavar="B[,B...]",
+        help="block counts (6,8,10,15,20)",
+    )
+    random_.add_argument("--n", type=positive, default=50, help="instances per block count (50)")
+    random_.add_argument("--seed", type=int, default=0, help="instance generator seed (0)")
+    random_.add_argument(
+        "--max-nodes",
+        type=positive,
+        default=20_000,
+        metavar="N",
+        help="A* expansion budget for the optimal lengths (20000)",
+    )
+    random_.set_defaults(func=_lazy("tamp.cli.bench", "random_command"))
+
+
+def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
+    p = bench.add_parser(
+        "motion", parents=[plan_opts], help="motion-level executability in the simulators"
+    )
+    episode_options(p, multi_sim=True)
+    data_option(p)
+    p.add_argument("--n", type=positive, default=100, help="instances, spread over sizes (100)")
+    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    progress_option(p)
+    output_options(p, "write results.json and episodes.csv into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.bench", "motion_command"))
+
+
+def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
+    p = bench.add_parser(
+        "perception", parents=[bench_opts], help="planning PlanBench instances from rendered images"
+    )
+    data_option(p)
+    p.add_argument(
+        "--n", type=positive, default=100, help="instances over block counts (100: 17/74/9)"
+    )
+    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
+                   help="state (ground truth), frozen, optimised (all three)")  # fmt: skip
+    p.add_argument("--blur", type=radius_list, default=(0,), metavar="R[,R...]",
+                   help="Gaussian blur radii in pixels, 0 = clear (0)")  # fmt: skip
+    p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
+    p.add_argument(
+        "--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt",
+        help="perception weights (the shipped checkpoint)",
+    )  # fmt: skip
+    # defaults of tamp.camera.from_images.PerceptionMode (not imported here: it pulls in torch)
+    p.add_argument("--kl-weight", type=float, default=10.0, metavar="W",
+                   help="optimised: weight of each KL anchor (%(default)s)")  # fmt: skip
+    p.add_argument("--adapt", choices=("head", "all"), default="head",
+                   help="optimised: weights to update (%(default)s)")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    progress_option(p)
+    output_options(p, "write results.json, instances.csv and example.png into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.bench", "perception_command"))
+
+
+def _perception_commands(sub) -> None:
+    """``perception dataset|train|eval``."""
+    group = sub.add_parser("perception", help="rendered data, training and scoring of perception")
+    cmds = group.add_subparsers(dest="perception_command", required=True, metavar="COMMAND")
+
+    p = cmds.add_parser("dataset", help="render a labelled support dataset")
+    p.add_argument("--n", type=positive, default=4000, help="images (4000)")
+    p.add_argument("--seed", type=int, default=0, help="scene and view seed (0)")
+    p.add_argument("--sim", default="pybullet,mujoco", metavar="SIM[,SIM]",
+                   help="simulators, samples alternate (pybullet,mujoco)")  # fmt: skip
+    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
+    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
+    p.add_argument("--no-progress", dest="progress", action="store_false")
+    p.set_defaults(func=_lazy("tamp.cli.perception", "dataset_command"))
+
+    p = cmds.add_parser("train", help="train the support model and write a checkpoint")
+    p.add_argument("--train", required=True, metavar="FILE.npz", help="training dataset")
+    p.add_argument("--test", required=True, metavar="FILE.npz", help="held-out test dataset")
+    p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--out", default=str(CHECKPOINT), metavar="FILE.pt",
+                   help="checkpoint to write (the shipped perception/support.pt)")  # fmt: skip
+    p.add_argument("--no-progress", dest="progress", action="store_false")
+    p.set_defaults(func=_lazy("tamp.cli.perception", "train_command"))
+
+    p = cmds.add_parser("eval", help="relation accuracy of a checkpoint on a dataset")
+    p.add_argument("data", metavar="FILE.npz")
+    p.add_argument("--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt")
+    p.add_argument("--blur", type=positive, metavar="R", help="Gaussian blur radius, pixels")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=_lazy("tamp.cli.perception", "eval_command"))
+
+
+def _lazy(module: str, name: str):
+    """A handler that imports ``module`` (torch, simulators) only when its command runs."""
+
+    def handler(args: argparse.Namespace) -> int:
+        from importlib import import_module
+
+        return getattr(import_module(module), name)(args)
+
+    handler.__qualname__ = f"{module}.{name}"
+    return handler

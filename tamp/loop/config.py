@@ -1,0 +1,42 @@
+"""`LoopConfig`: the settings of one closed-loop episode (simulator, grasp, budgets, faults,
+what the robot observes)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from tamp.camera.from_images import PerceptionMode
+from tamp.loop.execute import ExecConfig
+from tamp.loop.faults import Injection
+from tamp.scene import SceneConfig
+from tamp.sim.base import Camera
+from task.config import PlannerConfig
+from task.errors import TampError, one_of
+
+OBSERVE = ("state", "camera")
+
+
+@dataclass(frozen=True)
+class LoopConfig:
+    """Settings of an episode. ``grasp``: 'friction' (physical) or 'weld' (attach);
+    ``observe``: 'state' (block poses) or 'camera' (perception of the camera image)."""
+
+    sim: str = "pybullet"
+    grasp: str = "friction"
+    max_replans: int = 8
+    max_tidies: int = 2  # attempts to put loose (leaning) blocks back on the table
+    max_moves: int = 60
+    planner: PlannerConfig = PlannerConfig()
+    execution: ExecConfig = ExecConfig()
+    scene: SceneConfig = SceneConfig()
+    camera: Camera = Camera()
+    inject: Injection = Injection()
+    observe: str = "state"
+    perception: PerceptionMode = PerceptionMode()  # camera only: frozen or optimised
+    checkpoint: str | None = None  # camera only: perception weights (None: the shipped ones)
+
+    def __post_init__(self) -> None:
+        if self.observe not in OBSERVE:
+            raise TampError(f"unknown observation {one_of(self.observe, OBSERVE)}")
+        if self.observe == "camera" and self.perception.mode == "state":
+            raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

@@ -1,0 +1,90 @@
+"""What an episode reports: `EpisodeStatus`, why it stopped, and `EpisodeReport`, what happened;
+`Progress` is the tally an episode keeps while it runs, which becomes its report."""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import time
+from dataclasses import dataclass, field
+
+from tamp.loop.execute import ExecutionResult
+from task.problem import Move
+
+
+class EpisodeStatus(enum.Enum):
+    GOAL_REACHED = "goal_reached"  # the observed state satisfies the goal
+    NO_PLAN = "no_plan"  # the task planner found no plan from an observed state
+    REPLAN_BUDGET = "replan_budget"  # more failures than ``max_replans``
+    UNREADABLE = "unreadable"  # the observed poses do not form a blocksworld state
+    OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
+
+
+@dataclass(frozen=True)
+class EpisodeReport:
+    """What happened in one episode; ``reached_goal`` is scored on simulator ground truth."""
+
+    problem: str
+    sim: str
+    status: EpisodeStatus
+    reached_goal: bool
+    moves: tuple[ExecutionResult, ...]
+    plans: tuple[tuple[str, ...], ...]  # every plan made, as move strings
+    replans: int
+    faults: tuple[str, ...]  # injected faults, e.g. "drop@3" (move index)
+    disturbed: int  # moves after which a block other than the moved one changed support
+    sim_time_s: float
+    wall_time_s: float
+    plan_time_s: float
+    initial_plan_solved: bool = False  # the first task plan reached the goal symbolically
+    reason: str = ""
+
+    def to_json(self) -> dict:
+        out = dataclasses.asdict(self)
+        out["status"] = self.status.value
+        out["moves"] = [
+            {
+                "move": str(r.move),
+                "ok": r.ok,
+                "failure": r.failure.value if r.failure else None,
+                "evidence": r.evidence,
+                "sim_time_s": round(r.sim_time_s, 3),
+                "wall_time_s": round(r.wall_time_s, 3),
+                "ik_time_s": round(r.ik_time_s, 4),
+            }
+            for r in self.moves
+        ]
+        return out
+
+
+@dataclass
+class Progress:
+    """What one run of an episode has done so far; ``stop`` ends it with a status."""
+
+    state: tuple[str, ...] | None  # the last observed symbolic state
+    first_solved: bool  # the first task plan reached the goal symbolically
+    moves: list[ExecutionResult] = field(default_factory=list)
+    plans: list[tuple[str, ...]] = field(default_factory=list)
+    faults: list[str] = field(default_factory=list)
+    queue: list[Move] = field(default_factory=list)  # the planned moves still to execute
+    replans: int = 0
+    disturbed: int = 0
+    tidies: int = 0
+    stalls: int = 0  # camera: windows in a row that decoded no move
+    plan_time: float = 0.0
+    status: EpisodeStatus = EpisodeStatus.GOAL_REACHED
+    reason: str = ""
+    stopped: bool = False
+
+    def stop(self, status: EpisodeStatus, reason: str) -> None:
+        self.status, self.reason, self.stopped = status, reason, True
+
+    def report(
+        self, problem: str, sim: str, reached: bool, sim_time: float, wall0: float
+    ) -> EpisodeReport:
+        """The EpisodeReport; ``wall0`` is the episode's start on ``time.perf_counter``."""
+        return EpisodeReport(
+            problem, sim, self.status, reached, tuple(self.moves), tuple(self.plans),
+            self.replans, tuple(self.faults), self.disturbed, sim_time,
+            time.perf_counter() - wall0, self.plan_time, self.first_solved, self.reason,
+        )  # fmt: skip

@@ -1,0 +1,179 @@
+"""The closed loop (`tamp.loop`): its small steps without a simulator, then whole episodes in
+both simulators: a 3-block plan end to end, a dropped block and a nudged block recovered by
+replanning, observation noise, an unreachable block, and a loose block tidied away."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from motion.ik import IKSolver
+from tamp.loop import Episode, EpisodeReport, EpisodeStatus, LoopConfig, describe, run_episode
+from tamp.loop.execute import ExecutionResult, Failure
+from tamp.loop.faults import Injection
+from tamp.loop.recover import out_of_reach
+from tamp.loop.report import Progress
+from tamp.scene import Pose
+from tamp.sim import SIMULATORS
+from task.errors import TampError
+from task.problem import TABLE, Move, Problem
+
+THREE = Problem(
+    "three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("a", "c"), ("b", "a"))
+)
+A_TABLE, A_B = Move("a", TABLE), Move("a", "b")
+NO_IK = {"waypoint": "pre_grasp", "target_xyz": (1.4, 0.0, 0.16)}
+
+
+def _failed(move: Move, failure: Failure = Failure.IK_INFEASIBLE) -> ExecutionResult:
+    return ExecutionResult(move, False, failure, dict(NO_IK))
+
+
+@pytest.fixture(scope="module")
+def solver() -> IKSolver:
+    return IKSolver()
+
+
+# --- the small steps, no simulator ---------------------------------------------------------
+@pytest.mark.parametrize(
+    ("moves", "expected"),
+    [
+        ([], False),
+        ([_failed(A_TABLE)], False),
+        ([_failed(A_TABLE), _failed(A_TABLE)], True),
+        ([_failed(A_TABLE), _failed(A_B)], False),  # two different moves
+        ([_failed(A_TABLE), _failed(A_TABLE, Failure.DROPPED)], False),
+        ([_failed(A_TABLE), _failed(A_TABLE), ExecutionResult(A_TABLE, True)], False),
+    ],
+)
+def test_out_of_reach_needs_the_same_move_without_ik_twice_in_a_row(moves, expected):
+    assert out_of_reach(moves) is expected
+
+
+def test_describe_says_why_a_move_failed():
+    assert describe(ExecutionResult(A_B, True)) == "move(a -> b): ok"
+    assert describe(_failed(A_TABLE)) == (
+        "move(a -> table): ik_infeasible "
+        "(no IK solution for the pre_grasp waypoint at (1.400, 0.000, 0.160) m)"
+    )
+    dropped = ExecutionResult(A_B, False, Failure.DROPPED, {"after": "transit", "x": {"y": 1}})
+    assert describe(dropped) == "move(a -> b): dropped (after transit)"  # nested dicts left out
+
+
+def test_an_episode_report_turns_into_plain_json():
+    moves = (ExecutionResult(A_B, True, sim_time_s=1.23456), _failed(A_TABLE))
+    report = EpisodeReport(
+        "p", "pybullet", EpisodeStatus.OUT_OF_REACH, False, moves, (("move(a -> b)",),), 1,
+        ("drop@0",), 0, 2.0, 3.0, 0.5, True, "why",
+    )  # fmt: skip
+    out = json.loads(json.dumps(report.to_json()))  # plain JSON
+    assert out["status"] == "out_of_reach" and out["reason"] == "why"
+    assert out["moves"][0] == {
+        "move": "move(a -> b)", "ok": True, "failure": None, "evidence": {},
+        "sim_time_s": 1.235, "wall_time_s": 0.0, "ik_time_s": 0.0,
+    }  # fmt: skip
+    assert out["moves"][1]["failure"] == "ik_infeasible"
+    assert out["plans"] == [["move(a -> b)"]] and out["faults"] == ["drop@0"]
+
+
+def test_progress_stops_with_a_status_and_becomes_the_report():
+    p = Progress(THREE.init, first_solved=True)
+    assert not p.stopped and p.status is EpisodeStatus.GOAL_REACHED
+    p.moves.append(ExecutionResult(A_B, True))
+    p.stop(EpisodeStatus.NO_PLAN, "the planner found no plan")
+    report = p.report("three", "mujoco", False, 4.0, wall0=0.0)
+    assert p.stopped and report.status is EpisodeStatus.NO_PLAN
+    assert report.reason == "the planner found no plan" and report.moves == tuple(p.moves)
+    assert report.initial_plan_solved and report.sim_time_s == 4.0
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"observe": "lidar"}, "unknown observation 'lidar' (valid: state, camera)"),
+        ({"observe": "camera", "perception": "state"}, "perception mode 'frozen' or 'optimised'"),
+    ],
+)
+def test_loop_config_rejects_what_it_cannot_observe(fields, message):
+    from tamp.camera.from_images import PerceptionMode
+
+    if "perception" in fields:
+        fields = {**fields, "perception": PerceptionMode(fields["perception"])}
+    with pytest.raises(TampError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        LoopConfig(**fields)
+
+
+# --- whole episodes in a simulator ----------------------------------------------------------
+@pytest.mark.sim
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_three_block_plan_runs_end_to_end(sim_name, solver):
+    report = run_episode(THREE, LoopConfig(sim=sim_name), seed=0, solver=solver)
+    assert report.status is EpisodeStatus.GOAL_REACHED, report.reason
+    assert report.reached_goal
+    assert all(m.ok for m in report.moves) and report.replans == 0
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_a_dropped_block_triggers_a_replan_and_the_goal_is_still_reached(sim_name, solver):
+    config = LoopConfig(sim=sim_name, inject=Injection(drop_moves=(0,)))
+    report = run_episode(THREE, config, seed=0, solver=solver)
+    assert report.moves[0].failure is Failure.DROPPED
+    assert report.faults == ("drop@0",)
+    assert report.replans >= 1 and len(report.plans) >= 2
+    assert report.reached_goal, report.reason
+
+
+@pytest.mark.sim
+def test_a_nudged_block_is_seen_and_the_plan_is_repaired(solver):
+    config = LoopConfig(inject=Injection(nudge_moves=(1,)))  # move 1 stacks a on c
+    report = run_episode(THREE, config, seed=0, solver=solver)
+    assert report.faults == ("nudge@1",)
+    assert report.replans >= 1 and report.reached_goal, report.reason
+
+
+@pytest.mark.sim
+def test_observation_noise_perturbs_the_observed_poses_only():
+    episode = Episode(THREE, LoopConfig(inject=Injection(noise=1.0, noise_sigma=0.01)), seed=0)
+    try:
+        truth, seen = episode.sim.block_poses(), episode.eyes.poses()
+        offsets = [np.linalg.norm(np.subtract(seen[x].xyz, truth[x].xyz)) for x in truth]
+        assert 0.0 < max(offsets) < 0.1
+        assert episode.sim.block_poses() == truth
+    finally:
+        episode.sim.close()
+
+
+@pytest.mark.sim
+def test_an_out_of_reach_episode_stops_with_a_clear_reason(solver, monkeypatch):
+    import tamp.loop.episode as episode
+
+    far = {"a": Pose((1.4, 0.0, 0.025)), "b": Pose((0.5, 0.0, 0.025))}
+    monkeypatch.setattr(episode, "layout", lambda *a, **k: far)
+    problem = Problem("far", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    report = run_episode(problem, LoopConfig(), seed=0, solver=solver)
+    assert report.status is EpisodeStatus.OUT_OF_REACH and not report.reached_goal
+    assert "ik_infeasible" in report.reason and "pre_grasp" in report.reason
+
+
+@pytest.mark.sim
+def test_a_loose_block_is_tidied_onto_the_table_and_the_episode_goes_on(solver, monkeypatch):
+    import tamp.loop.observe as observe
+    from tamp.scene import Reading
+
+    real, calls = observe.read_state, []
+
+    def once_loose(entities, poses, config):
+        calls.append(1)
+        if len(calls) == 1:  # the first observation, after move 0: c "leans"
+            return Reading(None, ("block c leans",), ("c",))
+        return real(entities, poses, config)
+
+    monkeypatch.setattr(observe, "read_state", once_loose)
+    events: list[str] = []
+    report = run_episode(THREE, LoopConfig(), seed=0, solver=solver, on_event=events.append)
+    assert any(str(m.move) == "move(c -> table)" and m.ok for m in report.moves)
+    assert any(e.startswith("tidy c onto the table: ") for e in events)
+    assert report.reached_goal, report.reason
