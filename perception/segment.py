@@ -4,8 +4,9 @@ Each block has its own saturated colour. A pixel belongs to a block when it is s
 bright enough (the grey table and the light-grey robot are not) and, among the colours looked
 for, the block's hue is the nearest to the pixel's, within ``hue_tol`` (nearest, so that
 neighbouring hues such as orange and yellow never share a pixel); the block's region is the
-largest connected component of those pixels after a small morphological opening. Nothing is
-read from a simulator.
+largest connected component of those pixels after a small morphological opening.
+`colour_labels` gives the per-pixel labels behind the boxes (for fitting block poses to a depth
+image). Nothing is read from a simulator.
 """
 
 from __future__ import annotations
@@ -44,6 +45,23 @@ def check_image(image: np.ndarray) -> None:
         raise PerceptionError(f"an image must be uint8 RGB, got dtype {image.dtype}")
 
 
+def colour_labels(
+    image: np.ndarray, colours: Sequence[Sequence[float]], config: SegmentConfig = SegmentConfig()
+) -> np.ndarray:
+    """Per-pixel labels (H, W) int16: the index in ``colours`` (RGB in [0, 1]) whose hue is the
+    nearest to the pixel's, within ``hue_tol``, on saturated and bright pixels; -1 elsewhere."""
+    check_image(image)
+    hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
+    h = hsv[..., 0].astype(np.int16)
+    vivid = (hsv[..., 1] >= config.min_saturation) & (hsv[..., 2] >= config.min_value)
+    hues = np.asarray([hue_of(rgb) for rgb in colours], dtype=np.int16)  # (N,)
+    d = np.abs(h[..., None] - hues)  # (H, W, N)
+    d = np.minimum(d, 180 - d)  # hue is circular
+    nearest = d.argmin(-1) if len(hues) else np.zeros(h.shape, int)  # (H, W)
+    close = vivid & (d.min(-1, initial=255) <= config.hue_tol)
+    return np.where(close, nearest, -1).astype(np.int16)
+
+
 def find_boxes(
     image: np.ndarray,
     colours: Sequence[Sequence[float]],
@@ -59,18 +77,11 @@ def find_boxes(
     names = [f"#{i}" for i in range(len(colours))] if names is None else list(names)
     if len(names) != len(colours):
         raise PerceptionError(f"{len(names)} block names for {len(colours)} colours")
-    hsv = cv2.cvtColor(image, cv2.COLOR_RGB2HSV)
-    h = hsv[..., 0].astype(np.int16)
-    vivid = (hsv[..., 1] >= config.min_saturation) & (hsv[..., 2] >= config.min_value)
-    hues = np.asarray([hue_of(rgb) for rgb in colours], dtype=np.int16)  # (N,)
-    d = np.abs(h[..., None] - hues)  # (H, W, N)
-    d = np.minimum(d, 180 - d)  # hue is circular
-    nearest = d.argmin(-1) if len(hues) else np.zeros(h.shape, int)  # (H, W)
-    close = vivid & (d.min(-1, initial=255) <= config.hue_tol)
+    labels = colour_labels(image, colours, config)  # (H, W)
     kernel = np.ones((2, 2), np.uint8)
     boxes, missing = [], []
     for k, name in enumerate(names):
-        mask = (close & (nearest == k)).astype(np.uint8)
+        mask = (labels == k).astype(np.uint8)
         mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
         count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
         if count < 2:

@@ -4,8 +4,14 @@ By default a window starts from the one-hot encoding of the crisp state and aims
 problem's goal atoms. A `BeliefSource` replaces both with soft support matrices (from images,
 say) and may expose parameters of its own (perception weights), which the window's Adam then
 updates together with the action logits, at their own learning rate, on the planning loss
-plus the source's penalty (KL anchors). The crisp side never changes: decoded moves are still
-checked against the true symbolic state and the goal test is the problem's.
+plus the source's penalty (KL anchors).
+
+Two crisp protocols. By default (the paper's) decoded moves are checked against the true
+symbolic state and a problem is done when the true state satisfies its goal. Beliefs that
+expose ``crisp_states`` (the perceived protocol: a robot without an oracle) make the planner
+decode against those states instead, apply the decoded moves to the true state (the world),
+end the plan as inexecutable at the first move that is illegal there (that move kept, last),
+and finish a problem when a crisp state read after its moves satisfies the goal.
 """
 
 from __future__ import annotations
@@ -22,6 +28,9 @@ class WindowBeliefs(Protocol):
     """The soft inputs of one planning window for P problems (all of one size N)."""
 
     lr: float  # Adam learning rate of ``parameters()`` (the paper: 1e-4 for perception)
+    # the crisp state of each problem that decoding checks moves against and that the goal is
+    # tested on; None (or no such attribute): the true states, the paper's protocol
+    crisp_states: Sequence[State] | None
 
     def compute(self) -> tuple[Tensor, Tensor, Tensor]:
         """(F0, goal, penalty): (P, N, Y) soft initial supports, (P, N, Y) soft goal supports,

@@ -26,6 +26,7 @@ class PlannerConfig:
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
     max_windows: int = 40  # replanning windows before giving up
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
+    crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
 
     def horizons(self) -> tuple[int, ...]:
         """Window length of each restart: the long-lookahead restarts come last."""

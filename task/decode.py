@@ -1,9 +1,15 @@
-"""Decode optimised soft windows into crisp moves, checked against the true symbolic state.
+"""Decode optimised soft windows into crisp moves, checked against a crisp state.
 
 At each step the single strongest applied move mass ``g_t(x, y)`` is a move when it reaches the
 confidence threshold (otherwise the step is a STAY). Each decoded move is checked against the
-crisp state reached so far; decoding stops at the first illegal one, so only legal moves are
-ever returned. Among a problem's restarts the best decoded window is kept.
+crisp state reached so far (the planner passes the true state, or under the perceived protocol
+the state read from the current image); decoding stops at the first illegal one, so only legal
+moves are returned. Among a problem's restarts the best decoded window is kept.
+
+Without the crisp check (``check=False``, `task.config.PlannerConfig.crisp_check`) the first
+illegal move is kept as the window's last move, and the restart with the lowest soft objective
+wins (ranking restarts by their crisp replay would be the check again); the planner then finds
+the move illegal in the world and the plan is inexecutable.
 """
 
 from __future__ import annotations
@@ -25,6 +31,7 @@ class DecodedWindow:
     complete: bool  # every confident step decoded to a legal move
     loss: float  # the soft objective of the restart it came from
     remaining: int  # the domain's admissible lower bound on moves still needed from ``state``
+    illegal: str | None = None  # check=False: why the last move is illegal in ``state``
 
     def key(self) -> tuple:
         """Sort key: the goal reached in fewest moves; else some progress, then the least
@@ -47,12 +54,17 @@ def decode_row(
     gates: Tensor,
     threshold: float,
     loss: float,
+    check: bool = True,
 ) -> DecodedWindow:
-    """Decode one rollout row. gates: (T, N, Y) applied move mass of that row."""
+    """Decode one rollout row. gates: (T, N, Y) applied move mass of that row.
+
+    ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``)."""
     n = gates.shape[1]
     best, flat = gates.flatten(1).max(-1)  # (T,), (T,)
     moves: list[Move] = []
-    complete = True
+    complete, illegal = True, None
+    if domain.is_goal(problem, state):  # nothing to do (a perceived state may already be it)
+        return DecodedWindow((), state, True, True, loss, 0)
     for value, index in zip(best.tolist(), flat.tolist(), strict=True):
         if value < threshold:
             continue  # a STAY step
@@ -60,8 +72,12 @@ def decode_row(
         move = None
         if x < problem.n and not n > y >= problem.n:  # padding is never a legal move
             move = Move(problem.entities[x], target_name(problem, y, n))
-        if move is None or domain.check_move(problem, state, move) is not None:
+        reason = "padding" if move is None else domain.check_move(problem, state, move)
+        if reason is not None:
             complete = False
+            if not check and move is not None:
+                moves.append(move)
+                illegal = reason
             break
         state = domain.apply_move(problem, state, move)
         moves.append(move)
@@ -69,7 +85,7 @@ def decode_row(
             break
     reached = domain.is_goal(problem, state)
     remaining = 0 if reached else domain.lower_bound(problem, state)
-    return DecodedWindow(tuple(moves), state, reached, complete, loss, remaining)
+    return DecodedWindow(tuple(moves), state, reached, complete, loss, remaining, illegal)
 
 
 def decode_best(
@@ -80,12 +96,22 @@ def decode_best(
     losses: Tensor,
     restarts: int,
     threshold: float,
+    check: bool = True,
 ) -> list[DecodedWindow]:
-    """Best decoded window per problem. gates: (P * R, T, N, Y) with restarts adjacent."""
+    """Best decoded window per problem. gates: (P * R, T, N, Y) with restarts adjacent.
+
+    ``check=False``: illegal moves are kept and the lowest soft objective wins."""
     gates, losses = gates.cpu(), losses.cpu().tolist()
     out = []
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
         rows = range(i * restarts, (i + 1) * restarts)
-        windows = [decode_row(domain, problem, state, gates[r], threshold, losses[r]) for r in rows]
-        out.append(min(windows, key=DecodedWindow.key))
+        windows = [
+            decode_row(domain, problem, state, gates[r], threshold, losses[r], check) for r in rows
+        ]
+        out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
     return out
+
+
+def _soft_objective(window: DecodedWindow) -> float:
+    """Restart ranking without the crisp check: the soft objective alone."""
+    return window.loss

@@ -5,6 +5,14 @@ as extra rows; the code pads and masks, so any mix of sizes also works in one pr
 problems that reach their goal leave the batch.
 With ``PlannerConfig(batched=False)`` the same code runs one problem at a time, so the speed-up
 of batching can be measured.
+
+Each window decodes against a crisp state (the true one, or under the perceived protocol of
+`task.beliefs` the one read from the current image), then applies its moves to the true state,
+the world. A move illegal there ends the plan as inexecutable (`PlanStatus.INVALID`, the move
+kept last so that `task.symbolic.validate` names it); with the crisp check on and the true
+protocol that never happens. Under the perceived protocol a window that predicts the goal is
+confirmed by one more reading (a new image, no optimisation), so a perfect reading gives
+exactly the true protocol's plans.
 """
 
 from __future__ import annotations
@@ -21,7 +29,7 @@ from task.domains import get_domain
 from task.domains.base import Domain, State
 from task.errors import TampError
 from task.optimize import optimise_window
-from task.problem import Plan, PlanResult, PlanStatus, Problem
+from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 
 
 def _window(
@@ -37,8 +45,38 @@ def _window(
     steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
     _, roll = optimise_window(domain, batch, steps, config, generator, beliefs)
     return decode_best(
-        domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold
-    )
+        domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold,
+        config.crisp_check,
+    )  # fmt: skip
+
+
+def _crisp_states(
+    beliefs: WindowBeliefs | None, world: Sequence[State]
+) -> tuple[Sequence[State], bool]:
+    """The states a window decodes against and whether they are perceived (not the world)."""
+    crisp = getattr(beliefs, "crisp_states", None)
+    if crisp is None:
+        return world, False
+    if len(crisp) != len(world):
+        raise TampError(f"beliefs give {len(crisp)} crisp states for {len(world)} problems")
+    return tuple(crisp), True
+
+
+def _execute(
+    domain: Domain, problem: Problem, state: State, moves: Sequence[Move]
+) -> tuple[tuple[Move, ...], State, str | None]:
+    """Apply ``moves`` to the world ``state`` until one is illegal there.
+
+    Returns the moves tried (an illegal one last), the world state after the legal ones, and
+    why the illegal one is illegal (None when all were legal)."""
+    done = []
+    for move in moves:
+        done.append(move)
+        reason = domain.check_move(problem, state, move)
+        if reason is not None:
+            return tuple(done), state, f"{move}: {reason}"
+        state = domain.apply_move(problem, state, move)
+    return tuple(done), state, None
 
 
 def _run(
@@ -54,37 +92,53 @@ def _run(
 
     ``indices``: the problems' positions in the caller's list (what ``source`` is told)."""
     start = time.perf_counter()
-    states = [domain.initial_state(p) for p in problems]
+    states = [domain.initial_state(p) for p in problems]  # the world
     moves: list[list] = [[] for _ in problems]
-    windows = [0] * len(problems)
-    active = [i for i, p in enumerate(problems) if not domain.is_goal(p, states[i])]
+    windows, misread = [0] * len(problems), [0] * len(problems)
+    solved = [domain.is_goal(p, s) for p, s in zip(problems, states, strict=True)]
+    illegal: list[str | None] = [None] * len(problems)
+    active = [i for i in range(len(problems)) if not solved[i]]
     on_done(len(problems) - len(active))
     for _ in range(config.max_windows):
         if not active:
             break
         now = [states[i] for i in active]
         beliefs = None if source is None else source([indices[i] for i in active], now)
-        decoded = _window(domain, [problems[i] for i in active], now, config, generator, beliefs)
-        still = []
-        for i, win in zip(active, decoded, strict=True):
+        crisp, perceived = _crisp_states(beliefs, now)
+        decoded = _window(domain, [problems[i] for i in active], crisp, config, generator, beliefs)
+        hoped = []  # perceived: windows that predict the goal, for a new image to confirm
+        for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1
-            moves[i].extend(win.moves)
-            states[i] = win.state
-            if not win.reached:
-                still.append(i)
+            misread[i] += seen != states[i]
+            tried, states[i], illegal[i] = _execute(domain, problems[i], states[i], win.moves)
+            moves[i].extend(tried)
+            if not perceived:
+                solved[i] = win.reached  # decoded on the world: the world reached the goal
+            elif domain.is_goal(problems[i], seen):
+                solved[i] = True  # the image already showed the goal (no move was decoded)
+            elif win.reached and illegal[i] is None:
+                hoped.append(i)
+        if hoped:  # look again: done when the new image shows the goal
+            looked = source([indices[i] for i in hoped], [states[i] for i in hoped])
+            seen_now, _ = _crisp_states(looked, [states[i] for i in hoped])
+            for i, seen in zip(hoped, seen_now, strict=True):
+                solved[i] = domain.is_goal(problems[i], seen)
+        still = [i for i in active if illegal[i] is None and not solved[i]]
         on_done(len(active) - len(still))
         active = still
     on_done(len(active))
     elapsed = time.perf_counter() - start
     results = []
     for i, p in enumerate(problems):
-        reached = domain.is_goal(p, states[i])
         stats = {
             "windows": windows[i],
             "time_s": elapsed / len(problems),
             "batch_time_s": elapsed,
+            "misread_windows": misread[i],  # windows decoded against a state not the world's
         }
-        status = PlanStatus.SOLVED if reached else PlanStatus.NO_PLAN
+        status = PlanStatus.SOLVED if solved[i] else PlanStatus.NO_PLAN
+        if illegal[i] is not None:
+            status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
         results.append(PlanResult(status, Plan(tuple(moves[i])), p, None, stats))
     return results
 

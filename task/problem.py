@@ -71,7 +71,8 @@ class Problem:
 class PlanStatus(enum.Enum):
     SOLVED = "solved"
     NO_PLAN = "no_plan"  # the window budget ran out before the goal was reached
-    INVALID = "invalid"  # a plan was produced but failed validation (should never happen)
+    INVALID = "invalid"  # a planned move is illegal in the true state (perceived protocol or
+    # no crisp check; the plan ends with that move, ``stats["illegal"]`` says why)
 
 
 @dataclass(frozen=True)

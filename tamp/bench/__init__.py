@@ -5,6 +5,7 @@
   ``bench random``); ``summary``: its rows in the paper's format;
 - ``motion``: closed-loop episodes in the simulators (``bench motion``);
 - ``perception``: planning from rendered images (``bench perception``);
+- ``poses``: block poses from RGB-D images against the true poses (``bench poses``);
 - ``results``: the one results writer (output folder, machine record, JSON, CSV, plots);
 - ``tables``: the one table printer.
 

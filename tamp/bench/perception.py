@@ -2,22 +2,28 @@
 
 For each instance the initial state and a goal scene (the PDDL goal completed by
 `task.domains.blocksworld_states.complete_goal`: blocks the goal leaves free keep their support when
-they can) are rendered by a simulator camera. Every (blur, mode, horizon) row plans the same
-instances with the same seed:
+they can) are rendered by a simulator camera. Every (blur, mode, crisp protocol, horizon) row plans
+the same instances with the same seed:
 
 - ``state``: ground-truth symbolic states (no images);
-- ``frozen`` / ``optimised``: see `tamp.camera.from_images`.
+- ``frozen`` / ``optimised``: see `tamp.camera.from_images`;
+- crisp ``true`` (the paper's: moves checked against the true state) or ``perceived`` (checked
+  against the state read from the current image, then applied to the true state, where an
+  illegal one makes the plan inexecutable).
 
-Every plan is validated against the instance's own PDDL goal (`tamp.bench.planning.check`). Each
-window's image is a fresh render of the current true state (new slots, new jitter); a render in
-which a block is hidden is redrawn with the next layout seed and counted. Times per instance exclude
-rendering (a camera's job) but include segmentation, the model and planning.
+Every plan is replayed by the validator against the instance's own PDDL
+(`tamp.bench.planning.check`), and "optimal" is `tamp.bench.summary.is_optimal`. Each window's
+image is a fresh render of the current true state (new slots, new jitter); a render in which a
+block is hidden is redrawn with the next layout seed, and each row counts the images it used that
+had to be redrawn. Times per instance exclude rendering (a camera's job) but include
+segmentation, the model and planning.
 """
 
 from __future__ import annotations
 
 import time
 import zlib
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
@@ -26,8 +32,9 @@ import numpy as np
 from perception.errors import PerceptionError
 from perception.perceive import Perceiver, blur
 from perception.segment import find_boxes
-from tamp.bench.planning import check
-from tamp.camera.from_images import MODES, ImageBeliefs, PerceptionMode, perceived_goal
+from tamp.bench.planning import STATUSES, check
+from tamp.bench.summary import is_optimal
+from tamp.camera.from_images import CRISP, MODES, ImageBeliefs, PerceptionMode, perceived_goal
 from tamp.camera.render import StateRenderer, block_colours
 from task.config import PlannerConfig
 from task.domains.blocksworld_states import complete_goal
@@ -38,21 +45,36 @@ REDRAWS = 8  # layout seeds tried before a render counts as hiding a block
 
 
 class Renders:
-    """Renders instance images, redrawing layouts that hide a block; keeps time and counts."""
+    """Renders instance images, redrawing layouts that hide a block; keeps time and counts.
+
+    ``redrawn``: redraws in all; ``served[i]``: images of problem i handed out that had to be
+    redrawn (a cached goal image counts each time it is handed out)."""
 
     def __init__(self, renderer: StateRenderer, problems, seed: int) -> None:
         self.renderer, self.problems, self.seed = renderer, problems, seed
         self.render_s = 0.0
         self.redrawn = 0
-        self._goals: dict[int, np.ndarray] = {}  # every row uses the same goal images
+        self.served: Counter[int] = Counter()
+        self._goals: dict[int, tuple[np.ndarray, bool]] = {}  # every row uses the same goals
 
     def goal(self, i: int) -> np.ndarray:
         """The goal image of problem i: its completed goal scene, rendered once."""
         if i not in self._goals:
-            self._goals[i] = self.image(i, complete_goal(self.problems[i]), "goal")
-        return self._goals[i]
+            before = self.redrawn
+            image = self._render(i, complete_goal(self.problems[i]), "goal")
+            self._goals[i] = image, self.redrawn > before
+        image, redrawn = self._goals[i]
+        self.served[i] += redrawn
+        return image
 
     def image(self, i: int, state, kind: str = "init") -> np.ndarray:
+        """A fresh render of problem i in ``state`` (the same state and kind: the same image)."""
+        before = self.redrawn
+        image = self._render(i, state, kind)
+        self.served[i] += self.redrawn > before
+        return image
+
+    def _render(self, i: int, state, kind: str) -> np.ndarray:
         p = self.problems[i]
         key = f"{self.seed}:{i}:{kind}:{','.join(state)}".encode()
         base = zlib.crc32(key)
@@ -83,14 +105,25 @@ class PerceptionBench:
 
 def parse_modes(text: str) -> tuple[str, ...]:
     """``state,frozen,optimised`` as a tuple; TampError naming an unknown mode."""
-    modes = tuple(m for m in text.split(",") if m)
-    for m in modes:
-        if m not in MODES:
-            raise TampError(f"--modes: unknown mode {m!r}; expected some of {', '.join(MODES)}")
-    return modes
+    return _choices(text, MODES, "--modes", "mode")
 
 
-def _goals(problems, mode: PerceptionMode, perceiver, camera) -> tuple[list, set[int]]:
+def parse_crisp(text: str) -> tuple[str, ...]:
+    """``true,perceived`` as a tuple; TampError naming an unknown crisp protocol."""
+    return _choices(text, CRISP, "--crisp", "crisp protocol")
+
+
+def _choices(text: str, valid: Sequence[str], option: str, noun: str) -> tuple[str, ...]:
+    chosen = tuple(dict.fromkeys(m for m in text.split(",") if m))
+    for m in chosen:
+        if m not in valid:
+            raise TampError(f"{option}: unknown {noun} {m!r}; expected some of {', '.join(valid)}")
+    if not chosen:
+        raise TampError(f"{option}: expected some of {', '.join(valid)}")
+    return chosen
+
+
+def _goals(problems, mode: PerceptionMode, perceiver, goal_images) -> tuple[list, set[int]]:
     """The goals the planner sees (perceived from goal images unless ``state``), and the
     problems whose goal image hides a block."""
     planned, failed = list(problems), set()
@@ -98,7 +131,7 @@ def _goals(problems, mode: PerceptionMode, perceiver, camera) -> tuple[list, set
         return planned, failed
     for i, p in enumerate(problems):
         try:
-            planned[i] = perceived_goal(p, perceiver, camera.goal(i), mode.blur)
+            planned[i] = perceived_goal(p, perceiver, goal_images[i], mode.blur)
         except PerceptionError:
             failed.add(i)
     return planned, failed
@@ -122,11 +155,12 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
     """Plan ``chosen`` once in one mode; returns per-instance rows and the row summary."""
     config = replace(config, horizon=horizon)
     problems = [inst.problem for inst in chosen]
-    render0, t0 = camera.render_s, time.perf_counter()
-    planned, failed_goal = _goals(problems, mode, perceiver, camera)
-    beliefs = None
+    render0, served0, t0 = camera.render_s, Counter(camera.served), time.perf_counter()
+    beliefs = goal_images = None
     if mode.mode != "state":
         goal_images = [camera.goal(i) for i in range(len(problems))]
+    planned, failed_goal = _goals(problems, mode, perceiver, goal_images)
+    if mode.mode != "state":
         beliefs = ImageBeliefs(planned, perceiver, camera.image, goal_images, mode)
     keep = [i for i in range(len(problems)) if i not in failed_goal]
     results = _plan(planned, keep, config, seed, beliefs)
@@ -135,20 +169,29 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
     for i, inst in enumerate(chosen):
         r = results.get(i)
         status, length = ("perception_error", None) if r is None else check(suite.domain, inst, r)
+        stats = {} if r is None else r.stats
         rows.append({
             "instance": inst.name, "blocks": inst.blocks, "optimal": inst.optimal,
-            "mode": mode.mode, "blur": mode.blur, "horizon": horizon, "status": status,
-            "length": length, "windows": None if r is None else r.stats.get("windows"),
+            "mode": mode.mode, "crisp": mode.crisp, "blur": mode.blur, "horizon": horizon,
+            "status": status, "length": length, "windows": stats.get("windows"),
             "goal_misread": mode.mode != "state" and planned[i].goal != _full_goal(problems[i]),
+            "misread_windows": stats.get("misread_windows", 0),
+            "redrawn": camera.served[i] - served0[i], "illegal": stats.get("illegal"),
         })  # fmt: skip
     valid = [r for r in rows if r["status"] == "valid"]
+    optimal = [is_optimal(r["length"], r["optimal"], r["instance"]) for r in valid
+               if r["optimal"] is not None]  # fmt: skip
     summary = {
-        "mode": mode.mode, "blur": mode.blur, "horizon": horizon, "n": len(rows),
-        "valid": len(valid), "optimal": sum(r["length"] == r["optimal"] for r in valid),
+        "mode": mode.mode, "crisp": mode.crisp, "blur": mode.blur, "horizon": horizon,
+        "n": len(rows), "valid": len(valid), "optimal": sum(optimal),
+        "optimal_pct": 100.0 * sum(optimal) / len(optimal) if optimal else None,
+        **{s: sum(r["status"] == s for r in rows) for s in STATUSES if s != "valid"},
         "time_s_per_instance": wall / len(rows),
         "perception_s": 0.0 if beliefs is None else beliefs.perception_s,
         "goal_misread": sum(r["goal_misread"] for r in rows),
         "perception_errors": sum(r["status"] == "perception_error" for r in rows),
+        "misread_windows": sum(r["misread_windows"] for r in rows),
+        "redrawn": sum(r["redrawn"] for r in rows),
     }  # fmt: skip
     return rows, summary
 
@@ -174,7 +217,8 @@ def run(
     example_blur: int = 0,
     progress: Callable[[PerceptionMode, int], None] | None = None,
 ) -> PerceptionBench:
-    """One row per (mode, horizon) in the given order; ``progress(mode, horizon)`` before each.
+    """One row per (mode, horizon) in the given order (a mode carries its blur and crisp
+    protocol); ``progress(mode, horizon)`` before each.
 
     The same layout ``seed`` renders the same images for every row. The example strip shows the
     first instance's initial and goal images, then both blurred by ``example_blur`` if > 0."""

@@ -18,11 +18,10 @@ from pddl.core import Domain
 from tamp.bench.suites import Suite
 from task.config import PlannerConfig
 from task.domains import get_domain
-from task.errors import ProblemError
 from task.planner import plan_batch
-from task.problem import PlanResult
+from task.problem import Move, PlanResult, PlanStatus
 from task.symbolic.instances import Instance
-from task.symbolic.validate import validate
+from task.symbolic.validate import Validation, validate
 
 STATUSES = ("valid", "inexecutable", "non_goal_reaching", "no_plan")
 
@@ -90,17 +89,24 @@ class Bench:
         return tuple(r for run in self.runs for r in run.rows)
 
 
+def replay(domain: Domain, instance: Instance, moves: Sequence[Move]) -> Validation:
+    """``moves`` as the domain's PDDL actions, replayed by `validate` from the instance's PDDL
+    initial state to its PDDL goal. An illegal move is translated as it stands, so the
+    validator names the first step that fails."""
+    problem = instance.problem
+    actions = get_domain(problem.domain).to_actions(problem, moves, strict=False)
+    return validate(domain, instance.pddl, actions)
+
+
 def check(domain: Domain, instance: Instance, result: PlanResult) -> tuple[str, int | None]:
-    """``(status, 4-op length)`` of a planner result, validated against the instance's PDDL."""
-    if not result.solved:
+    """``(status, 4-op length)`` of a planner result, validated against the instance's PDDL.
+
+    Every plan the planner returns is replayed (`replay`), an inexecutable one too; only a
+    window budget that ran out is ``no_plan``."""
+    if result.status is PlanStatus.NO_PLAN:
         return "no_plan", None
-    try:
-        actions = get_domain(instance.problem.domain).to_actions(
-            instance.problem, result.plan.moves
-        )
-    except ProblemError:  # a move the planner claimed legal is not: report, do not crash
-        return "inexecutable", 2 * len(result.plan)
-    return validate(domain, instance.pddl, actions).status.value, len(actions)
+    validation = replay(domain, instance, result.plan.moves)
+    return validation.status.value, validation.length
 
 
 def run_once(

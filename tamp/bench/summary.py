@@ -2,8 +2,9 @@
 
 A `Summary` covers one horizon and either one seed or the mean over seeds (``seed`` None), over
 all instances or one block count. Counts of a mean row are means over seeds (e.g. 598.3 valid).
-"Optimal" counts valid plans no longer than the known optimum; its percentage is taken over the
-valid plans whose instance has a known optimum (``known`` says how many instances have one).
+"Optimal" counts valid plans as long as the known optimum (`is_optimal`, the one definition
+every benchmark uses); its percentage is taken over the valid plans whose instance has a known
+optimum (``known`` says how many instances have one).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields
 
 from tamp.bench.planning import STATUSES, Bench, Row
+from task.errors import TampError
 
 
 @dataclass(frozen=True)
@@ -36,6 +38,18 @@ class Summary:
         return asdict(self)
 
 
+def is_optimal(length: int, optimal: int, instance: str) -> bool:
+    """Whether a *valid* plan of ``length`` 4-op actions is optimal: as long as the known
+    optimum. A valid plan shorter than the optimum raises TampError naming ``instance``: the
+    optimum or the validator is wrong, and no benchmark may count that as a success."""
+    if length < optimal:
+        raise TampError(
+            f"{instance}: a valid plan of {length} actions is shorter than its known optimum "
+            f"{optimal}; the optimum or the validator is wrong"
+        )
+    return length == optimal
+
+
 def _fmean(values: Sequence[float]) -> float:
     return statistics.fmean(values) if values else 0.0
 
@@ -46,7 +60,7 @@ def summarise(
     """The summary of one seed's ``rows``."""
     count = {s: sum(r.status == s for r in rows) for s in STATUSES}
     scored = [r for r in rows if r.status == "valid" and r.optimal is not None]
-    optimal = sum(r.length is not None and r.length <= r.optimal for r in scored)
+    optimal = sum(is_optimal(r.length, r.optimal, r.instance) for r in scored)
     return Summary(
         horizon=horizon,
         seed=seed,

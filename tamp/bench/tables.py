@@ -2,8 +2,9 @@
 
 `table` pads columns to their widest cell (numbers right-aligned); `planning_report` prints a
 planning benchmark (by horizon and seed, then by block count), `motion_table` the executability
-table of the motion benchmark, `perception_table` the rows of planning from images. Pure string
-formatting: nothing here runs a benchmark or prints.
+table of the motion benchmark, `perception_table` the rows of planning from images,
+`poses_table` the pose errors of the pose benchmark. Pure string formatting: nothing here runs a
+benchmark or prints.
 """
 
 from __future__ import annotations
@@ -29,7 +30,11 @@ def table(headers: Sequence[str], rows: Sequence[Sequence[object]], indent: str 
 
 
 def _is_number(text: str) -> bool:
-    return text.replace(".", "", 1).replace("%", "").replace("/", "", 1).strip("-").isdigit()
+    """A count, a ratio, a percentage, or "-" (not applicable) in a numeric column."""
+    return (
+        text == "-"
+        or text.replace(".", "", 1).replace("%", "").replace("/", "", 1).strip("-").isdigit()
+    )
 
 
 def count(value: float) -> str:
@@ -66,7 +71,8 @@ def planning_report(bench: Bench) -> str:
         f"{bench.suite}: {bench.n} instances ({bench.source})",
         f"seeds {seeds}; restarts {c.restarts}, iters {c.iters}, goal loss {c.goal_loss}, "
         f"lookahead {c.lookahead} x {c.lookahead_share:g} of restarts, "
-        f"tau {c.tau:g}->{c.tau_end:g}, max windows {c.max_windows}",
+        f"tau {c.tau:g}->{c.tau_end:g}, max windows {c.max_windows}"
+        + ("" if c.crisp_check else "; NO crisp check (illegal moves kept, restarts by loss)"),
         "",
     ]
     main = [_row(s, "mean" if s.seed is None else str(s.seed)) for s in main_rows(bench)]
@@ -91,20 +97,21 @@ def planning_report(bench: Bench) -> str:
 
 
 def motion_table(rows: dict[str, dict], inject: str) -> str:
-    head = (
-        f"{'sim':9} {'episodes':>8} {'plans valid':>11} {'goal':>9} {'moves ok':>13} "
-        f"{'replans':>7} "
-        f"{'disturbed':>9} {'wall/move':>9} {'sim/move':>8} {'x real':>6}"
-    )
-    lines = [head]
+    """plans valid: the first task plan replayed by the validator ("-" with the camera, whose
+    first plan is one window); exec. valid: the moves that executed ok, replayed."""
+    head = ["sim", "episodes", "plans valid", "exec. valid", "goal", "moves ok", "replans",
+            "disturbed", "wall/move", "sim/move", "x real"]  # fmt: skip
+    body = []
     for sim, s in rows.items():
         e = s["episodes"]
-        lines.append(
-            f"{sim:9} {e:>8} {s['plans_valid']:>7}/{e:<3} {s['goal_reached']:>4}/{e:<4} "
-            f"{s['moves_ok']:>6}/{s['moves']:<6} {s['replans']:>7} {s['disturbed']:>9} "
-            f"{s['wall_per_move_s']:>8.2f}s {s['sim_per_move_s']:>7.2f}s "
-            f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):>6.1f}"
-        )
+        valid = "-" if s["plans_valid"] is None else f"{s['plans_valid']}/{e}"
+        body.append([
+            sim, e, valid, f"{s['executed_valid']}/{e}", f"{s['goal_reached']}/{e}",
+            f"{s['moves_ok']}/{s['moves']}", s["replans"], s["disturbed"],
+            f"{s['wall_per_move_s']:.2f}s", f"{s['sim_per_move_s']:.2f}s",
+            f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):.1f}",
+        ])  # fmt: skip
+    lines = [table(head, body, indent="")]
     lines.append("")
     for sim, s in rows.items():
         kinds = ", ".join(f"{k} {v}" for k, v in sorted(s["failures"].items())) or "none"
@@ -118,18 +125,46 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
 
 
 def perception_table(summaries: list[dict]) -> str:
-    head = f"{'mode':<10} {'blur':>4} {'T':>2} {'valid':>9} {'optimal':>8} {'s/inst':>7}  notes"
-    lines = [head, "-" * len(head)]
+    """One row per (mode, crisp protocol, blur, horizon); a ``crisp`` column when rows differ in
+    it. redrawn: images the row used that were re-rendered because a block was hidden."""
+    crisp = len({s.get("crisp", "true") for s in summaries}) > 1
+    head = ["mode", *(["crisp"] if crisp else []), "blur", "T", "valid", "optimal", "inexec.",
+            "non-goal", "no plan", "redrawn", "s/inst", "notes"]  # fmt: skip
+    rows = []
     for s in summaries:
-        opt = 100.0 * s["optimal"] / max(s["valid"], 1)
+        pct = s.get("optimal_pct", 100.0 * s["optimal"] / max(s["valid"], 1))
         notes = []
         if s["goal_misread"]:
             notes.append(f"{s['goal_misread']} goal images misread")
         if s["perception_errors"]:
             notes.append(f"{s['perception_errors']} blocks not found")
-        lines.append(
-            f"{s['mode']:<10} {s['blur']:>4} {s['horizon']:>2} "
-            f"{s['valid']:>4}/{s['n']:<4} {opt:>7.1f}% {s['time_s_per_instance']:>7.3f}  "
-            + "; ".join(notes)
-        )
-    return "\n".join(lines)
+        if s.get("misread_windows"):
+            notes.append(f"{s['misread_windows']} windows decoded against a misread state")
+        rows.append([
+            s["mode"], *([s.get("crisp", "true")] if crisp else []), s["blur"], s["horizon"],
+            f"{s['valid']}/{s['n']}", "-" if pct is None else f"{pct:.1f}%",
+            s.get("inexecutable", 0), s.get("non_goal_reaching", 0), s.get("no_plan", 0),
+            s.get("redrawn", 0), f"{s['time_s_per_instance']:.3f}", "; ".join(notes),
+        ])  # fmt: skip
+    return table(head, rows, indent="")
+
+
+def poses_table(summary: dict[str, dict]) -> str:
+    """The pose benchmark: per simulator and split (all, top face free, covered), the blocks
+    estimated, position error (mm) and yaw error (degrees, modulo 90)."""
+    head = ["sim", "blocks", "estimated", "pos mean", "median", "p95", "max mm",
+            "yaw mean", "median", "p95", "max deg"]  # fmt: skip
+    rows = []
+    for sim, by_split in summary.items():
+        for split in ("all", "top", "covered"):
+            s = by_split[split]
+            pos, yaw = s["position_mm"], s["yaw_deg"]
+            cells = [
+                f"{v[k]:.2f}" if v is not None else "-"
+                for v in (pos, yaw)
+                for k in ("mean", "median", "p95", "max")
+            ]
+            name = sim if split == "all" else ""
+            label = {"all": "all", "top": "top free", "covered": "covered"}[split]
+            rows.append([name, label, f"{s['estimated']}/{s['blocks']}", *cells])
+    return table(head, rows, indent="")

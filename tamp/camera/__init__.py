@@ -4,6 +4,8 @@
 - ``dataset``: randomised rendered scenes labelled with their supports (perception training data);
 - ``from_images``: soft beliefs for the planner from camera images (frozen or
   planning-optimised perception).
+- ``geometry``: pinhole geometry of a camera (intrinsics, pose, projection, back-projection);
+- ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on.
 
 The image -> soft-state model itself lives in `perception` and never sees a simulator.
 """

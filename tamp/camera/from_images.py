@@ -15,10 +15,14 @@ Three modes, for every planning entry point that takes a ``PerceptionMode``:
   ``adapt="all"`` also updates the backbone and reruns it on both images at every step (see
   BENCHMARKS.md for what that costs).
 
-The crisp side is the paper's: decoded moves are checked against the true symbolic state. The
-goal the planner stops at is the *perceived* goal scene (the most likely valid state under the
-trained model's reading of the goal image, every block's support), so a misread goal image
-gives a plan that fails validation against the PDDL goal; it is never corrected from the PDDL.
+Two crisp protocols (``crisp``). ``true``, the paper's: decoded moves are checked against the
+true symbolic state. ``perceived``, a robot without an oracle: each window's moves are checked
+against the most likely valid state read from the current image by the trained weights
+(`perceived_state`), then applied to the world, where a move that is illegal ends the plan as
+inexecutable (`task.beliefs`). The goal the planner stops at is the *perceived* goal scene
+(the most likely valid state under the trained model's reading of the goal image, every block's
+support), so a misread goal image gives a plan that fails validation against the PDDL goal; it
+is never corrected from the PDDL.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ from task.problem import Problem
 
 MODES = ("state", "frozen", "optimised")
 ADAPT = ("head", "all")
+CRISP = ("true", "perceived")  # what decoded moves are checked against: the truth, the image
 
 Observe = Callable[[int, State], np.ndarray]  # (problem index, true state) -> RGB image
 
@@ -55,23 +60,28 @@ class PerceptionMode:
     kl_weight: float = 10.0  # weight of each KL anchor (chosen on the 100-subset, BENCHMARKS.md)
     blur: int = 0  # Gaussian blur radius (pixels) applied to every image; 0 = clear
     adapt: str = "head"  # which weights ``optimised`` updates: "head" or "all"
+    crisp: str = "true"  # decode against the true state (the paper's) or the "perceived" one
 
     def __post_init__(self) -> None:
         if self.mode not in MODES:
             raise TampError(f"unknown perception mode {one_of(self.mode, MODES)}")
         if self.adapt not in ADAPT:
             raise TampError(f"unknown adapt setting {one_of(self.adapt, ADAPT)}")
+        if self.crisp not in CRISP:
+            raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
+        if self.mode == "state" and self.crisp != "true":
+            raise TampError("perception mode 'state' reads no image: it needs crisp 'true'")
         if self.lr <= 0 or self.kl_weight < 0 or self.blur < 0:
             raise TampError("PerceptionMode needs lr > 0, kl_weight >= 0 and blur >= 0")
 
 
 class _Frozen:
-    """Soft inputs computed once, no parameters."""
+    """Soft inputs computed once, no parameters; ``crisp_states`` see `task.beliefs`."""
 
     lr = 0.0
 
-    def __init__(self, F0: Tensor, goal: Tensor) -> None:
-        self.F0, self.goal = F0, goal
+    def __init__(self, F0: Tensor, goal: Tensor, crisp_states=None) -> None:
+        self.F0, self.goal, self.crisp_states = F0, goal, crisp_states
 
     def compute(self):
         return self.F0, self.goal, self.F0.new_zeros(self.F0.shape[0])
@@ -87,9 +97,11 @@ class _Adapted:
     the problem's own (adapted) backbone every step.
     """
 
-    def __init__(self, models, inputs, features, anchors, mode: PerceptionMode) -> None:
+    def __init__(
+        self, models, inputs, features, anchors, mode: PerceptionMode, crisp_states=None
+    ) -> None:
         self.models, self.inputs, self.features, self.anchors = models, inputs, features, anchors
-        self.mode = mode
+        self.mode, self.crisp_states = mode, crisp_states
         self.lr, self.kl_weight = mode.lr, mode.kl_weight
 
     def compute(self):
@@ -118,6 +130,8 @@ class ImageBeliefs:
 
     ``observe(i, state)`` returns the current camera image of problem i (whose true state is
     ``state``); ``goal_images[i]`` is its goal image. Images are blurred per ``mode.blur``.
+    With ``mode.crisp == "perceived"`` each window also gives the planner the most likely valid
+    state of the current image under the trained weights (``crisp_states``).
     """
 
     def __init__(
@@ -152,10 +166,16 @@ class ImageBeliefs:
                 model.head(f, boxes, mask, images.shape[-2:])
                 for f, (images, boxes, mask) in zip(features, inputs, strict=True)
             ]
+        crisp = None
+        if self.mode.crisp == "perceived":  # (N, Y) reading of the current image per problem
+            crisp = [
+                most_likely_state(self.problems[i], a[0])
+                for i, a in zip(indices, anchors, strict=True)
+            ]
         self.perception_s += time.perf_counter() - t0
         if self.mode.mode == "frozen":
             return _Frozen(
-                torch.stack([a[0] for a in anchors]), torch.stack([a[1] for a in anchors])
+                torch.stack([a[0] for a in anchors]), torch.stack([a[1] for a in anchors]), crisp
             )
         models = []
         for _ in indices:  # a fresh copy of the trained weights for every problem and window
@@ -166,7 +186,7 @@ class ImageBeliefs:
             models.append(model)
         if self.mode.adapt == "all":
             features = [None] * len(inputs)  # each step reruns the adapted backbone
-        return _Adapted(models, inputs, features, anchors, self.mode)
+        return _Adapted(models, inputs, features, anchors, self.mode, crisp)
 
 
 def perceived_goal(

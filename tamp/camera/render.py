@@ -90,6 +90,21 @@ class StateRenderer:
         ``seed`` picks the tower slots and jitter (`tamp.scene.layout`); ``colours`` gives the
         palette index of each entity (default 0, 1, 2, ...).
         """
+        self.place(entities, state, seed, colours, camera, lighting, scene)
+        return self.sim.render()
+
+    def place(
+        self,
+        entities: Sequence[str],
+        state: Sequence[str],
+        seed: int = 0,
+        colours: Sequence[int] | None = None,
+        camera: Camera | None = None,
+        lighting: Lighting = Lighting(),
+        scene: SceneConfig | None = None,
+    ) -> dict[str, Pose]:
+        """Set up the view of `render` without rendering; returns each entity's true pose (the
+        caller renders with ``self.sim``, e.g. `Simulator.render_rgbd`)."""
         colours = list(range(len(entities))) if colours is None else list(colours)
         if len(entities) > CAMERA_COLOURS:
             raise SceneError(
@@ -106,7 +121,7 @@ class StateRenderer:
         for name, pose in placed.items():
             self.sim.set_block_pose(name, pose)
         self.sim.set_view(camera or self.camera, lighting)
-        return self.sim.render()
+        return poses
 
     def close(self) -> None:
         self.sim.close()

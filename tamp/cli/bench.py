@@ -1,4 +1,5 @@
-"""``tamp bench planbench|random|motion|perception``: options in, `tamp.bench` runs, tables out.
+"""``tamp bench planbench|random|motion|perception|poses``: options in, `tamp.bench` runs, tables
+out.
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
 bar on stderr, prints the paper-style table (`tamp.bench.tables`; the ``results.json`` content
@@ -93,7 +94,7 @@ def motion_command(args: argparse.Namespace) -> int:
         "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
                    "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
                    "observe": base.observe, "perception": base.perception.mode,
-                   "blur": base.perception.blur},
+                   "blur": base.perception.blur, "crisp": base.crisp},
         "machine": results.machine(),
         "ik_batch": result.ik,
         "summary": result.summary,
@@ -109,7 +110,7 @@ def motion_command(args: argparse.Namespace) -> int:
     seen = base.observe + (f" ({base.perception.mode} perception)" if base.observe == "camera"
                            else "")  # fmt: skip
     print(f"motion benchmark: {len(suite.instances)} PlanBench instances, grasp {base.grasp}, "
-          f"observe {seen}, faults {inject}, seed {args.seed}")  # fmt: skip
+          f"observe {seen}, crisp {base.crisp}, faults {inject}, seed {args.seed}")  # fmt: skip
     print(tables.motion_table(result.summary, inject))
     ik = result.ik
     print(f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
@@ -128,19 +129,21 @@ def perception_command(args: argparse.Namespace) -> int:
     from tamp.bench import perception as bench
     from tamp.camera.from_images import PerceptionMode
 
-    names = bench.parse_modes(args.modes)
+    names, crisps = bench.parse_modes(args.modes), bench.parse_crisp(args.crisp)
     torch.set_num_threads(args.threads)
     suite = suites.planbench(args.data, args.n)
     chosen = list(suite.instances)
     perceiver = Perceiver.load(args.checkpoint)
     config = planner_config(args)
     horizons = args.horizons or (config.horizon,)
-    modes = [
-        PerceptionMode(m, kl_weight=args.kl_weight, blur=r, adapt=args.adapt)
+    modes = [  # ground truth (no images) once, as crisp "true"
+        PerceptionMode(m, kl_weight=args.kl_weight, blur=r, adapt=args.adapt,
+                       crisp="true" if m == "state" else c)
         for r in args.blur
         for m in names
-        if not (m == "state" and r != args.blur[0])
-    ]
+        for c in crisps
+        if not (m == "state" and (r != args.blur[0] or c != crisps[0]))
+    ]  # fmt: skip
     with tqdm(total=len(modes) * len(horizons), desc="perception bench", unit="row",
               file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
         started = []
@@ -177,4 +180,39 @@ def perception_command(args: argparse.Namespace) -> int:
         print(tables.perception_table(list(result.summaries)))
         if result.redrawn:
             print(f"{result.redrawn} renders redrawn because a block was hidden")
+    return 0
+
+
+def poses_command(args: argparse.Namespace) -> int:
+    """Block poses from RGB-D images of ``--n`` random scenes in each ``--sim``, against truth."""
+    from tamp.bench import poses
+
+    sims = poses.parse_sims(args.sim)
+    with tqdm(total=args.n * len(sims), desc="poses", unit="scene", file=sys.stderr,
+              disable=not args.progress) as bar:  # fmt: skip
+        result = poses.run(sims, args.n, args.seed, args.min_blocks, args.max_blocks,
+                           args.jitter, lambda sim: bar.update(1))  # fmt: skip
+    body = {
+        "config": {"sims": list(sims), "n": args.n, "seed": args.seed,
+                   "blocks": [args.min_blocks, args.max_blocks], "jitter": args.jitter},
+        "machine": results.machine(),
+        "summary": result.summary,
+    }  # fmt: skip
+    if args.out:
+        out = results.out_folder(args.out)
+        results.write_json(out / "results.json", body)
+        results.write_csv(out / "blocks.csv", poses.block_rows(result), digits=3)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    view = "random camera and light" if args.jitter else "default camera and light"
+    print(f"pose benchmark: {args.n} scenes of {args.min_blocks}-{args.max_blocks} blocks per "
+          f"simulator, {view}, seed {args.seed}; errors against the true poses")  # fmt: skip
+    print(tables.poses_table(result.summary))
+    times = ", ".join(f"{sim} {s['estimate_ms_per_image']:.0f} ms" for sim, s in
+                      result.summary.items())  # fmt: skip
+    print(f"estimation per image: {times}; yaw modulo 90 degrees; top free: nothing rests on "
+          f"the block; covered: its top face is under another block")  # fmt: skip
+    if args.out:
+        print(f"wrote results.json, blocks.csv to {args.out}")
     return 0

@@ -14,7 +14,9 @@ from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains.blocksworld import GOAL_LOSSES
 
-_OVERRIDES = ("horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end")
+_OVERRIDES = (
+    "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
+)  # fmt: skip
 
 
 def planner_config(args: argparse.Namespace) -> PlannerConfig:
@@ -166,3 +168,6 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
                    help="camera: Gaussian blur radius in pixels (0)")  # fmt: skip
     p.add_argument("--checkpoint", metavar="FILE.pt",
                    help="camera: perception weights (perception/support.pt)")  # fmt: skip
+    p.add_argument("--crisp", choices=("perceived", "true"), default="perceived",
+                   help="decode moves against the observed state, or the simulator's true "
+                   "state (an oracle) (perceived)")  # fmt: skip

@@ -38,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     _planning_benchmarks(bench, bench_opts)
     _motion_benchmark(bench, plan_opts)
     _perception_benchmark(bench, bench_opts)
+    _poses_benchmark(bench)
     _perception_commands(sub)
     return parser
 
@@ -93,6 +94,11 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             metavar="N",
             help="also time batched vs sequential planning on the first N instances",
         )
+        p.add_argument(
+            "--no-crisp-check", dest="crisp_check", action="store_false",
+            help="keep a window's strongest move even when it is illegal (the plan is then "
+            "inexecutable); measures the soft planner without the decoder's legality filter",
+        )  # fmt: skip
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
@@ -148,6 +154,9 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
                    help="state (ground truth), frozen, optimised (all three)")  # fmt: skip
     p.add_argument("--blur", type=radius_list, default=(0,), metavar="R[,R...]",
                    help="Gaussian blur radii in pixels, 0 = clear (0)")  # fmt: skip
+    p.add_argument("--crisp", default="true", metavar="C[,C...]",
+                   help="what decoded moves are checked against: true (the true state, the "
+                   "paper's) and/or perceived (the state read from the image) (true)")  # fmt: skip
     p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
     p.add_argument(
         "--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt",
@@ -163,6 +172,22 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json, instances.csv and example.png into this folder")
     p.set_defaults(func=_lazy("tamp.cli.bench", "perception_command"))
+
+
+def _poses_benchmark(bench) -> None:
+    p = bench.add_parser("poses", help="block poses from RGB-D images against the true poses")
+    p.add_argument("--sim", default=",".join(SIMULATORS), metavar="SIM[,SIM]",
+                   help=f"simulators, comma-separated ({','.join(SIMULATORS)})")  # fmt: skip
+    p.add_argument("--n", type=positive, default=200, help="random scenes per simulator (200)")
+    p.add_argument("--seed", type=int, default=0, help="scene seed (0)")
+    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
+    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument(
+        "--jitter", action="store_true", help="random camera and light, as in perception dataset"
+    )
+    progress_option(p)
+    output_options(p, "write results.json and blocks.csv into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.bench", "poses_command"))
 
 
 def _perception_commands(sub) -> None:

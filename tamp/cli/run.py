@@ -45,6 +45,7 @@ def loop_config(args: argparse.Namespace) -> LoopConfig:
         observe=args.observe,
         perception=PerceptionMode(args.perception, blur=args.blur),
         checkpoint=args.checkpoint,
+        crisp=args.crisp,
     )
     if args.max_replans is not None:
         config = replace(config, max_replans=args.max_replans)

@@ -4,8 +4,13 @@
   `run_episode`;
 - ``config``: `LoopConfig`, the settings of an episode;
 - ``report``: `EpisodeStatus` and `EpisodeReport`, what an episode returns;
-- ``observe``: what the robot senses (block poses with noise, or the camera);
+- ``observe``: what the robot senses: block poses (for the arm) and the symbolic state (for the
+  planner), from the mocap oracle or from the camera;
+- ``sensors``: the two pose sensors, `MocapPoses` (``observe="state"`` only: the one sensor whose
+  reading is ground truth, plus optional noise) and `CameraPoses` (RGB-D pose estimation);
 - ``execute``: one move as a pick-and-place, with its robot-side checks and failure kinds;
+- ``score``: `Scorer`, the only reader of simulator ground truth in the loop (the goal check and
+  disturbed stacks); an episode locks ``sim.truth`` for the rest;
 - ``recover``: tidying loose blocks, injected nudges, failure descriptions;
 - ``faults``: fault injection settings (drop, nudge, noise).
 """

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tamp.camera.from_images import PerceptionMode
+from tamp.camera.from_images import CRISP, PerceptionMode
 from tamp.loop.execute import ExecConfig
 from tamp.loop.faults import Injection
 from tamp.scene import SceneConfig
@@ -19,7 +19,10 @@ OBSERVE = ("state", "camera")
 @dataclass(frozen=True)
 class LoopConfig:
     """Settings of an episode. ``grasp``: 'friction' (physical) or 'weld' (attach);
-    ``observe``: 'state' (block poses) or 'camera' (perception of the camera image)."""
+    ``observe``: 'state' (block poses) or 'camera' (perception of the camera image);
+    ``crisp``: what decoded moves are checked against, 'perceived' (the observed state, what a
+    robot has) or 'true' (simulator ground truth, an oracle variant). The loop sets its own
+    planning basis, so ``perception.crisp`` is not used here."""
 
     sim: str = "pybullet"
     grasp: str = "friction"
@@ -34,9 +37,12 @@ class LoopConfig:
     observe: str = "state"
     perception: PerceptionMode = PerceptionMode()  # camera only: frozen or optimised
     checkpoint: str | None = None  # camera only: perception weights (None: the shipped ones)
+    crisp: str = "perceived"  # decode against the observed state; "true": against the truth
 
     def __post_init__(self) -> None:
         if self.observe not in OBSERVE:
             raise TampError(f"unknown observation {one_of(self.observe, OBSERVE)}")
+        if self.crisp not in CRISP:
+            raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
         if self.observe == "camera" and self.perception.mode == "state":
             raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

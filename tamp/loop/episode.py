@@ -4,8 +4,10 @@ An episode lays out the problem's initial state, plans with the soft-T_P planner
 the plan move by move. After each move it observes (`tamp.loop.observe`) and reads the symbolic
 state. A failed move, or a state that differs from the one the plan expected, triggers a
 replan from the observed state (SS-Replan style: execute one action, observe, check); the
-number of replans is bounded. Ground truth is read only to count disturbed stacks and, at the
-end, to score the episode.
+number of replans is bounded. The episode locks the simulator's ground truth (``sim.truth``)
+for its whole run: only its `Scorer` (disturbed stacks, the final goal check), the injected
+nudge (the experimenter) and, with ``observe="state"``, the mocap oracle may read it; any other
+read raises `tamp.sim.truth.GroundTruthLeak`.
 
 With ``observe="camera"`` the goal is the perceived goal scene; each planning window starts
 from the soft state perceived in the current image (frozen or planning-optimised perception),
@@ -16,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from contextlib import contextmanager
 
 import numpy as np
@@ -29,7 +31,8 @@ from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
-from tamp.scene import Reading, layout, read_state
+from tamp.loop.score import Scorer
+from tamp.scene import Pose, Reading, layout
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from task.domains import get_domain
@@ -64,6 +67,8 @@ class Episode:
         self.sim = make_simulator(
             config.sim, problem.entities, poses, config.scene, config.grasp, config.camera
         )
+        self.sim.truth.lock()  # simulator ground truth only scores episodes
+        self.score = Scorer(self.sim.truth, problem, config.scene)
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
 
     def belief_lines(self) -> list[str]:
@@ -83,8 +88,7 @@ class Episode:
             self._first_observation(p)
             while not p.stopped and not self.domain.is_goal(self.target, p.state):
                 self._step(p)
-            truth = self._true_state()
-            reached = truth is not None and self.domain.is_goal(self.problem, truth)
+            reached = self.score.reached(self.domain)
         finally:
             self.sim.close()
         return p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
@@ -107,7 +111,8 @@ class Episode:
             p.stop(EpisodeStatus.REPLAN_BUDGET, f"{self.config.max_moves} moves used")
             return
         move = p.queue.pop(0)
-        expected = self.domain.apply_move(self.problem, p.state, move)
+        expected = self.domain.apply_move(self.problem, p.planned, move)
+        p.planned = expected
         done = self._execute_next(p, move)
         self._check(p, move, done, expected)
 
@@ -115,20 +120,32 @@ class Episode:
         """Plan from the observed state and queue its moves; False when there is none to run
         (no plan: a stop, or with the camera a stalled window that is planned again)."""
         t0 = time.perf_counter()
-        result = self._plan_window(p.state, self.seed + len(p.plans))
+        basis = self._crisp_basis(p.state)
+        result = self._plan_window(basis, self.seed + len(p.plans))
         p.plan_time += time.perf_counter() - t0
         p.plans.append(tuple(str(m) for m in result.plan))
         if len(p.plans) == 1:
-            p.first_solved = result.solved
+            p.first_solved, p.first_plan = result.solved, result.plan.moves
         window = self.config.observe == "camera" and len(result.plan) > 0
         p.stalls = 0 if window or result.solved else p.stalls + 1
         if not (result.solved or window):
             if self.config.observe == "state" or p.stalls > self.config.max_replans:
                 p.stop(EpisodeStatus.NO_PLAN, "the planner found no plan")
             return False
-        p.queue = list(result.plan)
+        p.queue, p.planned = list(result.plan), basis
         self.say(f"plan {len(p.plans)}: {len(p.queue)} moves")
         return True
+
+    def _crisp_basis(self, observed):
+        """The state decoded moves are checked against: the observed one (``crisp="perceived"``,
+        the default: a robot has no oracle) or, with ``crisp="true"``, the simulator's true
+        state, read through ``GroundTruth.oracle()`` (the observed one if the truth forms no
+        state)."""
+        if self.config.crisp != "true":
+            return observed
+        with self.sim.truth.oracle():
+            truth = self.sim.truth.state(self.problem.entities, self.config.scene)
+        return observed if truth is None else truth
 
     def _plan_window(self, state, seed: int):
         """Plan from ``state``; with the camera, one window from the current image."""
@@ -136,10 +153,10 @@ class Episode:
         if self.config.observe == "state":
             return plan(current, self.config.planner, seed=seed)
         image = self.eyes.image
+        mode = dataclasses.replace(self.config.perception, crisp="true")  # checked against init
         beliefs = ImageBeliefs(
-            [current], self.eyes.perceiver, lambda i, s: image, [self.goal_image],
-            self.config.perception,
-        )  # fmt: skip
+            [current], self.eyes.perceiver, lambda i, s: image, [self.goal_image], mode
+        )
         window = dataclasses.replace(self.config.planner, max_windows=1)
         return plan(current, window, seed=seed, beliefs=beliefs)
 
@@ -149,7 +166,7 @@ class Episode:
         inject, k = self.config.inject, len(p.moves)
         drop = draw(self.rng, inject.drop) or k in inject.drop_moves
         drop_at = float(self.rng.uniform(0.2, 0.8)) if drop else None
-        before = self._true_state()
+        before = self.score.state()
         done = self._act(move, f"{move}", drop_at)
         if done.evidence.get("injected"):  # drawn, and the move reached its transit
             p.faults.append(f"drop@{k}")
@@ -159,7 +176,7 @@ class Episode:
             p.faults.append(f"nudge@{k}")
         p.moves.append(done)
         self._settle()
-        p.disturbed += _others_moved(self.problem.entities, move, before, self._true_state())
+        p.disturbed += self.score.disturbed(move, before)
         return done
 
     def _check(self, p: Progress, move: Move, done: ExecutionResult, expected) -> None:
@@ -195,31 +212,21 @@ class Episode:
         self.status_text = label
         cfg = self.config
         return execute_move(
-            self.sim, self.solver, move, self.eyes.poses, cfg.execution, cfg.scene, drop_at,
+            self.sim, self.solver, move, self._poses, cfg.execution, cfg.scene, drop_at,
             self.on_frame,
         )  # fmt: skip
 
     def _settle(self) -> None:
         self.eyes.settle(self.on_frame)
 
+    def _poses(self) -> dict[str, Pose]:
+        return self.eyes.poses(self.on_frame, self._show)
+
     def _read(self) -> Reading:
         return self.eyes.read(self.on_frame, self._show)
 
     def _show(self, text: str) -> None:
         self.status_text = text
-
-    def _true_state(self) -> tuple[str, ...] | None:
-        """Ground truth: the state the simulator's block poses form (None when unreadable)."""
-        return read_state(self.problem.entities, self.sim.block_poses(), self.config.scene).state
-
-
-def _others_moved(
-    entities: Sequence[str], move: Move, before: tuple | None, after: tuple | None
-) -> bool:
-    """A block other than the moved one changed support (False when a state is unreadable)."""
-    if before is None or after is None:
-        return False
-    return any(x != move.entity and before[i] != after[i] for i, x in enumerate(entities))
 
 
 @contextmanager

@@ -1,9 +1,13 @@
 """Execute one relational move as a pick-and-place and detect how it failed.
 
-Failure detection uses signals a real robot has: the finger width against the block width,
-contact on both fingers, a check after the lift and after the transit (is the block still
-between the fingers?), and a post-place check of the observed block pose. The simulator's
-ground truth is not used here; `tamp.loop.episode` uses it only to score episodes.
+Failure detection uses signals a real robot has: the finger opening against the block width,
+contact force on both fingers (from whatever they touch: a fingertip sensor cannot tell what it
+holds), a check after the lift and after the transit (are the fingers still held apart by a
+block-wide object?), and a post-place check of the observed block pose. Every pose comes from
+``observe``: the motion-capture oracle with ``observe="state"``, the depth camera with
+``observe="camera"`` (`tamp.loop.observe.Observer.poses`). When the camera cannot see a block
+the move needs, even from home, the move fails as ``unobservable``. The simulator's ground
+truth is not read here (an episode locks it; `tamp.loop.score` alone scores).
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import numpy as np
 from motion.ik import IKSolver
 from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
 from motion.trajectory import JointTrajectory
+from perception.errors import PerceptionError
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Simulator
 from task.problem import Move
@@ -32,6 +37,7 @@ class Failure(enum.Enum):
     DROPPED = "dropped"  # the block left the fingers after the lift
     MISPLACED = "misplaced"  # after release the block is not where it was to be placed
     TRACKING = "tracking_error"  # the arm could not follow its trajectory (blocked)
+    UNOBSERVABLE = "unobservable"  # the camera could not see a block the move needs, from home
 
 
 @dataclass(frozen=True)
@@ -59,12 +65,13 @@ class ExecutionResult:
     ik_time_s: float = 0.0
 
 
-Observe = Callable[[], dict[str, Pose]]
+Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
 
 
-def _holding(sim: Simulator, block: str, config: ExecConfig, fresh: bool) -> dict | None:
-    """None when the fingers hold ``block``; otherwise the evidence that they do not."""
-    r = sim.gripper(block)
+def _holding(sim: Simulator, config: ExecConfig, fresh: bool) -> dict | None:
+    """None when the fingers hold a block: opened to the block width and, on a fresh grasp,
+    both pushing; otherwise the evidence that they do not."""
+    r = sim.gripper()
     size = config.motion.block_size
     wide = abs(r.width - size) <= config.width_tol
     floor = config.min_force if fresh else 0.0
@@ -116,7 +123,10 @@ def execute_move(
             time.perf_counter() - wall0, ik_time,
         )  # fmt: skip
 
-    poses = observe()
+    try:
+        poses = observe()
+    except PerceptionError as err:
+        return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
     target = place_pose(move, poses, scene)
     if target is None:
         return result(Failure.NO_FREE_SLOT, slots=len(scene.slots))
@@ -139,20 +149,23 @@ def execute_move(
             _back_off(sim, planned.phases, on_frame)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
-            missed = _holding(sim, move.entity, config, fresh=True)
+            missed = _holding(sim, config, fresh=True)
             if missed is not None:
                 _back_off(sim, planned.phases, on_frame)
                 return result(Failure.GRASP_MISSED, ik, **missed)
             if sim.grasp == "weld":
                 sim.attach(move.entity)
         elif phase.name in ("lift", "transit"):
-            gone = _holding(sim, move.entity, config, fresh=False)
+            gone = _holding(sim, config, fresh=False)
             if gone is not None:
                 sim.detach()
                 sim.run(JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt), "open", on_frame=on_frame)
                 injected = release is not None  # the fault injection opened the gripper
                 return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **gone)
-    seen = observe()[move.entity]
+    try:
+        seen = observe()[move.entity]
+    except PerceptionError as err:
+        return result(Failure.UNOBSERVABLE, ik, when="after the place", seen=str(err))
     dxy = float(np.linalg.norm(seen.xy - np.asarray(target.xyz[:2])))
     dz = abs(seen.xyz[2] - target.xyz[2])
     if dxy > config.place_tol_xy or dz > config.place_tol_z:

@@ -1,11 +1,16 @@
-"""What the robot senses: block poses with injected noise, or the camera image read by the
-trained perception model, turned into the symbolic state it plans from.
+"""What the robot senses: block poses (for picking and placing) and the symbolic state it plans
+from, each from the sensor its observation mode has (`tamp.loop.sensors`).
 
-``observe="state"`` reads the state from block poses (`tamp.scene.read_state`).
-``observe="camera"`` reads it from the simulator's camera image (`tamp.camera.from_images`);
-when perception fails while the arm is away from home, the arm may hide a block, so it goes
-home (high above the table) and looks again. The goal, too, is perceived: from a rendered
-completion of the problem's goal (`camera_goal`).
+``observe="state"``: poses from the motion-capture oracle (`MocapPoses`, the one sensor that
+reads simulator ground truth, by design), optionally with injected noise; the state is read
+from them (`tamp.scene.read_state`).
+``observe="camera"``: poses estimated from one RGB-D image per observation (`CameraPoses`);
+the state is read from the camera image by the trained perception model
+(`tamp.camera.from_images`). When the camera cannot see a block while the arm is away from
+home, the arm may hide it, so the arm goes home (high above the table) and looks again; a block
+still unseen from home raises `PerceptionError` for ``poses`` and gives an unreadable state for
+``read``. The goal, too, is perceived: from a rendered completion of the problem's goal
+(`camera_goal`). Nothing here reads ground truth in camera mode.
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ from tamp.camera.from_images import perceived_goal, perceived_state
 from tamp.camera.render import StateRenderer
 from tamp.loop.config import LoopConfig
 from tamp.loop.faults import draw
+from tamp.loop.sensors import CameraPoses, MocapPoses
 from tamp.scene import PALETTE, Pose, Reading, read_state
 from tamp.sim.base import Simulator
 from task.domains.blocksworld_states import complete_goal
@@ -53,8 +59,10 @@ def camera_goal(problem: Problem, config: LoopConfig, seed: int):
 
 
 class Observer:
-    """The robot's senses in ``sim``. Noise draws come from the episode's ``rng``; with the
-    camera, ``image`` and ``perceived`` keep the last image and its soft supports."""
+    """The robot's senses in ``sim``: the pose sensor of ``config.observe`` (the mocap oracle is
+    built only for ``"state"``), and for ``"camera"`` the perception model. Noise draws come
+    from the episode's ``rng``; ``image`` and ``perceived`` keep the last camera image and its
+    soft supports."""
 
     def __init__(
         self,
@@ -69,10 +77,21 @@ class Observer:
         self.target, self.perceiver = target, perceiver
         self.image = None  # camera: the last camera image
         self.perceived = None  # camera: the last perceived soft supports F (N, N + 1)
+        if config.observe == "state":
+            self.sensor = MocapPoses(sim)
+        else:
+            self.sensor = CameraPoses(sim, problem.entities, config.scene)
 
-    def poses(self) -> dict[str, Pose]:
-        """Block poses as the robot sees them: true poses, plus injected noise."""
-        poses = self.sim.block_poses()
+    def poses(
+        self, on_frame: OnFrame = None, show: Callable[[str], None] = _silent
+    ) -> dict[str, Pose]:
+        """Every block's pose as the robot sees it (plus injected noise): from the mocap oracle,
+        or from the depth camera, going home to look again when a block is hidden. Raises
+        `PerceptionError` when the camera cannot see a block even from home."""
+        if self.config.observe == "state":
+            poses = self.sensor()
+        else:
+            poses = self._look(self.sensor, on_frame, show)
         inj = self.config.inject
         if draw(self.rng, inj.noise):
             noise = self.rng.normal(0.0, inj.noise_sigma, size=(len(poses), 3))
@@ -92,22 +111,31 @@ class Observer:
         ``show`` announces a trip home to look again; ``on_frame`` sees that move."""
         if self.config.observe == "state":
             return read_state(self.problem.entities, self.poses(), self.config.scene)
-        self.image = self.sim.render()
         try:
-            state, F = perceived_state(
-                self.target, self.perceiver, self.image, self.config.perception.blur
-            )
+            state, self.perceived = self._look(self._perceive, on_frame, show)
         except PerceptionError as err:
-            home = np.asarray(PANDA.q_home)
-            if np.abs(self.sim.arm_q() - home).max() < HOME_TOL:
-                return Reading(None, (str(err),))
-            # the arm may hide a block: take it home (high above the table) and look again
-            show("home to look again")
-            self.sim.run(straight_segment(self.sim.arm_q(), home, self.sim.dt), "open",
-                         on_frame=on_frame)  # fmt: skip
-            return self.read(on_frame, show)
-        self.perceived = F
+            return Reading(None, (str(err),))
         return Reading(state)
+
+    def _perceive(self):
+        """One camera image, read by the perception model: (state, soft supports F)."""
+        self.image = self.sim.render()
+        return perceived_state(self.target, self.perceiver, self.image, self.config.perception.blur)
+
+    def _look(self, look: Callable, on_frame: OnFrame, show: Callable[[str], None]):
+        """``look()`` with the camera; when it cannot see a block while the arm is away from
+        home, the arm may hide it: take the arm home (high above the table) and look again.
+        From home, the `PerceptionError` stands."""
+        home = np.asarray(PANDA.q_home)
+        try:
+            return look()
+        except PerceptionError:
+            if np.abs(self.sim.arm_q() - home).max() < HOME_TOL:
+                raise
+        show("home to look again")
+        self.sim.run(straight_segment(self.sim.arm_q(), home, self.sim.dt), "open",
+                     on_frame=on_frame)  # fmt: skip
+        return look()
 
     def belief_lines(self) -> list[str]:
         """The last perceived soft state, one line per block: its most likely support and that

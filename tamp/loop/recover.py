@@ -1,5 +1,9 @@
 """Recovery and its vocabulary: tidying loose blocks, the injected nudge, and one line on why a
-move failed (`describe`), including the give-up test `out_of_reach`."""
+move failed (`describe`), including the give-up test `out_of_reach`.
+
+The nudge is the experimenter's fault, not the robot's act: it reads the pose it perturbs from
+simulator ground truth inside ``GroundTruth.experimenter()`` and teleports the block.
+"""
 
 from __future__ import annotations
 
@@ -33,8 +37,10 @@ def tidy(
 
 def nudge(sim: Simulator, block: str, distance: float, rng: np.random.Generator) -> None:
     """Injected fault: push ``block`` ``distance`` m in a random direction (one draw from
-    ``rng``), off whatever it rests on: it falls to the table next to its support."""
-    pose = sim.block_poses()[block]
+    ``rng``), off whatever it rests on: it falls to the table next to its support. The
+    experimenter reads the block's true pose to do so (``GroundTruth.experimenter()``)."""
+    with sim.truth.experimenter():
+        pose = sim.truth.block_poses()[block]
     angle = rng.uniform(0, 2 * np.pi)
     x, y, z = pose.xyz
     sim.set_block_pose(

@@ -38,10 +38,12 @@ class EpisodeReport:
     plan_time_s: float
     initial_plan_solved: bool = False  # the first task plan reached the goal symbolically
     reason: str = ""
+    first_plan: tuple[Move, ...] = ()  # the first task plan's moves (camera: its first window)
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)
         out["status"] = self.status.value
+        out["first_plan"] = [str(m) for m in self.first_plan]
         out["moves"] = [
             {
                 "move": str(r.move),
@@ -63,10 +65,12 @@ class Progress:
 
     state: tuple[str, ...] | None  # the last observed symbolic state
     first_solved: bool  # the first task plan reached the goal symbolically
+    first_plan: tuple[Move, ...] = ()  # the first task plan's moves
     moves: list[ExecutionResult] = field(default_factory=list)
     plans: list[tuple[str, ...]] = field(default_factory=list)
     faults: list[str] = field(default_factory=list)
     queue: list[Move] = field(default_factory=list)  # the planned moves still to execute
+    planned: tuple[str, ...] | None = None  # the state the queue was planned from, advanced
     replans: int = 0
     disturbed: int = 0
     tidies: int = 0
@@ -87,4 +91,5 @@ class Progress:
             problem, sim, self.status, reached, tuple(self.moves), tuple(self.plans),
             self.replans, tuple(self.faults), self.disturbed, sim_time,
             time.perf_counter() - wall0, self.plan_time, self.first_solved, self.reason,
+            self.first_plan,
         )  # fmt: skip

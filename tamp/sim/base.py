@@ -3,8 +3,9 @@
 A backend owns a world with the Panda, a table and the blocks of a scene. The same
 `motion.trajectory.JointTrajectory` (sampled at the simulator's ``dt`` = 2 ms in both
 backends) drives both: each physics step gets the trajectory's joint targets. What the loop
-may observe is what a real robot has: joint positions, finger width, finger contact forces and
-(in `tamp.observe`) block poses; ground-truth poses are used to score episodes.
+may sense is what a real robot has: joint positions, finger opening and the contact force on
+each finger (from whatever it touches), and camera images. The true block poses sit behind
+``sim.truth`` (`tamp.sim.truth.GroundTruth`), which scores episodes and which an episode locks.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 if TYPE_CHECKING:
     from motion.trajectory import JointTrajectory
 from tamp.scene import Pose, SceneConfig
+from tamp.sim.truth import GroundTruth
 from task.errors import TampError, one_of
 
 SIMULATORS = ("pybullet", "mujoco")
@@ -55,8 +57,9 @@ class Lighting:
 
 @dataclass(frozen=True)
 class GripperReading:
-    """Finger signals: opening between the fingers (m) and normal contact force (N) of each
-    finger on one block."""
+    """What the finger sensors give: the opening between the fingers (m) and the total normal
+    contact force (N) on each finger from anything it touches except the robot itself. A
+    fingertip sensor cannot tell what it touches, so neither can this."""
 
     width: float
     left_force: float
@@ -86,6 +89,7 @@ class Simulator(abc.ABC):
         self.lighting = Lighting()
         self.time = 0.0
         self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
+        self.truth = GroundTruth(self._block_poses)  # scoring only; see tamp.sim.truth
 
     # --- what a backend implements -------------------------------------------------------
     @abc.abstractmethod
@@ -101,12 +105,13 @@ class Simulator(abc.ABC):
         """Measured arm joint positions (J,)."""
 
     @abc.abstractmethod
-    def gripper(self, block: str) -> GripperReading:
-        """Finger width and the contact force of each finger on ``block``."""
+    def gripper(self) -> GripperReading:
+        """Finger opening and the normal contact force on each finger from anything but the
+        robot (the finger sensors)."""
 
     @abc.abstractmethod
-    def block_poses(self) -> dict[str, Pose]:
-        """Ground-truth block poses (centre, yaw)."""
+    def _block_poses(self) -> dict[str, Pose]:
+        """Ground-truth block poses (centre, yaw); read them through ``self.truth`` only."""
 
     @abc.abstractmethod
     def set_block_pose(self, block: str, pose: Pose) -> None:
@@ -123,6 +128,15 @@ class Simulator(abc.ABC):
     @abc.abstractmethod
     def render(self) -> np.ndarray:
         """An RGB image (H, W, 3) uint8 from ``camera``."""
+
+    @abc.abstractmethod
+    def render_rgbd(self) -> tuple[np.ndarray, np.ndarray]:
+        """An RGB image (H, W, 3) uint8, as `render` gives it, and its depth (H, W) float32.
+
+        Depth is z-depth in metres: the distance from the camera's eye along its optical axis
+        (eye -> target), not the length of the ray through the pixel. Pixels that see nothing
+        read the backend's far plane. `tamp.camera.geometry.backproject` turns it into points.
+        """
 
     @abc.abstractmethod
     def set_view(self, camera: Camera, lighting: Lighting) -> None:

@@ -103,24 +103,25 @@ class MuJoCoSim(Simulator):
     def arm_q(self) -> np.ndarray:
         return self.data.qpos[self._arm_q].copy()
 
-    def gripper(self, block: str) -> GripperReading:
+    def gripper(self) -> GripperReading:
         m, d = self.model, self.data
-        target = self._block_ids[block]
+        robot = m.body_rootid[self._hand]  # every Panda body shares this root
         forces = [0.0, 0.0]
         f6 = np.zeros(6)
         for i in range(d.ncon):
             con = d.contact[i]
             bodies = (m.geom_bodyid[con.geom1], m.geom_bodyid[con.geom2])
-            if target not in bodies:
-                continue
             for k, finger in enumerate(self._finger_ids):
-                if finger in bodies:
+                if finger not in bodies:
+                    continue
+                other = bodies[1] if bodies[0] == finger else bodies[0]
+                if m.body_rootid[other] != robot:  # any contact but the robot's own links
                     mujoco.mj_contactForce(m, d, i, f6)
                     forces[k] += abs(f6[0])
         width = float(d.qpos[self._fingers].sum())
         return GripperReading(width, forces[0], forces[1])
 
-    def block_poses(self) -> dict[str, Pose]:
+    def _block_poses(self) -> dict[str, Pose]:
         out = {}
         for name, adr in self._block_q.items():
             pos = self.data.qpos[adr : adr + 3]
@@ -168,12 +169,31 @@ class MuJoCoSim(Simulator):
         sun.diffuse[:] = lighting.diffuse
         m.vis.headlight.ambient[:] = lighting.ambient
         m.vis.headlight.diffuse[:] = 0.1
+        # renders read the world poses of cameras and lights (cam_xpos, light_xdir), which
+        # only the kinematics pass recomputes: without this the view lags one set_view behind
+        mujoco.mj_camlight(m, self.data)
 
     def render(self) -> np.ndarray:
+        return self._scene_renderer().render().copy()
+
+    def render_rgbd(self) -> tuple[np.ndarray, np.ndarray]:
+        # the classic Renderer undoes the projection itself: float32 z-depth in metres along
+        # the optical axis (checked against the table plane in tests/tamp/camera)
+        renderer = self._scene_renderer()
+        rgb = renderer.render().copy()
+        renderer.enable_depth_rendering()
+        try:
+            depth = renderer.render().copy()
+        finally:
+            renderer.disable_depth_rendering()
+        return rgb, depth
+
+    def _scene_renderer(self) -> mujoco.Renderer:
+        """The offscreen renderer (made on first use) with the scene camera's current view."""
         if self._renderer is None:
             self._renderer = mujoco.Renderer(self.model, self.camera.height, self.camera.width)
         self._renderer.update_scene(self.data, camera="scene")
-        return self._renderer.render().copy()
+        return self._renderer
 
     def close(self) -> None:
         if self._renderer is not None:

@@ -17,10 +17,27 @@ from tamp.sim.base import Camera, GripperReading, Lighting, Simulator
 
 FINGER_FORCE = 40.0  # N per finger
 ARM_KP, ARM_KD = 0.3, 1.0  # PyBullet position-control gains
+NEAR, FAR = 0.05, 3.0  # m, the camera's clipping planes
+EDGE = 1.02  # depths this far apart (ratio) in a 2x2 window straddle an edge: not interpolated
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
     return p.getQuaternionFromEuler((0.0, 0.0, yaw))
+
+
+def _at_pixel_centres(z: np.ndarray) -> np.ndarray:
+    """z-depth (H, W) at the pinhole's pixel centres from ``ER_TINY_RENDERER``'s samples.
+
+    TINY samples pixel (u, v) at (u - 1/2, v + 1/2) of the pinhole model (measured against the
+    table plane and a box face), so the centre of (u, v) lies midway between the samples of
+    (u, v), (u + 1, v), (u, v - 1) and (u + 1, v - 1). On one surface 1/z is affine in the image,
+    so their mean 1/z is exact there; across an edge pixel (u, v) keeps its own sample, as the
+    RGB image does.
+    """
+    inv = np.pad(1.0 / z, ((1, 0), (0, 1)), mode="edge")  # (H + 1, W + 1): row -1, column W
+    quad = np.stack([inv[1:, :-1], inv[1:, 1:], inv[:-1, :-1], inv[:-1, 1:]])  # (4, H, W)
+    smooth = quad.max(0) <= EDGE * quad.min(0)
+    return np.where(smooth, 1.0 / quad.mean(0), z)
 
 
 class PyBulletSim(Simulator):
@@ -82,21 +99,21 @@ class PyBulletSim(Simulator):
         states = p.getJointStates(self.robot.body, self.robot.arm, physicsClientId=self.client)
         return np.array([s[0] for s in states])
 
-    def gripper(self, block: str) -> GripperReading:
+    def gripper(self) -> GripperReading:
         r, c = self.robot, self.client
         width = sum(s[0] for s in p.getJointStates(r.body, r.fingers, physicsClientId=c))
+        # every contact on the finger link, from any body but the robot (pt[2]: the other body)
         forces = [
             sum(
                 pt[9]
-                for pt in p.getContactPoints(
-                    r.body, self.blocks[block], linkIndexA=link, physicsClientId=c
-                )
+                for pt in p.getContactPoints(r.body, linkIndexA=link, physicsClientId=c)
+                if pt[2] != r.body
             )
             for link in r.fingers
         ]
         return GripperReading(width, forces[0], forces[1])
 
-    def block_poses(self) -> dict[str, Pose]:
+    def _block_poses(self) -> dict[str, Pose]:
         out = {}
         for name, body in self.blocks.items():
             pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
@@ -133,18 +150,29 @@ class PyBulletSim(Simulator):
         self.camera, self.lighting = camera, lighting
         self._view = p.computeViewMatrix(camera.eye, camera.target, camera.up, physicsClientId=c)
         self._proj = p.computeProjectionMatrixFOV(
-            camera.fovy, camera.width / camera.height, 0.05, 3.0, physicsClientId=c
+            camera.fovy, camera.width / camera.height, NEAR, FAR, physicsClientId=c
         )
 
     def render(self) -> np.ndarray:
+        return self._camera_image()[0]
+
+    def render_rgbd(self) -> tuple[np.ndarray, np.ndarray]:
+        rgb, buffer = self._camera_image()
+        # the OpenGL depth buffer d in [0, 1] -> z-depth: z = far near / (far - (far - near) d)
+        depth = FAR * NEAR / (FAR - (FAR - NEAR) * buffer.astype(np.float64))
+        return rgb, _at_pixel_centres(depth).astype(np.float32)
+
+    def _camera_image(self) -> tuple[np.ndarray, np.ndarray]:
+        """RGB (H, W, 3) uint8 and the raw depth buffer (H, W) in [0, 1]."""
         cam, light = self.camera, self.lighting
-        _, _, rgb, _, _ = p.getCameraImage(
+        _, _, rgb, buffer, _ = p.getCameraImage(
             cam.width, cam.height, self._view, self._proj, renderer=p.ER_TINY_RENDERER,
             lightDirection=[-v for v in light.direction], lightColor=[1.0, 1.0, 1.0],
             lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
             lightSpecularCoeff=0.05, shadow=0, physicsClientId=self.client,
         )  # fmt: skip
-        return np.asarray(rgb, dtype=np.uint8).reshape(cam.height, cam.width, 4)[..., :3].copy()
+        rgb = np.asarray(rgb, dtype=np.uint8).reshape(cam.height, cam.width, 4)[..., :3].copy()
+        return rgb, np.asarray(buffer, dtype=np.float32).reshape(cam.height, cam.width)
 
     def close(self) -> None:
         if self.client is not None and p.isConnected(self.client):

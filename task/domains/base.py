@@ -114,6 +114,9 @@ class Domain(Protocol):
         """An admissible lower bound on the moves still needed to reach the goal."""
         ...
 
-    def to_actions(self, problem: Problem, moves: Sequence[Move]) -> tuple[Action, ...]:
-        """The domain's PDDL actions for a sequence of relational moves (its PDDL mapping)."""
+    def to_actions(
+        self, problem: Problem, moves: Sequence[Move], strict: bool = True
+    ) -> tuple[Action, ...]:
+        """The domain's PDDL actions for a sequence of relational moves (its PDDL mapping);
+        ``strict=False`` also translates illegal moves, for a validator to find."""
         ...

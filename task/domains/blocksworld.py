@@ -110,12 +110,23 @@ def is_goal(problem: Problem, state: State) -> bool:
 # ---------------------------------------------------------------------------- moves <-> actions
 
 
-def moves_to_actions(problem: Problem, moves: Sequence[Move]) -> tuple[Action, ...]:
-    """The 4-op plan of ``moves``, replayed from init (ProblemError on an illegal move)."""
+def moves_to_actions(
+    problem: Problem, moves: Sequence[Move], strict: bool = True
+) -> tuple[Action, ...]:
+    """The 4-op plan of ``moves``, replayed from init (ProblemError on an illegal move).
+
+    ``strict=False`` translates an illegal move too (picked from where the replay puts it), so
+    that a validator can name the first step that fails; the replay then goes on as if it had
+    succeeded. Unknown names raise ProblemError either way."""
     state, out = initial_state(problem), []
     for move in moves:
-        source = state[_entity(problem, move.entity)]
-        state = apply_move(problem, state, move)
+        i = _entity(problem, move.entity)
+        source = state[i]
+        if strict:
+            state = apply_move(problem, state, move)
+        else:
+            problem.index(move.target)
+            state = (*state[:i], move.target, *state[i + 1 :])
         x, y = move.entity, move.target
         out.append(Action("pick-up", (x,)) if source == TABLE else Action("unstack", (x, source)))
         out.append(Action("put-down", (x,)) if y == TABLE else Action("stack", (x, y)))

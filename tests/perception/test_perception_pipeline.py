@@ -5,6 +5,8 @@ Images here are drawn with OpenCV (coloured squares on grey), so no simulator is
 
 from __future__ import annotations
 
+import random
+
 import cv2
 import numpy as np
 import pytest
@@ -99,15 +101,66 @@ def test_a_missing_dataset_or_checkpoint_is_a_one_line_error(tmp_path):
         load_checkpoint(tmp_path / "junk.pt")
 
 
-def test_training_fits_a_tiny_dataset_and_the_checkpoint_round_trips(tmp_path):
-    t = pdata.tensors(_dataset())
-    small = ModelConfig(channels=(8, 8), dim=16, bands=2)
-    model = train(t, TrainConfig(epochs=30, batch=8, lr=1e-2), small)
-    scores = evaluate(model, t)
-    assert scores["relation_accuracy"] == 1.0 and scores["blocks"] == 24
+def _scene(rng: random.Random) -> tuple[np.ndarray, np.ndarray]:
+    """A random 3-block scene: towers in 4 jittered columns. Returns (image, supports (4,))."""
+    order = [0, 1, 2]
+    rng.shuffle(order)
+    towers: list[list[int]] = []
+    for b in order:  # each block starts a tower or goes on top of one
+        k = rng.randrange(len(towers) + 1)
+        towers.append([b]) if k == len(towers) else towers[k].append(b)
+    supports = np.full(4, pdata.PAD, np.int8)
+    squares = []
+    for tower, column in zip(towers, rng.sample(range(4), len(towers)), strict=False):
+        x = 8 + 38 * column + rng.randrange(12)
+        for level, b in enumerate(tower):
+            squares.append((RGB[b], x, 70 - 16 * level, 16))
+            supports[b] = pdata.TABLE if level == 0 else tower[level - 1]
+    return _image(squares), supports
+
+
+def _scenes(m: int, seed: int) -> pdata.SupportData:
+    rng = random.Random(seed)
+    images, supports = zip(*(_scene(rng) for _ in range(m)), strict=True)
+    colours = np.tile(np.array([[0, 1, 2, -1]], np.int8), (m, 1))
+    palette = np.asarray(RGB, np.float32)
+    return pdata.SupportData(np.stack(images), colours, np.stack(supports), palette, {})
+
+
+SMALL = ModelConfig(channels=(8, 8), dim=16, bands=2)
+
+
+@pytest.fixture(scope="module")
+def trained():
+    """A small model trained on 32 random scenes (seed 1); its data and per-epoch losses."""
+    t = pdata.tensors(_scenes(32, seed=1))
+    losses: list[float] = []
+    model = train(t, TrainConfig(epochs=30, batch=8, lr=1e-2), SMALL, lambda k, x: losses.append(x))
+    return model, t, losses
+
+
+def test_training_lowers_the_loss_and_reads_held_out_scenes(trained):
+    model, t, losses = trained
+    assert len(losses) == 30 and losses[-1] < 0.3 * losses[0]  # from ~ln 3 = 1.1 to ~0.07
+    held_out = pdata.tensors(_scenes(64, seed=999))  # other layouts than the training scenes
+    assert held_out["dropped"] == 0 and held_out["mask"].sum() == 192
+    train_images = {img.numpy().tobytes() for img in t["images"]}
+    assert not any(img.numpy().tobytes() in train_images for img in held_out["images"])
+    table = held_out["target"] == 4
+    baseline = float((table & held_out["mask"]).sum()) / 192  # "every block on the table"
+    assert baseline == pytest.approx(0.625)
+    scores = evaluate(model, held_out)
+    assert scores["blocks"] == 192 and scores["scenes"] == 64
+    # Measured: 0.81-0.97 over training seeds 0-3 and training sets 1-2 (0.92 for this one);
+    # chance is about 1/3 (two other blocks or the table), "all on the table" scores 0.625.
+    assert scores["relation_accuracy"] >= 0.75
+
+
+def test_the_checkpoint_round_trips(tmp_path, trained):
+    model, t, _ = trained
     path = save_checkpoint(tmp_path / "m.pt", model, {"seed": 0})
     again, meta = load_checkpoint(path)
-    assert meta == {"seed": 0} and again.config == small
+    assert meta == {"seed": 0} and again.config == SMALL
     x = (t["images"].float() / 255, t["boxes"], t["mask"])
     torch.testing.assert_close(again(*x), model(*x))
 

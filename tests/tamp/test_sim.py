@@ -28,9 +28,9 @@ def solver() -> IKSolver:
 def test_one_pick_and_place_stacks_the_block(sim_name, solver):
     entities = ("a", "b")
     with make_simulator(sim_name, entities, layout(entities, (TABLE, TABLE), seed=2)) as sim:
-        done = execute_move(sim, solver, Move("a", "b"), sim.block_poses)
+        done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses)
         assert done.ok, done.evidence
-        assert read_state(entities, sim.block_poses()).state == ("b", TABLE)
+        assert read_state(entities, sim.truth.block_poses()).state == ("b", TABLE)
         assert done.sim_time_s > 1.0 and done.ik_time_s > 0.0
 
 
@@ -39,15 +39,15 @@ def test_weld_grasp_mode_also_stacks_the_block(sim_name, solver):
     entities = ("a", "b")
     poses = layout(entities, (TABLE, TABLE), seed=4)
     with make_simulator(sim_name, entities, poses, grasp="weld") as sim:
-        done = execute_move(sim, solver, Move("a", "b"), sim.block_poses)
+        done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses)
         assert done.ok, done.evidence
-        assert read_state(entities, sim.block_poses()).state == ("b", TABLE)
+        assert read_state(entities, sim.truth.block_poses()).state == ("b", TABLE)
 
 
 def test_an_unreachable_block_is_an_ik_infeasible_failure(solver):
     entities = ("a",)
     with make_simulator("pybullet", entities, {"a": Pose((1.4, 0.0, 0.025))}) as sim:
-        done = execute_move(sim, solver, Move("a", TABLE), sim.block_poses)
+        done = execute_move(sim, solver, Move("a", TABLE), sim.truth.block_poses)
     assert not done.ok and done.failure is Failure.IK_INFEASIBLE
     assert done.evidence["waypoint"] == "pre_grasp"
 

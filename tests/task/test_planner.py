@@ -16,6 +16,8 @@ from task.planner import plan, plan_batch
 from task.problem import Problem
 from task.rollout import rollout
 from task.symbolic.generate import random_problem
+from task.symbolic.search import optimal_moves
+from tests.pddl_check import assert_valid, validate_moves
 
 BW = get_domain("blocksworld")
 FAST = PlannerConfig(restarts=4, iters=60)
@@ -90,12 +92,8 @@ def test_decoding_stops_at_the_first_illegal_move():
 def test_small_problems_solved_with_legal_plans(seed):
     problem = random_problem(3 + seed % 2, seed)
     result = plan(problem, FAST, seed=seed)
-    assert result.solved
-    state = BW.initial_state(problem)
-    for move in result.plan:
-        assert BW.check_move(problem, state, move) is None
-        state = BW.apply_move(problem, state, move)
-    assert BW.is_goal(problem, state)
+    assert result.solved and result.plan  # random_problem never starts at its goal
+    assert_valid(problem, result.plan)  # the PDDL validator, not the decoder's own checks
 
 
 def test_batched_and_sequential_paths_both_solve():
@@ -103,21 +101,27 @@ def test_batched_and_sequential_paths_both_solve():
     for batched in (True, False):
         results = plan_batch(problems, replace(FAST, batched=batched), seed=0)
         assert [r.solved for r in results] == [True] * 3
+        for problem, result in zip(problems, results, strict=True):
+            assert_valid(problem, result.plan)
 
 
-def test_paper_configuration_plans_a_two_move_problem():
+def test_paper_configuration_plans_a_three_move_problem():
+    # a on b; goal a on b on c: a must leave b, b go onto c, a come back (two goal atoms, 3 moves)
     problem = Problem(
         "p", "blocksworld", ("a", "b", "c"), ("b", "table", "table"), (("b", "c"), ("a", "b"))
     )
     config = PlannerConfig(goal_loss="atoms", lookahead_share=0.0, restarts=1)
     result = plan(problem, config)
+    assert len(optimal_moves(problem)) == 3
     assert result.solved and len(result.plan) == 3
+    assert_valid(problem, result.plan)
 
 
 def test_goal_already_true_gives_an_empty_plan():
     problem = Problem("p", "blocksworld", ("a", "b"), ("b", "table"), (("a", "b"),))
     result = plan(problem, FAST)
     assert result.solved and len(result.plan) == 0
+    assert validate_moves(problem, result.plan).valid
 
 
 def test_bad_inputs_raise_one_line_errors():
@@ -156,8 +160,6 @@ def test_restart_ranking_prefers_goal_then_estimated_total():
 
 
 def test_lower_bound_is_zero_at_the_goal_and_admissible():
-    from task.symbolic.search import optimal_moves
-
     for seed in range(5):
         problem = random_problem(5, seed)
         state = BW.initial_state(problem)
@@ -178,4 +180,11 @@ def test_deep_unstacking_needs_more_moves_than_the_lookahead():
         (("b", "d"), ("c", "b"), ("d", "a")),
     )
     result = plan(problem, PlannerConfig(), seed=0)
-    assert result.solved and len(result.plan) >= 6
+    optimum = len(optimal_moves(problem))
+    assert optimum == 6
+    assert result.solved and result.stats["windows"] >= 2  # no single window covers 6 moves
+    assert_valid(problem, result.plan)
+    # Not the exact optimum: windows are planned greedily, so a seed can take a detour. Over
+    # seeds 0-9 the planner found 6 moves eight times, 8 (seed 1) and 10 (seed 9); seed 0 finds 6.
+    # One two-move detour is tolerated so a harmless numerical change does not flip the test.
+    assert optimum <= len(result.plan) <= optimum + 2

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import random
 
 import pytest
 import torch
@@ -13,6 +14,9 @@ from task.soft import prod_others, transition
 from task.symbolic.generate import random_problem
 
 DOMAINS = names()
+BLOCKS = (3, 4, 5, 6)
+SEEDS = (0, 1)
+WALK = 6  # random legal moves per walk; every state along it is a case
 
 
 def _onehot_action(batch, x: int, y: int | None) -> torch.Tensor:
@@ -26,18 +30,43 @@ def _onehot_action(batch, x: int, y: int | None) -> torch.Tensor:
     return M
 
 
+def _legal_moves(domain, problem, state) -> list[Move]:
+    targets = problem.entities + problem.fixed
+    moves = [Move(x, y) for x in problem.entities for y in targets if y != x]
+    return [m for m in moves if domain.check_move(problem, state, m) is None]
+
+
 def _cases(domain_name: str):
-    """Random problems with states reached by random legal moves."""
+    """States reached by seeded random legal moves from random problems of several sizes.
+
+    Yields ``(problem, state)`` for the initial state and every state along each walk.
+    """
     domain = get_domain(domain_name)
-    for seed in range(4):
-        problem = random_problem(3 + seed, seed)
+    for n_blocks, seed in itertools.product(BLOCKS, SEEDS):
+        problem = random_problem(n_blocks, seed)
+        rng = random.Random(1000 * n_blocks + seed)
         state = domain.initial_state(problem)
         yield problem, state
+        for _ in range(WALK):
+            state = domain.apply_move(
+                problem, state, rng.choice(_legal_moves(domain, problem, state))
+            )
+            yield problem, state
+
+
+@pytest.mark.parametrize("domain_name", DOMAINS)
+def test_walks_reach_states_beyond_the_initial_ones(domain_name):
+    cases = list(_cases(domain_name))
+    assert len(cases) == len(BLOCKS) * len(SEEDS) * (WALK + 1)
+    assert {p.n for p, _ in cases} == set(BLOCKS)
+    walked = {(p.name, s) for p, s in cases if s != tuple(p.init)}
+    assert len(walked) >= len(cases) // 2  # most cases are not the problem's initial state
 
 
 @pytest.mark.parametrize("domain_name", DOMAINS)
 def test_soft_step_equals_crisp_apply_on_onehot_states(domain_name):
     domain = get_domain(domain_name)
+    checked = {"legal": 0, "illegal": 0}
     for problem, state in _cases(domain_name):
         batch = domain.encode([problem], [state], torch.float64)
         n = batch.n
@@ -54,9 +83,12 @@ def test_soft_step_equals_crisp_apply_on_onehot_states(domain_name):
                 ).F0
                 assert torch.equal(F1, expected), move
                 assert g.sum().item() == 1.0
+                checked["legal"] += 1
             else:
                 assert g.abs().sum().item() == 0.0, f"illegal {move} carries mass"
                 assert torch.equal(F1, F)
+                checked["illegal"] += 1
+    assert min(checked.values()) >= 100, checked  # both branches, over many walked states
 
 
 @pytest.mark.parametrize("domain_name", DOMAINS)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 
 import pytest
@@ -71,11 +72,23 @@ def test_run_ablation_sequential_and_artefacts(tmp_path):
     assert sum(done) == bench.total(4, 2, 2, 2) == 20
     assert [(r.horizon, r.seed) for r in result.runs] == [(1, 0), (1, 1), (3, 0), (3, 1)]
     assert len(main_rows(result)) == 6 and len(block_rows(result)) == 4
-    assert result.speed is not None and result.speed.n == 2 and result.speed.speedup > 0
+    rows = result.rows()
+    assert len(rows) == 4 * 4 and {r.instance for r in rows} == {i.name for i in suite.instances}
+    assert all(r.status == "valid" for r in rows), [(r.instance, r.status) for r in rows]
+    assert all(r.optimal <= r.length and r.length % 2 == 0 for r in rows)  # 4-op actions
+    assert [run.valid() for run in result.runs] == [4] * 4
+    assert all(s.valid == 4 for s in main_rows(result))  # per (horizon, seed) and their mean
+    speed = result.speed  # fields agree with each other; how fast is for the benchmarks
+    assert (speed.n, speed.horizon, speed.seed) == (2, 1, 0)
+    assert speed.batched_valid == speed.sequential_valid == speed.n
+    assert speed.batched_s > 0 and speed.sequential_s > 0
+    assert speed.speedup == pytest.approx(speed.sequential_s / speed.batched_s)
     paths = bench_io.write(result, tmp_path / "out")
     report = json.loads(paths[1].read_text())
     assert report["config"]["restarts"] == 4 and report["horizons"] == [1, 3]
-    assert report["machine"]["cores"] and report["speed"]["n"] == 2
+    assert report["machine"]["cores"] and report["instances"] == 4
+    assert report["speed"] == {**dataclasses.asdict(speed), "speedup": speed.speedup}
+    assert [s["valid"] for s in report["summary"]] == [4] * 6
     assert len(paths[0].read_text().splitlines()) == 1 + 4 * 4
     assert paths[2].read_bytes().startswith(b"\x89PNG")
 

@@ -1,4 +1,8 @@
-"""Image beliefs for the planner: gradients reach perception only in optimised mode."""
+"""Image beliefs for the planner: gradients reach perception only in optimised mode, and the
+shipped checkpoint's beliefs lead the planner to the goal with a plan the PDDL validator accepts.
+
+Images are drawn with OpenCV (coloured squares on grey), so no simulator is needed.
+"""
 
 from __future__ import annotations
 
@@ -7,28 +11,39 @@ import numpy as np
 import pytest
 import torch
 
+from perception import CHECKPOINT
 from perception.model import ModelConfig, SupportModel
 from perception.perceive import Perceiver
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode
 from tamp.camera.render import block_colours
 from task.config import PlannerConfig
-from task.domains.blocksworld import DOMAIN
 from task.errors import TampError
 from task.planner import plan
 from task.problem import TABLE, Problem
+from tests.pddl_check import assert_valid
 
 THREE = Problem("three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("c", "b"),))
 
 
-def _image(boxes) -> np.ndarray:
+def _draw(state) -> np.ndarray:
+    """THREE in ``state``: one column per tower, bases in entity order, 16-pixel squares."""
     img = np.full((120, 160, 3), 110, np.uint8)
-    for rgb, (x, y) in zip(block_colours(3), boxes, strict=True):
-        cv2.rectangle(img, (x, y), (x + 15, y + 15), tuple(int(255 * c) for c in rgb), -1)
+    colours = dict(zip(THREE.entities, block_colours(3), strict=True))
+    supports = dict(zip(THREE.entities, state, strict=True))
+    bases = [x for x in THREE.entities if supports[x] == TABLE]
+    for column, base in enumerate(bases):
+        block, level = base, 0
+        while block is not None:
+            x, y = 40 + 60 * column, 70 - 16 * level
+            colour = tuple(int(255 * c) for c in colours[block])
+            cv2.rectangle(img, (x, y), (x + 15, y + 15), colour, -1)
+            block = next((z for z in THREE.entities if supports[z] == block), None)
+            level += 1
     return img
 
 
-INIT = _image([(40, 70), (40, 54), (100, 70)])  # b on a, c alone
-GOAL = _image([(40, 70), (40, 54), (40, 38)])  # c on b on a
+INIT = _draw(THREE.init)  # b on a, c alone
+GOAL = _draw((TABLE, "a", "b"))  # c on b on a
 
 
 def _beliefs(mode: str, adapt: str = "head"):
@@ -63,15 +78,22 @@ def test_optimised_beliefs_send_planning_gradients_into_the_weights(adapt):
     assert conv == (adapt == "all")
 
 
+@pytest.fixture(scope="module")
+def shipped() -> Perceiver:
+    return Perceiver.load(CHECKPOINT)
+
+
 @pytest.mark.parametrize("mode", ["frozen", "optimised"])
-def test_planning_from_images_checks_moves_against_the_true_state(mode):
-    _, source = _beliefs(mode)
+def test_planning_from_images_reaches_the_goal_with_a_valid_plan(mode, shipped):
+    def observe(i, state):  # the camera sees the true state
+        return _draw(state)
+
+    source = ImageBeliefs([THREE], shipped, observe, [GOAL], PerceptionMode(mode))
     result = plan(THREE, PlannerConfig(iters=8, restarts=2, max_windows=3), beliefs=source)
-    assert result.solved or result.stats["windows"] == 3  # every window was planned
-    state = THREE.init
-    for move in result.plan:  # an untrained model may not reach the goal, but never cheats
-        assert DOMAIN.check_move(THREE, state, move) is None
-        state = DOMAIN.apply_move(THREE, state, move)
+    assert result.solved and result.stats["misread_windows"] == 0, result.stats
+    assert_valid(THREE, result.plan)  # legal and goal-reaching for the PDDL validator
+    # the optimum is one move (c -> b), found with seeds 0 and 2; seed 1 detours to 3 moves
+    assert 1 <= len(result.plan) <= 3
 
 
 def test_bad_perception_modes_are_refused():

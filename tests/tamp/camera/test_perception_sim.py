@@ -11,8 +11,11 @@ import numpy as np
 import pytest
 
 from perception import CHECKPOINT
+from perception import data as pdata
 from perception.errors import PerceptionError
 from perception.perceive import Perceiver
+from perception.train import evaluate, load_checkpoint
+from tamp.camera.dataset import generate
 from tamp.camera.from_images import perceived_goal, perceived_state
 from tamp.camera.render import StateRenderer
 from tamp.loop import EpisodeStatus, LoopConfig, run_episode
@@ -31,12 +34,23 @@ def perceiver() -> Perceiver:
 
 
 def test_the_shipped_checkpoint_says_how_it_was_made():
-    from perception.train import load_checkpoint
-
     _, meta = load_checkpoint(CHECKPOINT)
     assert meta["command"].startswith("tamp perception train")
-    assert meta["test"]["relation_accuracy"] >= 0.995
-    assert "seed" in meta
+    assert "seed" in meta and meta["train"]["data_seed"] != meta["test"]["data_seed"]
+    assert meta["test"]["scenes"] > 0 and "relation_accuracy" in meta["test"]
+
+
+@pytest.mark.parametrize("sim", SIMULATORS)
+def test_the_shipped_checkpoint_is_accurate_on_fresh_scenes(sim):
+    model, meta = load_checkpoint(CHECKPOINT)
+    seed = 7  # neither the training nor the test data seed of the checkpoint
+    assert seed not in (meta["train"]["data_seed"], meta["test"]["data_seed"])
+    fresh = pdata.tensors(generate(8, seed, (sim,)))
+    scores = evaluate(model, fresh)
+    assert scores["scenes"] == 8 and scores["unreadable"] == 0 and scores["blocks"] >= 3 * 8
+    # Recomputed, not read from the checkpoint (which claims ~0.998 on its test set): 1.0 on
+    # every block and scene of seeds 11-15 in both simulators. The floors allow a few misreads.
+    assert scores["relation_accuracy"] >= 0.9 and scores["scene_accuracy"] >= 0.75
 
 
 @pytest.mark.parametrize("sim", SIMULATORS)

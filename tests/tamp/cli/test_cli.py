@@ -117,27 +117,58 @@ def test_help_exits_0(capsys):
     assert "plan" in capsys.readouterr().out
 
 
+def _bench_artefacts(out, n: int) -> tuple[list[dict], dict]:
+    """Check a planning benchmark's files in ``out`` against each other; (CSV rows, JSON).
+
+    ``n`` instances, one horizon and one seed: every plan valid and no shorter than its optimum
+    (lengths in 4-op actions), and the JSON summaries counting exactly what the CSV holds."""
+    assert all((out / name).stat().st_size > 0 for name in ARTEFACTS)
+    assert (out / "steps.png").read_bytes().startswith(b"\x89PNG")
+    with (out / "instances.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == n and len({r["instance"] for r in rows}) == n
+    assert [r["status"] for r in rows] == ["valid"] * n, rows
+    lengths = [(int(r["length"]), int(r["optimal"])) for r in rows]
+    assert all(ours >= best > 0 and ours % 2 == 0 for ours, best in lengths), lengths
+    report = json.loads((out / "results.json").read_text())
+    assert report["instances"] == n
+    (summary,) = report["summary"]  # one horizon, one seed: no mean row
+    assert (summary["n"], summary["known"], summary["valid"]) == (n, n, n)
+    assert summary["optimal"] == sum(ours == best for ours, best in lengths)
+    assert summary["inexecutable"] == summary["non_goal_reaching"] == summary["no_plan"] == 0
+    times = [float(r["time_s"]) for r in rows]
+    assert summary["time_s"] == pytest.approx(sum(times) / n, abs=1e-3)
+    per_block = {int(b["blocks"]): b for b in report["by_blocks"]}
+    assert sorted(per_block) == sorted({int(r["blocks"]) for r in rows})
+    for blocks, row in per_block.items():
+        mine = [
+            (o, b) for (o, b), r in zip(lengths, rows, strict=True) if int(r["blocks"]) == blocks
+        ]
+        assert row["n"] == row["valid"] == len(mine)
+        assert row["optimal"] == sum(o == b for o, b in mine)
+    return rows, report
+
+
 @pytest.mark.shared
-def test_bench_planbench_writes_artefacts(capsys, planbench_dir, tmp_path):
+def test_bench_planbench_plans_every_instance_validly(capsys, planbench_dir, tmp_path):
     argv = ["bench", "planbench", "--data", str(planbench_dir / "blocksworld"), "--limit", "6"]
     argv += ["--seeds", "1", *FAST, "--out", str(tmp_path), "--json", "--no-progress"]
     assert main(argv) == 0
-    report = json.loads(capsys.readouterr().out)
-    assert report["instances"] == 6 and report["summary"][0]["n"] == 6
-    assert {row["blocks"] for row in report["by_blocks"]} == {3, 4, 5}
-    assert all((tmp_path / name).stat().st_size > 0 for name in ARTEFACTS)
-    assert json.loads((tmp_path / "results.json").read_text())["summary"] == report["summary"]
+    printed = json.loads(capsys.readouterr().out)
+    rows, report = _bench_artefacts(tmp_path, 6)
+    assert [int(r["blocks"]) for r in rows] == [3, 4, 4, 4, 4, 5]
+    for key in ("instances", "summary", "by_blocks", "config", "speed"):
+        assert printed[key] == report[key], key
 
 
-def test_bench_random_writes_artefacts(capsys, tmp_path):
-    argv = ["bench", "random", "--blocks", "3", "--n", "3", *FAST, "--out", str(tmp_path)]
+def test_bench_random_plans_every_instance_validly(capsys, tmp_path):
+    argv = ["bench", "random", "--blocks", "3,4", "--n", "2", *FAST, "--out", str(tmp_path)]
     assert main([*argv, "--no-progress"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith("random: 3 instances") and "by block count" in out
-    with (tmp_path / "instances.csv").open() as handle:
-        rows = list(csv.DictReader(handle))
-    assert len(rows) == 3 and all(r["blocks"] == "3" and r["optimal"] for r in rows)
-    assert all((tmp_path / name).stat().st_size > 0 for name in ARTEFACTS)
+    assert out.startswith("random: 4 instances") and "by block count" in out
+    rows, report = _bench_artefacts(tmp_path, 2 * 2)  # block counts x --n
+    assert [r["blocks"] for r in rows] == ["3", "3", "4", "4"]
+    assert report["benchmark"] == "random" and "4/4" in out  # the printed table: 4 of 4 valid
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,119 @@
+"""The simulator's ground truth behind one door, `GroundTruth`, which the closed loop locks.
+
+Simulator ground truth only scores episodes: a real robot has joint encoders, finger sensors
+and a camera, not the world's state. Every ground-truth query (block poses, the true symbolic
+state) goes through ``sim.truth``. An episode locks it; a locked `GroundTruth` answers only
+inside one of three named grants, and anything else that reads it raises `GroundTruthLeak`
+naming the caller:
+
+- ``scoring()``: the experimenter scores the episode (the goal check, disturbed stacks);
+- ``experimenter()``: fault injection reads what it perturbs (the nudged block's pose);
+- ``oracle()``: the motion-capture pose sensor of ``observe="state"``, whose documented sensor
+  is exactly the true block poses (plus optional noise).
+
+``reads`` counts every answered read by grant and calling function, so a test can check that a
+camera episode read nothing but scoring. Teleports (``Simulator.set_block_pose``) write the
+world and are not reads.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections import Counter
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
+
+from tamp.scene import Pose, SceneConfig, read_state
+from task.errors import TampError
+
+GRANTS = ("scoring", "experimenter", "oracle")
+RULE = "simulator ground truth only scores episodes"
+
+
+class GroundTruthLeak(TampError):
+    """Robot-side code read the simulator's ground truth while it was locked."""
+
+
+def _caller() -> str:
+    """The first function on the stack outside this module and contextlib, as module.qualname."""
+    frame = sys._getframe(1)
+    while frame is not None and frame.f_globals.get("__name__") in (__name__, "contextlib"):
+        frame = frame.f_back
+    if frame is None:
+        return "<unknown>"
+    return f"{frame.f_globals.get('__name__', '?')}.{frame.f_code.co_qualname}"
+
+
+class GroundTruth:
+    """Ground-truth queries of one simulator; ``read_poses`` gives the true block poses.
+
+    Unlocked (the default: tests, renderers, dataset builders), every read is answered.
+    Locked, only reads inside ``scoring()``, ``experimenter()`` or ``oracle()`` are.
+    """
+
+    def __init__(self, read_poses: Callable[[], dict[str, Pose]]) -> None:
+        self._read_poses = read_poses
+        self.locked = False
+        self._grants: list[str] = []
+        self.reads: Counter[tuple[str, str]] = Counter()  # (grant or "unlocked", caller) -> n
+
+    def lock(self) -> None:
+        """From now on, answer only reads inside a named grant."""
+        self.locked = True
+
+    def unlock(self) -> None:
+        self.locked = False
+
+    @contextmanager
+    def scoring(self) -> Iterator[GroundTruth]:
+        """Reads to score the episode (goal reached, disturbed stacks)."""
+        with self._grant("scoring"):
+            yield self
+
+    @contextmanager
+    def experimenter(self) -> Iterator[GroundTruth]:
+        """Reads by the experimenter's fault injection (what it perturbs), not by the robot."""
+        with self._grant("experimenter"):
+            yield self
+
+    @contextmanager
+    def oracle(self) -> Iterator[GroundTruth]:
+        """Reads by the motion-capture oracle of ``observe="state"`` (its sensor is the truth)."""
+        with self._grant("oracle"):
+            yield self
+
+    @contextmanager
+    def _grant(self, name: str) -> Iterator[None]:
+        self._grants.append(name)
+        try:
+            yield
+        finally:
+            self._grants.pop()
+
+    def purposes(self) -> set[str]:
+        """The grants under which reads were answered ("unlocked" for reads while unlocked)."""
+        return {grant for grant, _ in self.reads}
+
+    def block_poses(self) -> dict[str, Pose]:
+        """The true block poses (centre, yaw); raises `GroundTruthLeak` outside a grant when
+        locked."""
+        self._check("block_poses")
+        return self._read_poses()
+
+    def state(
+        self, entities: Sequence[str], scene: SceneConfig = SceneConfig()
+    ) -> tuple[str, ...] | None:
+        """The true symbolic state the block poses form (`tamp.scene.read_state`), or None when
+        they form none (a block leaning or on an edge)."""
+        self._check("state")
+        return read_state(entities, self._read_poses(), scene).state
+
+    def _check(self, query: str) -> None:
+        caller = _caller()
+        if self.locked and not self._grants:
+            raise GroundTruthLeak(
+                f"{caller} read the ground truth ({query}) while it is locked: {RULE}. "
+                f"Robot-side code observes with its sensors; only reads inside "
+                f"{', '.join(f'GroundTruth.{g}()' for g in GRANTS)} are answered"
+            )
+        self.reads[(self._grants[-1] if self._grants else "unlocked", caller)] += 1
