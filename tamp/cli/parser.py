@@ -203,6 +203,7 @@ def _perception_commands(sub) -> None:
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
     p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
     p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
     p.set_defaults(func=_lazy("tamp.cli.perception", "dataset_command"))
 
@@ -212,8 +213,9 @@ def _perception_commands(sub) -> None:
     p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
     p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
-    p.add_argument("--out", default=str(CHECKPOINT), metavar="FILE.pt",
-                   help="checkpoint to write (the shipped perception/support.pt)")  # fmt: skip
+    p.add_argument("--out", required=True, metavar="FILE.pt",
+                   help="checkpoint to write (never the shipped one)")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
     p.set_defaults(func=_lazy("tamp.cli.perception", "train_command"))
 

@@ -7,8 +7,12 @@ import json
 import shlex
 import sys
 import time
+from pathlib import Path
 
 from tqdm import tqdm
+
+from perception import CHECKPOINT
+from task.errors import TampError
 
 
 def _command_line() -> str:
@@ -27,7 +31,10 @@ def dataset_command(args: argparse.Namespace) -> int:
             progress=bar.update, meta={"command": _command_line()},
         )  # fmt: skip
     path = pdata.save(args.out, data)
-    print(f"{len(data)} images ({data.meta['redrawn']} redrawn for occlusion) -> {path}")
+    if args.json:
+        print(json.dumps({"images": len(data), "redrawn": data.meta["redrawn"], "out": str(path)}))
+    else:
+        print(f"{len(data)} images ({data.meta['redrawn']} redrawn for occlusion) -> {path}")
     return 0
 
 
@@ -37,6 +44,11 @@ def train_command(args: argparse.Namespace) -> int:
     from perception import data as pdata
     from perception.train import TrainConfig, evaluate, save_checkpoint, train
 
+    if Path(args.out).resolve() == CHECKPOINT.resolve():
+        raise TampError(
+            f"--out {args.out} is the shipped checkpoint; write elsewhere and copy it over "
+            "deliberately"
+        )
     torch.set_num_threads(args.threads)
     t0 = time.perf_counter()
     train_raw, test_raw = pdata.load(args.train), pdata.load(args.test)
@@ -72,6 +84,9 @@ def train_command(args: argparse.Namespace) -> int:
         "threads": args.threads,
     }
     save_checkpoint(args.out, model, meta)
+    if args.json:
+        print(json.dumps({**scores, "out": str(args.out), "train_time_s": meta["train_time_s"]}))
+        return 0
     print(
         f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
         f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "

@@ -7,6 +7,7 @@ import re
 
 import pytest
 
+from perception import CHECKPOINT
 from perception import data as pdata
 from tamp.cli import main
 
@@ -22,8 +23,11 @@ def _one_line_error(capsys) -> str:
 def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
     path = tmp_path / "d.npz"
     args = ["perception", "dataset", "--n", "4", "--seed", "3", "--out", str(path)]
-    assert main([*args, "--no-progress"]) == 0
+    assert main([*args, "--no-progress", "--json"]) == 0
+    made = json.loads(capsys.readouterr().out)
+    assert made == {"images": 4, "redrawn": made["redrawn"], "out": str(path)}
     data = pdata.load(path)
+    assert made["redrawn"] == data.meta["redrawn"]
     assert len(data) == 4 and data.images.shape[1:] == (240, 320, 3)
     assert data.meta["sims"] == ["pybullet", "mujoco"] and data.meta["seed"] == 3
     assert ((data.colours >= 0).sum(1) >= 3).all()
@@ -61,7 +65,15 @@ def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
     ("argv", "needle"),
     [
         (["perception", "eval", "missing.npz"], "no dataset at missing.npz"),
-        (["perception", "train", "--train", "a.npz", "--test", "b.npz"], "no dataset at a.npz"),
+        (
+            ["perception", "train", "--train", "a.npz", "--test", "b.npz", "--out", "c.pt"],
+            "no dataset at a.npz",
+        ),
+        (
+            ["perception", "train", "--train", "a", "--test", "b", "--out", str(CHECKPOINT)],
+            "is the shipped checkpoint",
+        ),
+        (["perception", "train", "--train", "a.npz", "--test", "b.npz"], "required: --out"),
         (["bench", "perception", "--data", "nowhere"], "PlanBench data not found"),
         (["bench", "perception", "--modes", "psychic"], "unknown mode 'psychic'"),
         (["run", "--observe", "camera", "--checkpoint", "none.pt"], "no perception checkpoint"),
