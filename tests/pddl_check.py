@@ -1,28 +1,28 @@
 """Test helper: judge a planner's moves with the crisp PDDL validator, not the decoder's checks.
 
 The problem goes out as PDDL text (`task.domains.blocksworld.to_pddl`), is parsed back against the
-embedded 4-operator domain, and the moves become 4-op actions through the domain's ``to_actions``
-(``strict=False``: an illegal move is translated as it stands, not refused by the domain's own
-``check_move``); `task.symbolic.validate` then simulates those actions over the STRIPS semantics
-and is the only judge of legality and of the goal.
+embedded 4-operator domain, and the moves are replayed by `tamp.bench.planning.replay` (the
+benchmarks' own check: an illegal move is translated as it stands, not refused by the domain's
+``check_move``); `task.symbolic.validate` is the only judge of legality and of the goal.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 
+from tamp.bench.planning import replay
 from task import data
-from task.domains import blocksworld, get_domain
+from task.domains import blocksworld
 from task.problem import Move, Problem
-from task.symbolic import pddl_io, validate
+from task.symbolic import validate
+from task.symbolic.instances import from_text
 
 
 def validate_moves(problem: Problem, moves: Sequence[Move]) -> validate.Validation:
     """The PDDL validator's verdict on ``moves`` from the problem's initial state."""
     domain = data.domain()
-    pddl_problem = pddl_io.parse_problem(blocksworld.to_pddl(problem), domain=domain)
-    actions = get_domain(problem.domain).to_actions(problem, moves, strict=False)
-    return validate.validate(domain, pddl_problem, actions)
+    instance = from_text(domain, blocksworld.to_pddl(problem), problem.name)
+    return replay(domain, instance, moves)
 
 
 def assert_valid(problem: Problem, moves: Sequence[Move]) -> validate.Validation:

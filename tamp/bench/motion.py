@@ -26,10 +26,8 @@ from motion.ik import IKSolver, top_down_pose
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
-from task.errors import TampError
 from task.symbolic.instances import Instance
 
-SIMS = ("pybullet", "mujoco")
 EPISODE_COLUMNS = (
     "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
     "disturbed", "sim_time_s", "wall_time_s",
@@ -44,15 +42,6 @@ class MotionBench:
     reports: tuple[EpisodeReport, ...]
     summary: dict[str, dict]
     ik: dict
-
-
-def parse_sims(text: str) -> tuple[str, ...]:
-    """``pybullet,mujoco`` as a tuple; TampError naming an unknown simulator."""
-    sims = tuple(dict.fromkeys(text.split(",")))
-    for name in sims:
-        if name not in SIMS:
-            raise TampError(f"unknown simulator {name!r} (valid: {', '.join(SIMS)})")
-    return sims
 
 
 def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:

@@ -218,7 +218,7 @@ def run(
     progress: Callable[[PerceptionMode, int], None] | None = None,
 ) -> PerceptionBench:
     """One row per (mode, horizon) in the given order (a mode carries its blur and crisp
-    protocol); ``progress(mode, horizon)`` before each.
+    protocol); ``progress(mode, horizon)`` after each.
 
     The same layout ``seed`` renders the same images for every row. The example strip shows the
     first instance's initial and goal images, then both blurred by ``example_blur`` if > 0."""
@@ -228,11 +228,11 @@ def run(
         camera = Renders(renderer, [i.problem for i in chosen], seed)
         for mode in modes:
             for horizon in horizons:
-                if progress is not None:
-                    progress(mode, horizon)
                 r, s = run_row(suite, chosen, mode, horizon, config, seed, perceiver, camera)
                 rows += r
                 summaries.append(s)
+                if progress is not None:
+                    progress(mode, horizon)
         sample = chosen[0].problem
         views = [camera.image(0, sample.init), camera.goal(0)]
         if example_blur:

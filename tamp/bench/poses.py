@@ -29,8 +29,8 @@ from tamp.camera.render import (
     random_lighting,
 )
 from tamp.scene import CAMERA_COLOURS, SceneConfig, towers
-from tamp.sim.base import SIMULATORS, Lighting
-from task.errors import TampError, one_of
+from tamp.sim.base import Lighting
+from task.errors import TampError
 
 SPLITS = ("all", "top", "covered")
 
@@ -60,15 +60,6 @@ class PoseBench:
     sims: tuple[str, ...]
     rows: tuple[BlockRow, ...]
     summary: dict[str, dict]
-
-
-def parse_sims(text: str) -> tuple[str, ...]:
-    """``pybullet,mujoco`` as a tuple; TampError naming an unknown simulator."""
-    sims = tuple(dict.fromkeys(t.strip() for t in text.split(",")))
-    for name in sims:
-        if name not in SIMULATORS:
-            raise TampError(f"--sim: unknown simulator {one_of(name, SIMULATORS)}")
-    return sims
 
 
 def yaw_error(estimate: float, truth: float) -> float:

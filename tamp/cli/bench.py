@@ -14,13 +14,14 @@ import json
 import os
 import sys
 import time
+from collections import Counter
 from contextlib import contextmanager
 
 from tqdm import tqdm
 
 from tamp.bench import planning, results, suites, tables
 from tamp.bench.suites import Suite
-from tamp.cli.options import planner_config
+from tamp.cli.options import planner_config, sim_list
 from task.errors import TampError
 
 
@@ -70,25 +71,19 @@ def motion_command(args: argparse.Namespace) -> int:
     from tamp.bench import motion
     from tamp.cli.run import loop_config
 
-    sims = motion.parse_sims(args.sim)
+    sims = sim_list(args.sim)
     suite = suites.planbench(args.data, args.n)
     base = loop_config(args)
-    bars = {}
+    goals: Counter[str] = Counter()
+    with tqdm(total=len(sims) * len(suite.instances), desc="motion", unit="episode",
+              file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
 
-    def progress(sim: str, report) -> None:
-        if sim not in bars:
-            for bar in bars.values():
-                bar.close()
-            bars[sim] = tqdm(total=len(suite.instances), desc=f"motion {sim}", unit="episode",
-                             file=sys.stderr, disable=not args.progress)  # fmt: skip
-            bars[sim].goals = 0
-        bars[sim].goals += report.reached_goal
-        bars[sim].set_postfix(goal=bars[sim].goals, refresh=False)
-        bars[sim].update(1)
+        def progress(sim: str, report) -> None:
+            goals[sim] += report.reached_goal
+            bar.set_postfix(sim=sim, goal=goals[sim], refresh=False)
+            bar.update(1)
 
-    result = motion.run(suite, base, sims, args.seed, progress)
-    for bar in bars.values():
-        bar.close()
+        result = motion.run(suite, base, sims, args.seed, progress)
     inject = str(base.inject)
     body = {
         "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
@@ -146,18 +141,15 @@ def perception_command(args: argparse.Namespace) -> int:
     ]  # fmt: skip
     with tqdm(total=len(modes) * len(horizons), desc="perception bench", unit="row",
               file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
-        started = []
 
-        def progress(mode, horizon) -> None:  # before each row: the previous one is done
-            bar.update(len(started[:1]))
-            started.append(mode)
-            bar.set_postfix(mode=mode.mode, blur=mode.blur, T=horizon)
+        def progress(mode, horizon) -> None:
+            bar.set_postfix(mode=mode.mode, blur=mode.blur, T=horizon, refresh=False)
+            bar.update(1)
 
         result = bench.run(
             suite, modes, horizons, config, args.seed, perceiver, args.sim,
             example_blur=args.blur[-1], progress=progress,
         )  # fmt: skip
-        bar.update(1)
     split = {str(b): sum(i.blocks == b for i in chosen) for b in bench.sizes(chosen)}
     body = {
         "suite": suite.name, "source": suite.source, "n": len(chosen),
@@ -187,7 +179,7 @@ def poses_command(args: argparse.Namespace) -> int:
     """Block poses from RGB-D images of ``--n`` random scenes in each ``--sim``, against truth."""
     from tamp.bench import poses
 
-    sims = poses.parse_sims(args.sim)
+    sims = sim_list(args.sim)
     with tqdm(total=args.n * len(sims), desc="poses", unit="scene", file=sys.stderr,
               disable=not args.progress) as bar:  # fmt: skip
         result = poses.run(sims, args.n, args.seed, args.min_blocks, args.max_blocks,

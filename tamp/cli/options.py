@@ -13,10 +13,20 @@ from tamp.bench.suites import DEFAULT_PLANBENCH
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains.blocksworld import GOAL_LOSSES
+from task.errors import TampError
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
 )  # fmt: skip
+
+
+def sim_list(text: str) -> tuple[str, ...]:
+    """``--sim pybullet,mujoco`` as a tuple; TampError naming an unknown simulator."""
+    sims = tuple(dict.fromkeys(t.strip() for t in text.split(",")))
+    for name in sims:
+        if name not in SIMULATORS:
+            raise TampError(f"unknown simulator {name!r} (valid: {', '.join(SIMULATORS)})")
+    return sims
 
 
 def planner_config(args: argparse.Namespace) -> PlannerConfig:

@@ -119,7 +119,7 @@ class Observer:
 
     def _perceive(self):
         """One camera image, read by the perception model: (state, soft supports F)."""
-        self.image = self.sim.render()
+        self.image = self.sensor.frame()[0]  # the RGB of the camera's RGB-D image
         return perceived_state(self.target, self.perceiver, self.image, self.config.perception.blur)
 
     def _look(self, look: Callable, on_frame: OnFrame, show: Callable[[str], None]):
