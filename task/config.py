@@ -15,7 +15,7 @@ class PlannerConfig:
     tau: float = 0.5  # softmax temperature of the action logits
     tau_end: float = 0.05  # temperature at the last Adam step (geometric annealing from tau)
     threshold: float = 0.3  # decoding confidence: a step's move mass must reach this
-    goal_loss: str = "towers"  # "atoms": the paper's goal CE; "towers": CE on well-placed blocks
+    goal_loss: str = "default"  # the domain's first goal loss; "atoms": the paper's goal CE
     lambda_move: float = 0.05  # weight of the move-count loss (shorter plans)
     lambda_cycle: float = 1.0  # weight of the direct two-cycle loss
     lambda_fp: float = 1.0  # weight of the fixed-point loss (before refinement)

@@ -14,37 +14,35 @@ the move illegal in the world and the plan is inexecutable.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 from torch import Tensor
 
 from task.domains.base import Domain, State
-from task.problem import Move, Problem
+from task.problem import Problem
 
 
 @dataclass(frozen=True)
 class DecodedWindow:
-    moves: tuple[Move, ...]
+    moves: tuple
     state: State  # crisp state after the moves
     reached: bool  # the goal holds in ``state``
     complete: bool  # every confident step decoded to a legal move
     loss: float  # the soft objective of the restart it came from
-    remaining: int  # the domain's admissible lower bound on moves still needed from ``state``
+    remaining: float  # the domain's admissible lower bound from ``state`` (inf: a dead end)
     illegal: str | None = None  # check=False: why the last move is illegal in ``state``
 
     def key(self) -> tuple:
-        """Sort key: the goal reached in fewest moves; else some progress, then the least
-        estimated total (moves + remaining), then the most moves, then the soft objective."""
+        """Sort key: the goal reached in fewest moves; else not a dead end (an infinite lower
+        bound ranks last, whatever moved), then some progress, then the least estimated total
+        (moves + remaining), then the most moves, then the soft objective."""
         g = len(self.moves)
         if self.reached:
             return (0, g, 0, 0, self.loss)
-        return (1, g == 0, g + self.remaining, -g, not self.complete, self.loss)
-
-
-def target_name(problem: Problem, column: int, n: int) -> str:
-    """Name of padded target column ``column`` (entities occupy 0..n-1, fixed targets n..)."""
-    return problem.entities[column] if column < n else problem.fixed[column - n]
+        dead = math.isinf(self.remaining)
+        return (1, dead, g == 0, g + self.remaining, -g, not self.complete, self.loss)
 
 
 def decode_row(
@@ -56,22 +54,20 @@ def decode_row(
     loss: float,
     check: bool = True,
 ) -> DecodedWindow:
-    """Decode one rollout row. gates: (T, N, Y) applied move mass of that row.
+    """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row.
 
     ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``)."""
     n = gates.shape[1]
     best, flat = gates.flatten(1).max(-1)  # (T,), (T,)
-    moves: list[Move] = []
+    moves: list = []
     complete, illegal = True, None
     if domain.is_goal(problem, state):  # nothing to do (a perceived state may already be it)
         return DecodedWindow((), state, True, True, loss, 0)
     for value, index in zip(best.tolist(), flat.tolist(), strict=True):
         if value < threshold:
             continue  # a STAY step
-        x, y = divmod(index, gates.shape[2])
-        move = None
-        if x < problem.n and not n > y >= problem.n:  # padding is never a legal move
-            move = Move(problem.entities[x], target_name(problem, y, n))
+        row, col = divmod(index, gates.shape[2])
+        move = domain.decode(problem, row, col, n)  # None: padding, never a legal move
         reason = "padding" if move is None else domain.check_move(problem, state, move)
         if reason is not None:
             complete = False
@@ -98,7 +94,7 @@ def decode_best(
     threshold: float,
     check: bool = True,
 ) -> list[DecodedWindow]:
-    """Best decoded window per problem. gates: (P * R, T, N, Y) with restarts adjacent.
+    """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
 
     ``check=False``: illegal moves are kept and the lowest soft objective wins."""
     gates, losses = gates.cpu(), losses.cpu().tolist()

@@ -26,8 +26,8 @@ from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig
 from task.decode import decode_best
 from task.domains import get_domain
-from task.domains.base import Domain, State
-from task.errors import TampError
+from task.domains.base import Domain, State, resolve_goal_loss
+from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 
@@ -162,6 +162,10 @@ def plan_batch(
     if len(names) > 1:
         raise TampError(f"plan_batch needs problems of one domain, got {sorted(names)}")
     domain = get_domain(problems[0].domain)
+    if resolve_goal_loss(domain, config.goal_loss) not in domain.goal_losses:
+        raise ProblemError(
+            f"unknown goal loss for {domain.name} {one_of(config.goal_loss, domain.goal_losses)}"
+        )
     generator = torch.Generator().manual_seed(seed)
     report = progress or (lambda k: None)
     if not config.batched:
@@ -169,10 +173,11 @@ def plan_batch(
             _run(domain, [p], config, generator, report, beliefs, [i])[0]
             for i, p in enumerate(problems)
         ]
-    # one tensor program per problem size: no padding work, and per-size times in the stats
+    # one tensor program per shape key (the domain's: sizes that pad alike), per-key times
     results: list[PlanResult | None] = [None] * len(problems)
-    for n in sorted({p.n for p in problems}):
-        group = [i for i, p in enumerate(problems) if p.n == n]
+    keys = [domain.shape_key(p) for p in problems]
+    for key in sorted(set(keys)):
+        group = [i for i, k in enumerate(keys) if k == key]
         subset = [problems[i] for i in group]
         planned = _run(domain, subset, config, generator, report, beliefs, group)
         for i, result in zip(group, planned, strict=True):

@@ -1,7 +1,9 @@
 """Plain data that crosses package boundaries: problems, moves, plans and planner results.
 
 No tensors here. A problem is relational: N movable *entities* (blocks) each rest on one
-*support* drawn from the targets = entities + fixed targets (K=1: the table).
+*support* drawn from the targets = entities + fixed targets (K=1: the table). Other domains
+read the same fields their own way (their file says how) and keep what they need beyond them
+(static facts, a grounding) in ``data``.
 """
 
 from __future__ import annotations
@@ -50,6 +52,7 @@ class Problem:
     init: tuple[str, ...]
     goal: tuple[tuple[str, str], ...]
     fixed: tuple[str, ...] = (TABLE,)
+    data: object = field(default=None, compare=False, repr=False)  # domain-owned, crisp
 
     @property
     def targets(self) -> tuple[str, ...]:

@@ -1,6 +1,6 @@
 """Differentiable rollout of a window of action logits through the soft-T_P transition.
 
-Shared by every domain: the domain supplies soft legality and its T_P consistency operator.
+Shared by every domain: the domain supplies its soft step and its T_P consistency operator.
 """
 
 from __future__ import annotations
@@ -11,8 +11,7 @@ import torch
 from torch import Tensor
 
 from task.config import PlannerConfig
-from task.domains.base import Domain, SoftBatch
-from task.soft import transition
+from task.domains.base import Domain, SoftBatch, resolve_goal_loss
 
 NEG = -1e9  # logit of a masked action
 
@@ -20,7 +19,7 @@ NEG = -1e9  # logit of a masked action
 @dataclass(frozen=True)
 class Rollout:
     states: Tensor  # (B, T+1, N, Y) soft supports, refined
-    gates: Tensor  # (B, T, N, Y) move mass g_t(x, y) actually applied
+    gates: Tensor  # (B, T, N, A - 1) move mass g_t actually applied per action column
     loss: Tensor  # (B,) total objective per rollout
     goal: Tensor  # (B,) goal cross-entropy at the window's end
     moves: Tensor  # (B,) expected number of moves, sum_t sum_x m_t(x)
@@ -56,7 +55,7 @@ def rollout(
     fp = torch.zeros(F.shape[0], dtype=F.dtype, device=F.device)
     cycle = domain.cycle_loss(F, batch)
     for t in range(M.shape[1]):
-        F, g = transition(F, M[:, t], domain.soft_legality(F, batch))  # (B, N, Y)
+        F, g = domain.step(F, M[:, t], batch)  # (B, N, Y), (B, N, A - 1)
         refined = domain.consistency(F, batch)
         fp = fp + (refined - F).pow(2).sum((-1, -2))  # fixed-point loss before refinement
         F = refined
@@ -65,8 +64,8 @@ def rollout(
         cycle = cycle + domain.cycle_loss(F, batch)
         states.append(F)
         gates.append(g)
-    G = torch.stack(gates, dim=1)  # (B, T, N, Y)
+    G = torch.stack(gates, dim=1)  # (B, T, N, A - 1)
     moves = G.sum((1, 2, 3))
-    goal = domain.goal_loss(F, batch, config.goal_loss)
+    goal = domain.goal_loss(F, batch, resolve_goal_loss(domain, config.goal_loss))
     loss = goal + config.lambda_move * moves + config.lambda_cycle * cycle + config.lambda_fp * fp
     return Rollout(torch.stack(states, dim=1), G, loss, goal, moves)

@@ -1,10 +1,11 @@
 """Planning benchmarks: plan a suite per (horizon, seed), validate every plan, summarise.
 
-Each plan is converted to 4-op PDDL actions and checked by `task.symbolic.validate.validate` against
-the instance's parsed PDDL problem (the official check, independent of the planner's own crisp
-replay). Summaries follow the paper's table: valid out of N, optimal as a share of the valid plans,
-inexecutable, non-goal-reaching, mean time per instance and total wall time, one row per
-(horizon, seed), a mean over seeds, and rows per block count.
+Each plan is converted to its domain's PDDL actions and checked by
+`task.symbolic.validate.validate` against the instance's parsed PDDL problem (the official check,
+independent of the planner's own crisp replay). Summaries follow the paper's table: valid out of
+N, optimal as a share of the valid plans, inexecutable, non-goal-reaching, mean time per instance
+and total wall time, one row per (horizon, seed), a mean over seeds, and rows per size (blocks,
+packages, boxes).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from dataclasses import dataclass, replace
 
 from pddl.core import Domain
 
-from tamp.bench.suites import Suite
+from tamp.bench.suites import Suite, domain_of
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.planner import plan_batch
@@ -28,11 +29,13 @@ STATUSES = ("valid", "inexecutable", "non_goal_reaching", "no_plan")
 
 @dataclass(frozen=True)
 class Row:
-    """One instance planned with one (horizon, seed). ``length``: our 4-op actions or None."""
+    """One instance planned with one (horizon, seed). ``length``: our PDDL actions or None;
+    ``size``: the instance's size in its domain's units (blocks, packages, boxes, atoms)."""
 
     instance: str
-    blocks: int
+    size: int
     optimal: int | None
+    reference: int | None
     horizon: int
     seed: int
     length: int | None
@@ -74,7 +77,7 @@ class Speed:
 
 @dataclass(frozen=True)
 class Bench:
-    """Everything one benchmark invocation measured."""
+    """Everything one benchmark invocation measured; ``size_name``: what a row's size counts."""
 
     suite: str
     source: str
@@ -84,6 +87,7 @@ class Bench:
     horizons: tuple[int, ...]
     runs: tuple[Run, ...]
     speed: Speed | None = None
+    size_name: str = "blocks"
 
     def rows(self) -> tuple[Row, ...]:
         return tuple(r for run in self.runs for r in run.rows)
@@ -99,7 +103,7 @@ def replay(domain: Domain, instance: Instance, moves: Sequence[Move]) -> Validat
 
 
 def check(domain: Domain, instance: Instance, result: PlanResult) -> tuple[str, int | None]:
-    """``(status, 4-op length)`` of a planner result, validated against the instance's PDDL.
+    """``(status, PDDL length)`` of a planner result, validated against the instance's PDDL.
 
     Every plan the planner returns is replayed (`replay`), an inexecutable one too; only a
     window budget that ran out is ``no_plan``."""
@@ -127,8 +131,9 @@ def run_once(
         rows.append(
             Row(
                 instance.name,
-                instance.blocks,
+                instance.size,
                 instance.optimal,
+                instance.reference,
                 config.horizon,
                 seed,
                 length,
@@ -172,7 +177,8 @@ def run(
             len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s, fast.valid(), slow.valid()
         )
     n = len(suite.instances)
-    return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed)
+    size_name = get_domain(domain_of(suite)).size_name
+    return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed, size_name)
 
 
 def total(n: int, seeds: int, horizons: int, sequential: int = 0) -> int:

@@ -20,7 +20,7 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from tamp.bench.planning import Bench, Row
-from tamp.bench.summary import block_rows, main_rows
+from tamp.bench.summary import main_rows, size_rows
 from task.errors import TampError
 
 
@@ -54,7 +54,8 @@ def results(bench: Bench) -> dict:
         "config": asdict(bench.config),
         "machine": machine(),
         "summary": [s.asdict() for s in main_rows(bench)],
-        "by_blocks": [s.asdict() for s in block_rows(bench)],
+        "size_name": bench.size_name,
+        "by_size": [s.asdict() for s in size_rows(bench)],
         "speed": speed,
     }
 
@@ -125,20 +126,22 @@ def plot_steps(bench: Bench, path: Path) -> Path:
 
     rows, scale = bench.rows(), 1.0 / len(bench.seeds)
     first = [r for r in rows if r.horizon == bench.horizons[0] and r.seed == bench.seeds[0]]
-    lengths = [("optimal", Counter(r.optimal for r in first if r.optimal is not None), 1.0)]
+    best = {r.instance: r.optimal if r.optimal is not None else r.reference for r in first}
+    label = "optimal" if all(r.reference is None for r in first) else "optimal or reference"
+    lengths = [(label, Counter(v for v in best.values() if v is not None), 1.0)]
     excess = []
     for h in bench.horizons:
         valid = [r for r in rows if r.horizon == h and r.status == "valid"]
         lengths.append((f"ours, T={h}", Counter(r.length for r in valid), scale))
-        known = Counter(r.length - r.optimal for r in valid if r.optimal is not None)
+        known = Counter(r.length - best[r.instance] for r in valid if best[r.instance] is not None)
         excess.append((f"T={h}", known, scale))
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), constrained_layout=True)
     _bars(left, lengths)
-    left.set(xlabel="plan length (4-op actions)", ylabel="instances")
+    left.set(xlabel="plan length (PDDL actions)", ylabel="instances")
     left.set_title(f"{bench.suite} ({bench.n} instances): plan lengths")
     _bars(right, excess)
-    right.set(xlabel="our length - optimal length (actions)", ylabel="valid plans")
-    right.set_title("excess over the optimum")
+    right.set(xlabel=f"our length - {label} length (actions)", ylabel="valid plans")
+    right.set_title(f"excess over the {label}")
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path

@@ -1,8 +1,12 @@
-"""Benchmark suites: the official PlanBench Blocksworld-600 and seeded random problems.
+"""Benchmark suites: PlanBench's official sets, any folder of PDDL problems, random problems.
 
-PlanBench is read through its ``manifest.csv`` where there is one, else the official files are
-picked by name and their optima searched (`tamp.bench.optimal`); seeded random problems get
-their optimal lengths from A* with a node budget (``generated``). A `Suite` is a tuple of
+PlanBench (Blocksworld-600, Logistics-200, Sokoban-55; `OFFICIAL`) is read through its
+``manifest.csv`` where there is one, else the official files are picked by name. Lengths the
+data lack come from an optimal search: exact A* for Blocksworld (`tamp.bench.optimal`), Fast
+Downward for every other domain when the benchmark-only extra is installed
+(`tamp.bench.fast_downward`), both cached in the output folder. A folder of a domain file and
+problem files (the IPC sets) is read by `pddl_folder`. Seeded random Blocksworld problems get
+their optima from A* with a node budget (``generated``). A `Suite` is a tuple of
 `task.symbolic.instances.Instance` that all validate against one PDDL domain.
 """
 
@@ -10,6 +14,7 @@ from __future__ import annotations
 
 import csv
 import random
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -19,21 +24,48 @@ from pddl.core import Domain
 from tamp.bench.optimal import digest, optimal_lengths
 from task import data
 from task.domains import blocksworld
-from task.errors import DataError, PDDLError
+from task.errors import DataError, PDDLError, ProblemError, one_of
 from task.symbolic import pddl_io
 from task.symbolic.generate import random_problem
-from task.symbolic.instances import Instance, from_text
+from task.symbolic.instances import Instance, from_text, rules_for
 from task.symbolic.search import optimal_moves
 
-PLANBENCH_SOURCE = (
-    "github.com/karthikv792/LLMs-Planning, folder llm_planning_analysis/instances/blocksworld"
-)
-DEFAULT_PLANBENCH = Path("..") / "shared" / "data" / "planbench" / "blocksworld"
-_COLUMNS = ("file", "in_official_600", "n_blocks", "optimal_plan_length")
+PLANBENCH_SOURCE = "github.com/karthikv792/LLMs-Planning, folder llm_planning_analysis/instances"
+DEFAULT_DATA = Path("..") / "shared" / "data"
+DEFAULT_PLANBENCH = DEFAULT_DATA / "planbench" / "blocksworld"
 _DOMAIN_FILES = ("domain.pddl", "generated_domain.pddl")  # ours, PlanBench's own name
-# The official 600 as (subfolder, last instance number), in manifest.csv order: PlanBench's
-# zero-shot configs run blocksworld_3 instances 1..100 and blocksworld instances 1..500.
-OFFICIAL_600 = (("generated_basic_3", 100), ("generated_basic", 500))
+
+
+@dataclass(frozen=True)
+class Official:
+    """An official PlanBench set: its files by name and its ``manifest.csv`` columns."""
+
+    domain: str
+    names: tuple[str, ...]  # paths below instances/ without .pddl, in manifest order
+    flag: str  # manifest column: 1 for the official rows
+    size: str  # manifest column: the size the domain's `size` counts
+    optimal: str | None  # manifest column of optimal lengths (blank: unknown)
+    reference: str | None  # manifest column of reference lengths (not necessarily optimal)
+
+
+# Blocksworld-600: PlanBench's zero-shot configs run blocksworld_3 instances 1..100 and
+# blocksworld instances 1..500; Logistics-200: 1..200; Sokoban-55: 1..55 (README there).
+OFFICIAL = {
+    "blocksworld": Official(
+        "blocksworld",
+        tuple(f"{sub}/instance-{i}" for sub, n in (("generated_basic_3", 100),
+              ("generated_basic", 500)) for i in range(1, n + 1)),
+        "in_official_600", "n_blocks", "optimal_plan_length", None,
+    ),
+    "logistics": Official(
+        "logistics", tuple(f"instance-{i}" for i in range(1, 201)),
+        "in_official_200", "n_packages", None, "planbench_ground_truth_plan_length",
+    ),
+    "sokoban": Official(
+        "sokoban", tuple(f"instance-{i}" for i in range(1, 56)),
+        "in_official_55", "n_boxes", "optimal_plan_length_astar", None,
+    ),
+}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -50,7 +82,7 @@ def spread(items: Sequence, limit: int | None, key: Callable) -> list:
     """``limit`` items spread evenly over ``items`` stably sorted by ``key`` (all if None).
 
     Item ``i`` of the result is the middle of the ``i``-th of ``limit`` equal slices, so every
-    block count gets its share: ``--limit 6`` of PlanBench gives one 3-, four 4- and one 5-block.
+    size gets its share: ``--limit 6`` of Blocksworld-600 gives one 3-, four 4- and one 5-block.
     """
     ordered = sorted(items, key=key)
     if limit is None or limit >= len(ordered):
@@ -58,131 +90,169 @@ def spread(items: Sequence, limit: int | None, key: Callable) -> list:
     return [ordered[(2 * i + 1) * len(ordered) // (2 * limit)] for i in range(limit)]
 
 
-def _missing(root: Path) -> DataError:
+def default_data(domain: str) -> Path:
+    """Where `planbench` looks by default for ``domain``'s set."""
+    return DEFAULT_DATA / "planbench" / domain
+
+
+def _missing(root: Path, domain: str) -> DataError:
     return DataError(
-        f"PlanBench data not found at {root.resolve()} (needs domain.pddl and "
-        f"instances/generated_basic{{,_3}}/instance-N.pddl); get it from {PLANBENCH_SOURCE}, "
-        f"laid out as {DEFAULT_PLANBENCH}, and pass --data DIR"
+        f"PlanBench {domain} data not found at {root.resolve()} (needs domain.pddl and "
+        f"instances/*.pddl); get it from {PLANBENCH_SOURCE}/{domain}, laid out as "
+        f"{default_data(domain)}, and pass --data DIR"
     )
 
 
-def _signature(domain: Domain) -> tuple[frozenset, frozenset]:
-    """Action and predicate names with their arities, lowercased."""
-    actions = frozenset((str(a.name).lower(), len(a.parameters)) for a in domain.actions)
-    predicates = frozenset((str(p.name).lower(), p.arity) for p in domain.predicates)
-    return actions, predicates
-
-
-def _blocksworld_domain(root: Path) -> Domain:
-    """The domain file of ``root``, which must be the 4-op blocksworld domain."""
+def _domain(root: Path, rules: str | None) -> tuple[Domain, Path]:
+    """The domain file of ``root`` (None if absent); with ``rules``, it must be that domain."""
     path = next((root / n for n in _DOMAIN_FILES if (root / n).is_file()), None)
     if path is None:
-        raise _missing(root)
+        raise DataError(f"{root}: no domain.pddl")
     domain = pddl_io.load_domain(path)
-    expected = data.domain()
-    if _signature(domain) != _signature(expected):
-        actions = ", ".join(sorted(str(a.name).lower() for a in domain.actions))
-        wanted = ", ".join(sorted(str(a.name) for a in expected.actions))
-        raise DataError(
-            f"{root}: {path.name} is domain {str(domain.name)!r} (actions {actions}), "
-            f"not the blocksworld 4-op domain {str(expected.name)!r} (actions {wanted})"
-        )
-    return domain
+    try:
+        rules_for(domain, rules)
+    except PDDLError as exc:
+        raise DataError(f"{root}: {path.name}: {exc}") from None
+    return domain, path
 
 
-def _manifest(root: Path) -> list[tuple[str, int, int]]:
-    """``(file, n_blocks, optimal length)`` of the official rows of ``manifest.csv``."""
+def _int(text: str | None, path: Path, line: int, column: str) -> int | None:
+    if text is None or not text.strip():
+        return None
+    try:
+        return int(text)
+    except ValueError:
+        raise DataError(f"{path}: line {line}: {column} {text!r} is not an integer") from None
+
+
+def _manifest(root: Path, spec: Official) -> list[tuple[str, int, int | None, int | None]]:
+    """``(file, size, optimal, reference)`` of the official rows of ``manifest.csv``."""
     path = root / "manifest.csv"
+    lengths = [c for c in (spec.optimal, spec.reference) if c]
     with path.open(newline="", encoding="utf-8") as handle:
         reader = csv.DictReader(handle)
-        missing = [c for c in _COLUMNS if c not in (reader.fieldnames or ())]
+        missing = [c for c in ("file", spec.flag, spec.size, *lengths)
+                   if c not in (reader.fieldnames or ())]  # fmt: skip
         if missing:
             raise DataError(f"{path}: missing column(s) {', '.join(missing)}")
         rows = []
         for line, row in enumerate(reader, start=2):
-            if row["in_official_600"].strip() != "1":
-                continue
-            try:
-                rows.append((row["file"], int(row["n_blocks"]), int(row["optimal_plan_length"])))
-            except ValueError:
-                raise DataError(
-                    f"{path}: line {line}: n_blocks/optimal_plan_length not integers"
-                ) from None
+            if row[spec.flag].strip() == "1":
+                size = _int(row[spec.size], path, line, spec.size)
+                if size is None:
+                    raise DataError(f"{path}: line {line}: {spec.size} is blank")
+                opt, ref = (_int(row[c], path, line, c) if c else None
+                            for c in (spec.optimal, spec.reference))  # fmt: skip
+                rows.append((row["file"], size, opt, ref))
     if not rows:
-        raise DataError(f"{path}: no rows with in_official_600 = 1")
+        raise DataError(f"{path}: no rows with {spec.flag} = 1")
     return rows
 
 
-def official_600() -> tuple[str, ...]:
-    """Names of the official 600 in ``manifest.csv`` order: 3-block set first, each by number."""
-    return tuple(f"{sub}/instance-{i}" for sub, n in OFFICIAL_600 for i in range(1, n + 1))
-
-
-def _load(
-    domain: Domain, path: Path, name: str, optimal: int | None = None
-) -> tuple[Instance, str]:
+def _load(domain: Domain, path: Path, name: str, rules: str) -> tuple[Instance, str]:
     """``(instance, text)`` of one file; a problem of another domain is a `DataError`."""
     try:
         text = pddl_io.read_text(path)
-        return from_text(domain, text, str(path), name, optimal), text
-    except PDDLError as exc:
+        return from_text(domain, text, str(path), name, rules=rules), text
+    except (PDDLError, ProblemError) as exc:
         raise DataError(str(exc)) from None
 
 
-def _with_manifest(
-    root: Path, domain: Domain, rows: list[tuple[str, int, int]], limit: int | None
+def _fill_optima(
+    found: list[tuple[Instance, str]], domain_path: Path, cache_dir: str | Path | None
 ) -> list[Instance]:
-    """The official ``rows`` of ``manifest.csv``, their block counts checked against the files."""
-    instances = []
-    for file, blocks, optimal in spread(rows, limit, key=lambda row: row[1]):
-        path = root / file
-        name = file.removeprefix("instances/").removesuffix(".pddl")
-        instance, _ = _load(domain, path, name, optimal)
-        if instance.blocks != blocks:
-            raise DataError(f"{path}: {instance.blocks} blocks, manifest.csv says {blocks}")
-        instances.append(instance)
-    return instances
-
-
-def _without_manifest(
-    root: Path, domain: Domain, limit: int | None, cache_dir: str | Path | None
-) -> list[Instance]:
-    """The official files present, optima from `tamp.bench.optimal` (cached in ``cache_dir``)."""
-    folder = root / "instances" if (root / "instances").is_dir() else root
-    paths = [(name, folder / f"{name}.pddl") for name in official_600()]
-    found = [_load(domain, path, name) for name, path in paths if path.is_file()]
+    """Optima for the instances whose data give no length: A* for Blocksworld, else Fast
+    Downward if installed (None when it is not, or runs out of time). Cached in ``cache_dir``."""
     if not found:
-        raise DataError(
-            f"{root}: no PlanBench Blocksworld instances (expected "
-            "instances/generated_basic/instance-1..500.pddl and "
-            "instances/generated_basic_3/instance-1..100.pddl)"
-        )
-    chosen = spread(found, limit, key=lambda item: item[0].blocks)
-    keys = [(i.name, digest(text), i.problem) for i, text in chosen]
-    lengths = optimal_lengths(keys, cache_dir)
-    return [replace(i, optimal=length) for (i, _), length in zip(chosen, lengths, strict=True)]
+        return []
+    lacking = [k for k, (i, _) in enumerate(found) if i.optimal is None and i.reference is None]
+    out = [i for i, _ in found]
+    if not lacking:
+        return out
+    from tamp.bench import fast_downward  # benchmark-only extra, imported when needed
+
+    if found[0][0].problem.domain == blocksworld.NAME:
+        keys = [(out[k].name, digest(found[k][1]), out[k].problem) for k in lacking]
+        lengths = optimal_lengths(keys, cache_dir)
+    elif fast_downward.available():
+        pairs = [(domain_path, found[k][0].name, found[k][1]) for k in lacking]
+        lengths = fast_downward.cached_optima(pairs, cache_dir)
+    else:
+        return out
+    for k, length in zip(lacking, lengths, strict=True):
+        out[k] = replace(out[k], optimal=length)
+    return out
 
 
 def planbench(
-    data_dir: str | Path, limit: int | None = None, cache_dir: str | Path | None = None
+    data_dir: str | Path,
+    limit: int | None = None,
+    cache_dir: str | Path | None = None,
+    domain: str = "blocksworld",
 ) -> Suite:
-    """The official PlanBench Blocksworld-600 (or a ``limit``-instance `spread` of it).
+    """The official PlanBench set of ``domain`` (or a ``limit``-instance `spread` of it).
 
-    With a ``manifest.csv`` in ``data_dir``, its official rows and optimal lengths are used.
-    Without one, the official files are known by name (`OFFICIAL_600`; others are left out)
-    and their optima are searched, cached in ``cache_dir`` when given (see `tamp.bench.optimal`).
-    Both ways give the same instances in the same order. ``data_dir`` may also be PlanBench's
-    own folder (``generated_domain.pddl``, ``generated_basic*/`` without ``instances/``).
+    With a ``manifest.csv`` in ``data_dir``, its official rows and lengths are used (sizes are
+    checked against the files); without one the official files are known by name (others are
+    left out). Lengths the data lack are searched (`_fill_optima`), cached in ``cache_dir``.
+    ``data_dir`` may also be PlanBench's own folder (``generated_domain.pddl``, instance
+    folders without ``instances/``). Both ways give the same instances in the same order.
     """
+    if domain not in OFFICIAL:
+        raise ProblemError(f"--domain: no PlanBench set for {one_of(domain, OFFICIAL)}")
+    spec, root = OFFICIAL[domain], Path(data_dir)
+    if not root.is_dir() or not any((root / n).is_file() for n in _DOMAIN_FILES):
+        raise _missing(root, domain)
+    pddl_domain, domain_path = _domain(root, domain)
+    folder = root / "instances" if (root / "instances").is_dir() else root
+    if (root / "manifest.csv").is_file():
+        rows = spread(_manifest(root, spec), limit, key=lambda row: row[1])
+        found = []
+        for file, size, opt, ref in rows:
+            name = file.removeprefix("instances/").removesuffix(".pddl")
+            instance, text = _load(pddl_domain, root / file, name, domain)
+            if instance.size != size:
+                raise DataError(f"{root / file}: size {instance.size}, manifest.csv says {size}")
+            found.append((replace(instance, optimal=opt, reference=ref), text))
+    else:
+        paths = [(n, folder / f"{n}.pddl") for n in spec.names]
+        found = [_load(pddl_domain, p, n, domain) for n, p in paths if p.is_file()]
+        if not found:
+            first, last = spec.names[0], spec.names[-1]
+            raise DataError(
+                f"{root}: no official PlanBench {domain} instances (expected "
+                f"instances/{first}.pddl ... {last}.pddl)"
+            )
+        found = spread(found, limit, key=lambda item: item[0].size)
+    instances = _fill_optima(found, domain_path, cache_dir)
+    name = "planbench" if domain == "blocksworld" else f"planbench-{domain}"
+    return Suite(name, pddl_domain, tuple(instances), str(root.resolve()))
+
+
+def _natural(path: Path) -> tuple:
+    return tuple(int(t) if t.isdigit() else t for t in re.split(r"(\d+)", path.name))
+
+
+def pddl_folder(
+    data_dir: str | Path,
+    limit: int | None = None,
+    cache_dir: str | Path | None = None,
+    rules: str | None = None,
+) -> Suite:
+    """Every problem file of a folder holding ``domain.pddl`` and problems (``*.pddl``),
+    natural order; planned with the recognised domain rules or ``rules``."""
     root = Path(data_dir)
     if not root.is_dir():
-        raise _missing(root)
-    domain = _blocksworld_domain(root)  # first: another benchmark's folder has a manifest too
-    if (root / "manifest.csv").is_file():
-        instances = _with_manifest(root, domain, _manifest(root), limit)
-    else:
-        instances = _without_manifest(root, domain, limit, cache_dir)
-    return Suite("planbench", domain, tuple(instances), str(root.resolve()))
+        raise DataError(f"{root}: no such folder (needs domain.pddl and problem files)")
+    pddl_domain, domain_path = _domain(root, rules)
+    chosen = rules_for(pddl_domain, rules)
+    paths = sorted((p for p in root.glob("*.pddl") if p.name not in _DOMAIN_FILES), key=_natural)
+    if not paths:
+        raise DataError(f"{root}: no problem files (*.pddl besides {domain_path.name})")
+    found = [_load(pddl_domain, p, p.stem, chosen) for p in paths]
+    found = spread(found, limit, key=lambda item: item[0].size)
+    instances = _fill_optima(found, domain_path, cache_dir)
+    return Suite(root.name, pddl_domain, tuple(instances), str(root.resolve()))
 
 
 def generated(
@@ -213,3 +283,8 @@ def generated(
             report(1)
     source = f"task.symbolic.generate.random_problem, seed {seed}, A* budget {max_nodes} nodes"
     return Suite("random", domain, tuple(instances), source)
+
+
+def domain_of(suite: Suite) -> str:
+    """The domain rules that plan ``suite`` (its first instance's)."""
+    return suite.instances[0].problem.domain if suite.instances else blocksworld.NAME

@@ -1,10 +1,13 @@
 """Summary rows of a benchmark in the paper's format, computed from its per-instance rows.
 
 A `Summary` covers one horizon and either one seed or the mean over seeds (``seed`` None), over
-all instances or one block count. Counts of a mean row are means over seeds (e.g. 598.3 valid).
+all instances or one size (block count, packages, boxes). Counts of a mean row are means over
+seeds (e.g. 598.3 valid).
 "Optimal" counts valid plans as long as the known optimum (`is_optimal`, the one definition
 every benchmark uses); its percentage is taken over the valid plans whose instance has a known
-optimum (``known`` says how many instances have one).
+optimum (``known`` says how many instances have one). Where the data give a reference plan that
+need not be optimal (PlanBench Logistics), ``at_most_ref`` counts valid plans no longer than it
+and ``shorter_than_ref`` those strictly shorter.
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from task.errors import TampError
 class Summary:
     horizon: int
     seed: int | None  # None: mean over seeds
-    blocks: int | None  # None: every block count
+    size: int | None  # None: every size
     n: int  # instances
     known: int  # instances with a known optimal length
     valid: float
@@ -33,6 +36,10 @@ class Summary:
     time_s: float  # mean planning time per instance
     wall_s: float | None  # wall time of the whole batch (None for a block-count row)
     windows: float  # mean replanning windows per instance
+    with_ref: int = 0  # instances with a reference length
+    at_most_ref: float = 0.0  # valid plans no longer than the reference
+    at_most_ref_pct: float | None = None  # 100 * at_most_ref / valid plans with a reference
+    shorter_than_ref: float = 0.0  # valid plans shorter than the reference
 
     def asdict(self) -> dict:
         return asdict(self)
@@ -55,16 +62,18 @@ def _fmean(values: Sequence[float]) -> float:
 
 
 def summarise(
-    rows: Sequence[Row], horizon: int, seed: int | None, blocks: int | None, wall: float | None
+    rows: Sequence[Row], horizon: int, seed: int | None, size: int | None, wall: float | None
 ) -> Summary:
     """The summary of one seed's ``rows``."""
     count = {s: sum(r.status == s for r in rows) for s in STATUSES}
     scored = [r for r in rows if r.status == "valid" and r.optimal is not None]
     optimal = sum(is_optimal(r.length, r.optimal, r.instance) for r in scored)
+    refs = [r for r in rows if r.status == "valid" and r.reference is not None]
+    at_most = sum(r.length <= r.reference for r in refs)
     return Summary(
         horizon=horizon,
         seed=seed,
-        blocks=blocks,
+        size=size,
         n=len(rows),
         known=sum(r.optimal is not None for r in rows),
         valid=count["valid"],
@@ -76,6 +85,10 @@ def summarise(
         time_s=_fmean([r.time_s for r in rows]),
         wall_s=wall,
         windows=_fmean([r.windows for r in rows]),
+        with_ref=sum(r.reference is not None for r in rows),
+        at_most_ref=at_most,
+        at_most_ref_pct=100.0 * at_most / len(refs) if refs else None,
+        shorter_than_ref=sum(r.length < r.reference for r in refs),
     )
 
 
@@ -84,7 +97,7 @@ def mean_over_seeds(per_seed: Sequence[Summary]) -> Summary:
     first = per_seed[0]
     values = {}
     for f in fields(Summary):
-        if f.name in ("horizon", "blocks", "n", "known"):
+        if f.name in ("horizon", "size", "n", "known", "with_ref"):
             values[f.name] = getattr(first, f.name)
         elif f.name == "seed":
             values[f.name] = None
@@ -106,15 +119,15 @@ def main_rows(bench: Bench) -> list[Summary]:
     return out
 
 
-def block_rows(bench: Bench) -> list[Summary]:
-    """A row per (horizon, block count), each the mean over seeds."""
-    counts = sorted({r.blocks for r in bench.rows()})
+def size_rows(bench: Bench) -> list[Summary]:
+    """A row per (horizon, size), each the mean over seeds."""
+    counts = sorted({r.size for r in bench.rows()})
     out = []
     for h in bench.horizons:
         runs = [r for r in bench.runs if r.horizon == h]
         for b in counts:
             per_seed = [
-                summarise([x for x in r.rows if x.blocks == b], h, r.seed, b, None) for r in runs
+                summarise([x for x in r.rows if x.size == b], h, r.seed, b, None) for r in runs
             ]
             out.append(mean_over_seeds(per_seed))
     return out

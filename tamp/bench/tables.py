@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from tamp.bench.planning import Bench
-from tamp.bench.summary import Summary, block_rows, main_rows
+from tamp.bench.summary import Summary, main_rows, size_rows
 
 
 def table(headers: Sequence[str], rows: Sequence[Sequence[object]], indent: str = "  ") -> str:
@@ -61,6 +61,19 @@ def _row(s: Summary, first: str) -> list[str]:
 
 
 _HEAD = ["valid", "optimal", "known", "inexec.", "non-goal", "no plan", "s/inst", "wall s", "win."]
+_SIZE_LABEL = {"blocks": "block count"}
+
+
+def _ref(cells: list[str], s: Summary | None, refs: bool) -> list[str]:
+    """``cells`` with the reference-plan columns after "known" when the data have references."""
+    if not refs:
+        return list(cells)
+    if s is None:
+        extra = ["<=ref", "<ref"]
+    else:
+        pct = "-" if s.at_most_ref_pct is None else f"{s.at_most_ref_pct:.1f}%"
+        extra = [pct, count(s.shorter_than_ref)]
+    return [*cells[:5], *extra, *cells[5:]]
 
 
 def planning_report(bench: Bench) -> str:
@@ -75,15 +88,24 @@ def planning_report(bench: Bench) -> str:
         + ("" if c.crisp_check else "; NO crisp check (illegal moves kept, restarts by loss)"),
         "",
     ]
-    main = [_row(s, "mean" if s.seed is None else str(s.seed)) for s in main_rows(bench)]
-    lines += [table(["T", "seed", *_HEAD], main), ""]
-    lines.append("by block count (mean over seeds):")
-    blocks = [[*_row(s, str(s.blocks))[:-2], f"{s.windows:.2f}"] for s in block_rows(bench)]
-    lines.append(table(["T", "blocks", *_HEAD[:-2], "win."], blocks))
+    refs = any(r.reference is not None for r in bench.rows())
+    main = [_ref(_row(s, "mean" if s.seed is None else str(s.seed)), s, refs)
+            for s in main_rows(bench)]  # fmt: skip
+    lines += [table(["T", "seed", *_ref(_HEAD, None, refs)], main), ""]
+    lines.append(f"by {_SIZE_LABEL.get(bench.size_name, bench.size_name)} (mean over seeds):")
+    by_size = [_ref([*_row(s, str(s.size))[:-2], f"{s.windows:.2f}"], s, refs)
+               for s in size_rows(bench)]  # fmt: skip
+    head = ["T", bench.size_name, *_HEAD[:-2], "win."]
+    lines.append(table(_ref(head, None, refs), by_size))
     lines.append(
         "optimal: share of valid plans (on instances with a known optimum) that are optimal; "
         "known: instances with a known optimum"
     )
+    if refs:
+        lines.append(
+            "<=ref: share of valid plans no longer than the data's reference plan (which need not "
+            "be optimal); <ref: valid plans shorter than it"
+        )
     if bench.speed is not None:
         sp = bench.speed
         ratio = "n/a" if sp.speedup is None else f"{sp.speedup:.1f}x"

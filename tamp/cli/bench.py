@@ -1,5 +1,5 @@
-"""``tamp bench planbench|random|motion|perception|poses``: options in, `tamp.bench` runs, tables
-out.
+"""``tamp bench planbench|pddl|random|motion|perception|poses``: options in, `tamp.bench` runs,
+tables out.
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
 bar on stderr, prints the paper-style table (`tamp.bench.tables`; the ``results.json`` content
@@ -52,8 +52,14 @@ def _run(suite: Suite, args: argparse.Namespace) -> int:
 
 
 def planbench_command(args: argparse.Namespace) -> int:
-    """The official PlanBench Blocksworld-600 (or a ``--limit`` spread of it)."""
-    return _run(suites.planbench(args.data, args.limit, args.out), args)
+    """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
+    data = args.data if args.data is not None else suites.default_data(args.domain)
+    return _run(suites.planbench(data, args.limit, args.out, args.domain), args)
+
+
+def pddl_command(args: argparse.Namespace) -> int:
+    """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
+    return _run(suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules), args)
 
 
 def random_command(args: argparse.Namespace) -> int:

@@ -9,11 +9,15 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 
-from tamp.bench.suites import DEFAULT_PLANBENCH
+from tamp.bench.suites import OFFICIAL, default_data
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
-from task.domains.blocksworld import GOAL_LOSSES
+from task.domains import names
 from task.errors import TampError
+
+# every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
+# Blocksworld's "towers", Logistics' and Sokoban's "potential", the STRIPS lift's "hadd"
+GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
@@ -133,13 +137,29 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
     return p
 
 
-def data_option(p: argparse.ArgumentParser) -> None:
+def data_option(p: argparse.ArgumentParser, domains: bool = False) -> None:
+    """``--data`` (and with ``domains``, ``--domain``: which PlanBench set)."""
+    if domains:
+        p.add_argument(
+            "--domain", choices=tuple(OFFICIAL), default="blocksworld",
+            help="which PlanBench set: Blocksworld-600, Logistics-200, Sokoban-55 (blocksworld)",
+        )  # fmt: skip
     p.add_argument(
         "--data",
-        default=str(DEFAULT_PLANBENCH),
+        default=None if domains else str(default_data("blocksworld")),
         metavar="DIR",
-        help=f"PlanBench blocksworld folder ({DEFAULT_PLANBENCH})",
+        help=f"PlanBench folder of the domain ({default_data('DOMAIN')})"
+        if domains
+        else f"PlanBench blocksworld folder ({default_data('blocksworld')})",
     )
+
+
+def rules_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--domain-rules", choices=names(), metavar="NAME",
+        help=f"plan with these domain rules ({'|'.join(names())}; default: recognised from the "
+        "PDDL domain, the generic STRIPS lift for a domain no file is written for)",
+    )  # fmt: skip
 
 
 def progress_option(p: argparse.ArgumentParser) -> None:

@@ -20,6 +20,7 @@ from tamp.cli.options import (
     positive_list,
     progress_option,
     radius_list,
+    rules_option,
 )
 from tamp.sim.base import SIMULATORS
 
@@ -45,10 +46,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     """``plan``, ``validate`` and ``demo``."""
-    p = sub.add_parser("plan", parents=[plan_opts], help="plan a blocksworld PDDL problem")
+    p = sub.add_parser(
+        "plan", parents=[plan_opts],
+        help="plan a PDDL problem (blocksworld, logistics, sokoban or any STRIPS domain)",
+    )  # fmt: skip
     p.add_argument("domain", metavar="DOMAIN.pddl")
     p.add_argument("problem", metavar="PROBLEM.pddl")
     p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
     p.set_defaults(func=_lazy("tamp.cli.plan", "plan_command"))
 
@@ -81,8 +86,12 @@ def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
 
 
 def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
-    """``bench planbench`` and ``bench random``."""
-    for name, what in (("planbench", "PlanBench Blocksworld-600"), ("random", "random problems")):
+    """``bench planbench``, ``bench pddl`` and ``bench random``."""
+    for name, what in (
+        ("planbench", "PlanBench Blocksworld-600, Logistics-200 or Sokoban-55"),
+        ("pddl", "a folder of a PDDL domain and its problems (e.g. IPC gripper)"),
+        ("random", "random blocksworld problems"),
+    ):
         p = bench.add_parser(name, parents=[bench_opts], help=f"benchmark on {what}")
         p.add_argument(
             "--seeds", type=positive, default=1, metavar="S", help="planner seeds 0..S-1 (1)"
@@ -102,14 +111,19 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
-    data_option(planbench)
-    planbench.add_argument(
-        "--limit",
-        type=positive,
-        metavar="N",
-        help="a spread of N instances over the block counts (all 600)",
+    data_option(planbench, domains=True)
+    folder = bench.choices["pddl"]
+    folder.add_argument(
+        "--data", required=True, metavar="DIR", help="folder with domain.pddl and problem files"
     )
+    rules_option(folder)
+    for p in (planbench, folder):
+        p.add_argument(
+            "--limit", type=positive, metavar="N",
+            help="a spread of N instances over the sizes (all)",
+        )  # fmt: skip
     planbench.set_defaults(func=_lazy("tamp.cli.bench", "planbench_command"))
+    folder.set_defaults(func=_lazy("tamp.cli.bench", "pddl_command"))
     random_.add_argument(
         "--blocks",
         type=positive_list,

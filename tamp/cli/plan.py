@@ -20,8 +20,8 @@ from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.planner import plan
-from task.problem import TABLE, PlanResult
-from task.symbolic import pddl_io
+from task.problem import Move, PlanResult
+from task.symbolic import pddl_io, strips
 from task.symbolic.instances import Instance, example, from_files
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
@@ -36,7 +36,7 @@ def _write(path: Path, text: str) -> None:
 
 
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
-    """Plan ``instance`` and validate the 4-op plan against its PDDL (None without a plan)."""
+    """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan)."""
     config = planner_config(args)
     result = plan(instance.problem, config, args.seed)
     actions: tuple = ()
@@ -61,7 +61,8 @@ def _plan_json(
             "problem": result.problem.name,
             "status": result.status.value,
             "valid": validation is not None and validation.valid,
-            "moves": [[m.entity, m.target] for m in result.plan.moves],
+            "domain_rules": result.problem.domain,
+            "moves": [_move_json(m) for m in result.plan.moves],
             "actions": [str(a).lower() for a in actions],
             "validation": None if validation is None else report.validation_dict(validation),
             "stats": result.stats,
@@ -72,31 +73,38 @@ def _plan_json(
     )
 
 
-def _outcome(result: PlanResult, validation: Validation | None) -> str:
+def _move_json(move: object) -> object:
+    """A relational move as ``[entity, target]``; any other move (a ground action) as text."""
+    return [move.entity, move.target] if isinstance(move, Move) else str(move).lower()
+
+
+def _outcome(result: PlanResult, validation: Validation | None, instance: Instance) -> str:
     windows, moves = result.stats.get("windows", 0), len(result.plan)
     took = (
         f"{moves} move{'' if moves == 1 else 's'}, {windows} window{'' if windows == 1 else 's'}, "
         f"{result.stats['time_s']:.2f} s"
     )
     if validation is None:
-        left = ", ".join(
-            f"(ontable {x})" if y == TABLE else f"(on {x} {y})"
-            for x, y in blocksworld.unsatisfied_goals(result.problem, _final_state(result))
-        )
+        left = " ".join(strips.atom_str(a) for a in _unmet(result, instance))
         return f"NO PLAN: goal not reached after {took}; unmet: {left}"
     return f"{report.validation_line(validation)} ({took})"
 
 
-def _final_state(result: PlanResult) -> tuple[str, ...]:
-    state = blocksworld.initial_state(result.problem)
+def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
+    """The PDDL goal atoms that do not hold after the plan's legal moves."""
+    domain = get_domain(result.problem.domain)
+    state = domain.initial_state(result.problem)
     for move in result.plan.moves:
-        state = blocksworld.apply_move(result.problem, state, move)
-    return state
+        if domain.check_move(result.problem, state, move) is not None:
+            break
+        state = domain.apply_move(result.problem, state, move)
+    holds = domain.to_atoms(result.problem, state)
+    return [a for a in strips.goal_atoms(instance.pddl) if a not in holds]
 
 
 def plan_command(args: argparse.Namespace) -> int:
     """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line."""
-    domain, instance = from_files(args.domain, args.problem)
+    domain, instance = from_files(args.domain, args.problem, args.domain_rules)
     config, result, actions, validation = _solve(domain, instance, args)
     if args.out is not None and validation is not None:
         _write(Path(args.out), pddl_io.format_plan(actions))
@@ -105,7 +113,7 @@ def plan_command(args: argparse.Namespace) -> int:
     else:
         if actions:
             print(pddl_io.format_plan(actions), end="")
-        print(_outcome(result, validation))
+        print(_outcome(result, validation, instance))
     return 0 if validation is not None and validation.valid else 1
 
 
@@ -149,7 +157,7 @@ def demo_command(args: argparse.Namespace) -> int:
         f"PDDL plan ({blocksworld.PDDL_DOMAIN}):",
         pddl_io.format_plan(actions).rstrip(),
         "",
-        _outcome(result, validation),
+        _outcome(result, validation, instance),
     ]
     print("\n".join(lines))
     if written:

@@ -32,8 +32,15 @@ def load_problem(problem: str | None, domain: str | None) -> Problem:
     if problem is None:
         return example()[1].problem
     if domain is None:
-        return from_text(data.domain(), pddl_io.read_text(problem), str(problem)).problem
-    return from_files(domain, problem)[1].problem
+        loaded = from_text(data.domain(), pddl_io.read_text(problem), str(problem)).problem
+    else:
+        loaded = from_files(domain, problem)[1].problem
+    if loaded.domain != "blocksworld":
+        raise TampError(
+            f"{problem}: the arm executes blocksworld problems only; this is a "
+            f"{loaded.domain} problem (plan it with 'tamp plan')"
+        )
+    return loaded
 
 
 def loop_config(args: argparse.Namespace) -> LoopConfig:

@@ -1,28 +1,42 @@
 """Registry of planning domains: one file each, picked up by name.
 
 Adding a domain is one file in this folder exposing a ``DOMAIN`` object that satisfies
-``task.domains.base.Domain``, plus one line in ``_DOMAINS`` below. ``base`` holds the protocol
-and the soft batch every domain fills. A domain too large for one file keeps helpers beside it
-under its own prefix: ``blocksworld_pddl`` (problem PDDL in and out) and ``blocksworld_states``
-(full goal scenes, the most likely state of a perceived soft state).
+`task.domains.base.Domain`, plus its name in ``_NAMES`` below; modules are imported on first
+use. ``base`` holds the protocol and the soft batch every domain fills. A domain too large for
+one file keeps helpers beside it under its own prefix: ``blocksworld_pddl`` (problem PDDL in
+and out) and ``blocksworld_states`` (full goal scenes, the most likely state of a perceived
+soft state). ``strips`` is the generic soft lift of any grounded STRIPS domain: the planner of
+a PDDL domain no file is written for, and the oracle the hand-written domains are tested on.
 """
 
 from __future__ import annotations
 
-from task.domains import blocksworld
-from task.domains.base import Domain
+import importlib
+from typing import TYPE_CHECKING
+
 from task.errors import ProblemError, one_of
 
-_DOMAINS: dict[str, Domain] = {blocksworld.NAME: blocksworld.DOMAIN}
+if TYPE_CHECKING:  # the registry itself stays light: no torch until a domain is used
+    from task.domains.base import Domain
+
+_NAMES = ("blocksworld", "logistics", "sokoban", "strips")
+GENERIC = "strips"  # the generic lift: recognised last, matches any supported STRIPS domain
 
 
 def names() -> tuple[str, ...]:
-    return tuple(_DOMAINS)
+    return _NAMES
 
 
 def get_domain(name: str) -> Domain:
     """The registered domain called ``name``; raises ProblemError listing the valid names."""
-    try:
-        return _DOMAINS[name]
-    except KeyError:
-        raise ProblemError(f"unknown domain {one_of(name, _DOMAINS)}") from None
+    if name not in _NAMES:
+        raise ProblemError(f"unknown domain {one_of(name, _NAMES)}")
+    return importlib.import_module(f"task.domains.{name}").DOMAIN
+
+
+def recognise(pddl_domain) -> str:
+    """The name of the hand-written domain a parsed PDDL domain is, else the generic lift."""
+    for name in _NAMES:
+        if name != GENERIC and get_domain(name).matches(pddl_domain):
+            return name
+    return GENERIC

@@ -1,38 +1,51 @@
 """The interface a planning domain supplies, and the tensor encoding shared by relational domains.
 
-A domain is one file in ``task/domains/`` that provides its soft gates (``soft_legality``,
-``consistency``), its crisp legality and apply, and its PDDL mapping. The rollout, optimiser,
+A domain is one file in ``task/domains/`` exposing an object that satisfies `Domain`: its soft
+transition (``step``, ``consistency``), its action columns and how a column decodes into a
+move, its crisp legality and apply, its goal terms, an admissible lower bound, its PDDL
+mapping and a sampler of small problems for the contract tests. The rollout, optimiser,
 decoder and replanning windows (``task.rollout``, ``task.optimize``, ``task.decode``,
 ``task.planner``) are shared and never change per domain.
+
+Shapes: a state tensor is ``F: (B, N, Y)`` (N rows, e.g. entities; Y columns, e.g. support
+targets), an action distribution ``M: (B, N, A)`` per row whose last column is STAY, and the
+applied move mass ``g: (B, N, A - 1)``, one entry per non-STAY action column. Relational
+domains (Blocksworld, Logistics) use ``Y = N + K`` support targets and ``A = Y + 1``
+(`encode_supports`, `relational_step`); other domains choose their own Y and A.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+import math
+from collections.abc import Callable, Hashable, Iterator, Sequence
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import torch
+from pddl.core import Domain as PDDLDomain
+from pddl.core import Problem as PDDLProblem
 from torch import Tensor
 
 from task.problem import Action, Move, Problem
+from task.soft import transition
 
-State = tuple[str, ...]  # crisp support of each entity, in problem.entities order
+State = tuple | frozenset  # crisp: supports per entity (relational), or a set of atoms
+INF = math.inf  # the lower bound of a dead end: no sequence of moves reaches the goal
 
 
 @dataclass(frozen=True)
 class SoftBatch:
-    """Padded tensors for B problems with at most N entities and K fixed targets.
+    """Padded tensors for B problems of one domain.
 
-    Columns are ``N`` entity slots followed by ``K`` fixed targets, so the table sits at column
-    ``N`` for every problem whatever its size. Padded entities rest on the first fixed target,
-    may only STAY and are never targets.
+    ``static`` holds the domain's per-problem constant tensors (adjacency, city masks,
+    preconditions), batch first; `repeat` repeats them with the rest.
     """
 
-    F0: Tensor  # (B, N, Y) crisp initial supports, one-hot rows
-    entity_mask: Tensor  # (B, N) bool, real entities
-    action_mask: Tensor  # (B, N, A) bool, A = Y + 1, last column STAY
+    F0: Tensor  # (B, N, Y) crisp initial state, one-hot
+    entity_mask: Tensor  # (B, N) bool, real rows
+    action_mask: Tensor  # (B, N, A) bool, last column STAY (always allowed)
     goal: Tensor  # (B, N, Y) one-hot goal atoms, zero rows for entities the goal leaves free
+    static: dict[str, Tensor] = field(default_factory=dict)
 
     @property
     def n(self) -> int:
@@ -40,7 +53,8 @@ class SoftBatch:
 
     def repeat(self, r: int) -> SoftBatch:
         """Each problem ``r`` times in a row (restarts): (B, ...) -> (B * r, ...)."""
-        return SoftBatch(*(t.repeat_interleave(r, dim=0) for t in self.astuple()))
+        rep = {k: v.repeat_interleave(r, dim=0) for k, v in self.static.items()}
+        return SoftBatch(*(t.repeat_interleave(r, dim=0) for t in self.astuple()), static=rep)
 
     def astuple(self) -> tuple[Tensor, Tensor, Tensor, Tensor]:
         return (self.F0, self.entity_mask, self.action_mask, self.goal)
@@ -49,9 +63,15 @@ class SoftBatch:
 def encode_supports(
     problems: Sequence[Problem], states: Sequence[State], dtype: torch.dtype = torch.float32
 ) -> SoftBatch:
-    """One-hot support tensors for problems whose targets are entities + fixed targets."""
+    """One-hot support tensors for problems whose targets are entities + fixed targets.
+
+    Both axes are padded: ``N`` entity slots, then ``K`` fixed-target slots, so the first fixed
+    target sits at column ``N`` for every problem. Padded entities rest on the first fixed
+    target, may only STAY and are never targets; padded fixed targets are never targets. A
+    domain narrows ``action_mask`` further with its own static legality.
+    """
     n = max(p.n for p in problems)
-    k = len(problems[0].fixed)
+    k = max(len(p.fixed) for p in problems)
     b, y = len(problems), n + k
     F0 = torch.zeros(b, n, y, dtype=dtype)
     goal = torch.zeros(b, n, y, dtype=dtype)
@@ -68,24 +88,61 @@ def encode_supports(
             goal[i, col[x], col[sup]] = 1.0
         entity[i, : p.n] = True
         target[i, : p.n] = True
-        target[i, n:] = True
+        target[i, n : n + len(p.fixed)] = True
     not_self = ~torch.eye(n, y, dtype=torch.bool)  # (N, Y)
     moves = entity[:, :, None] & target[:, None, :] & not_self  # (B, N, Y)
     stay = torch.ones(b, n, 1, dtype=torch.bool)
     return SoftBatch(F0, entity, torch.cat([moves, stay], dim=-1), goal)
 
 
+def relational_step(
+    legality: Callable[[Tensor, SoftBatch], Tensor],
+) -> Callable[[Tensor, Tensor, SoftBatch], tuple[Tensor, Tensor]]:
+    """The support-relation step ``F' = (1 - m) F + g`` (`task.soft.transition`) gated by a
+    domain's soft ``legality(F, batch) -> (B, N, Y)``: one row changes per committed move."""
+
+    def step(F: Tensor, M: Tensor, batch: SoftBatch) -> tuple[Tensor, Tensor]:
+        return transition(F, M, legality(F, batch))
+
+    return step
+
+
+def relational_decode(problem: Problem, row: int, col: int, n: int) -> Move | None:
+    """Column ``col`` of entity row ``row`` as ``move(entity -> target)`` (None on padding);
+    ``n`` is the padded entity count (targets: entities 0..n-1, fixed targets from n)."""
+    if row >= problem.n:
+        return None
+    if col < n:
+        return Move(problem.entities[row], problem.entities[col]) if col < problem.n else None
+    k = col - n
+    return Move(problem.entities[row], problem.fixed[k]) if k < len(problem.fixed) else None
+
+
+def zero_cycle_loss(F: Tensor, batch: SoftBatch) -> Tensor:
+    """No cycle term (domains whose relation cannot form cycles): (B, N, Y) -> (B,) zeros."""
+    return F.new_zeros(F.shape[0])
+
+
 class Domain(Protocol):
     """What a domain file provides. Tensors are batch first; see the glossary in ``task``."""
 
     name: str
+    size_name: str  # what `size` counts, a table's column head ("blocks", "packages", ...)
+    goal_losses: tuple[str, ...]  # accepted goal-loss kinds; "default" resolves to the first
+    distributions: bool  # rows of F are distributions (False: independent atom probabilities)
+
+    # ------------------------------------------------------------------ tensors (soft side)
+    def shape_key(self, problem: Problem) -> Hashable:
+        """Problems with equal keys share one tensor program (sortable: int or int tuple)."""
+        ...
 
     def encode(
         self, problems: Sequence[Problem], states: Sequence[State], dtype: torch.dtype
     ) -> SoftBatch: ...
 
-    def soft_legality(self, F: Tensor, batch: SoftBatch) -> Tensor:
-        """Soft legality of every move(x -> y): (B, N, Y) -> (B, N, Y) in [0, 1]."""
+    def step(self, F: Tensor, M: Tensor, batch: SoftBatch) -> tuple[Tensor, Tensor]:
+        """One soft transition: F (B, N, Y), M (B, N, A) -> (F', g) with g (B, N, A - 1) the
+        move mass applied per action column. One-hot F and M give the crisp successor."""
         ...
 
     def consistency(self, F: Tensor, batch: SoftBatch) -> Tensor:
@@ -97,9 +154,16 @@ class Domain(Protocol):
         ...
 
     def goal_loss(self, F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
-        """Goal term of the objective, (B, N, Y) -> (B,); ``kind`` names the variant."""
+        """Goal term of the objective, (B, N, Y) -> (B,); ``kind`` is one of ``goal_losses``
+        (or "default"); "atoms" is the paper's cross-entropy on the goal atoms."""
         ...
 
+    def decode(self, problem: Problem, row: int, col: int, n: int) -> Move | None:
+        """The move of action column ``col`` of row ``row`` (None for padding); ``n``: the
+        batch's padded row count ``F.shape[1]``."""
+        ...
+
+    # ------------------------------------------------------------------------- crisp side
     def initial_state(self, problem: Problem) -> State: ...
 
     def check_move(self, problem: Problem, state: State, move: Move) -> str | None:
@@ -108,15 +172,52 @@ class Domain(Protocol):
 
     def apply_move(self, problem: Problem, state: State, move: Move) -> State: ...
 
+    def legal_moves(self, problem: Problem, state: State) -> list[Move]:
+        """Every legal move in ``state`` (samplers' random walks, tests)."""
+        ...
+
     def is_goal(self, problem: Problem, state: State) -> bool: ...
 
-    def lower_bound(self, problem: Problem, state: State) -> int:
-        """An admissible lower bound on the moves still needed to reach the goal."""
+    def lower_bound(self, problem: Problem, state: State) -> float:
+        """An admissible lower bound on the moves still needed; `INF` at a dead end."""
+        ...
+
+    def size(self, problem: Problem) -> int:
+        """The problem's size in ``size_name`` units."""
+        ...
+
+    # ------------------------------------------------------------------------------- PDDL
+    def matches(self, domain: PDDLDomain) -> bool:
+        """Whether the parsed PDDL domain is this domain (recognition, ``--domain-rules``)."""
+        ...
+
+    def from_pddl(self, domain: PDDLDomain, problem: PDDLProblem, order: Sequence[str]) -> Problem:
+        """The relational problem of a parsed PDDL problem; ``order``: objects in file order.
+        Raises PDDLError naming what does not fit the domain."""
         ...
 
     def to_actions(
         self, problem: Problem, moves: Sequence[Move], strict: bool = True
     ) -> tuple[Action, ...]:
-        """The domain's PDDL actions for a sequence of relational moves (its PDDL mapping);
+        """The domain's PDDL actions for a sequence of moves (its PDDL mapping);
         ``strict=False`` also translates illegal moves, for a validator to find."""
         ...
+
+    def to_atoms(self, problem: Problem, state: State) -> frozenset[tuple[str, ...]]:
+        """The PDDL atoms (fluent and static) that hold in ``state``, lowercased."""
+        ...
+
+    def to_pddl(self, problem: Problem) -> str:
+        """Problem PDDL text for ``problem`` (the domain file is ``pddl_domain_text()``)."""
+        ...
+
+    def pddl_domain_text(self) -> str: ...
+
+    def samples(self, seed: int) -> Iterator[Problem]:
+        """Small random problems of this domain of several sizes, for the contract tests."""
+        ...
+
+
+def resolve_goal_loss(domain: Domain, kind: str) -> str:
+    """``kind``, with "default" replaced by the domain's first goal loss."""
+    return domain.goal_losses[0] if kind == "default" else kind

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import torch
 from torch import Tensor
 
-from task.domains.base import SoftBatch, encode_supports
+from task.domains.base import SoftBatch, encode_supports, relational_decode, relational_step
 from task.domains.blocksworld_pddl import (  # the domain's PDDL mapping, re-exported
     NAME as NAME,
 )
@@ -215,24 +215,68 @@ def tower_cross_entropy(F: Tensor, batch: SoftBatch) -> Tensor:
     return -(has_goal * log_well_placed(F, batch)).sum(-1)
 
 
-GOAL_LOSSES = ("atoms", "towers")
+GOAL_LOSSES = ("towers", "atoms")  # the first is the default
 
 
 def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
-    """The goal term of the objective: ``atoms`` (the paper's CE) or ``towers``. -> (B,)."""
+    """The goal term of the objective: ``atoms`` (the paper's CE) or ``towers`` (default).
+    -> (B,)."""
     if kind == "atoms":
         return goal_cross_entropy(F, batch.goal)
-    if kind == "towers":
+    if kind in ("towers", "default"):
         return tower_cross_entropy(F, batch)
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
+
+
+def legal_moves(problem: Problem, state: State) -> list[Move]:
+    """Every legal move in ``state``, entities in order, targets in order."""
+    moves = [Move(x, y) for x in problem.entities for y in problem.targets if y != x]
+    return [m for m in moves if check_move(problem, state, m) is None]
+
+
+def to_atoms(problem: Problem, state: State) -> frozenset[tuple[str, ...]]:
+    """The 4-op PDDL atoms of ``state`` (hand empty between moves)."""
+    atoms = {("handempty",)}
+    for x, s in zip(problem.entities, state, strict=True):
+        atoms.add(("ontable", x) if s == TABLE else ("on", x, s))
+        if is_clear(problem, state, x):
+            atoms.add(("clear", x))
+    return frozenset(atoms)
+
+
+def samples(seed: int):
+    """Random problems of 3 to 6 blocks (`task.symbolic.generate.random_problem`)."""
+    from task.symbolic.generate import random_problem
+
+    for n_blocks in (3, 4, 5, 6):
+        yield random_problem(n_blocks, seed)
+
+
+def matches(domain) -> bool:
+    """Whether a parsed PDDL domain has the 4-op actions and predicates with their arities."""
+    from task import data
+    from task.symbolic.signature import signature
+
+    return signature(domain) == signature(data.domain())
+
+
+def _pddl_domain_text() -> str:
+    from task import data
+
+    return data.read_text(data.DOMAIN_FILE)
 
 
 class Blocksworld:
     """The blocksworld domain object the shared planner drives (see task.domains.base.Domain)."""
 
     name = NAME
+    size_name = "blocks"
+    goal_losses = GOAL_LOSSES
+    distributions = True
     encode = staticmethod(encode_supports)
     soft_legality = staticmethod(soft_legality)
+    step = staticmethod(relational_step(soft_legality))
+    decode = staticmethod(relational_decode)
     consistency = staticmethod(consistency)
     cycle_loss = staticmethod(cycle_loss)
     goal_loss = staticmethod(goal_loss)
@@ -242,6 +286,21 @@ class Blocksworld:
     is_goal = staticmethod(is_goal)
     to_actions = staticmethod(moves_to_actions)
     lower_bound = staticmethod(moves_lower_bound)
+    legal_moves = staticmethod(legal_moves)
+    to_atoms = staticmethod(to_atoms)
+    to_pddl = staticmethod(to_pddl)
+    from_pddl = staticmethod(from_pddl)
+    samples = staticmethod(samples)
+    matches = staticmethod(matches)
+    pddl_domain_text = staticmethod(_pddl_domain_text)
+
+    @staticmethod
+    def shape_key(problem: Problem) -> int:
+        return problem.n
+
+    @staticmethod
+    def size(problem: Problem) -> int:
+        return problem.n
 
 
 DOMAIN = Blocksworld()

@@ -11,7 +11,7 @@ from tamp.bench import planning as bench
 from tamp.bench import results as bench_io
 from tamp.bench import suites
 from tamp.bench.planning import Row
-from tamp.bench.summary import block_rows, main_rows, summarise
+from tamp.bench.summary import main_rows, size_rows, summarise
 from task import data
 from task.config import PlannerConfig
 from task.errors import DataError
@@ -45,7 +45,7 @@ def test_spread_is_stratified_and_deterministic(limit):
 
 def test_summaries_follow_the_paper_format():
     def row(seed, status, length, optimal=4, blocks=3):
-        return Row("i", blocks, optimal, 3, seed, length, status, 0.5, 1)
+        return Row("i", blocks, optimal, None, 3, seed, length, status, 0.5, 1)
 
     seed0 = (row(0, "valid", 4), row(0, "valid", 6), row(0, "no_plan", None, blocks=4))
     seed1 = (row(1, "valid", 4), row(1, "valid", 4), row(1, "inexecutable", 8, None, 4))
@@ -55,7 +55,7 @@ def test_summaries_follow_the_paper_format():
     assert (first.valid, first.optimal, first.optimal_pct, first.no_plan) == (2, 1, 50.0, 1)
     assert (second.known, second.optimal_pct, second.inexecutable) == (2, 100.0, 1)
     assert (mean.seed, mean.valid, mean.optimal_pct, mean.wall_s) == (None, 2.0, 75.0, 2.0)
-    by_blocks = {s.blocks: s for s in block_rows(result)}
+    by_blocks = {s.size: s for s in size_rows(result)}
     assert by_blocks[3].valid == 2 and by_blocks[4].valid == 0 and by_blocks[4].optimal_pct is None
     assert summarise((), 3, 0, None, None).optimal_pct is None
 
@@ -71,7 +71,7 @@ def test_run_ablation_sequential_and_artefacts(tmp_path):
     result = bench.run(suite, config, (0, 1), (1, 3), sequential=2, progress=done.append)
     assert sum(done) == bench.total(4, 2, 2, 2) == 20
     assert [(r.horizon, r.seed) for r in result.runs] == [(1, 0), (1, 1), (3, 0), (3, 1)]
-    assert len(main_rows(result)) == 6 and len(block_rows(result)) == 4
+    assert len(main_rows(result)) == 6 and len(size_rows(result)) == 4
     rows = result.rows()
     assert len(rows) == 4 * 4 and {r.instance for r in rows} == {i.name for i in suite.instances}
     assert all(r.status == "valid" for r in rows), [(r.instance, r.status) for r in rows]
@@ -94,7 +94,7 @@ def test_run_ablation_sequential_and_artefacts(tmp_path):
 
 
 def test_missing_planbench_data_is_one_line(tmp_path):
-    with pytest.raises(DataError, match=r"PlanBench data not found at .*karthikv792"):
+    with pytest.raises(DataError, match=r"PlanBench blocksworld data not found at .*karthikv792"):
         suites.planbench(tmp_path / "missing")
 
 

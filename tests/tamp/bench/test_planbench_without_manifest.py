@@ -125,7 +125,7 @@ def _error(root):
 
 def test_missing_folder_points_to_the_data(tmp_path):
     message = _error(tmp_path / "missing")
-    assert "PlanBench data not found at" in message and "karthikv792" in message
+    assert "PlanBench blocksworld data not found at" in message and "karthikv792" in message
     assert "manifest" not in message
 
 
@@ -133,7 +133,8 @@ def test_folder_without_instances_is_named(fake_planbench):
     shutil.rmtree(fake_planbench / "instances")
     (fake_planbench / "instances").mkdir()
     message = _error(fake_planbench)
-    assert str(fake_planbench) in message and "no PlanBench Blocksworld instances" in message
+    assert str(fake_planbench) in message
+    assert "no official PlanBench blocksworld instances" in message
 
 
 def test_other_domain_is_named(fake_planbench):

@@ -33,10 +33,10 @@ def test_is_optimal_is_equality_and_shorter_than_optimal_is_an_error():
 
 
 def test_planning_summary_refuses_a_valid_plan_shorter_than_the_optimum():
-    row = Row("instance-7", 3, 6, 3, 0, 4, "valid", 0.1, 1)
+    row = Row("instance-7", 3, 6, None, 3, 0, 4, "valid", 0.1, 1)
     with pytest.raises(TampError, match="instance-7"):
         summarise([row], 3, 0, None, None)
-    longer = Row("instance-7", 3, 6, 3, 0, 8, "valid", 0.1, 1)
+    longer = Row("instance-7", 3, 6, None, 3, 0, 8, "valid", 0.1, 1)
     assert summarise([longer], 3, 0, None, None).optimal == 0
 
 

@@ -94,7 +94,7 @@ def test_validate_names_the_first_failing_step(capsys, files, tmp_path):
         (["plan", "{domain}", "{problem}", "--horizon", "0"], "positive integer"),
         (["plan", "{domain}", "{problem}", "--goal-loss", "l2"], "invalid choice: 'l2'"),
         (["bench", "planbench", "--horizon", "1,x"], "comma-separated"),
-        (["bench", "planbench", "--data", "{missing}"], "PlanBench data not found"),
+        (["bench", "planbench", "--data", "{missing}"], "PlanBench blocksworld data not found"),
         (["bench", "random", "--blocks", "1"], "at least 2 blocks"),
         (["bench"], "required: SUITE"),
     ],
@@ -138,12 +138,10 @@ def _bench_artefacts(out, n: int) -> tuple[list[dict], dict]:
     assert summary["inexecutable"] == summary["non_goal_reaching"] == summary["no_plan"] == 0
     times = [float(r["time_s"]) for r in rows]
     assert summary["time_s"] == pytest.approx(sum(times) / n, abs=1e-3)
-    per_block = {int(b["blocks"]): b for b in report["by_blocks"]}
-    assert sorted(per_block) == sorted({int(r["blocks"]) for r in rows})
+    per_block = {int(b["size"]): b for b in report["by_size"]}
+    assert sorted(per_block) == sorted({int(r["size"]) for r in rows})
     for blocks, row in per_block.items():
-        mine = [
-            (o, b) for (o, b), r in zip(lengths, rows, strict=True) if int(r["blocks"]) == blocks
-        ]
+        mine = [(o, b) for (o, b), r in zip(lengths, rows, strict=True) if int(r["size"]) == blocks]
         assert row["n"] == row["valid"] == len(mine)
         assert row["optimal"] == sum(o == b for o, b in mine)
     return rows, report
@@ -156,8 +154,8 @@ def test_bench_planbench_plans_every_instance_validly(capsys, planbench_dir, tmp
     assert main(argv) == 0
     printed = json.loads(capsys.readouterr().out)
     rows, report = _bench_artefacts(tmp_path, 6)
-    assert [int(r["blocks"]) for r in rows] == [3, 4, 4, 4, 4, 5]
-    for key in ("instances", "summary", "by_blocks", "config", "speed"):
+    assert [int(r["size"]) for r in rows] == [3, 4, 4, 4, 4, 5]
+    for key in ("instances", "summary", "by_size", "config", "speed"):
         assert printed[key] == report[key], key
 
 
@@ -167,7 +165,7 @@ def test_bench_random_plans_every_instance_validly(capsys, tmp_path):
     out = capsys.readouterr().out
     assert out.startswith("random: 4 instances") and "by block count" in out
     rows, report = _bench_artefacts(tmp_path, 2 * 2)  # block counts x --n
-    assert [r["blocks"] for r in rows] == ["3", "3", "4", "4"]
+    assert [r["size"] for r in rows] == ["3", "3", "4", "4"]
     assert report["benchmark"] == "random" and "4/4" in out  # the printed table: 4 of 4 valid
 
 

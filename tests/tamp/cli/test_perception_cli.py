@@ -74,7 +74,7 @@ def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
             "is the shipped checkpoint",
         ),
         (["perception", "train", "--train", "a.npz", "--test", "b.npz"], "required: --out"),
-        (["bench", "perception", "--data", "nowhere"], "PlanBench data not found"),
+        (["bench", "perception", "--data", "nowhere"], "PlanBench blocksworld data not found"),
         (["bench", "perception", "--modes", "psychic"], "unknown mode 'psychic'"),
         (["run", "--observe", "camera", "--checkpoint", "none.pt"], "no perception checkpoint"),
     ],
