@@ -89,9 +89,31 @@ def _parse(text: str, start: str, transformer: lark.Transformer, source: str) ->
         raise PDDLError(f"{source}: invalid {start}: {_one_line(exc)}") from None
 
 
+_TYPES = re.compile(r"\(\s*:types\b", re.IGNORECASE)
+_REQUIREMENTS = re.compile(r"\(\s*:requirements\b", re.IGNORECASE)
+
+
+def _implied_typing(text: str) -> str:
+    """Domain text with ``:typing`` added to its requirements when it declares ``(:types``
+    without it: many IPC domains (miconic, say) do, and Fast Downward and VAL accept them."""
+    body = re.sub(r";[^\n]*", " ", text)
+    if not _TYPES.search(body) or re.search(r":typing\b", body, re.IGNORECASE):
+        return text
+    if _REQUIREMENTS.search(text):
+        return _REQUIREMENTS.sub(lambda m: m.group(0) + " :typing", text, count=1)
+    return re.sub(
+        r"(\(\s*domain\s+[^\s()]+\s*\))",
+        lambda m: m.group(1) + " (:requirements :typing)",
+        text,
+        count=1,
+        flags=re.IGNORECASE,
+    )
+
+
 def parse_domain(text: str, source: str = "<domain>") -> Domain:
-    """Parse domain PDDL text; ``source`` names it in error messages."""
-    return _parse(text, "domain", DomainTransformer(), source)
+    """Parse domain PDDL text; ``source`` names it in error messages. A domain that declares
+    types without the ``:typing`` requirement is read as if it had it (`_implied_typing`)."""
+    return _parse(_implied_typing(text), "domain", DomainTransformer(), source)
 
 
 def parse_problem(

@@ -127,3 +127,14 @@ def test_planbench_domains_parse(planbench_dir, name):
         assert {str(o.name).lower() for o in problem.objects} == set(
             pddl_io.load_object_order(path)
         )
+
+
+def test_types_without_the_typing_requirement_are_read_as_typed():
+    """IPC domains such as miconic declare (:types ...) under (:requirements :strips) only."""
+    text = """(define (domain lift) (:requirements :strips) (:types floor - object)
+      (:predicates (at ?f - floor))
+      (:action go :parameters (?f - floor) :precondition (and) :effect (at ?f)))"""
+    domain = pddl_io.parse_domain(text)
+    assert str(domain.name) == "lift" and "floor" in {str(t) for t in domain.types}
+    bare = "(define (domain d) (:types t) (:predicates (p ?x - t)))"
+    assert "t" in {str(t) for t in pddl_io.parse_domain(bare).types}
