@@ -34,6 +34,7 @@ PLANBENCH_SOURCE = "github.com/karthikv792/LLMs-Planning, folder llm_planning_an
 DEFAULT_DATA = Path("..") / "shared" / "data"
 DEFAULT_PLANBENCH = DEFAULT_DATA / "planbench" / "blocksworld"
 _DOMAIN_FILES = ("domain.pddl", "generated_domain.pddl")  # ours, PlanBench's own name
+FD_CACHE, FD_LIMIT_S, FD_WORKERS = "fd_optima.json", 120.0, 2  # Fast Downward optima
 
 
 @dataclass(frozen=True)
@@ -149,34 +150,39 @@ def _manifest(root: Path, spec: Official) -> list[tuple[str, int, int | None, in
     return rows
 
 
-def _load(domain: Domain, path: Path, name: str, rules: str) -> tuple[Instance, str]:
-    """``(instance, text)`` of one file; a problem of another domain is a `DataError`."""
+def _load(domain: Domain, path: Path, name: str, rules: str) -> tuple[Instance, str, Path]:
+    """``(instance, text, path)`` of one file; a problem of another domain is a `DataError`."""
     try:
         text = pddl_io.read_text(path)
-        return from_text(domain, text, str(path), name, rules=rules), text
+        return from_text(domain, text, str(path), name, rules=rules), text, path
     except (PDDLError, ProblemError) as exc:
         raise DataError(str(exc)) from None
 
 
 def _fill_optima(
-    found: list[tuple[Instance, str]], domain_path: Path, cache_dir: str | Path | None
+    found: list[tuple[Instance, str, Path]],
+    domain_path: Path,
+    cache_dir: str | Path | None,
+    progress: Callable[[int], None] | None = None,
 ) -> list[Instance]:
-    """Optima for the instances whose data give no length: A* for Blocksworld, else Fast
-    Downward if installed (None when it is not, or runs out of time). Cached in ``cache_dir``."""
-    if not found:
-        return []
-    lacking = [k for k, (i, _) in enumerate(found) if i.optimal is None and i.reference is None]
-    out = [i for i, _ in found]
+    """Optima for the instances whose data give no length: A* for Blocksworld problems, else
+    Fast Downward (`FD_LIMIT_S` each) when the benchmark extra is installed (None when it is not,
+    or when it runs out of time). Cached in ``cache_dir`` (``optimal_lengths.json``,
+    ``fd_optima.json``)."""
+    out = [i for i, _, _ in found]
+    lacking = [k for k, i in enumerate(out) if i.optimal is None and i.reference is None]
     if not lacking:
         return out
     from tamp.bench import fast_downward  # benchmark-only extra, imported when needed
 
-    if found[0][0].problem.domain == blocksworld.NAME:
+    if out[0].problem.domain == blocksworld.NAME:
         keys = [(out[k].name, digest(found[k][1]), out[k].problem) for k in lacking]
         lengths = optimal_lengths(keys, cache_dir)
     elif fast_downward.available():
-        pairs = [(domain_path, found[k][0].name, found[k][1]) for k in lacking]
-        lengths = fast_downward.cached_optima(pairs, cache_dir)
+        cache = None if cache_dir is None else Path(cache_dir) / FD_CACHE
+        pairs = [(domain_path, found[k][2]) for k in lacking]
+        results = fast_downward.optimal_lengths(pairs, cache, FD_LIMIT_S, progress, FD_WORKERS)
+        lengths = [r.length if r.status == "optimal" else None for r in results]
     else:
         return out
     for k, length in zip(lacking, lengths, strict=True):
@@ -189,12 +195,14 @@ def planbench(
     limit: int | None = None,
     cache_dir: str | Path | None = None,
     domain: str = "blocksworld",
+    progress: Callable[[int], None] | None = None,
 ) -> Suite:
     """The official PlanBench set of ``domain`` (or a ``limit``-instance `spread` of it).
 
     With a ``manifest.csv`` in ``data_dir``, its official rows and lengths are used (sizes are
     checked against the files); without one the official files are known by name (others are
-    left out). Lengths the data lack are searched (`_fill_optima`), cached in ``cache_dir``.
+    left out). Lengths the data lack are searched (`_fill_optima`), cached in ``cache_dir``;
+    ``progress(k)``: k more searched.
     ``data_dir`` may also be PlanBench's own folder (``generated_domain.pddl``, instance
     folders without ``instances/``). Both ways give the same instances in the same order.
     """
@@ -213,7 +221,7 @@ def planbench(
             instance, text = _load(pddl_domain, root / file, name, domain)
             if instance.size != size:
                 raise DataError(f"{root / file}: size {instance.size}, manifest.csv says {size}")
-            found.append((replace(instance, optimal=opt, reference=ref), text))
+            found.append((replace(instance, optimal=opt, reference=ref), text, root / file))
     else:
         paths = [(n, folder / f"{n}.pddl") for n in spec.names]
         found = [_load(pddl_domain, p, n, domain) for n, p in paths if p.is_file()]
@@ -224,7 +232,7 @@ def planbench(
                 f"instances/{first}.pddl ... {last}.pddl)"
             )
         found = spread(found, limit, key=lambda item: item[0].size)
-    instances = _fill_optima(found, domain_path, cache_dir)
+    instances = _fill_optima(found, domain_path, cache_dir, progress)
     name = "planbench" if domain == "blocksworld" else f"planbench-{domain}"
     return Suite(name, pddl_domain, tuple(instances), str(root.resolve()))
 
@@ -238,6 +246,7 @@ def pddl_folder(
     limit: int | None = None,
     cache_dir: str | Path | None = None,
     rules: str | None = None,
+    progress: Callable[[int], None] | None = None,
 ) -> Suite:
     """Every problem file of a folder holding ``domain.pddl`` and problems (``*.pddl``),
     natural order; planned with the recognised domain rules or ``rules``."""
@@ -251,7 +260,7 @@ def pddl_folder(
         raise DataError(f"{root}: no problem files (*.pddl besides {domain_path.name})")
     found = [_load(pddl_domain, p, p.stem, chosen) for p in paths]
     found = spread(found, limit, key=lambda item: item[0].size)
-    instances = _fill_optima(found, domain_path, cache_dir)
+    instances = _fill_optima(found, domain_path, cache_dir, progress)
     return Suite(root.name, pddl_domain, tuple(instances), str(root.resolve()))
 
 

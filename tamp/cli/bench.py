@@ -26,9 +26,12 @@ from task.errors import TampError
 
 
 @contextmanager
-def _bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
+def _bar(total: int | None, desc: str, enabled: bool, unit: str = "plan"):
     """A tqdm bar on stderr; yields ``update(k)``, the `plan_batch` progress callback."""
-    with tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled) as bar:
+    with tqdm(
+        total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled,
+        leave=total is not None,
+    ) as bar:  # fmt: skip
         yield bar.update
 
 
@@ -54,12 +57,16 @@ def _run(suite: Suite, args: argparse.Namespace) -> int:
 def planbench_command(args: argparse.Namespace) -> int:
     """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
     data = args.data if args.data is not None else suites.default_data(args.domain)
-    return _run(suites.planbench(data, args.limit, args.out, args.domain), args)
+    with _bar(None, "optimal lengths the data lack", args.progress, "problem") as update:
+        suite = suites.planbench(data, args.limit, args.out, args.domain, update)
+    return _run(suite, args)
 
 
 def pddl_command(args: argparse.Namespace) -> int:
     """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
-    return _run(suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules), args)
+    with _bar(None, "optimal lengths (Fast Downward)", args.progress, "problem") as update:
+        suite = suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules, update)
+    return _run(suite, args)
 
 
 def random_command(args: argparse.Namespace) -> int:

@@ -17,37 +17,18 @@ from collections.abc import Sequence
 import torch
 from torch import Tensor
 
+from task.domains import blocksworld_pddl as _pddl
 from task.domains.base import SoftBatch, encode_supports, relational_decode, relational_step
-from task.domains.blocksworld_pddl import (  # the domain's PDDL mapping, re-exported
-    NAME as NAME,
-)
-from task.domains.blocksworld_pddl import (
-    OPERATORS as OPERATORS,
-)
-from task.domains.blocksworld_pddl import (
-    PDDL_DOMAIN as PDDL_DOMAIN,
-)
-from task.domains.blocksworld_pddl import (
-    from_pddl as from_pddl,
-)
-from task.domains.blocksworld_pddl import (
-    problem_from_files as problem_from_files,
-)
-from task.domains.blocksworld_pddl import (
-    problem_from_text as problem_from_text,
-)
-from task.domains.blocksworld_pddl import (
-    support_error as support_error,
-)
-from task.domains.blocksworld_pddl import (
-    to_pddl as to_pddl,
-)
 from task.errors import ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
 from task.soft import column_free, exclusive_support, goal_cross_entropy, row_normalise
 from task.symbolic.search import moves_lower_bound
 
 State = tuple[str, ...]
+# the domain's PDDL mapping, re-exported
+NAME, PDDL_DOMAIN, OPERATORS = _pddl.NAME, _pddl.PDDL_DOMAIN, _pddl.OPERATORS
+from_pddl, to_pddl, support_error = _pddl.from_pddl, _pddl.to_pddl, _pddl.support_error
+problem_from_text, problem_from_files = _pddl.problem_from_text, _pddl.problem_from_files
 
 # -------------------------------------------------------------------------------------- crisp
 
@@ -252,20 +233,6 @@ def samples(seed: int):
         yield random_problem(n_blocks, seed)
 
 
-def matches(domain) -> bool:
-    """Whether a parsed PDDL domain has the 4-op actions and predicates with their arities."""
-    from task import data
-    from task.symbolic.signature import signature
-
-    return signature(domain) == signature(data.domain())
-
-
-def _pddl_domain_text() -> str:
-    from task import data
-
-    return data.read_text(data.DOMAIN_FILE)
-
-
 class Blocksworld:
     """The blocksworld domain object the shared planner drives (see task.domains.base.Domain)."""
 
@@ -291,8 +258,8 @@ class Blocksworld:
     to_pddl = staticmethod(to_pddl)
     from_pddl = staticmethod(from_pddl)
     samples = staticmethod(samples)
-    matches = staticmethod(matches)
-    pddl_domain_text = staticmethod(_pddl_domain_text)
+    matches = staticmethod(_pddl.matches)
+    pddl_domain_text = staticmethod(_pddl.pddl_domain_text)
 
     @staticmethod
     def shape_key(problem: Problem) -> int:

@@ -18,6 +18,7 @@ from pddl.core import Problem as PDDLProblem
 from task.errors import PDDLError, one_of
 from task.problem import TABLE, Problem
 from task.symbolic import pddl_io, strips
+from task.symbolic.signature import signature
 
 NAME = "blocksworld"
 PDDL_DOMAIN = "blocksworld-4ops"
@@ -149,3 +150,17 @@ def to_pddl(problem: Problem) -> str:
     lines += ["(and", *goal[:-1], goal[-1] + ")"] if goal else ["(and)"]
     lines += [")", ")"]
     return "\n".join(lines) + "\n"
+
+
+def pddl_domain_text() -> str:
+    """The embedded 4-op domain's text (`task.data`)."""
+    from task import data  # task.data parses with task.symbolic; imported when asked
+
+    return data.read_text(data.DOMAIN_FILE)
+
+
+def matches(domain: Domain) -> bool:
+    """Whether a parsed PDDL domain has the 4-op actions and predicates with their arities."""
+    from task import data
+
+    return signature(domain) == signature(data.domain())
