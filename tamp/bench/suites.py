@@ -165,12 +165,12 @@ def _fill_optima(
     cache_dir: str | Path | None,
     progress: Callable[[int], None] | None = None,
 ) -> list[Instance]:
-    """Optima for the instances whose data give no length: A* for Blocksworld problems, else
-    Fast Downward (`FD_LIMIT_S` each) when the benchmark extra is installed (None when it is not,
-    or when it runs out of time). Cached in ``cache_dir`` (``optimal_lengths.json``,
-    ``fd_optima.json``)."""
+    """Optima for the instances whose data give none (a reference plan's length is kept beside
+    it): A* for Blocksworld problems, else Fast Downward (`FD_LIMIT_S` each) when the benchmark
+    extra is installed (None when it is not, or when it runs out of time). Cached in
+    ``cache_dir`` (``optimal_lengths.json``, ``fd_optima.json``)."""
     out = [i for i, _, _ in found]
-    lacking = [k for k, i in enumerate(out) if i.optimal is None and i.reference is None]
+    lacking = [k for k, i in enumerate(out) if i.optimal is None]
     if not lacking:
         return out
     from tamp.bench import fast_downward  # benchmark-only extra, imported when needed

@@ -1,0 +1,291 @@
+"""The grounded task of the generic STRIPS lift, its tensors and its crisp relaxations.
+
+A problem is one row of P independent fluent-atom probabilities, ``F: (B, 1, P)``, and one
+commitment per step over ``A = G + 1`` columns (the G reachable ground actions, then STAY).
+Columns P and P + 1 of the extended row ``[F, 1, 0]`` are a constant-true and a constant-false
+atom: precondition lists are padded with P, padded actions' with P + 1 (they never apply), and
+effect lists with P + 1 (a dump column, dropped). Each per-action list is an index tensor
+``(B, G, k)``: a step costs O(B G k) (a gather and two scatter-adds), never O(B G P).
+
+Goal terms: "atoms" is the paper's CE, which a 3-5 step window cannot feel for goal atoms more
+than a window away. The default "hadd" adds the expected h_add of the goal (`relaxed_cost`),
+so reaching preconditions of goal achievers pays. Its cost: ``sweeps`` Jacobi sweeps (relaxed
+depth of the window's crisp start + 2) of one gather and one scatter over (B, G, ka, kp), once
+per rollout, against T steps of the transition. Tuned on generated Blocksworld (3-6 blocks),
+tiny gripper (3-6 balls) and Logistics instances 201-286 only.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+from torch import Tensor
+
+from task.domains.base import INF, SoftBatch
+from task.errors import ProblemError, one_of
+from task.problem import Action, Problem
+from task.symbolic.strips import Atom, GroundAction, atom_str, initial_state
+
+CAP = 30.0  # the relaxed cost of an atom nothing reaches (and the ceiling of every cost)
+SOFTMIN_TAU = 0.1  # temperature of the softmin over an atom's achievers
+ATOMS_WEIGHT = 1.0  # weight of the paper's goal cross-entropy inside "hadd"
+ATOMS_FLOOR = 0.0  # TEMP
+SWEEP_MARGIN = 2  # Bellman sweeps beyond the relaxed depth of the window's start
+MAX_SWEEPS = 40
+GOAL_LOSSES = ("hadd", "atoms")  # the first is the default
+
+
+def _padded(rows: Sequence[Sequence[int]], pad: int) -> np.ndarray:
+    """Ragged index lists -> (len(rows), k) int64, padded with ``pad`` (k >= 1)."""
+    out = np.full((len(rows), max(map(len, rows), default=1) or 1), pad, dtype=np.int64)
+    for j, r in enumerate(rows):
+        out[j, : len(r)] = r
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class StripsTask:
+    """The grounding of one problem (``Problem.data`` of the lift). Column j of the action
+    axis is ``actions[j]``; column i of the state row is ``atoms[i]``."""
+
+    actions: tuple[Action, ...]  # the G reachable ground actions, sorted by (name, args)
+    effects: tuple[GroundAction, ...]  # per action: fluent preconditions, adds, deletes
+    atoms: tuple[Atom, ...]  # the P fluent atoms (added or deleted by some action), sorted
+    static: frozenset[Atom]  # the other atoms of init: they hold in every reachable state
+    init: frozenset[Atom]  # the fluent atoms of the initial state
+    goal: tuple[Atom, ...]  # fluent goal atoms in file order (static goal atoms hold already)
+    pre: np.ndarray = field(repr=False)  # (G, kp) fluent precondition columns, padded with P
+    add: np.ndarray = field(repr=False)  # (G, ka) added columns, padded with P + 1
+    delete: np.ndarray = field(repr=False)  # (G, kd) deleted and not added, padded with P + 1
+    consumed: np.ndarray = field(repr=False)  # (G, kp) bool: the precondition is deleted
+    goal_adds: int = 1  # the most fluent goal atoms one action adds (the goal-count bound)
+    pddl_domain: object = field(default=None, repr=False)  # the parsed PDDL it was built from
+    pddl_problem: object = field(default=None, repr=False)
+    order: tuple[str, ...] = ()  # the problem's objects in file order
+
+    @classmethod
+    def build(cls, ground, goal: Sequence[Atom], domain, problem, order=()) -> StripsTask:
+        """The task of reachable ``ground`` ``(Action, GroundAction)`` pairs; static
+        preconditions (true at init, never changed) are dropped."""
+        fluent = sorted({a for _, g in ground for a in g.add | g.delete})
+        col, n = {a: i for i, a in enumerate(fluent)}, len(fluent)
+        init = initial_state(problem)
+        static = init.difference(fluent)
+        effects = tuple(
+            GroundAction(g.pre_pos - static, frozenset(), g.add, g.delete) for _, g in ground
+        )
+        goal = tuple(a for a in goal if a in col)
+        return cls(
+            tuple(a for a, _ in ground), effects, tuple(fluent), frozenset(static),
+            frozenset(init & set(fluent)), goal,
+            _padded([[col[a] for a in sorted(e.pre_pos)] for e in effects], n),
+            _padded([[col[a] for a in sorted(e.add)] for e in effects], n + 1),
+            _padded([[col[a] for a in sorted(e.delete - e.add)] for e in effects], n + 1),
+            _padded([[a in e.delete - e.add for a in sorted(e.pre_pos)] for e in effects], 0) > 0,
+            max((len(e.add & set(goal)) for e in effects), default=1),
+            domain, problem, tuple(order),
+        )  # fmt: skip
+
+    @functools.cached_property
+    def column(self) -> dict[Atom, int]:
+        return {a: i for i, a in enumerate(self.atoms)}
+
+    @functools.cached_property
+    def index(self) -> dict[Action, int]:
+        return {a: j for j, a in enumerate(self.actions)}
+
+    @functools.cached_property
+    def pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(added atom, action) pairs sorted by atom: their actions (E,), the atoms some
+        action adds (U,) and where each one's pairs start (U,), for ``np.minimum.reduceat``."""
+        j, k = np.nonzero(self.add < len(self.atoms))
+        order = np.argsort(self.add[j, k], kind="stable")
+        targets, starts = np.unique(self.add[j, k][order], return_index=True)
+        return j[order], targets, starts
+
+    @functools.cached_property
+    def bounds(self) -> dict[frozenset, float]:
+        """Memo of the domain's lower bound by state (restarts often reach the same one)."""
+        return {}
+
+
+def encode(
+    problems: Sequence[Problem], states: Sequence[frozenset], dtype: torch.dtype = torch.float32
+) -> SoftBatch:
+    """One-hot rows of crisp states (sets of fluent atoms; static ones are ignored), padded.
+
+    ``static``: ``pre`` (B, G, kp) into P + 2 extended columns, ``add`` and ``delete``
+    (B, G, ka), (B, G, kd) (deletes the same action does not add), ``consumed`` (B, G, kp)
+    (the precondition is deleted), ``sweeps`` (B,)."""
+    tasks: list[StripsTask] = [p.data for p in problems]
+    b, n, g = len(tasks), max(len(t.atoms) for t in tasks), max(len(t.actions) for t in tasks)
+    F0, goal = torch.zeros(b, 1, n, dtype=dtype), torch.zeros(b, 1, n, dtype=dtype)
+    mask = torch.zeros(b, 1, g + 1, dtype=torch.bool)
+    mask[:, :, -1] = True  # STAY
+    static = {  # padded actions: false preconditions, no effects
+        k: torch.full((b, g, max(getattr(t, k).shape[1] for t in tasks)), n + 1)
+        for k in ("pre", "add", "delete")
+    }
+    static["consumed"] = static["pre"] < 0  # (B, G, kp) all False
+    depth = []
+    for i, (task, state) in enumerate(zip(tasks, states, strict=True)):
+        bad = sorted(a for a in state if a not in task.column and a not in task.static)
+        if bad:
+            raise ProblemError(f"atom {atom_str(bad[0])} is not reachable in {problems[i].name}")
+        F0[i, 0, [task.column[a] for a in state if a in task.column]] = 1.0
+        goal[i, 0, [task.column[a] for a in task.goal]] = 1.0
+        p, rows = len(task.atoms), len(task.actions)
+        mask[i, 0, :rows] = True
+        for key in static:
+            own = torch.from_numpy(getattr(task, key))  # (G_i, k_i)
+            if key != "consumed":  # the task's own columns P, P + 1 -> the batch's n, n + 1
+                static[key][i, :rows] = n + (key != "pre")
+                own = torch.where(own >= p, own - p + n, own)
+            static[key][i, :rows, : own.shape[1]] = own
+        h = hmax(task, state)
+        depth.append(int(h[np.isfinite(h)].max()))
+    static["sweeps"] = (torch.tensor(depth) + SWEEP_MARGIN).clamp_max(MAX_SWEEPS)
+    return SoftBatch(F0, torch.ones(b, 1, dtype=torch.bool), mask, goal, static)
+
+
+def _extend(x: Tensor, one: float, zero: float) -> Tensor:
+    """(B, P) -> (B, P + 2): the constant-true and constant-false columns appended."""
+    return torch.cat([x, x.new_full((x.shape[0], 1), one), x.new_full((x.shape[0], 1), zero)], -1)
+
+
+def _gather(ext: Tensor, index: Tensor) -> Tensor:
+    """ext (B, P + 2), index (B, G, k) -> (B, G, k)."""
+    return ext.gather(1, index.flatten(1)).view(index.shape)
+
+
+def _scatter(values: Tensor, index: Tensor, width: int) -> Tensor:
+    """Sum ``values`` (B, G) of each action into its listed columns: -> (B, width)."""
+    src = values.unsqueeze(-1).expand(index.shape).reshape(index.shape[0], -1)  # (B, G k)
+    return values.new_zeros(values.shape[0], width).scatter_add(1, index.flatten(1), src)
+
+
+def step(F: Tensor, M: Tensor, batch: SoftBatch) -> tuple[Tensor, Tensor]:
+    """One soft STRIPS step. F (B, 1, P), M (B, 1, G + 1) -> (F' (B, 1, P), g (B, 1, G)).
+
+    Applicability (product t-norm): a_j = prod_{i in pre_j} p_i; gated mass g_j = M_j a_j.
+    Effects: A = g @ Add, D = g @ (Del minus Add); p'_i = p_i (1 - D_i) + (1 - p_i) A_i.
+    Exact on one-hot F and M (delete, then add); in [0, 1] since sum_j g_j <= 1."""
+    p = F[:, 0]  # (B, P)
+    width = p.shape[1] + 2
+    a = _gather(_extend(p, 1.0, 0.0), batch.static["pre"]).prod(-1)  # (B, G)
+    g = M[:, 0, :-1] * a  # (B, G)
+    add = _scatter(g, batch.static["add"], width)[:, :-2]  # (B, P)
+    delete = _scatter(g, batch.static["delete"], width)[:, :-2]  # (B, P)
+    return (p * (1.0 - delete) + (1.0 - p) * add).unsqueeze(1), g.unsqueeze(1)
+
+
+def consistency(F: Tensor, batch: SoftBatch) -> Tensor:
+    """T_P of independent atoms: a clamp to [0, 1] (rounding only; identity on [0, 1])."""
+    return F.clamp(0.0, 1.0)
+
+
+def relaxed_cost(F: Tensor, batch: SoftBatch) -> Tensor:
+    """Expected h_add cost of every fluent atom from the soft state: (B, 1, P) -> (B, P).
+
+    An atom is free with probability p_i, else it costs its cheapest achiever:
+    c_i = (1 - p_i) S_i, S_i = softmin_tau(CAP, C_ji for j adding i), from S = CAP, over
+    ``sweeps`` Jacobi sweeps: crisp h_add on one-hot states (tau -> 0), linear in each p_i.
+    C_ji = 1 + sum_{q in pre_j} (1 - p'_q) S_q, where a precondition q that j consumes
+    (deletes) counts as true with the mass already past j to i, p'_q = min(1, p_q + p_i):
+    independent atoms would otherwise charge the mass moved from q to i twice (q lost, i not
+    yet certain) and make every first step of a relaxed plan look worse than staying put."""
+    p = _extend(F[:, 0], 1.0, 0.0)  # (B, P + 2)
+    pre, add = batch.static["pre"], batch.static["add"]
+    flat = add.flatten(1)  # (B, G ka)
+    p_pre = _gather(p, pre).unsqueeze(2)  # (B, G, 1, kp)
+    p_add = _gather(p, add).unsqueeze(3)  # (B, G, ka, 1)
+    consumed = batch.static["consumed"].unsqueeze(2)  # (B, G, 1, kp)
+    free = torch.where(consumed, (p_pre + p_add).clamp_max(1.0), p_pre)  # (B, G, ka, kp)
+    S = torch.full_like(p, CAP)
+    for _ in range(int(batch.static["sweeps"].max())):
+        s_pre = _gather(S, pre).unsqueeze(2)  # (B, G, 1, kp)
+        src = (1.0 + ((1.0 - free) * s_pre).sum(-1)).clamp_max(CAP).flatten(1)  # (B, G ka)
+        m = torch.full_like(p, CAP).scatter_reduce(1, flat, src.detach(), "amin")  # (B, P + 2)
+        terms = torch.exp(-(src - m.gather(1, flat)) / SOFTMIN_TAU)
+        s = torch.exp(-(CAP - m) / SOFTMIN_TAU).scatter_add(1, flat, terms)  # >= 1
+        S = m - SOFTMIN_TAU * torch.log(s)
+    return ((1.0 - p) * S)[:, :-2]
+
+
+def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
+    """The goal term, (B, 1, P) -> (B,): "atoms", the paper's CE -sum_goal log p_i, or
+    "hadd" (default): sum over goal atoms of `relaxed_cost` plus ``ATOMS_WEIGHT`` times the CE.
+    The h_add part rewards reaching the preconditions of goal achievers that a 3-5 step
+    window cannot finish; the CE part pulls hard on goal atoms the window can reach."""
+    tiny = torch.finfo(F.dtype).tiny
+    if kind == "atoms":
+        return -(batch.goal * torch.log(F.clamp_min(tiny))).sum((-1, -2))
+    if kind in ("hadd", "default"):
+        ce = math.log1p(ATOMS_FLOOR) - torch.log((F + ATOMS_FLOOR).clamp_min(tiny))
+        return (batch.goal[:, 0] * (relaxed_cost(F, batch) + ATOMS_WEIGHT * ce[:, 0])).sum(-1)
+    raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
+
+
+# ------------------------------------------------------------------------- crisp relaxations
+
+
+def hmax(task: StripsTask, state: frozenset, cost: np.ndarray | None = None, h=None):
+    """h_max of every column from ``state`` (delete relaxation, action costs ``cost``, unit by
+    default): Bellman sweeps from ``h`` (an upper bound; none: 0 on ``state`` and column P,
+    inf elsewhere) until nothing changes. -> (P + 2,)"""
+    actions, targets, starts = task.pairs
+    cost = np.ones(len(task.actions)) if cost is None else cost
+    if h is None:
+        h = np.full(len(task.atoms) + 2, np.inf)
+        h[[len(task.atoms), *(task.column[a] for a in state if a in task.column)]] = 0.0
+    while targets.size:
+        price = h[task.pre].max(axis=1) + cost  # (G,)
+        best = np.minimum(h[targets], np.minimum.reduceat(price[actions], starts))
+        if np.array_equal(best, h[targets]):
+            break
+        h = h.copy()
+        h[targets] = best
+    return h
+
+
+def lm_cut(task: StripsTask, state: frozenset) -> float:
+    """The LM-cut bound (Helmert & Domshlak 2009), unit costs; INF when the relaxation cannot
+    reach the goal. Each round takes the cut of the h_max justification graph between the
+    state and the goal zone (atoms reaching the costliest goal atom through zero-cost
+    actions), adds its cheapest action cost and takes that cost off the whole cut."""
+    n, g, pre, add = len(task.atoms), len(task.actions), task.pre, task.add
+    goal = np.array([task.column[a] for a in task.goal])
+    cost = np.ones(g)
+    h = hmax(task, state, cost)
+    start, total = h == 0.0, 0.0
+    while h[goal].max() > 0.0:
+        if np.isinf(h[goal].max()):
+            return INF
+        pcf = pre[np.arange(g), h[pre].argmax(axis=1)]  # (G,) the costliest precondition
+        zone = np.zeros(n + 2, dtype=bool)
+        zone[goal[h[goal].argmax()]] = True
+        while True:  # the goal zone: backwards through zero-cost actions
+            grow = np.zeros(n + 2, dtype=bool)
+            grow[pcf[zone[add].any(axis=1) & (cost == 0.0)]] = True
+            if not (grow & ~zone).any():
+                break
+            zone |= grow
+        reach = start & ~zone
+        while True:  # before the cut: forwards from the state, never into the goal zone
+            grow = np.zeros(n + 2, dtype=bool)
+            grow[add[reach[pcf]]] = True
+            grow &= ~zone & ~reach
+            grow[n + 1] = False
+            if not grow.any():
+                break
+            reach |= grow
+        cut = zone[add].any(axis=1) & reach[pcf]
+        total += cost[cut].min()
+        cost[cut] -= cost[cut].min()
+        h = hmax(task, state, cost, h)
+    return total
