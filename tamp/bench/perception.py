@@ -1,7 +1,7 @@
 """The perception benchmark (``tamp bench perception``): planning from rendered images.
 
 For each instance the initial state and a goal scene (the PDDL goal completed by
-`task.domains.blocksworld_states.complete_goal`: blocks the goal leaves free keep their support when
+`tamp.camera.states.complete_goal`: blocks the goal leaves free keep their support when
 they can) are rendered by a simulator camera. Every (blur, mode, crisp protocol, horizon) row plans
 the same instances with the same seed:
 
@@ -37,7 +37,7 @@ from tamp.bench.summary import is_optimal
 from tamp.camera.from_images import CRISP, MODES, ImageBeliefs, PerceptionMode, perceived_goal
 from tamp.camera.render import StateRenderer, block_colours
 from task.config import PlannerConfig
-from task.domains.blocksworld_states import complete_goal
+from tamp.camera.states import complete_goal
 from task.errors import TampError
 from task.planner import plan_batch
 

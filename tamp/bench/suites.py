@@ -218,7 +218,7 @@ def planbench(
         found = []
         for file, size, opt, ref in rows:
             name = file.removeprefix("instances/").removesuffix(".pddl")
-            instance, text = _load(pddl_domain, root / file, name, domain)
+            instance, text, _ = _load(pddl_domain, root / file, name, domain)
             if instance.size != size:
                 raise DataError(f"{root / file}: size {instance.size}, manifest.csv says {size}")
             found.append((replace(instance, optimal=opt, reference=ref), text, root / file))

@@ -91,7 +91,7 @@ def planning_report(bench: Bench) -> str:
     refs = any(r.reference is not None for r in bench.rows())
     main = [_ref(_row(s, "mean" if s.seed is None else str(s.seed)), s, refs)
             for s in main_rows(bench)]  # fmt: skip
-    lines += [table(["T", "seed", *_ref(_HEAD, None, refs)], main), ""]
+    lines += [table(_ref(["T", "seed", *_HEAD], None, refs), main), ""]
     lines.append(f"by {_SIZE_LABEL.get(bench.size_name, bench.size_name)} (mean over seeds):")
     by_size = [_ref([*_row(s, str(s.size))[:-2], f"{s.windows:.2f}"], s, refs)
                for s in size_rows(bench)]  # fmt: skip

@@ -5,7 +5,8 @@
 - ``from_images``: soft beliefs for the planner from camera images (frozen or
   planning-optimised perception).
 - ``geometry``: pinhole geometry of a camera (intrinsics, pose, projection, back-projection);
-- ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on.
+- ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on;
+- ``states``: full goal scenes a goal image shows, the most likely state of a soft state.
 
 The image -> soft-state model itself lives in `perception` and never sees a simulator.
 """

@@ -40,7 +40,7 @@ from torch import Tensor
 from perception.perceive import Perceiver, blur, kl_rows
 from tamp.camera.render import block_colours
 from task.domains.base import State
-from task.domains.blocksworld_states import most_likely_state
+from tamp.camera.states import most_likely_state
 from task.errors import TampError, one_of
 from task.problem import Problem
 

@@ -31,7 +31,7 @@ from tamp.loop.faults import draw
 from tamp.loop.sensors import CameraPoses, MocapPoses
 from tamp.scene import PALETTE, Pose, Reading, read_state
 from tamp.sim.base import Simulator
-from task.domains.blocksworld_states import complete_goal
+from tamp.camera.states import complete_goal
 from task.problem import TABLE, Problem
 
 SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation

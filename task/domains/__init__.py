@@ -3,10 +3,11 @@
 Adding a domain is one file in this folder exposing a ``DOMAIN`` object that satisfies
 `task.domains.base.Domain`, plus its name in ``_NAMES`` below; modules are imported on first
 use. ``base`` holds the protocol and the soft batch every domain fills. A domain too large for
-one file keeps helpers beside it under its own prefix: ``blocksworld_pddl`` (problem PDDL in
-and out) and ``blocksworld_states`` (full goal scenes, the most likely state of a perceived
-soft state). ``strips`` is the generic soft lift of any grounded STRIPS domain: the planner of
-a PDDL domain no file is written for, and the oracle the hand-written domains are tested on.
+one file keeps helpers beside it under its own prefix: ``blocksworld_pddl``, ``logistics_pddl``,
+``sokoban_pddl`` (problem PDDL in and out), ``sokoban_grid`` (the grid's static tables),
+``strips_soft`` (the lift's tensors). ``strips`` is the generic soft lift of any grounded STRIPS
+domain: the planner of a PDDL domain no file is written for, and the oracle the hand-written
+domains are tested on.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ unstack), where each move is two actions: ``(unstack x s)`` or ``(pick-up x)``, 
 ``(stack x y)`` or ``(put-down x)``. A crisp state is the support of every entity, in
 ``problem.entities`` order. All functions are pure. Reading and writing problem PDDL is
 `task.domains.blocksworld_pddl` (re-exported here); full goal scenes and the most likely state
-of a perceived soft state are `task.domains.blocksworld_states`.
+of a perceived soft state are `tamp.camera.states` (the camera's side).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ import torch
 
 from task.config import PlannerConfig
 from task.domains.blocksworld import DOMAIN, is_goal
-from task.domains.blocksworld_states import all_states, complete_goal, most_likely_state
+from tamp.camera.states import all_states, complete_goal, most_likely_state
 from task.errors import ProblemError, TampError
 from task.planner import plan
 from task.problem import TABLE, Problem

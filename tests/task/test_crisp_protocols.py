@@ -13,7 +13,7 @@ from task.config import PlannerConfig
 from task.decode import decode_best, decode_row
 from task.domains.blocksworld import DOMAIN as BW
 from task.domains.blocksworld_pddl import to_pddl
-from task.domains.blocksworld_states import complete_goal
+from tamp.camera.states import complete_goal
 from task.errors import TampError
 from task.planner import plan, plan_batch
 from task.problem import TABLE, Move, PlanStatus, Problem

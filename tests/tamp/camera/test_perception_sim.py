@@ -21,7 +21,7 @@ from tamp.camera.render import StateRenderer
 from tamp.loop import EpisodeStatus, LoopConfig, run_episode
 from tamp.scene import Pose
 from tamp.sim import SIMULATORS
-from task.domains.blocksworld_states import complete_goal
+from tamp.camera.states import complete_goal
 from task.problem import TABLE, Problem
 from task.symbolic.generate import block_names, random_towers
 
