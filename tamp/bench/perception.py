@@ -36,8 +36,8 @@ from tamp.bench.planning import STATUSES, check
 from tamp.bench.summary import is_optimal
 from tamp.camera.from_images import CRISP, MODES, ImageBeliefs, PerceptionMode, perceived_goal
 from tamp.camera.render import StateRenderer, block_colours
-from task.config import PlannerConfig
 from tamp.camera.states import complete_goal
+from task.config import PlannerConfig
 from task.errors import TampError
 from task.planner import plan_batch
 

@@ -39,8 +39,8 @@ from torch import Tensor
 
 from perception.perceive import Perceiver, blur, kl_rows
 from tamp.camera.render import block_colours
-from task.domains.base import State
 from tamp.camera.states import most_likely_state
+from task.domains.base import State
 from task.errors import TampError, one_of
 from task.problem import Problem
 

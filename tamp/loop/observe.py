@@ -26,12 +26,12 @@ from perception.perceive import Perceiver
 from robots.panda import PANDA
 from tamp.camera.from_images import perceived_goal, perceived_state
 from tamp.camera.render import StateRenderer
+from tamp.camera.states import complete_goal
 from tamp.loop.config import LoopConfig
 from tamp.loop.faults import draw
 from tamp.loop.sensors import CameraPoses, MocapPoses
 from tamp.scene import PALETTE, Pose, Reading, read_state
 from tamp.sim.base import Simulator
-from tamp.camera.states import complete_goal
 from task.problem import TABLE, Problem
 
 SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 import torch
 
+from tamp.camera.states import all_states, complete_goal, most_likely_state
 from task.config import PlannerConfig
 from task.domains.blocksworld import DOMAIN, is_goal
-from tamp.camera.states import all_states, complete_goal, most_likely_state
 from task.errors import ProblemError, TampError
 from task.planner import plan
 from task.problem import TABLE, Problem

@@ -8,12 +8,12 @@ from dataclasses import replace
 import pytest
 import torch
 
+from tamp.camera.states import complete_goal
 from task import data
 from task.config import PlannerConfig
 from task.decode import decode_best, decode_row
 from task.domains.blocksworld import DOMAIN as BW
 from task.domains.blocksworld_pddl import to_pddl
-from tamp.camera.states import complete_goal
 from task.errors import TampError
 from task.planner import plan, plan_batch
 from task.problem import TABLE, Move, PlanStatus, Problem

@@ -18,10 +18,10 @@ from perception.train import evaluate, load_checkpoint
 from tamp.camera.dataset import generate
 from tamp.camera.from_images import perceived_goal, perceived_state
 from tamp.camera.render import StateRenderer
+from tamp.camera.states import complete_goal
 from tamp.loop import EpisodeStatus, LoopConfig, run_episode
 from tamp.scene import Pose
 from tamp.sim import SIMULATORS
-from tamp.camera.states import complete_goal
 from task.problem import TABLE, Problem
 from task.symbolic.generate import block_names, random_towers
 
