@@ -196,13 +196,15 @@ def planbench(
     cache_dir: str | Path | None = None,
     domain: str = "blocksworld",
     progress: Callable[[int], None] | None = None,
+    rules: str | None = None,
 ) -> Suite:
     """The official PlanBench set of ``domain`` (or a ``limit``-instance `spread` of it).
 
     With a ``manifest.csv`` in ``data_dir``, its official rows and lengths are used (sizes are
     checked against the files); without one the official files are known by name (others are
     left out). Lengths the data lack are searched (`_fill_optima`), cached in ``cache_dir``;
-    ``progress(k)``: k more searched.
+    ``progress(k)``: k more searched. ``rules`` plans the set with other domain rules
+    (``strips``: the generic lift).
     ``data_dir`` may also be PlanBench's own folder (``generated_domain.pddl``, instance
     folders without ``instances/``). Both ways give the same instances in the same order.
     """
@@ -218,13 +220,13 @@ def planbench(
         found = []
         for file, size, opt, ref in rows:
             name = file.removeprefix("instances/").removesuffix(".pddl")
-            instance, text, _ = _load(pddl_domain, root / file, name, domain)
-            if instance.size != size:
+            instance, text, _ = _load(pddl_domain, root / file, name, rules or domain)
+            if rules in (None, domain) and instance.size != size:
                 raise DataError(f"{root / file}: size {instance.size}, manifest.csv says {size}")
             found.append((replace(instance, optimal=opt, reference=ref), text, root / file))
     else:
         paths = [(n, folder / f"{n}.pddl") for n in spec.names]
-        found = [_load(pddl_domain, p, n, domain) for n, p in paths if p.is_file()]
+        found = [_load(pddl_domain, p, n, rules or domain) for n, p in paths if p.is_file()]
         if not found:
             first, last = spec.names[0], spec.names[-1]
             raise DataError(
@@ -234,6 +236,7 @@ def planbench(
         found = spread(found, limit, key=lambda item: item[0].size)
     instances = _fill_optima(found, domain_path, cache_dir, progress)
     name = "planbench" if domain == "blocksworld" else f"planbench-{domain}"
+    name += f" ({rules} rules)" if rules not in (None, domain) else ""
     return Suite(name, pddl_domain, tuple(instances), str(root.resolve()))
 
 

@@ -58,7 +58,7 @@ def planbench_command(args: argparse.Namespace) -> int:
     """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
     data = args.data if args.data is not None else suites.default_data(args.domain)
     with _bar(None, "optimal lengths the data lack", args.progress, "problem") as update:
-        suite = suites.planbench(data, args.limit, args.out, args.domain, update)
+        suite = suites.planbench(data, args.limit, args.out, args.domain, update, args.domain_rules)
     return _run(suite, args)
 
 

@@ -21,6 +21,7 @@ GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
+    "lookahead", "max_windows",
 )  # fmt: skip
 
 
@@ -127,6 +128,14 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         help=f"share of restarts whose window is {d.lookahead} moves long "
         f"({d.lookahead_share:g}; 0 = the paper's planner)",
     )
+    g.add_argument(
+        "--lookahead", type=positive, metavar="T",
+        help=f"window length of the long-lookahead restarts ({d.lookahead})",
+    )  # fmt: skip
+    g.add_argument(
+        "--max-windows", type=positive, metavar="W",
+        help=f"replanning windows before giving up ({d.max_windows})",
+    )  # fmt: skip
     g.add_argument(
         "--tau-end",
         type=positive_float,

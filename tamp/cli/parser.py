@@ -112,6 +112,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
     data_option(planbench, domains=True)
+    rules_option(planbench)
     folder = bench.choices["pddl"]
     folder.add_argument(
         "--data", required=True, metavar="DIR", help="folder with domain.pddl and problem files"
