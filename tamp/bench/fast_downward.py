@@ -31,7 +31,7 @@ import tempfile
 import threading
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor, as_completed
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -93,7 +93,6 @@ def _require_driver() -> Path:
 
 
 def _read(path: str | Path) -> str:
-    """A PDDL file's text; one-line DataError if it cannot be read."""
     try:
         return Path(path).read_text(encoding="utf-8")
     except OSError as exc:
@@ -284,14 +283,16 @@ def optimal_lengths(
     with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
         run = [(_solve, driver, *texts[i], time_limit_s, memory_mb, stop) for i in todo]
         jobs = {pool.submit(*job): i for job, i in zip(run, todo, strict=True)}
+        pending = set(jobs)
         try:
-            for job in as_completed(jobs):
-                i = jobs[job]
-                results[i] = result = job.result()
-                if path is not None and result.status != "error" and GUARD not in result.detail:
-                    entries[keys[i]] = {**asdict(result), "time_limit_s": time_limit_s}
-                    _save(path, entries)
-                report(1)
+            while pending:  # a timed wait, so that Ctrl-C reaches the main thread at once
+                done, pending = wait(pending, timeout=0.5, return_when=FIRST_COMPLETED)
+                for job in done:
+                    results[jobs[job]] = result = job.result()
+                    if path and result.status != "error" and GUARD not in result.detail:
+                        entries[keys[jobs[job]]] = {**asdict(result), "time_limit_s": time_limit_s}
+                        _save(path, entries)
+                    report(1)
         except BaseException:
             stop.set()
             pool.shutdown(cancel_futures=True)

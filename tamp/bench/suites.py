@@ -2,12 +2,10 @@
 
 PlanBench (Blocksworld-600, Logistics-200, Sokoban-55; `OFFICIAL`) is read through its
 ``manifest.csv`` where there is one, else the official files are picked by name. Lengths the
-data lack come from an optimal search: exact A* for Blocksworld (`tamp.bench.optimal`), Fast
-Downward for every other domain when the benchmark-only extra is installed
-(`tamp.bench.fast_downward`), both cached in the output folder. A folder of a domain file and
-problem files (the IPC sets) is read by `pddl_folder`. Seeded random Blocksworld problems get
-their optima from A* with a node budget (``generated``). A `Suite` is a tuple of
-`task.symbolic.instances.Instance` that all validate against one PDDL domain.
+data lack come from A* for Blocksworld (`tamp.bench.optimal`), else Fast Downward when the
+benchmark extra is installed (`tamp.bench.fast_downward`), cached in the output folder.
+`pddl_folder` reads a domain file and its problems (the IPC sets); ``generated`` makes seeded
+random Blocksworld problems. A `Suite`'s instances all validate against one PDDL domain.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ the samples `task.domains.sokoban_pddl`. Departures from the paper's Blocksworld
   A_b(c) the fewest actions that take box b alone from c to its goal (the robot placed best; a
   large finite value from dead cells), W_b(r, c) the extra actions when the robot starts on r
   (walking to a pushing side, round the box), C a placement bonus above any W. Goal ordering:
-  a box whose goal must wait for others (`sokoban_grid.first`) adds no pull and no robot term
+  a box whose goal must wait for others (`first`) adds no pull and no robot term
   until they are placed. Goal "atoms": the paper's goal cross-entropy.
 - `lower_bound` is admissible (`sokoban_grid`); the domain also offers `estimate`, an
   inadmissible cost-to-go that ranks restarts far better where the planner reads it.
@@ -26,9 +26,10 @@ the samples `task.domains.sokoban_pddl`. Departures from the paper's Blocksworld
 
 from __future__ import annotations
 
+import heapq
 import itertools
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 
 import torch
 from torch import Tensor
@@ -36,7 +37,16 @@ from torch import Tensor
 from task.domains import sokoban_grid as rules
 from task.domains.base import SoftBatch, zero_cycle_loss
 from task.domains.sokoban_grid import INF, ROBOT, State, grid
-from task.domains.sokoban_pddl import NAME, from_pddl, random_problem, to_actions, to_atoms, to_pddl
+from task.domains.sokoban_pddl import (
+    NAME,
+    from_pddl,
+    matches,
+    pddl_domain_text,
+    samples,
+    to_actions,
+    to_atoms,
+    to_pddl,
+)
 from task.errors import ProblemError, one_of
 from task.problem import Move, Problem
 from task.soft import goal_cross_entropy, row_normalise
@@ -60,25 +70,51 @@ def first(problem: Problem, state: State) -> dict[int, set[int]]:
     return {b: {a for a in s if b not in pairs[a]} for b, s in pairs.items()}
 
 
+def _placed_cost(g, goal: int, c: int, r: int, walls: set[int]) -> float:
+    """Fewest actions that take the box on c to ``goal`` from the robot on r with the ``walls``
+    cells filled (A* over box x robot cells guided by the exact obstacle-free
+    `Grid.lone_cost`); after 4000 expansions, the least f still open (a bound)."""
+    lone, best = g.lone_cost(goal), {(c, r): 0}
+    heap = [(lone[c][r], 0, c, r)] if lone[c][r] < INF else []
+    for _ in range(4000):
+        if not heap or heap[0][2] == goal:
+            return heap[0][1] if heap else INF
+        _, t, c, r = heapq.heappop(heap)
+        for d, q in enumerate(g.nbr[r] if t == best[(c, r)] else ()):
+            nxt = (g.nbr[c][d], c) if q == c else (c, q)  # a push, or a step
+            if q < 0 or q in walls or nxt[0] < 0 or nxt[0] in walls:
+                continue
+            if t + 1 < best.get(nxt, INF) and lone[nxt[0]][nxt[1]] < INF:
+                best[nxt] = t + 1
+                heapq.heappush(heap, (t + 1 + lone[nxt[0]][nxt[1]], t + 1, *nxt))
+    return heap[0][0] if heap else INF
+
+
 def estimate(problem: Problem, state: State) -> float:
-    """A cost-to-go estimate for ranking (not admissible): the boxes placed one after another in
-    the best order the goal ordering allows, each at its lone-box optimum, the robot starting
-    from where the last one ended; INF at a dead end, never below `lower_bound`."""
-    g, bound = grid(problem), rules.lower_bound(problem, state)
-    key = ("estimate", tuple(state))
-    if key not in g.cache and bound < INF:
-        at, goal = [g.index[c] for c in state[1:]], rules.goals(problem)
-        before = first(problem, state)
-        todo, best = [k for k, c in goal.items() if at[k] != c], INF
+    """A cost-to-go estimate for ranking (not admissible): the boxes placed one after another,
+    in the best order the goal ordering allows; the first box with the others where they stand
+    (`_placed_cost`), the rest alone (`Grid.lone_cost`), each from where the last one ended
+    (all alone + 8 when every first box is walled in). INF at a dead end, >= `lower_bound`."""
+    g, bound, key = grid(problem), rules.lower_bound(problem, state), ("estimate", tuple(state))
+    if key not in g.cache and 0 < bound < INF:
+        at, goal, robot = [g.index[c] for c in state[1:]], rules.goals(problem), g.index[state[0]]
+        before, todo = first(problem, state), [k for k, c in goal.items() if at[k] != c]
         orders = list(itertools.permutations(todo))
         fine = [o for o in orders if all(o.index(a) < o.index(b) for b in o for a in before[b]
                                          if a in o)] or orders  # fmt: skip
-        for order in fine:
-            t, where = 0.0, [g.index[state[0]]]
-            for k in order:
+        heads = {o[0] for o in fine}
+        walled = {k: _placed_cost(g, goal[k], at[k], robot, set(at) - {at[k]}) for k in heads}
+        alone = {k: g.lone_cost(goal[k])[at[k]][robot] for k in heads}
+
+        def chain(order: tuple[int, ...], head: dict[int, float]) -> float:
+            t, where = head[order[0]], rules.ends(g, goal[order[0]])
+            for k in order[1:]:
                 t += min(g.lone_cost(goal[k])[at[k]][r] for r in where)
-                where = list(rules.ends(g, goal[k]))
-            best = min(best, t)
+                where = rules.ends(g, goal[k])
+            return t
+
+        best = min(chain(o, walled) for o in fine)
+        best = best if best < INF else min(chain(o, alone) for o in fine) + 8
         g.cache[key] = max(best, bound)
     return g.cache.get(key, bound)
 
@@ -217,27 +253,6 @@ def decode(problem: Problem, row: int, col: int, n: int) -> Move | None:
     return Move(ROBOT, dirs[col]) if row == 0 and col < len(dirs) else None
 
 
-def samples(seed: int) -> Iterator[Problem]:
-    """Random solvable grids of 4x4 to 6x6 with a few walls and 1-2 boxes."""
-    for rows, cols, boxes, walls in ((4, 4, 1, 1), (5, 5, 1, 3), (5, 5, 2, 2), (6, 6, 2, 4)):
-        yield random_problem(rows, cols, boxes, walls, seed)
-
-
-def matches(domain) -> bool:
-    """Whether a parsed PDDL domain has typed-sokoban's actions and predicates (arities)."""
-    from task.symbolic.signature import signature
-
-    return signature(domain) == signature(_pddl_domain())
-
-
-def _pddl_domain():
-    from task import data
-    from task.domains.sokoban_pddl import DOMAIN_FILE
-    from task.symbolic import pddl_io
-
-    return pddl_io.parse_domain(data.read_text(DOMAIN_FILE), data.source(DOMAIN_FILE))
-
-
 class Sokoban:
     """The Sokoban domain object the shared planner drives (see task.domains.base.Domain)."""
 
@@ -263,14 +278,8 @@ class Sokoban:
     to_pddl = staticmethod(to_pddl)
     samples = staticmethod(samples)
     matches = staticmethod(matches)
+    pddl_domain_text = staticmethod(pddl_domain_text)
     estimate = staticmethod(estimate)
-
-    @staticmethod
-    def pddl_domain_text() -> str:
-        from task import data
-        from task.domains.sokoban_pddl import DOMAIN_FILE
-
-        return data.read_text(DOMAIN_FILE)
 
     @staticmethod
     def shape_key(problem: Problem) -> int:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import random
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
@@ -65,8 +65,6 @@ def _checked(atoms: Iterable[tuple], kinds: dict[str, list[str]], where: str) ->
 
 def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None = None) -> Problem:
     """The `Problem` of a parsed typed-sokoban problem (``order``: objects in file order)."""
-    from task.domains.sokoban import matches
-
     if not matches(domain):
         raise PDDLError(f"domain {domain.name} is not {PDDL_DOMAIN} (needs move/3, push/5)")
     kinds = _kinds(problem, order)
@@ -208,3 +206,23 @@ def random_problem(rows: int, cols: int, n_boxes: int, n_walls: int, seed: int) 
         if boxes != goals:
             name = f"sokoban-{rows}x{cols}-b{n_boxes}-w{n_walls}-s{seed}"
             return grid_problem(name, rows, cols, walls, robot, boxes, goals)
+
+
+def samples(seed: int) -> Iterator[Problem]:
+    """Random solvable grids of 4x4 to 6x6 with a few walls and 1-2 boxes."""
+    for rows, cols, boxes, walls in ((4, 4, 1, 1), (5, 5, 1, 3), (5, 5, 2, 2), (6, 6, 2, 4)):
+        yield random_problem(rows, cols, boxes, walls, seed)
+
+
+def pddl_domain_text() -> str:
+    """The embedded typed-sokoban domain (``task/data/typed-sokoban.pddl``)."""
+    from task import data
+
+    return data.read_text(DOMAIN_FILE)
+
+
+def matches(domain: Domain) -> bool:
+    """Whether a parsed PDDL domain has typed-sokoban's actions and predicates (arities)."""
+    from task.symbolic.signature import signature
+
+    return signature(domain) == signature(pddl_io.parse_domain(pddl_domain_text()))

@@ -18,7 +18,6 @@ tiny gripper (3-6 balls) and Logistics instances 201-286 only.
 from __future__ import annotations
 
 import functools
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -34,7 +33,6 @@ from task.symbolic.strips import Atom, GroundAction, atom_str, initial_state
 CAP = 30.0  # the relaxed cost of an atom nothing reaches (and the ceiling of every cost)
 SOFTMIN_TAU = 0.1  # temperature of the softmin over an atom's achievers
 ATOMS_WEIGHT = 1.0  # weight of the paper's goal cross-entropy inside "hadd"
-ATOMS_FLOOR = 0.0  # TEMP
 SWEEP_MARGIN = 2  # Bellman sweeps beyond the relaxed depth of the window's start
 MAX_SWEEPS = 40
 GOAL_LOSSES = ("hadd", "atoms")  # the first is the default
@@ -223,11 +221,11 @@ def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     The h_add part rewards reaching the preconditions of goal achievers that a 3-5 step
     window cannot finish; the CE part pulls hard on goal atoms the window can reach."""
     tiny = torch.finfo(F.dtype).tiny
+    atoms = -(batch.goal * torch.log(F.clamp_min(tiny))).sum((-1, -2))
     if kind == "atoms":
-        return -(batch.goal * torch.log(F.clamp_min(tiny))).sum((-1, -2))
+        return atoms
     if kind in ("hadd", "default"):
-        ce = math.log1p(ATOMS_FLOOR) - torch.log((F + ATOMS_FLOOR).clamp_min(tiny))
-        return (batch.goal[:, 0] * (relaxed_cost(F, batch) + ATOMS_WEIGHT * ce[:, 0])).sum(-1)
+        return (batch.goal[:, 0] * relaxed_cost(F, batch)).sum(-1) + ATOMS_WEIGHT * atoms
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
 
 
