@@ -6,6 +6,8 @@
 - ``motion``: closed-loop episodes in the simulators (``bench motion``);
 - ``perception``: planning from rendered images (``bench perception``);
 - ``poses``: block poses from RGB-D images against the true poses (``bench poses``);
+- ``fast_downward``: optimal plan lengths from Fast Downward (the ``bench`` extra,
+  benchmark-only) for sets whose data lack them, cached by the PDDL texts' digest;
 - ``results``: the one results writer (output folder, machine record, JSON, CSV, plots);
 - ``tables``: the one table printer.
 

@@ -93,6 +93,7 @@ def _require_driver() -> Path:
 
 
 def _read(path: str | Path) -> str:
+    """A PDDL file's text; one-line DataError if it cannot be read."""
     try:
         return Path(path).read_text(encoding="utf-8")
     except OSError as exc:
@@ -146,11 +147,6 @@ def _last_message(log: Path) -> str:
     return " | ".join(useful[-3:])[:300] if useful else "no output"
 
 
-def _plan_length(plan: Path) -> int:
-    lines = plan.read_text(encoding="utf-8").splitlines()
-    return sum(1 for s in lines if s.strip() and not s.lstrip().startswith(";"))
-
-
 def _outcome(code: int | None, seconds: float, start: float, work: Path, step: str) -> FDResult:
     """The result of a run that stopped at ``step`` with exit ``code`` after ``seconds`` of CPU
     (``code`` None: a guard kill, timed in wall seconds since ``start``)."""
@@ -158,8 +154,10 @@ def _outcome(code: int | None, seconds: float, start: float, work: Path, step: s
         wall = time.monotonic() - start
         return FDResult(None, "timeout", wall, f"{step} {GUARD} after {wall:.0f} s wall")
     plan = work / "plan.txt"
-    if code == 0 and plan.is_file():
-        return FDResult(_plan_length(plan), "optimal", seconds, f"{step} exit 0: optimal plan")
+    if code == 0 and plan.is_file():  # one action a line, then "; cost = ..." comments
+        lines = plan.read_text(encoding="utf-8").splitlines()
+        length = sum(1 for s in lines if s.strip() and not s.lstrip().startswith(";"))
+        return FDResult(length, "optimal", seconds, f"{step} exit 0: optimal plan")
     status = _EXIT.get(code, "error")
     detail = f"{step} exit {code}"
     if status in ("unsolvable", "error"):

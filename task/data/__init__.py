@@ -1,4 +1,6 @@
-"""soft-tamp's own embedded PDDL: the 4-operator blocksworld domain and a 5-block example.
+"""soft-tamp's own embedded PDDL: the 4-operator blocksworld domain and a 5-block example, and
+the logistics-strips and typed-sokoban domains (written out here; the same names and semantics as
+PlanBench's) that `task.domains.logistics` and `task.domains.sokoban` recognise and write for.
 
 The files ship as package data and are read through `importlib.resources`, so they work from a
 source checkout, an installed wheel or a zip alike. ``DOMAIN_FILE`` is the domain that PlanBench

@@ -147,6 +147,9 @@ class Grid:
 
 
 def grid(problem: Problem) -> Grid:
+    """The `Grid` of a Sokoban problem; ProblemError for a problem of another domain."""
+    if not isinstance(problem.data, Grid):
+        raise ProblemError(f"problem {problem.name} is not a Sokoban problem (no grid in data)")
     return problem.data
 
 

@@ -129,8 +129,7 @@ def to_pddl(problem: Problem) -> str:
     """PlanBench-style problem PDDL text of ``problem`` at its initial state."""
     g = grid(problem)
     lines = [f"(define (problem {problem.name})", f"(:domain {PDDL_DOMAIN})", "(:objects"]
-    lines += [" ".join(g.dirs) + " - DIR", " ".join(g.boxes) + " - BOX"] if g.boxes else []
-    lines += [" ".join(g.dirs) + " - DIR"] if not g.boxes else []
+    lines += [" ".join(g.dirs) + " - DIR"] + ([" ".join(g.boxes) + " - BOX"] if g.boxes else [])
     lines += [" ".join(g.locs) + " - LOC", ")", "(:init"]
     lines += [f"(adjacent {a} {b} {d})" for a, b, d in g.adjacent]
     lines += [f"(at {b} {c})" for b, c in zip(problem.entities[1:], problem.init[1:], strict=True)]

@@ -16,9 +16,14 @@ from task.errors import DataError
 from task.symbolic.generate import random_problem
 from task.symbolic.search import optimal_moves
 
-needs_fd = pytest.mark.skipif(
+_installed = pytest.mark.skipif(
     not fast_downward.available(), reason="needs the bench extra: pip install 'soft-tamp[bench]'"
 )
+
+
+def needs_fd(test):
+    """Fast Downward runs only in the slow tests (benchmark-only), and only when installed."""
+    return pytest.mark.slow(_installed(test))
 
 _DEAD_END = """(define (problem stuck) (:domain blocksworld-4ops)
 (:objects a b)
