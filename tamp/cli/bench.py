@@ -26,12 +26,9 @@ from task.errors import TampError
 
 
 @contextmanager
-def _bar(total: int | None, desc: str, enabled: bool, unit: str = "plan"):
+def _bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
     """A tqdm bar on stderr; yields ``update(k)``, the `plan_batch` progress callback."""
-    with tqdm(
-        total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled,
-        leave=total is not None,
-    ) as bar:  # fmt: skip
+    with tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled) as bar:
         yield bar.update
 
 
@@ -57,16 +54,35 @@ def _run(suite: Suite, args: argparse.Namespace) -> int:
 def planbench_command(args: argparse.Namespace) -> int:
     """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
     data = args.data if args.data is not None else suites.default_data(args.domain)
-    with _bar(None, "optimal lengths the data lack", args.progress, "problem") as update:
+    with _searching(args.progress) as update:
         suite = suites.planbench(data, args.limit, args.out, args.domain, update, args.domain_rules)
     return _run(suite, args)
 
 
 def pddl_command(args: argparse.Namespace) -> int:
     """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
-    with _bar(None, "optimal lengths (Fast Downward)", args.progress, "problem") as update:
+    with _searching(args.progress) as update:
         suite = suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules, update)
     return _run(suite, args)
+
+
+@contextmanager
+def _searching(enabled: bool):
+    """A bar for optimal lengths the data lack, opened at the first one searched (nothing is
+    printed when none is)."""
+    bars = []
+
+    def update(k: int) -> None:
+        if not bars:
+            bars.append(tqdm(desc="optimal lengths the data lack", unit="problem",
+                             file=sys.stderr, disable=not enabled))  # fmt: skip
+        bars[0].update(k)
+
+    try:
+        yield update
+    finally:
+        for bar in bars:
+            bar.close()
 
 
 def random_command(args: argparse.Namespace) -> int:
