@@ -225,22 +225,30 @@ def test_dead_ends_have_an_infinite_lower_bound():
 
 
 def test_lower_bound_is_admissible_and_estimate_above_it():
-    problem = level("@.0.\n.#..\n.1..\n..ab")
+    problem = level("....\n.0..\n..1.\n@.ab")
     start = SOK.initial_state(problem)
-    seen, order, succ = {start}, [start], {}
+    seen, order, before = {start}, [start], collections.defaultdict(list)
     for s in order:
-        succ[s] = [SOK.apply_move(problem, s, m) for m in SOK.legal_moves(problem, s)]
-        order += [t for t in succ[s] if t not in seen and not seen.add(t)]
+        for t in (SOK.apply_move(problem, s, m) for m in SOK.legal_moves(problem, s)):
+            before[t].append(s)
+            order += [] if t in seen else [t]
+            seen.add(t)
     dist = {s: 0 for s in order if SOK.is_goal(problem, s)}
-    for _ in range(len(order)):
-        dist |= {s: 1 + min(dist[t] for t in ts if t in dist) for s, ts in succ.items()
-                 if s not in dist and any(t in dist for t in ts)}  # fmt: skip
+    queue = list(dist)
+    for t in queue:  # backward breadth-first search from the goal states
+        for s in (s for s in before[t] if s not in dist):
+            dist[s] = dist[t] + 1
+            queue.append(s)
     dead = 0
     for s in order:
-        bound, true = SOK.lower_bound(problem, s), dist.get(s, math.inf)
-        assert bound <= true and estimate(problem, s) >= bound
+        bound, true, guess = (
+            SOK.lower_bound(problem, s),
+            dist.get(s, math.inf),
+            estimate(problem, s),
+        )
+        assert bound <= true and guess >= bound and (guess == 0) == (true == 0)
         dead += bound == math.inf
-    assert dead > 0 and SOK.lower_bound(problem, start) > 2
+    assert dead > 0 and SOK.lower_bound(problem, start) > 2 and len(dist) > 10
 
 
 # ---------------------------------------------------------------------------------- planning
