@@ -25,6 +25,7 @@ def needs_fd(test):
     """Fast Downward runs only in the slow tests (benchmark-only), and only when installed."""
     return pytest.mark.slow(_installed(test))
 
+
 _DEAD_END = """(define (problem stuck) (:domain blocksworld-4ops)
 (:objects a b)
 (:init (handempty) (ontable a) (clear a) (ontable b) (clear b))
