@@ -28,6 +28,15 @@ class PlannerConfig:
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
 
+    @classmethod
+    def for_domain(cls, name: str, **given) -> PlannerConfig:
+        """The defaults with domain ``name``'s own (its ``planner_defaults``, e.g. Sokoban's
+        longer lookahead and window budget), then the fields ``given``."""
+        from task.domains import get_domain
+
+        tuned = getattr(get_domain(name), "planner_defaults", {})
+        return cls(**{**tuned, **given})
+
     def horizons(self) -> tuple[int, ...]:
         """Window length of each restart: the long-lookahead restarts come last."""
         n_long = round(self.restarts * self.lookahead_share)

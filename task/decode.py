@@ -15,8 +15,8 @@ the move illegal in the world and the plan is inexecutable.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass, replace
 
 from torch import Tensor
 
@@ -33,16 +33,21 @@ class DecodedWindow:
     loss: float  # the soft objective of the restart it came from
     remaining: float  # the domain's admissible lower bound from ``state`` (inf: a dead end)
     illegal: str | None = None  # check=False: why the last move is illegal in ``state``
+    estimated: float | None = None  # the domain's ranking estimate (None: ``remaining``)
+    revisit: bool = False  # ``state`` was already visited earlier in the plan (a loop)
 
     def key(self) -> tuple:
         """Sort key: the goal reached in fewest moves; else not a dead end (an infinite lower
-        bound ranks last, whatever moved), then some progress, then the least estimated total
-        (moves + remaining), then the most moves, then the soft objective."""
+        bound ranks last, whatever moved), then not back to a state the plan already visited,
+        then some progress, then the least estimated total
+        (moves + the domain's optional `estimate`, else its lower bound), then the most moves,
+        then the soft objective."""
         g = len(self.moves)
         if self.reached:
             return (0, g, 0, 0, self.loss)
         dead = math.isinf(self.remaining)
-        return (1, dead, g == 0, g + self.remaining, -g, not self.complete, self.loss)
+        rest = self.remaining if self.estimated is None else self.estimated
+        return (1, dead, self.revisit, g == 0, g + rest, -g, not self.complete, self.loss)
 
 
 def decode_row(
@@ -81,7 +86,10 @@ def decode_row(
             break
     reached = domain.is_goal(problem, state)
     remaining = 0 if reached else domain.lower_bound(problem, state)
-    return DecodedWindow(tuple(moves), state, reached, complete, loss, remaining, illegal)
+    estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
+    estimated = None if reached or estimate is None else estimate(problem, state)
+    moves_ = tuple(moves)
+    return DecodedWindow(moves_, state, reached, complete, loss, remaining, illegal, estimated)
 
 
 def decode_best(
@@ -93,10 +101,13 @@ def decode_best(
     restarts: int,
     threshold: float,
     check: bool = True,
+    visited: Sequence[Collection[State]] | None = None,
 ) -> list[DecodedWindow]:
     """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
 
-    ``check=False``: illegal moves are kept and the lowest soft objective wins."""
+    ``visited``: per problem, the states its plan has passed through (a window that ends in
+    one ranks below every window that does not). ``check=False``: illegal moves are kept and
+    the lowest soft objective wins."""
     gates, losses = gates.cpu(), losses.cpu().tolist()
     out = []
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
@@ -104,6 +115,9 @@ def decode_best(
         windows = [
             decode_row(domain, problem, state, gates[r], threshold, losses[r], check) for r in rows
         ]
+        if visited is not None:
+            seen = visited[i]
+            windows = [replace(w, revisit=w.state in seen) for w in windows]
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
     return out
 

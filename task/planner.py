@@ -39,6 +39,7 @@ def _window(
     config: PlannerConfig,
     generator: torch.Generator,
     beliefs: WindowBeliefs | None = None,
+    visited: Sequence[set] | None = None,
 ):
     batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
     horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
@@ -46,7 +47,7 @@ def _window(
     _, roll = optimise_window(domain, batch, steps, config, generator, beliefs)
     return decode_best(
         domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold,
-        config.crisp_check,
+        config.crisp_check, visited,
     )  # fmt: skip
 
 
@@ -63,9 +64,10 @@ def _crisp_states(
 
 
 def _execute(
-    domain: Domain, problem: Problem, state: State, moves: Sequence[Move]
+    domain: Domain, problem: Problem, state: State, moves: Sequence[Move], visited: set
 ) -> tuple[tuple[Move, ...], State, str | None]:
-    """Apply ``moves`` to the world ``state`` until one is illegal there.
+    """Apply ``moves`` to the world ``state`` until one is illegal there; each state reached
+    joins ``visited``.
 
     Returns the moves tried (an illegal one last), the world state after the legal ones, and
     why the illegal one is illegal (None when all were legal)."""
@@ -76,6 +78,7 @@ def _execute(
         if reason is not None:
             return tuple(done), state, f"{move}: {reason}"
         state = domain.apply_move(problem, state, move)
+        visited.add(state)
     return tuple(done), state, None
 
 
@@ -93,6 +96,7 @@ def _run(
     ``indices``: the problems' positions in the caller's list (what ``source`` is told)."""
     start = time.perf_counter()
     states = [domain.initial_state(p) for p in problems]  # the world
+    visited = [{s} for s in states]  # per problem, every world state its plan passed through
     moves: list[list] = [[] for _ in problems]
     windows, misread = [0] * len(problems), [0] * len(problems)
     solved = [domain.is_goal(p, s) for p, s in zip(problems, states, strict=True)]
@@ -105,12 +109,17 @@ def _run(
         now = [states[i] for i in active]
         beliefs = None if source is None else source([indices[i] for i in active], now)
         crisp, perceived = _crisp_states(beliefs, now)
-        decoded = _window(domain, [problems[i] for i in active], crisp, config, generator, beliefs)
+        decoded = _window(
+            domain, [problems[i] for i in active], crisp, config, generator, beliefs,
+            [visited[i] for i in active],
+        )  # fmt: skip
         hoped = []  # perceived: windows that predict the goal, for a new image to confirm
         for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1
             misread[i] += seen != states[i]
-            tried, states[i], illegal[i] = _execute(domain, problems[i], states[i], win.moves)
+            tried, states[i], illegal[i] = _execute(
+                domain, problems[i], states[i], win.moves, visited[i]
+            )
             moves[i].extend(tried)
             if not perceived:
                 solved[i] = win.reached  # decoded on the world: the world reached the goal

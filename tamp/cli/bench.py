@@ -33,7 +33,11 @@ def _bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
 
 
 def _run(suite: Suite, args: argparse.Namespace) -> int:
-    config = planner_config(args)
+    import torch
+
+    torch.set_num_threads(args.threads)
+    rules = {i.problem.domain for i in suite.instances}
+    config = planner_config(args, rules.pop() if len(rules) == 1 else None)
     horizons = args.horizons or (config.horizon,)
     seeds = tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)

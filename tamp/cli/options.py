@@ -7,7 +7,6 @@ stays fast.
 from __future__ import annotations
 
 import argparse
-from dataclasses import replace
 
 from tamp.bench.suites import OFFICIAL, default_data
 from tamp.sim.base import SIMULATORS
@@ -34,10 +33,11 @@ def sim_list(text: str) -> tuple[str, ...]:
     return sims
 
 
-def planner_config(args: argparse.Namespace) -> PlannerConfig:
-    """PlannerConfig defaults with the options the user gave (None: not given)."""
+def planner_config(args: argparse.Namespace, domain: str | None = None) -> PlannerConfig:
+    """PlannerConfig defaults (with ``domain``'s own, `PlannerConfig.for_domain`) and the
+    options the user gave (None: not given)."""
     given = {k: getattr(args, k) for k in _OVERRIDES if getattr(args, k, None) is not None}
-    return replace(PlannerConfig(), **given)
+    return PlannerConfig(**given) if domain is None else PlannerConfig.for_domain(domain, **given)
 
 
 class Parser(argparse.ArgumentParser):

@@ -108,6 +108,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             help="keep a window's strongest move even when it is illegal (the plan is then "
             "inexecutable); measures the soft planner without the decoder's legality filter",
         )  # fmt: skip
+        p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]

@@ -37,7 +37,7 @@ def _write(path: Path, text: str) -> None:
 
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan)."""
-    config = planner_config(args)
+    config = planner_config(args, instance.problem.domain)
     result = plan(instance.problem, config, args.seed)
     actions: tuple = ()
     validation = None

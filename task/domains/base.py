@@ -124,7 +124,11 @@ def zero_cycle_loss(F: Tensor, batch: SoftBatch) -> Tensor:
 
 
 class Domain(Protocol):
-    """What a domain file provides. Tensors are batch first; see the glossary in ``task``."""
+    """What a domain file provides. Tensors are batch first; see the glossary in ``task``.
+
+    Optional: ``estimate(problem, state) -> float``, an inadmissible cost-to-go the decoder
+    ranks restarts by instead of ``lower_bound`` (which still marks dead ends), and
+    ``planner_defaults``, a dict of `PlannerConfig` fields (`PlannerConfig.for_domain`)."""
 
     name: str
     size_name: str  # what `size` counts, a table's column head ("blocks", "packages", ...)

@@ -30,6 +30,7 @@ import heapq
 import itertools
 import math
 from collections.abc import Sequence
+from types import MappingProxyType
 
 import torch
 from torch import Tensor
@@ -141,7 +142,7 @@ def _tables(problem: Problem) -> tuple[Tensor, ...]:
         k, j, a = problem.entities.index(box) - 1, g.index[cell], best[box]
         walk[k] = torch.where(x < INF, x, bonus)
         walk[k, :, j] = bonus
-        dead = 4 * bonus + 2 * a[a < INF].max().item()
+        dead = 4 * bonus + 2 * torch.where(a < INF, a, 0.0).max().item()
         pot[k], wait[k] = torch.where(a < INF, a + bonus, dead), torch.where(a < INF, 0.0, dead)
         pot[k, j] = 0.0
     g.cache["soft"] = (nbr, pot, wait, walk)
@@ -280,6 +281,9 @@ class Sokoban:
     matches = staticmethod(matches)
     pddl_domain_text = staticmethod(pddl_domain_text)
     estimate = staticmethod(estimate)
+    # PlannerConfig.for_domain: pushes are irreversible and plans run to 65 actions, so
+    # longer lookahead restarts (8 moves) and a larger window budget (see BENCHMARKS.md)
+    planner_defaults = MappingProxyType({"lookahead": 8, "max_windows": 100})
 
     @staticmethod
     def shape_key(problem: Problem) -> int:

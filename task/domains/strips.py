@@ -9,9 +9,10 @@ rest are the P *fluent* atoms, the columns of a single state row (``entities = (
 atom). A crisp state is the frozenset of fluent atoms that hold (static atoms may be included:
 they are ignored); a move is the ground `task.problem.Action` itself, so ``to_actions`` is the
 identity. The grounding, tensors, goal terms and relaxations are `task.domains.strips_soft`.
-``lower_bound`` is LM-cut (admissible): the decoder ranks restarts by moves + bound, and with
-h_max or the goal count most windows tie, so the fewest moves win (Logistics dev instances
-201-286: 2 of 11 solved with h_max, 11 of 11 with LM-cut).
+``lower_bound`` is LM-cut (admissible; it marks dead ends) and ``estimate`` h_FF: the decoder
+ranks restarts by moves + estimate. With h_max or the goal count most windows tie, so the
+fewest moves win (Logistics dev instances 201-286: 2 of 11 solved with h_max, 11 of 11 with
+LM-cut); h_FF tracks progress more closely still (see BENCHMARKS.md).
 
 The parsed PDDL domain and problem stay in ``problem.data``: ``to_pddl`` writes the problem
 back (`pddl.formatter`), ``pddl_domain_text(problem)`` its domain; the lift has no domain of
@@ -32,7 +33,7 @@ from task.domains.base import zero_cycle_loss
 from task.domains.strips_soft import StripsTask
 from task.errors import PDDLError, ProblemError
 from task.problem import Action, Problem
-from task.symbolic import strips
+from task.symbolic import relaxed, strips
 from task.symbolic.strips import Atom, GroundAction
 
 NAME = "strips"
@@ -182,7 +183,16 @@ def lower_bound(problem: Problem, state: State) -> float:
         count = float(-(-unmet // max(task.goal_adds, 1)))
         if len(task.bounds) > 100_000:
             task.bounds.clear()
-        task.bounds[key] = max(strips_soft.lm_cut(task, key), count) if unmet else 0.0
+        task.bounds[key] = max(relaxed.lm_cut(task, key), count) if unmet else 0.0
+    return task.bounds[key]
+
+
+def estimate(problem: Problem, state: State) -> float:
+    """h_FF (`task.symbolic.relaxed.ff`), not admissible: what the decoder ranks restarts by
+    (moves + estimate); LM-cut still marks dead ends. Memoised with the bounds."""
+    task, key = _task(problem), ("ff", frozenset(state))
+    if key not in task.bounds:
+        task.bounds[key] = relaxed.ff(task, key[1]) if not is_goal(problem, state) else 0.0
     return task.bounds[key]
 
 
@@ -257,6 +267,7 @@ class Strips:
     legal_moves = staticmethod(legal_moves)
     is_goal = staticmethod(is_goal)
     lower_bound = staticmethod(lower_bound)
+    estimate = staticmethod(estimate)
     from_pddl = staticmethod(from_pddl)
     to_actions = staticmethod(to_actions)
     to_atoms = staticmethod(to_atoms)

@@ -25,9 +25,10 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from task.domains.base import INF, SoftBatch
+from task.domains.base import SoftBatch
 from task.errors import ProblemError, one_of
 from task.problem import Action, Problem
+from task.symbolic import relaxed
 from task.symbolic.strips import Atom, GroundAction, atom_str, initial_state
 
 CAP = 30.0  # the relaxed cost of an atom nothing reaches (and the ceiling of every cost)
@@ -107,8 +108,9 @@ class StripsTask:
         return j[order], targets, starts
 
     @functools.cached_property
-    def bounds(self) -> dict[frozenset, float]:
-        """Memo of the domain's lower bound by state (restarts often reach the same one)."""
+    def bounds(self) -> dict:
+        """Memo of the domain's lower bound and estimate by state (restarts often reach the
+        same one)."""
         return {}
 
 
@@ -145,7 +147,7 @@ def encode(
                 static[key][i, :rows] = n + (key != "pre")
                 own = torch.where(own >= p, own - p + n, own)
             static[key][i, :rows, : own.shape[1]] = own
-        h = hmax(task, state)
+        h = relaxed.hmax(task, state)
         depth.append(int(h[np.isfinite(h)].max()))
     static["sweeps"] = (torch.tensor(depth) + SWEEP_MARGIN).clamp_max(MAX_SWEEPS)
     return SoftBatch(F0, torch.ones(b, 1, dtype=torch.bool), mask, goal, static)
@@ -227,63 +229,3 @@ def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     if kind in ("hadd", "default"):
         return (batch.goal[:, 0] * relaxed_cost(F, batch)).sum(-1) + ATOMS_WEIGHT * atoms
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
-
-
-# ------------------------------------------------------------------------- crisp relaxations
-
-
-def hmax(task: StripsTask, state: frozenset, cost: np.ndarray | None = None, h=None):
-    """h_max of every column from ``state`` (delete relaxation, action costs ``cost``, unit by
-    default): Bellman sweeps from ``h`` (an upper bound; none: 0 on ``state`` and column P,
-    inf elsewhere) until nothing changes. -> (P + 2,)"""
-    actions, targets, starts = task.pairs
-    cost = np.ones(len(task.actions)) if cost is None else cost
-    if h is None:
-        h = np.full(len(task.atoms) + 2, np.inf)
-        h[[len(task.atoms), *(task.column[a] for a in state if a in task.column)]] = 0.0
-    while targets.size:
-        price = h[task.pre].max(axis=1) + cost  # (G,)
-        best = np.minimum(h[targets], np.minimum.reduceat(price[actions], starts))
-        if np.array_equal(best, h[targets]):
-            break
-        h = h.copy()
-        h[targets] = best
-    return h
-
-
-def lm_cut(task: StripsTask, state: frozenset) -> float:
-    """The LM-cut bound (Helmert & Domshlak 2009), unit costs; INF when the relaxation cannot
-    reach the goal. Each round takes the cut of the h_max justification graph between the
-    state and the goal zone (atoms reaching the costliest goal atom through zero-cost
-    actions), adds its cheapest action cost and takes that cost off the whole cut."""
-    n, g, pre, add = len(task.atoms), len(task.actions), task.pre, task.add
-    goal = np.array([task.column[a] for a in task.goal])
-    cost = np.ones(g)
-    h = hmax(task, state, cost)
-    start, total = h == 0.0, 0.0
-    while h[goal].max() > 0.0:
-        if np.isinf(h[goal].max()):
-            return INF
-        pcf = pre[np.arange(g), h[pre].argmax(axis=1)]  # (G,) the costliest precondition
-        zone = np.zeros(n + 2, dtype=bool)
-        zone[goal[h[goal].argmax()]] = True
-        while True:  # the goal zone: backwards through zero-cost actions
-            grow = np.zeros(n + 2, dtype=bool)
-            grow[pcf[zone[add].any(axis=1) & (cost == 0.0)]] = True
-            if not (grow & ~zone).any():
-                break
-            zone |= grow
-        reach = start & ~zone
-        while True:  # before the cut: forwards from the state, never into the goal zone
-            grow = np.zeros(n + 2, dtype=bool)
-            grow[add[reach[pcf]]] = True
-            grow &= ~zone & ~reach
-            grow[n + 1] = False
-            if not grow.any():
-                break
-            reach |= grow
-        cut = zone[add].any(axis=1) & reach[pcf]
-        total += cost[cut].min()
-        cost[cut] -= cost[cut].min()
-        h = hmax(task, state, cost, h)
-    return total

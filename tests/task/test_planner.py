@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import replace
 
 import pytest
@@ -157,6 +158,48 @@ def test_restart_ranking_prefers_goal_then_estimated_total():
     progress = DecodedWindow((m, m), (), False, True, 5.0, 1)  # 2 moves, 1 to go
     ranked = sorted([stuck, detour, progress, reached_long, reached_short], key=DecodedWindow.key)
     assert ranked == [reached_short, reached_long, progress, detour, stuck]
+
+
+def test_restart_ranking_reads_a_domain_estimate_but_dead_ends_stay_last():
+    from task.decode import DecodedWindow
+    from task.problem import Move
+
+    m = Move("a", "table")
+    # by the lower bound alone the short window wins; the estimate says the long one is ahead
+    short = DecodedWindow((m,), (), False, True, 0.0, 2, estimated=9.0)
+    long = DecodedWindow((m, m, m), (), False, True, 0.0, 2, estimated=4.0)
+    dead = DecodedWindow((m, m, m), (), False, True, 0.0, math.inf, estimated=0.0)
+    assert sorted([dead, short, long], key=DecodedWindow.key) == [long, short, dead]
+    no_estimate = [replace(w, estimated=None) for w in (short, long)]
+    assert min(no_estimate, key=DecodedWindow.key).moves == (m,)
+
+
+def test_a_window_back_to_a_visited_state_ranks_below_progress_elsewhere():
+    from task.decode import decode_best
+
+    problem = random_problem(4, 3)
+    state = BW.initial_state(problem)
+    ahead = optimal_moves(problem)[0]
+    after = BW.apply_move(problem, state, ahead)
+    n, y = problem.n, problem.n + len(problem.fixed)
+    gates = torch.zeros(2, 1, n, y)  # restart 0: the optimal first move; restart 1: a STAY
+    gates[0, 0, problem.entities.index(ahead.entity), problem.index(ahead.target)] = 1
+    losses = torch.tensor([5.0, 0.0])
+    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3)[0]
+    assert best.moves == (ahead,) and not best.revisit
+    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3, visited=[{after}])[0]
+    assert best.moves == () and not best.revisit  # staying beats going back to ``after``
+    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3, visited=[{state, after}])[0]
+    assert best.moves == (ahead,) and best.revisit  # both loop: then progress ranks first
+
+
+def test_domain_planner_defaults_and_overrides():
+    assert PlannerConfig.for_domain("blocksworld") == PlannerConfig()
+    sokoban = PlannerConfig.for_domain("sokoban")
+    assert (sokoban.lookahead, sokoban.max_windows) == (8, 100)
+    assert PlannerConfig.for_domain("sokoban", max_windows=7, horizon=2).max_windows == 7
+    with pytest.raises(ProblemError, match="unknown domain"):
+        PlannerConfig.for_domain("chess")
 
 
 def test_lower_bound_is_zero_at_the_goal_and_admissible():

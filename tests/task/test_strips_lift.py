@@ -192,6 +192,18 @@ def test_lower_bound_is_admissible_and_finds_dead_ends():
     assert LIFT.lower_bound(toy, dead) == INF
 
 
+def test_ff_estimate_is_a_relaxed_plan_at_least_lm_cut():
+    for problem, state in _walks(3):
+        bound, estimate = LIFT.lower_bound(problem, state), LIFT.estimate(problem, state)
+        assert bound <= estimate < INF
+        assert (estimate == 0) == LIFT.is_goal(problem, state)
+    line = problem_from_text(LINE, LINE_PROBLEM, "line")
+    assert LIFT.estimate(line, line.data.init) == 3  # the relaxed plan is the real one here
+    toy = _toy(goal="(q o1)", pre="(fuel)", init="(fuel)")
+    dead = LIFT.apply_move(toy, toy.data.init, Action("waste"))
+    assert LIFT.estimate(toy, dead) == INF
+
+
 @pytest.mark.parametrize("goal_loss", ["hadd", "atoms"])
 def test_plans_a_tiny_gripper_end_to_end(goal_loss):
     problem = _sample(3, 3)
