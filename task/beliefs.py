@@ -41,6 +41,11 @@ class WindowBeliefs(Protocol):
         """Tensors to optimise with the logits; empty when the beliefs are frozen."""
         ...
 
+    # Optional: ``fallback(rows) -> WindowBeliefs``, frozen beliefs for the problems at
+    # ``rows`` (positions in this window), with which the planner retries a window that decoded
+    # no move under adapted beliefs: adapting perception must never leave a problem stuck
+    # where the frozen reading plans on.
+
 
 class BeliefSource(Protocol):
     """Makes the beliefs of a window for the problems ``indices`` (positions in the list given

@@ -51,6 +51,22 @@ def _window(
     )  # fmt: skip
 
 
+def _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded):
+    """Windows that decoded no move under adapted beliefs are planned again with the beliefs'
+    frozen ``fallback`` (`task.beliefs`); a retry that moves replaces the window in place."""
+    fallback = getattr(beliefs, "fallback", None)
+    stuck = [k for k, w in enumerate(decoded) if not w.moves and not w.reached]
+    if fallback is None or not stuck:
+        return
+    again = _window(
+        domain, [problems[active[k]] for k in stuck], [crisp[k] for k in stuck], config,
+        generator, fallback(stuck), [visited[active[k]] for k in stuck],
+    )  # fmt: skip
+    for k, window in zip(stuck, again, strict=True):
+        if window.moves or window.reached:
+            decoded[k] = window
+
+
 def _crisp_states(
     beliefs: WindowBeliefs | None, world: Sequence[State]
 ) -> tuple[Sequence[State], bool]:
@@ -113,6 +129,7 @@ def _run(
             domain, [problems[i] for i in active], crisp, config, generator, beliefs,
             [visited[i] for i in active],
         )  # fmt: skip
+        _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded)
         hoped = []  # perceived: windows that predict the goal, for a new image to confirm
         for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1

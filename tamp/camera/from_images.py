@@ -119,6 +119,13 @@ class _Adapted:
             penalties.append(self.kl_weight * kl.sum())
         return torch.stack(F0s), torch.stack(goals), torch.stack(penalties)
 
+    def fallback(self, rows: Sequence[int]) -> _Frozen:
+        """The trained weights' reading (the anchors) for the problems at ``rows``: the
+        frozen beliefs a window that decoded no move is retried with (`task.beliefs`)."""
+        crisp = None if self.crisp_states is None else [self.crisp_states[r] for r in rows]
+        F0 = torch.stack([self.anchors[r][0] for r in rows])
+        return _Frozen(F0, torch.stack([self.anchors[r][1] for r in rows]), crisp)
+
     def parameters(self) -> list[Tensor]:
         if self.mode.adapt == "head":
             return [p for m in self.models for p in m.head_parameters()]

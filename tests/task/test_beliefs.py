@@ -132,3 +132,58 @@ def test_beliefs_of_the_wrong_shape_are_refused():
 def test_domain_encoding_is_untouched_without_beliefs():
     batch = DOMAIN.encode([THREE], [THREE.init], torch.float32)
     assert torch.equal(batch.F0[0], _onehot(THREE, THREE.init))
+
+
+class _Blind:
+    """Adapted beliefs that read the current image as the goal scene: no move is ever worth
+    making, so every window decodes nothing; ``fallback`` gives the true reading."""
+
+    lr = 0.05
+    crisp_states = None
+
+    def __init__(self, problem: Problem, with_fallback: bool) -> None:
+        self.problem, self.retried = problem, 0
+        self.goal = _onehot(problem, complete_goal(problem))[None]
+        if with_fallback:
+            self.fallback = self._fallback
+
+    def compute(self):
+        return self.goal, self.goal, self.goal.new_zeros(1)
+
+    def parameters(self):
+        return []
+
+    def _fallback(self, rows):
+        assert list(rows) == [0]
+        self.retried += 1
+        blind = self
+
+        class Frozen:
+            lr, crisp_states = 0.0, None
+
+            def compute(self):
+                return (
+                    _onehot(blind.problem, blind.state)[None],
+                    blind.goal,
+                    blind.goal.new_zeros(1),
+                )
+
+            def parameters(self):
+                return []
+
+        return Frozen()
+
+
+@pytest.mark.parametrize("with_fallback", [False, True])
+def test_a_window_stuck_under_adapted_beliefs_is_retried_frozen(with_fallback):
+    made = []
+
+    def source(indices, states):
+        beliefs = _Blind(THREE, with_fallback)
+        beliefs.state = states[0]
+        made.append(beliefs)
+        return beliefs
+
+    result = plan(THREE, PlannerConfig(max_windows=4, restarts=4), seed=0, beliefs=source)
+    assert result.solved == with_fallback
+    assert sum(b.retried for b in made) == (len(made) if with_fallback else 0)
