@@ -16,9 +16,11 @@ test time.
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 from torch import Tensor
@@ -79,6 +81,49 @@ def load(path: str | Path) -> SupportData:
     if data.images.ndim != 4 or data.colours.shape != data.supports.shape:
         raise PerceptionError(f"{path}: arrays of inconsistent shapes")
     return data
+
+
+def resize_image(image: np.ndarray, hw: Sequence[int]) -> np.ndarray:
+    """``image`` (H, W, 3) resized to ``hw`` = (H', W'): bilinear when enlarging, pixel-area
+    averaging when shrinking; unchanged when already that size."""
+    h, w = int(hw[0]), int(hw[1])
+    if image.shape[:2] == (h, w):
+        return image
+    shrink = h * w < image.shape[0] * image.shape[1]
+    return cv2.resize(image, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+
+
+def load_many(paths: str | Sequence[str | Path]) -> SupportData:
+    """Datasets ``paths`` (a list, or one string of comma-separated files) as one, every image
+    resized to the first file's size (`resize_image`): a model for several resolutions trains
+    on all of them at one input size. Palettes and block counts must agree."""
+    if isinstance(paths, str):
+        paths = [p for p in paths.split(",") if p]
+    parts = [load(p) for p in paths]
+    if not parts:
+        raise PerceptionError("no dataset files given")
+    first = parts[0]
+    for path, part in zip(paths[1:], parts[1:], strict=True):
+        if part.palette.shape != first.palette.shape or not np.allclose(
+            part.palette, first.palette
+        ):
+            raise PerceptionError(f"{path}: its palette differs from {paths[0]}'s")
+        if part.slots != first.slots:
+            raise PerceptionError(
+                f"{path}: {part.slots} blocks per sample, {paths[0]} has {first.slots}"
+            )
+    if len(parts) == 1:
+        return first
+    hw = first.images.shape[1:3]
+    images = np.concatenate([np.stack([resize_image(im, hw) for im in d.images]) for d in parts])
+    meta = {
+        **first.meta,
+        "parts": [{"file": str(p), **d.meta} for p, d in zip(paths, parts, strict=True)],
+    }
+    return SupportData(
+        images, np.concatenate([d.colours for d in parts]),
+        np.concatenate([d.supports for d in parts]), first.palette, meta,
+    )  # fmt: skip
 
 
 def label_matrix(supports: np.ndarray, slots: int) -> np.ndarray:

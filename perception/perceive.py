@@ -15,6 +15,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
+from perception.data import resize_image
 from perception.errors import PerceptionError
 from perception.model import SupportModel
 from perception.segment import SegmentConfig, check_image, find_boxes
@@ -42,15 +43,24 @@ def kl_rows(anchor: Tensor, F: Tensor, mask: Tensor) -> Tensor:
 class Perceiver:
     """A trained support model plus the colour segmentation that gives it entity boxes."""
 
-    def __init__(self, model: SupportModel, segment: SegmentConfig = SegmentConfig()) -> None:
+    def __init__(
+        self,
+        model: SupportModel,
+        segment: SegmentConfig = SegmentConfig(),
+        input_hw: Sequence[int] | None = None,
+    ) -> None:
         self.model = model.eval()
         self.segment = segment
+        self.input_hw = None if input_hw is None else tuple(int(v) for v in input_hw)
         for p in self.model.parameters():
             p.requires_grad_(False)
 
     @classmethod
     def load(cls, path: str | Path) -> Perceiver:
-        return cls(load_checkpoint(path)[0])
+        """The checkpoint at ``path``; one trained at one input size for several resolutions
+        (its meta's ``input_hw``) resizes every image to that size first."""
+        model, meta = load_checkpoint(path)
+        return cls(model, input_hw=meta.get("input_hw"))
 
     def inputs(
         self,
@@ -67,6 +77,8 @@ class Perceiver:
             raise PerceptionError(f"got {len(images)} images but {len(colours)} colour lists")
         for im in images:
             check_image(im)
+        if self.input_hw is not None:
+            images = [resize_image(im, self.input_hw) for im in images]
         if len({im.shape for im in images}) > 1:
             raise PerceptionError(f"images differ in size: {sorted({im.shape for im in images})}")
         n = max(len(c) for c in colours)

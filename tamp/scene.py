@@ -1,6 +1,7 @@
 """The scene model: a symbolic Blocksworld state <-> block poses on a table, and back.
 
-Blocks are cubes (5 cm by default) with distinct colours. Each tower stands on a *table slot*,
+Blocks are cubes (5 cm by default), or upright cylinders as tall as they are wide, with distinct
+colours from the scene's palette. Each tower stands on a *table slot*,
 a fixed grid of positions in front of the robot; a block moved onto the table goes to a free
 slot. ``layout`` turns a state into poses (with small seeded jitter); ``read_state`` turns
 observed poses into a state, with tolerances, and says which block it cannot explain.
@@ -36,6 +37,7 @@ PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
     ("white", (0.95, 0.95, 0.95)),
 )
 CAMERA_COLOURS = 8  # blocks that camera perception can tell apart by colour
+SHAPES = ("cube", "cylinder")
 
 
 class SceneError(TampError):
@@ -56,9 +58,12 @@ class Pose:
 
 @dataclass(frozen=True)
 class SceneConfig:
-    """Geometry of the table scene. Slots form a grid of ``slot_xs`` x ``slot_ys``."""
+    """Geometry of the table scene. Slots form a grid of ``slot_xs`` x ``slot_ys``.
 
-    block_size: float = 0.05  # cube edge, m
+    The default is the robot's cube scene; `tamp.camera.latplan` builds LatPlan's cylinder row.
+    """
+
+    block_size: float = 0.05  # cube edge, or a cylinder's height and diameter, m
     block_mass: float = 0.1  # kg
     # 16 cm apart: the open hand (about 20 cm across) clears a neighbouring tower
     slot_xs: tuple[float, ...] = (0.40, 0.56)
@@ -70,6 +75,15 @@ class SceneConfig:
     tol_z: float = 0.012  # ... and the heights differ by one block size within this
     slot_radius: float = 0.05  # a slot is occupied when a block centre lies this close
     isolation: float = 0.3  # free_slot prefers slots with this much room to every block
+    shape: str = "cube"  # one of SHAPES; a cylinder stands upright
+    palette: tuple[tuple[str, tuple[float, float, float]], ...] = PALETTE  # block i: palette[i]
+    floor_grey: float = 0.45  # RGB level of the floor, in [0, 1]
+    backdrop_y: float | None = None  # a vertical backdrop wall across the view at this y, m
+    backdrop_grey: float = 0.45
+
+    def __post_init__(self) -> None:
+        if self.shape not in SHAPES:
+            raise SceneError(f"unknown block shape {one_of(self.shape, SHAPES)}")
 
     @property
     def slots(self) -> tuple[tuple[float, float], ...]:
@@ -89,11 +103,11 @@ def cube_yaw(rotation) -> float:
     return (math.atan2(side[1], side[0]) + quarter / 2) % quarter - quarter / 2
 
 
-def colour(index: int) -> tuple[float, float, float]:
+def colour(index: int, palette=PALETTE) -> tuple[float, float, float]:
     """RGB in [0, 1] of the block at ``index`` in the problem's entity order."""
-    if index >= len(PALETTE):
-        raise SceneError(f"the scene has {len(PALETTE)} block colours, block #{index + 1} has none")
-    return PALETTE[index][1]
+    if index >= len(palette):
+        raise SceneError(f"the scene has {len(palette)} block colours, block #{index + 1} has none")
+    return palette[index][1]
 
 
 def towers(entities: Sequence[str], state: Sequence[str]) -> list[list[str]]:
@@ -116,20 +130,29 @@ def layout(
     state: Sequence[str],
     config: SceneConfig = SceneConfig(),
     seed: int = 0,
+    slots: Sequence[int] | None = None,
 ) -> dict[str, Pose]:
-    """Poses for a crisp state: tower i on slot i, stacked exactly, jittered in xy and yaw."""
+    """Poses for a crisp state: towers on random slots (or tower i, in `towers` order, on slot
+    ``slots[i]`` of ``config.slots``), stacked exactly, jittered in xy and yaw."""
     stacks = towers(entities, state)
-    if len(entities) > len(PALETTE):
-        raise SceneError(f"{len(entities)} blocks, but the scene has {len(PALETTE)} colours")
+    if len(entities) > len(config.palette):
+        raise SceneError(f"{len(entities)} blocks, but the scene has {len(config.palette)} colours")
     if len(stacks) > len(config.slots) - 1:
         raise SceneError(f"{len(stacks)} towers need more than the {len(config.slots)} slots")
     if max(len(t) for t in stacks) > config.max_height:
         raise SceneError(f"a tower is taller than {config.max_height} blocks")
     rng = np.random.default_rng(seed)
     s = config.block_size
-    slots = [config.slots[i] for i in rng.permutation(len(config.slots))[: len(stacks)]]
+    order = rng.permutation(len(config.slots))[: len(stacks)]
+    if slots is not None:
+        if len(slots) != len(stacks) or len(set(slots)) != len(slots):
+            raise SceneError(f"slots must give each of the {len(stacks)} towers its own slot")
+        if any(not 0 <= k < len(config.slots) for k in slots):
+            raise SceneError(f"slot indices must lie in 0..{len(config.slots) - 1}, got {slots}")
+        order = slots
     poses = {}
-    for tower, (sx, sy) in zip(stacks, slots, strict=True):
+    for tower, k in zip(stacks, order, strict=True):
+        sx, sy = config.slots[k]
         for level, x in enumerate(tower):
             dx, dy = rng.uniform(-config.jitter_xy, config.jitter_xy, size=2)
             yaw = float(rng.uniform(-config.jitter_yaw, config.jitter_yaw))

@@ -6,6 +6,7 @@
   planning-optimised perception).
 - ``geometry``: pinhole geometry of a camera (intrinsics, pose, projection, back-projection);
 - ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on;
+- ``latplan``: LatPlan's cylinder row, its generator's camera, and a randomised dataset of it;
 - ``states``: full goal scenes a goal image shows, the most likely state of a soft state.
 
 The image -> soft-state model itself lives in `perception` and never sees a simulator.

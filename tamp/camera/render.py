@@ -13,7 +13,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tamp.scene import CAMERA_COLOURS, PALETTE, Pose, SceneConfig, SceneError, colour, layout
+from tamp.scene import CAMERA_COLOURS, Pose, SceneConfig, SceneError, colour, layout
 from tamp.sim.base import Camera, Lighting
 from tamp.sim.factory import make_simulator
 
@@ -59,14 +59,14 @@ def jitter_camera(camera: Camera, jitter: ViewJitter, rng: np.random.Generator) 
 class StateRenderer:
     """Images of block states from one reusable simulator (``'pybullet'`` or ``'mujoco'``).
 
-    Block ``i`` of a problem gets palette colour ``i`` unless ``colours`` says otherwise; at
-    most `CAMERA_COLOURS` blocks, since perception tells blocks apart by colour.
+    Block ``i`` of a problem gets the scene's palette colour ``i`` unless ``colours`` says
+    otherwise; at most `CAMERA_COLOURS` blocks, since perception tells blocks apart by colour.
     """
 
     def __init__(
         self, sim: str = "pybullet", scene: SceneConfig = SceneConfig(), camera: Camera = Camera()
     ) -> None:
-        self.names = tuple(name for name, _ in PALETTE[:CAMERA_COLOURS])
+        self.names = tuple(name for name, _ in scene.palette[:CAMERA_COLOURS])
         self.scene = scene
         self.camera = camera
         self.sim = make_simulator(sim, self.names, self._parked(), scene, camera=camera)
@@ -84,13 +84,15 @@ class StateRenderer:
         camera: Camera | None = None,
         lighting: Lighting = Lighting(),
         scene: SceneConfig | None = None,
+        slots: Sequence[int] | None = None,
     ) -> np.ndarray:
         """RGB image (H, W, 3) uint8 of ``state`` (supports in ``entities`` order).
 
-        ``seed`` picks the tower slots and jitter (`tamp.scene.layout`); ``colours`` gives the
-        palette index of each entity (default 0, 1, 2, ...).
+        ``seed`` picks the tower slots (unless ``slots`` gives them) and jitter
+        (`tamp.scene.layout`); ``colours`` gives the palette index of each entity (default 0, 1,
+        2, ...).
         """
-        self.place(entities, state, seed, colours, camera, lighting, scene)
+        self.place(entities, state, seed, colours, camera, lighting, scene, slots)
         return self.sim.render()
 
     def place(
@@ -102,19 +104,19 @@ class StateRenderer:
         camera: Camera | None = None,
         lighting: Lighting = Lighting(),
         scene: SceneConfig | None = None,
+        slots: Sequence[int] | None = None,
     ) -> dict[str, Pose]:
         """Set up the view of `render` without rendering; returns each entity's true pose (the
         caller renders with ``self.sim``, e.g. `Simulator.render_rgbd`)."""
         colours = list(range(len(entities))) if colours is None else list(colours)
-        if len(entities) > CAMERA_COLOURS:
-            raise SceneError(
-                f"{len(entities)} blocks, but the camera tells at most {CAMERA_COLOURS} apart"
-            )
+        k = len(self.names)
+        if len(entities) > k:
+            raise SceneError(f"{len(entities)} blocks, but the camera tells at most {k} apart")
         if len(colours) != len(entities) or len(set(colours)) != len(colours):
             raise SceneError(f"colours must give each of the {len(entities)} blocks its own index")
-        if any(not 0 <= c < CAMERA_COLOURS for c in colours):
-            raise SceneError(f"colour indices must lie in 0..{CAMERA_COLOURS - 1}, got {colours}")
-        poses = layout(entities, state, scene or self.scene, seed)
+        if any(not 0 <= c < k for c in colours):
+            raise SceneError(f"colour indices must lie in 0..{k - 1}, got {colours}")
+        poses = layout(entities, state, scene or self.scene, seed, slots)
         placed = self._parked()
         for x, c in zip(entities, colours, strict=True):
             placed[self.names[c]] = poses[x]

@@ -32,6 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     plan_opts, bench_opts = planner_options(False), planner_options(True)
     _plan_commands(sub, plan_opts)
+    _images_command(sub, plan_opts)
     _run_command(sub, plan_opts)
     bench = sub.add_parser("bench", help="planning benchmarks").add_subparsers(
         dest="suite", required=True, metavar="SUITE"
@@ -68,6 +69,27 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
     output_options(p, "write the example's domain, problem and plan files into this folder")
     p.set_defaults(func=_lazy("tamp.cli.plan", "demo_command"))
+
+
+def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
+    p = sub.add_parser(
+        "plan-images", parents=[plan_opts],
+        help="plan a blocksworld problem from an initial and a goal image",
+    )  # fmt: skip
+    p.add_argument("init", metavar="INIT.png", help="image of the initial scene (PNG or JPG)")
+    p.add_argument("goal", metavar="GOAL.png", help="image of the goal scene, the same size")
+    p.add_argument("--scene", choices=("cubes", "latplan"), default="cubes",
+                   help="whose block colours to look for: the robot's cubes or LatPlan's red, "
+                   "blue, green and black cylinders (cubes)")  # fmt: skip
+    p.add_argument("--perception", choices=("frozen", "optimised"), default="frozen",
+                   help="frozen or planning-optimised perception (frozen)")  # fmt: skip
+    p.add_argument("--checkpoint", metavar="FILE.pt",
+                   help="perception weights (cubes: perception/support.pt; latplan: "
+                   "perception/support-latplan.pt)")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    output_options(p, "write the plan file (VAL format) here")
+    p.set_defaults(func=_lazy("tamp.cli.images", "images_command"))
 
 
 def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
@@ -218,6 +240,9 @@ def _perception_commands(sub) -> None:
                    help="simulators, samples alternate (pybullet,mujoco)")  # fmt: skip
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
     p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument("--scene", choices=("cubes", "latplan"), default="cubes",
+                   help="cubes (the robot's scene) or latplan: LatPlan's 4 cylinders on 5 slots, "
+                   "written at 150x100 to --out and at 45x30 beside it (cubes)")  # fmt: skip
     p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")

@@ -24,6 +24,8 @@ def dataset_command(args: argparse.Namespace) -> int:
     from tamp.camera.dataset import generate
 
     sims = tuple(s for s in args.sim.split(",") if s)
+    if args.scene == "latplan":
+        return _latplan_dataset(args, sims)
     with tqdm(total=args.n, desc="render", unit="image", file=sys.stderr,
               disable=not args.progress) as bar:  # fmt: skip
         data = generate(
@@ -38,7 +40,37 @@ def dataset_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _latplan_dataset(args: argparse.Namespace, sims: tuple[str, ...]) -> int:
+    """LatPlan's scene (always its 4 blocks): 150x100 to --out, 45x30 to OUT_45x30.npz."""
+    from perception import data as pdata
+    from tamp.camera import latplan
+
+    exclude = latplan.evaluation_layouts()
+    with tqdm(total=args.n, desc="render", unit="image", file=sys.stderr,
+              disable=not args.progress) as bar:  # fmt: skip
+        out = latplan.generate(
+            args.n, args.seed, sims, exclude=exclude, exclude_source=str(latplan.EVALUATION),
+            progress=bar.update, meta={"command": _command_line()},
+        )  # fmt: skip
+    big = Path(args.out)
+    paths = [pdata.save(big, out[(150, 100)]),
+             pdata.save(big.with_name(f"{big.stem}_45x30{big.suffix}"), out[(45, 30)])]  # fmt: skip
+    meta = out[(150, 100)].meta
+    if args.json:
+        print(json.dumps({"images": args.n, "out": [str(p) for p in paths],
+                          "excluded_layouts": meta["excluded_layouts"]}))  # fmt: skip
+        return 0
+    excluded = (
+        f"{meta['excluded_layouts']} evaluation layouts excluded"
+        if meta["evaluation_layouts_excluded"]
+        else f"no evaluation layouts found at {latplan.EVALUATION}: exclusion NOT applied"
+    )
+    print(f"{args.n} images at 150x100 and 45x30 ({excluded}) -> {paths[0]}, {paths[1]}")
+    return 0
+
+
 def train_command(args: argparse.Namespace) -> int:
+    import numpy as np
     import torch
 
     from perception import data as pdata
@@ -51,8 +83,10 @@ def train_command(args: argparse.Namespace) -> int:
         )
     torch.set_num_threads(args.threads)
     t0 = time.perf_counter()
-    train_raw, test_raw = pdata.load(args.train), pdata.load(args.test)
+    train_raw = pdata.load_many(args.train)  # several files: resized to the first's size
+    test_raw = pdata.load_many(args.test.split(",")[:1])
     train_data, test_data = pdata.tensors(train_raw), pdata.tensors(test_raw)
+    hw = list(train_raw.images.shape[1:3])
     config = TrainConfig(epochs=args.epochs, seed=args.seed)
     with tqdm(total=config.epochs, desc="train", unit="epoch", file=sys.stderr,
               disable=not args.progress) as bar:  # fmt: skip
@@ -63,6 +97,14 @@ def train_command(args: argparse.Namespace) -> int:
 
         model = train(train_data, config, on_epoch=on_epoch)
     scores = evaluate(model, test_data)
+    more = {}  # each further test file, resized to the training input size
+    for path in args.test.split(",")[1:]:
+        extra = pdata.load_many([path])
+        resized = pdata.SupportData(
+            np.stack([pdata.resize_image(im, hw) for im in extra.images]), extra.colours,
+            extra.supports, extra.palette, extra.meta,
+        )  # fmt: skip
+        more[path] = evaluate(model, pdata.tensors(resized))
     meta = {
         "command": _command_line(),
         "seed": args.seed,
@@ -79,10 +121,13 @@ def train_command(args: argparse.Namespace) -> int:
             "data_seed": test_raw.meta.get("seed"),
             **scores,
         },
+        "more_tests": more,
         "train_config": config.__dict__,
         "train_time_s": round(time.perf_counter() - t0, 1),
         "threads": args.threads,
     }
+    if len(train_raw.meta.get("parts", [])) > 1:
+        meta["input_hw"] = hw  # `Perceiver.load` resizes every image to this size first
     save_checkpoint(args.out, model, meta)
     if args.json:
         print(json.dumps({**scores, "out": str(args.out), "train_time_s": meta["train_time_s"]}))
@@ -92,6 +137,9 @@ def train_command(args: argparse.Namespace) -> int:
         f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
         f"{scores['unreadable']} unreadable, left out) -> {args.out}"
     )
+    for path, more_scores in more.items():
+        print(f"  {path}: relation accuracy {more_scores['relation_accuracy']:.4%}, "
+              f"scene accuracy {more_scores['scene_accuracy']:.2%}")  # fmt: skip
     return 0
 
 

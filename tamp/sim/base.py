@@ -67,7 +67,8 @@ class GripperReading:
 
 
 class Simulator(abc.ABC):
-    """A headless world: the Panda (at home, fingers open), a table, and cubes at ``poses``."""
+    """A headless world: the Panda (at home, fingers open), a table, and blocks at ``poses``
+    (cubes or cylinders, as ``scene.shape`` says; block i has ``scene.palette[i]``'s colour)."""
 
     name: str = ""
     dt: float = DT
@@ -141,6 +142,16 @@ class Simulator(abc.ABC):
     @abc.abstractmethod
     def set_view(self, camera: Camera, lighting: Lighting) -> None:
         """Move the camera and change the light for the next ``render``."""
+
+    @abc.abstractmethod
+    def set_colour(self, part: str, rgb: Sequence[float]) -> None:
+        """Recolour a block (by name), the ``'floor'`` or the ``'backdrop'`` (RGB in [0, 1])
+        for the next ``render``; a scene without a backdrop ignores ``'backdrop'``."""
+
+    def _check_part(self, part: str) -> None:
+        parts = (*self.entities, "floor", "backdrop")
+        if part not in parts:
+            raise TampError(f"unknown part to colour {one_of(part, parts)}")
 
     @abc.abstractmethod
     def close(self) -> None:

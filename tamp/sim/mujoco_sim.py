@@ -52,25 +52,35 @@ class MuJoCoSim(Simulator):
         cam = self.camera
         s.visual.global_.offwidth = max(cam.width, 640)
         s.visual.global_.offheight = max(cam.height, 480)
-        world = s.worldbody
-        world.add_geom(
-            type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01], rgba=[0.45, 0.45, 0.45, 1]
-        )
+        world, scene = s.worldbody, self.scene
+        world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01],
+                       rgba=[*[scene.floor_grey] * 3, 1])  # fmt: skip
+        if scene.backdrop_y is not None:  # collides with nothing (the other geoms have bit 1
+            # only); conaffinity 0 too would let the URDF import's discardvisual drop it
+            world.add_geom(name="backdrop", type=mujoco.mjtGeom.mjGEOM_BOX,
+                           size=[3.0, 0.005, 1.5], pos=[0.0, scene.backdrop_y, 1.5],
+                           rgba=[*[scene.backdrop_grey] * 3, 1], contype=0,
+                           conaffinity=2)  # fmt: skip
+        shape, size = mujoco.mjtGeom.mjGEOM_BOX, [scene.block_size / 2] * 3
+        if scene.shape == "cylinder":  # radius, half height; matte like LatPlan's rubber
+            shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [scene.block_size / 2] * 2
+            s.add_material(name="block", specular=0.1, shininess=0.1)
         world.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
                         pos=[0.5, 0.3, 2.0], dir=[-0.2, -0.1, -1.0],
                         diffuse=[0.8, 0.8, 0.8])  # fmt: skip
         world.add_camera(name="scene", pos=list(cam.eye), quat=_look_at(cam.eye, cam.target,
                          cam.up), fovy=cam.fovy)  # fmt: skip
-        half = self.scene.block_size / 2
         for i, name in enumerate(self.entities):
             pose = poses[name]
             body = world.add_body(name=f"block_{name}", pos=list(pose.xyz), quat=_quat(pose.yaw))
             body.add_freejoint(name=f"block_{name}")
-            body.add_geom(
-                type=mujoco.mjtGeom.mjGEOM_BOX, size=[half] * 3, mass=self.scene.block_mass,
-                rgba=[*colour(i), 1], friction=[1.0, 0.03, 0.0001], condim=4,
+            geom = body.add_geom(
+                name=f"block_{name}", type=shape, size=size, mass=scene.block_mass,
+                rgba=[*colour(i, scene.palette), 1], friction=[1.0, 0.03, 0.0001], condim=4,
                 solref=[0.004, 1.0],
             )  # fmt: skip
+            if scene.shape == "cylinder":
+                geom.material = "block"
             s.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=f"weld_{name}", name1=HAND_BODY,
                            name2=f"block_{name}", objtype=mujoco.mjtObj.mjOBJ_BODY,
                            active=False)  # fmt: skip
@@ -172,6 +182,13 @@ class MuJoCoSim(Simulator):
         # renders read the world poses of cameras and lights (cam_xpos, light_xdir), which
         # only the kinematics pass recomputes: without this the view lags one set_view behind
         mujoco.mj_camlight(m, self.data)
+
+    def set_colour(self, part, rgb) -> None:
+        self._check_part(part)
+        if part == "backdrop" and self.scene.backdrop_y is None:
+            return
+        name = part if part in ("floor", "backdrop") else f"block_{part}"
+        self.model.geom(name).rgba[:3] = rgb
 
     def render(self) -> np.ndarray:
         return self._scene_renderer().render().copy()

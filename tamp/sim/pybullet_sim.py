@@ -49,20 +49,24 @@ class PyBulletSim(Simulator):
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setTimeStep(self.dt, physicsClientId=c)
         plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
+        grey = [self.scene.floor_grey] * 3
         look = p.createVisualShape(
-            p.GEOM_BOX, halfExtents=[3.0, 3.0, 0.001], rgbaColor=[0.45, 0.45, 0.45, 1],
-            physicsClientId=c,
-        )  # fmt: skip
+            p.GEOM_BOX, halfExtents=[3.0, 3.0, 0.001], rgbaColor=[*grey, 1], physicsClientId=c
+        )
         self.table = p.createMultiBody(0, plane, look, [0, 0, 0], physicsClientId=c)
         p.changeDynamics(self.table, -1, lateralFriction=1.0, physicsClientId=c)
+        self.backdrop = None
+        if self.scene.backdrop_y is not None:  # visual only: nothing collides with it
+            wall = p.createVisualShape(
+                p.GEOM_BOX, halfExtents=[3.0, 0.005, 1.5],
+                rgbaColor=[*[self.scene.backdrop_grey] * 3, 1], physicsClientId=c,
+            )  # fmt: skip
+            at = [0.0, self.scene.backdrop_y, 1.5]
+            self.backdrop = p.createMultiBody(0, -1, wall, at, physicsClientId=c)
         self.robot = load_panda(c)
-        half = [self.scene.block_size / 2] * 3
         self.blocks: dict[str, int] = {}
         for i, name in enumerate(self.entities):
-            col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=c)
-            vis = p.createVisualShape(
-                p.GEOM_BOX, halfExtents=half, rgbaColor=[*colour(i), 1], physicsClientId=c
-            )
+            col, vis = self._block_shapes(colour(i, self.scene.palette))
             pose = poses[name]
             body = p.createMultiBody(
                 self.scene.block_mass, col, vis, pose.xyz, _quat(pose.yaw), physicsClientId=c
@@ -75,6 +79,22 @@ class PyBulletSim(Simulator):
         self._finger_command = ""
         self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+
+    def _block_shapes(self, rgb) -> tuple[int, int]:
+        """Collision and visual shape of one block (a cube, or an upright cylinder)."""
+        c, s = self.client, self.scene.block_size
+        if self.scene.shape == "cylinder":
+            col = p.createCollisionShape(p.GEOM_CYLINDER, radius=s / 2, height=s, physicsClientId=c)
+            vis = p.createVisualShape(
+                p.GEOM_CYLINDER, radius=s / 2, length=s, rgbaColor=[*rgb, 1], physicsClientId=c
+            )
+            return col, vis
+        half = [s / 2] * 3
+        col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=c)
+        vis = p.createVisualShape(
+            p.GEOM_BOX, halfExtents=half, rgbaColor=[*rgb, 1], physicsClientId=c
+        )
+        return col, vis
 
     def _command(self, q, qd, gripper) -> None:
         r, c = self.robot, self.client
@@ -152,6 +172,13 @@ class PyBulletSim(Simulator):
         self._proj = p.computeProjectionMatrixFOV(
             camera.fovy, camera.width / camera.height, NEAR, FAR, physicsClientId=c
         )
+
+    def set_colour(self, part, rgb) -> None:
+        self._check_part(part)
+        body = {"floor": self.table, "backdrop": self.backdrop, **self.blocks}[part]
+        if body is not None:
+            rgba = [*(float(v) for v in rgb), 1.0]
+            p.changeVisualShape(body, -1, rgbaColor=rgba, physicsClientId=self.client)
 
     def render(self) -> np.ndarray:
         return self._camera_image()[0]

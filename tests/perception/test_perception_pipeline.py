@@ -183,3 +183,24 @@ def test_perceiver_inputs_pad_to_the_largest_scene():
     assert F.shape == (2, 3, 4)
     with pytest.raises(PerceptionError, match="images differ in size"):
         perceiver.inputs([_tower_image(), _tower_image()[:100]], [RGB, RGB])
+
+
+def test_datasets_of_two_resolutions_load_as_one_at_the_first_size(tmp_path):
+    big = _dataset(4)
+    small = pdata.SupportData(
+        np.stack([cv2.resize(im, (48, 36), interpolation=cv2.INTER_AREA) for im in big.images]),
+        big.colours, big.supports, big.palette, {"y": 2},
+    )  # fmt: skip
+    a, b = pdata.save(tmp_path / "a.npz", big), pdata.save(tmp_path / "b.npz", small)
+    both = pdata.load_many(f"{a},{b}")
+    assert both.images.shape == (8, 120, 160, 3) and len(both.meta["parts"]) == 2
+    assert (both.supports[4:] == big.supports).all()
+    assert pdata.load_many([b]).images.shape[1:3] == (36, 48)  # one file: as it is
+    other = pdata.SupportData(big.images, big.colours, big.supports, big.palette[::-1], {})
+    with pytest.raises(PerceptionError, match="palette differs"):
+        pdata.load_many([a, pdata.save(tmp_path / "c.npz", other)])
+    # a perceiver trained at one input size reads a small image at that size
+    perceiver = Perceiver(SupportModel(ModelConfig()), input_hw=(120, 160))
+    images, boxes, _ = perceiver.inputs([small.images[0]], [RGB])
+    assert images.shape[-2:] == (120, 160)
+    assert boxes.shape == (1, 3, 4) and float(boxes[..., 2].max()) > 48
