@@ -5,6 +5,7 @@
   ``bench random``); ``summary``: its rows in the paper's format;
 - ``motion``: closed-loop episodes in the simulators (``bench motion``);
 - ``perception``: planning from rendered images (``bench perception``);
+- ``latplan``: LatPlan-40 planned from its true states and its images (``bench latplan``);
 - ``poses``: block poses from RGB-D images against the true poses (``bench poses``);
 - ``fast_downward``: optimal plan lengths from Fast Downward (the ``bench`` extra,
   benchmark-only) for sets whose data lack them, cached by the PDDL texts' digest;

@@ -4,6 +4,8 @@
 - ``dataset``: randomised rendered scenes labelled with their supports (perception training data);
 - ``from_images``: soft beliefs for the planner from camera images (frozen or
   planning-optimised perception).
+- ``image_pair``: planning from a photographed (initial, goal) pair with no ground truth
+  (``plan-images``, ``bench latplan``);
 - ``geometry``: pinhole geometry of a camera (intrinsics, pose, projection, back-projection);
 - ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on;
 - ``latplan``: LatPlan's cylinder row, its generator's camera, and a randomised dataset of it;

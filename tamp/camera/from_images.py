@@ -49,6 +49,7 @@ ADAPT = ("head", "all")
 CRISP = ("true", "perceived")  # what decoded moves are checked against: the truth, the image
 
 Observe = Callable[[int, State], np.ndarray]  # (problem index, true state) -> RGB image
+Colours = Sequence[Sequence[float]]  # RGB in [0, 1] of each block, in entity order
 
 
 @dataclass(frozen=True)
@@ -137,6 +138,8 @@ class ImageBeliefs:
 
     ``observe(i, state)`` returns the current camera image of problem i (whose true state is
     ``state``); ``goal_images[i]`` is its goal image. Images are blurred per ``mode.blur``.
+    ``colours[i]``: the RGB colour of each block of problem i (default: the first ``n`` palette
+    colours, `block_colours`).
     With ``mode.crisp == "perceived"`` each window also gives the planner the most likely valid
     state of the current image under the trained weights (``crisp_states``).
     """
@@ -148,16 +151,17 @@ class ImageBeliefs:
         observe: Observe,
         goal_images: Sequence[np.ndarray],
         mode: PerceptionMode,
+        colours: Sequence[Colours] | None = None,
     ) -> None:
         if mode.mode == "state":
             raise TampError("ImageBeliefs needs mode 'frozen' or 'optimised'")
         self.problems, self.perceiver, self.observe, self.mode = problems, perceiver, observe, mode
+        self.colours = [block_colours(p.n) for p in problems] if colours is None else list(colours)
         self.goal_images = [blur(im, mode.blur) for im in goal_images]
         self.perception_s = 0.0  # time spent reading images (segmentation and the model)
 
     def _inputs(self, i: int, image: np.ndarray):
-        p = self.problems[i]
-        colours = block_colours(p.n)
+        p, colours = self.problems[i], self.colours[i]
         return self.perceiver.inputs(
             [blur(image, self.mode.blur), self.goal_images[i]], [colours, colours],
             [p.entities, p.entities],
@@ -197,19 +201,30 @@ class ImageBeliefs:
 
 
 def perceived_goal(
-    problem: Problem, perceiver: Perceiver, goal_image: np.ndarray, radius: int = 0
+    problem: Problem,
+    perceiver: Perceiver,
+    goal_image: np.ndarray,
+    radius: int = 0,
+    colours: Colours | None = None,
 ) -> Problem:
     """``problem`` whose goal is the perceived goal scene: every block's most likely support
     under the trained model's reading of ``goal_image`` (a valid state by construction)."""
-    state, _ = perceived_state(problem, perceiver, goal_image, radius)
+    state, _ = perceived_state(problem, perceiver, goal_image, radius, colours)
     return dataclasses.replace(problem, goal=tuple(zip(problem.entities, state, strict=True)))
 
 
 def perceived_state(
-    problem: Problem, perceiver: Perceiver, image: np.ndarray, radius: int = 0
+    problem: Problem,
+    perceiver: Perceiver,
+    image: np.ndarray,
+    radius: int = 0,
+    colours: Colours | None = None,
 ) -> tuple[State, Tensor]:
-    """The most likely valid state of ``image`` and the soft supports F (N, Y) behind it."""
-    colours = block_colours(problem.n)
+    """The most likely valid state of ``image`` and the soft supports F (N, Y) behind it.
+
+    ``colours``: the RGB colour (in [0, 1]) of each block, in entity order (default: the first
+    ``n`` palette colours, `block_colours`)."""
+    colours = block_colours(problem.n) if colours is None else list(colours)
     x = perceiver.inputs([blur(image, radius)], [colours], [problem.entities])
     with torch.no_grad():
         F = perceiver.support(x)[0]  # (N, Y)

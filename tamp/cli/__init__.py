@@ -3,9 +3,11 @@
     tamp plan DOMAIN.pddl PROBLEM.pddl [--horizon 3 --restarts K --seed S --json --out plan.txt]
     tamp validate DOMAIN.pddl PROBLEM.pddl PLAN [--json]
     tamp demo [--json --out DIR]
+    tamp plan-images INIT.png GOAL.png [--scene cubes|latplan --perception frozen|optimised]
     tamp bench planbench [--data DIR --limit N --seeds 3 --horizon 1,3,5 --sequential N --out DIR]
     tamp bench random [--blocks 6,8,10 --n 50 --seed 0 --max-nodes 20000 --out DIR]
     tamp run [PROBLEM.pddl] [--sim pybullet|mujoco --inject drop:0.2 --seed S --out DIR]
+    tamp bench latplan [--checkpoint FILE.pt --res 150x100,45x30 --modes state,frozen --seeds 3]
     tamp bench motion [--sim pybullet,mujoco --data DIR --n 100 --inject drop:0.2 --out DIR]
 
 Exit codes: 0 success, 1 no plan or an invalid plan, 2 usage error or bad input (one line on

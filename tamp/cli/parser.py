@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 
 from perception import CHECKPOINT
+from tamp.bench.suites import DEFAULT_DATA
 from tamp.cli.options import (
     Parser,
     data_option,
@@ -40,6 +41,7 @@ def build_parser() -> argparse.ArgumentParser:
     _planning_benchmarks(bench, bench_opts)
     _motion_benchmark(bench, plan_opts)
     _perception_benchmark(bench, bench_opts)
+    _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
     _perception_commands(sub)
     return parser
@@ -210,6 +212,24 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json, instances.csv and example.png into this folder")
     p.set_defaults(func=_lazy("tamp.cli.bench", "perception_command"))
+
+
+def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
+    p = bench.add_parser("latplan", parents=[plan_opts], help="LatPlan-40: plan from its images")
+    p.add_argument("--data", default=str(DEFAULT_DATA / "latplan"), metavar="DIR",
+                   help="LatPlan-40 folder (%(default)s)")  # fmt: skip
+    p.add_argument("--checkpoint", default=str(CHECKPOINT.with_name("support-latplan.pt")),
+                   metavar="FILE.pt", help="perception weights (%(default)s)")  # fmt: skip
+    p.add_argument("--res", default="150x100,45x30", metavar="WxH[,WxH]",
+                   help="image_tr/ renders and/or LatPlan's own input (%(default)s)")  # fmt: skip
+    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
+                   help="state (the PDDL problem, no images), frozen, optimised (all)")  # fmt: skip
+    p.add_argument("--seeds", type=positive, default=3, metavar="S", help="planner seeds (3)")
+    p.add_argument("--limit", type=positive, metavar="N", help="a spread of N instances (40)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    progress_option(p)
+    output_options(p, "write results.json and instances.csv into this folder")
+    p.set_defaults(func=_lazy("tamp.cli.bench", "latplan_command"))
 
 
 def _poses_benchmark(bench) -> None:
