@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from perception.corrupt import Corruption
 from perception.errors import PerceptionError
 from perception.perceive import Perceiver, blur
 from perception.segment import find_boxes
@@ -42,6 +43,7 @@ from task.errors import TampError
 from task.planner import plan_batch
 
 REDRAWS = 8  # layout seeds tried before a render counts as hiding a block
+CLEAR = Corruption()  # renders as they are
 
 
 class Renders:
@@ -50,8 +52,11 @@ class Renders:
     ``redrawn``: redraws in all; ``served[i]``: images of problem i handed out that had to be
     redrawn (a cached goal image counts each time it is handed out)."""
 
-    def __init__(self, renderer: StateRenderer, problems, seed: int) -> None:
+    def __init__(
+        self, renderer: StateRenderer, problems, seed: int, corruption: Corruption = CLEAR
+    ) -> None:
         self.renderer, self.problems, self.seed = renderer, problems, seed
+        self.corruption = corruption  # applied to every render (the stress ladder)
         self.render_s = 0.0
         self.redrawn = 0
         self.served: Counter[int] = Counter()
@@ -83,11 +88,11 @@ class Renders:
             for k in range(REDRAWS):
                 img = self.renderer.render(p.entities, state, seed=base + k)
                 try:
-                    find_boxes(img, block_colours(p.n))
-                    return img
+                    boxes = find_boxes(img, block_colours(p.n))
+                    return self.corruption(img, base, boxes)
                 except PerceptionError:
                     self.redrawn += 1
-            return img
+            return self.corruption(img, base)
         finally:
             self.render_s += time.perf_counter() - t0
 
@@ -101,6 +106,28 @@ class PerceptionBench:
     summaries: tuple[dict, ...]
     redrawn: int
     example: np.ndarray
+
+
+def parse_corruption(text: str) -> Corruption:
+    """``noise:8,dim:0.35,occlude`` (any of them, comma-separated) as a `Corruption`."""
+    fields: dict = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        name, _, value = part.partition(":")
+        try:
+            if name == "occlude" and not value:
+                fields["occlude"] = True
+            elif name in ("noise", "dim"):
+                fields[name] = float(value)
+            else:
+                raise ValueError
+        except ValueError:
+            raise TampError(
+                f"--corrupt: cannot read {part!r} (expected noise:SIGMA, dim:FACTOR, occlude)"
+            ) from None
+    try:
+        return Corruption(**fields)
+    except PerceptionError as exc:
+        raise TampError(f"--corrupt: {exc}") from None
 
 
 def parse_modes(text: str) -> tuple[str, ...]:
@@ -216,16 +243,18 @@ def run(
     sim: str,
     example_blur: int = 0,
     progress: Callable[[PerceptionMode, int], None] | None = None,
+    corruption: Corruption = CLEAR,
 ) -> PerceptionBench:
     """One row per (mode, horizon) in the given order (a mode carries its blur and crisp
     protocol); ``progress(mode, horizon)`` after each.
 
-    The same layout ``seed`` renders the same images for every row. The example strip shows the
+    The same layout ``seed`` renders the same images for every row, each degraded by
+    ``corruption`` (the stress ladder; `perception.corrupt`). The example strip shows the
     first instance's initial and goal images, then both blurred by ``example_blur`` if > 0."""
     chosen = list(suite.instances)
     rows, summaries = [], []
     with StateRenderer(sim) as renderer:
-        camera = Renders(renderer, [i.problem for i in chosen], seed)
+        camera = Renders(renderer, [i.problem for i in chosen], seed, corruption)
         for mode in modes:
             for horizon in horizons:
                 r, s = run_row(suite, chosen, mode, horizon, config, seed, perceiver, camera)

@@ -158,6 +158,7 @@ def perception_command(args: argparse.Namespace) -> int:
     from tamp.camera.from_images import PerceptionMode
 
     names, crisps = bench.parse_modes(args.modes), bench.parse_crisp(args.crisp)
+    corruption = bench.parse_corruption(args.corrupt)
     torch.set_num_threads(args.threads)
     suite = suites.planbench(args.data, args.n)
     chosen = list(suite.instances)
@@ -181,7 +182,7 @@ def perception_command(args: argparse.Namespace) -> int:
 
         result = bench.run(
             suite, modes, horizons, config, args.seed, perceiver, args.sim,
-            example_blur=args.blur[-1], progress=progress,
+            example_blur=args.blur[-1], progress=progress, corruption=corruption,
         )  # fmt: skip
     split = {str(b): sum(i.blocks == b for i in chosen) for b in bench.sizes(chosen)}
     body = {
@@ -190,6 +191,7 @@ def perception_command(args: argparse.Namespace) -> int:
         "sim": args.sim, "checkpoint": str(args.checkpoint), "seed": args.seed,
         "threads": args.threads, "cores": os.cpu_count(), "machine": results.machine(),
         "date": time.strftime("%Y-%m-%d"), "redrawn_renders": result.redrawn,
+        "corruption": corruption.name,
         "rows": list(result.summaries),
     }  # fmt: skip
     if args.out:
@@ -201,7 +203,7 @@ def perception_command(args: argparse.Namespace) -> int:
         print(json.dumps(body, indent=2))
     else:
         print(f"{suite.name}: {len(chosen)} instances ({'/'.join(map(str, split.values()))} by "
-              f"block count), sim {args.sim}")  # fmt: skip
+              f"block count), sim {args.sim}, images: {corruption.name}")  # fmt: skip
         print(tables.perception_table(list(result.summaries)))
         if result.redrawn:
             print(f"{result.redrawn} renders redrawn because a block was hidden")

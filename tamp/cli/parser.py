@@ -120,13 +120,9 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         p.add_argument(
             "--seeds", type=positive, default=1, metavar="S", help="planner seeds 0..S-1 (1)"
         )
-        p.add_argument(
-            "--sequential",
-            type=nonnegative,
-            default=0,
-            metavar="N",
-            help="also time batched vs sequential planning on the first N instances",
-        )
+        p.add_argument("--sequential", type=nonnegative, default=0, metavar="N",
+                       help="also time batched vs sequential planning on the first N "
+                       "instances")  # fmt: skip
         p.add_argument(
             "--no-crisp-check", dest="crisp_check", action="store_false",
             help="keep a window's strongest move even when it is illegal (the plan is then "
@@ -197,6 +193,8 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     p.add_argument("--crisp", default="true", metavar="C[,C...]",
                    help="what decoded moves are checked against: true (the true state, the "
                    "paper's) and/or perceived (the state read from the image) (true)")  # fmt: skip
+    p.add_argument("--corrupt", default="", metavar="SPEC", help="degrade every render "
+                   "(stress ladder): noise:SIGMA (grey levels), dim:FACTOR, occlude")  # fmt: skip
     p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
     p.add_argument(
         "--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt",

@@ -76,6 +76,8 @@ def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
         (["perception", "train", "--train", "a.npz", "--test", "b.npz"], "required: --out"),
         (["bench", "perception", "--data", "nowhere"], "PlanBench blocksworld data not found"),
         (["bench", "perception", "--modes", "psychic"], "unknown mode 'psychic'"),
+        (["bench", "perception", "--corrupt", "fog:3"], "cannot read 'fog:3'"),
+        (["bench", "perception", "--corrupt", "dim:2"], "0 < dim <= 1"),
         (["run", "--observe", "camera", "--checkpoint", "none.pt"], "no perception checkpoint"),
     ],
 )
@@ -87,3 +89,13 @@ def test_bad_input_is_one_line(capsys, argv, needle):
 def test_bad_blur_is_a_usage_error(capsys):
     assert main(["bench", "perception", "--blur", "-3"]) == 2
     assert "radii >= 0" in capsys.readouterr().err
+
+
+def test_corruption_specs_read_back():
+    from perception.corrupt import Corruption
+    from tamp.bench.perception import parse_corruption
+
+    assert parse_corruption("") == Corruption()
+    spec = parse_corruption("noise:8, dim:0.35,occlude")
+    assert spec == Corruption(noise=8.0, dim=0.35, occlude=True)
+    assert spec.name == "noise 8 + dim 0.35 + occluder"
