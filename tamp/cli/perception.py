@@ -69,6 +69,12 @@ def _latplan_dataset(args: argparse.Namespace, sims: tuple[str, ...]) -> int:
     return 0
 
 
+# what a checkpoint's meta keeps of its training set's own meta (scene, camera provenance,
+# whether evaluation layouts were excluded)
+DATASET_KEYS = ("scene", "sims", "camera", "evaluation_layouts_excluded", "excluded_layouts",
+                "excluded_from", "randomisation")  # fmt: skip
+
+
 def train_command(args: argparse.Namespace) -> int:
     import numpy as np
     import torch
@@ -122,6 +128,7 @@ def train_command(args: argparse.Namespace) -> int:
             **scores,
         },
         "more_tests": more,
+        "dataset": {k: v for k, v in train_raw.meta.items() if k in DATASET_KEYS},
         "train_config": config.__dict__,
         "train_time_s": round(time.perf_counter() - t0, 1),
         "threads": args.threads,
