@@ -29,7 +29,7 @@ from task.problem import Move, PlanStatus
 from task.symbolic import pddl_io
 from task.symbolic.validate import validate
 
-LATPLAN_CHECKPOINT = CHECKPOINT.with_name("support-latplan.pt")  # not shipped yet
+LATPLAN_CHECKPOINT = CHECKPOINT.with_name("support-latplan.pt")  # the shipped LatPlan model
 
 
 def _checkpoint(args: argparse.Namespace) -> Path:
@@ -41,8 +41,8 @@ def _checkpoint(args: argparse.Namespace) -> Path:
     if args.scene == "latplan":
         if not LATPLAN_CHECKPOINT.is_file():
             raise TampError(
-                f"no LatPlan perception checkpoint at {LATPLAN_CHECKPOINT} (none is shipped "
-                "yet): pass a model trained on the latplan scene with --checkpoint FILE.pt"
+                f"no LatPlan perception checkpoint at {LATPLAN_CHECKPOINT} (is the package "
+                "complete?): pass a model trained on the latplan scene with --checkpoint FILE.pt"
             )
         return LATPLAN_CHECKPOINT
     return CHECKPOINT

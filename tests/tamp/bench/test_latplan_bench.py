@@ -1,7 +1,8 @@
 """``tamp bench latplan`` on a tiny fake LatPlan folder: two instances rendered here with our own
 LatPlan scene (PyBullet), their PDDL and manifest rows. Only the plumbing is tested (every row
 gets a status, the table prints, the files are written) and the one-line errors; the shipped
-cube checkpoint stands in for a LatPlan one, so what it reads is not asserted.
+cube checkpoint stands in for a LatPlan one there, so what it reads is not asserted; one test
+runs the shipped LatPlan checkpoint and asserts that it reads these renders right.
 """
 
 from __future__ import annotations
@@ -106,6 +107,21 @@ def test_state_and_frozen_rows_table_and_files(folder, tmp_path, capsys):
     assert [(s["resolution"], s["mode"]) for s in body["summary"]] == [
         ("-", "state"), ("150x100", "frozen"), ("45x30", "frozen")]  # fmt: skip
     assert body["summary"][0]["valid"]["mean"] == 2  # from the true states: solved
+
+
+@pytest.mark.sim
+def test_the_shipped_latplan_model_reads_our_own_renders(folder, tmp_path, capsys):
+    """The default checkpoint (perception/support-latplan.pt) on the two instances rendered
+    here: every state read right and every plan valid, at both resolutions."""
+    torch.set_num_threads(1)
+    out = tmp_path / "shipped"
+    args = ["bench", "latplan", "--data", str(folder), "--modes", "frozen", "--seeds", "1",
+            "--no-progress", "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    with (out / "instances.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 4
+    assert {r["status"] for r in rows} == {"valid"}, rows
 
 
 def test_state_mode_needs_no_checkpoint_and_json(folder, tmp_path, capsys):

@@ -130,13 +130,15 @@ def test_no_blocks_and_too_small_images(tmp_path, capsys):
     assert "6x4" in _one_line_error(capsys)
 
 
-def test_missing_checkpoints(tmp_path, capsys):
+def test_missing_checkpoints(tmp_path, capsys, monkeypatch):
+    from tamp.cli import images
+
+    assert LATPLAN_CHECKPOINT.is_file()  # shipped with the package
     grey = _grey(tmp_path, "grey.png")
     missing = str(tmp_path / "none.pt")
     assert main(["plan-images", grey, grey, "--checkpoint", missing]) == 2
     assert missing in _one_line_error(capsys)
-    if LATPLAN_CHECKPOINT.is_file():
-        pytest.skip("a LatPlan checkpoint exists")
+    monkeypatch.setattr(images, "LATPLAN_CHECKPOINT", tmp_path / "support-latplan.pt")
     assert main(["plan-images", grey, grey, "--scene", "latplan"]) == 2
     err = _one_line_error(capsys)
     assert "support-latplan.pt" in err and "--checkpoint" in err
