@@ -165,17 +165,34 @@ def _goals(problems, mode: PerceptionMode, perceiver, goal_images) -> tuple[list
 
 
 def _plan(planned, keep, config, seed, beliefs) -> dict:
-    """Plan the problems ``keep`` (indices into ``planned``); index -> PlanResult."""
+    """Plan the problems ``keep`` (indices into ``planned``); index -> PlanResult.
+
+    When an image met while planning cannot be read (a block lost in blur, say), the batch is
+    planned again one problem at a time, and a problem whose images cannot be read is left
+    out (its row says ``perception_error``): one unreadable scene never ends the benchmark."""
     if not keep:
         return {}
-    source = None
-    if beliefs is not None:
 
-        def source(indices, states):
-            return beliefs([keep[j] for j in indices], states)
+    def run(chosen):
+        source = None
+        if beliefs is not None:
 
-    out = plan_batch([planned[i] for i in keep], config, seed, beliefs=source)
-    return dict(zip(keep, out, strict=True))
+            def source(indices, states):
+                return beliefs([chosen[j] for j in indices], states)
+
+        out = plan_batch([planned[i] for i in chosen], config, seed, beliefs=source)
+        return dict(zip(chosen, out, strict=True))
+
+    try:
+        return run(keep)
+    except PerceptionError:
+        results = {}
+        for i in keep:
+            try:
+                results.update(run([i]))
+            except PerceptionError:
+                continue
+        return results
 
 
 def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, perceiver, camera):
