@@ -210,3 +210,18 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
     p.add_argument("--crisp", choices=("perceived", "true"), default="perceived",
                    help="decode moves against the observed state, or the simulator's true "
                    "state (an oracle) (perceived)")  # fmt: skip
+
+
+def run_options(p: argparse.ArgumentParser) -> None:
+    """``tamp run``'s own options: the video, and a given plan to execute instead of planning."""
+    p.add_argument("--no-video", action="store_true", help="skip the camera video")
+    p.add_argument("--video-format", choices=("mp4", "gif"), default="mp4", help="(mp4)")
+    p.add_argument("--plan", metavar="PLAN",
+                   help="execute this plan open-loop instead of planning: 4-op PDDL actions "
+                   "(VAL format) or moves 'move(a -> b)', one per line")  # fmt: skip
+    p.add_argument("--replan", action="store_true",
+                   help="--plan: after a failed or invalid step, replan from the observed "
+                   "state")  # fmt: skip
+    p.add_argument("--stop-at-invalid", action="store_true",
+                   help="--plan: stop at the first step invalid at task level instead of "
+                   "attempting it")  # fmt: skip

@@ -22,6 +22,7 @@ from tamp.cli.options import (
     progress_option,
     radius_list,
     rules_option,
+    run_options,
 )
 from tamp.sim.base import SIMULATORS
 
@@ -103,8 +104,7 @@ def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
     )
     episode_options(p)
     p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
-    p.add_argument("--no-video", action="store_true", help="skip the camera video")
-    p.add_argument("--video-format", choices=("mp4", "gif"), default="mp4", help="(mp4)")
+    run_options(p)
     output_options(p, "write the episode video and report.json into this folder")
     p.set_defaults(func=_lazy("tamp.cli.run", "run_command"))
 

@@ -1,4 +1,6 @@
 """``tamp run``: plan a problem, execute it with the simulated Panda, write video and report.
+With ``--plan PLAN`` it executes a given plan open-loop instead (`tamp.loop.given`), one line
+per step.
 
 Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise.
 """
@@ -16,6 +18,7 @@ from tamp.camera.from_images import PerceptionMode
 from tamp.cli.options import planner_config
 from tamp.loop import Episode, EpisodeReport, LoopConfig
 from tamp.loop.faults import Injection
+from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.video import VideoWriter
 from task import data
 from task.errors import TampError
@@ -64,6 +67,7 @@ def summary_lines(report: EpisodeReport) -> list[str]:
     ok = sum(r.ok for r in moves)
     per_move = report.wall_time_s / max(len(moves), 1)
     return [
+        *(step.line() for step in report.steps),
         f"{report.problem} in {report.sim}: {report.status.value}"
         f"{' (' + report.reason + ')' if report.reason else ''}; goal reached (ground truth): "
         f"{'yes' if report.reached_goal else 'no'}",
@@ -78,6 +82,9 @@ def summary_lines(report: EpisodeReport) -> list[str]:
 def run_command(args: argparse.Namespace) -> int:
     problem = load_problem(args.problem, args.domain)
     config = loop_config(args)
+    steps = None if args.plan is None else read_given(args.plan, problem)
+    if steps is None and (args.replan or args.stop_at_invalid):
+        raise TampError("--replan and --stop-at-invalid apply to a given plan (--plan PLAN)")
     out = Path(args.out) if args.out else None
     video = None
     if out is not None and not args.no_video:
@@ -93,7 +100,12 @@ def run_command(args: argparse.Namespace) -> int:
         if not quiet:
             print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
-    episode = Episode(problem, config, args.seed, on_event=say)
+    if steps is None:
+        episode = Episode(problem, config, args.seed, on_event=say)
+    else:
+        episode = GivenPlanEpisode(
+            problem, steps, config, args.seed, args.replan, args.stop_at_invalid, on_event=say
+        )
     if video is not None:
 
         def frame(sim) -> None:
@@ -107,7 +119,9 @@ def run_command(args: argparse.Namespace) -> int:
         seen = config.observe
         if seen == "camera":
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
-        print(f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}", file=sys.stderr)
+        given = f", given plan {args.plan} ({len(steps)} steps)" if steps else ""
+        print(f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
+              file=sys.stderr)  # fmt: skip
     report = episode.run()
     written = []
     if video is not None and video.close() is not None:
@@ -117,6 +131,7 @@ def run_command(args: argparse.Namespace) -> int:
         "sim": config.sim, "grasp": config.grasp, "inject": str(config.inject),
         "seed": args.seed, "max_replans": config.max_replans, "observe": config.observe,
         "perception": config.perception.mode, "blur": config.perception.blur,
+        "plan": args.plan, "replan": args.replan, "stop_at_invalid": args.stop_at_invalid,
     }  # fmt: skip
     if out is not None:
         (out / "report.json").write_text(json.dumps(body, indent=2))

@@ -9,8 +9,11 @@
 - ``sensors``: the two pose sensors, `MocapPoses` (``observe="state"`` only: the one sensor whose
   reading is ground truth, plus optional noise) and `CameraPoses` (RGB-D pose estimation);
 - ``execute``: one move as a pick-and-place, with its robot-side checks and failure kinds;
-- ``score``: `Scorer`, the only reader of simulator ground truth in the loop (the goal check and
-  disturbed stacks); an episode locks ``sim.truth`` for the rest;
+- ``given``: a plan from any source (4-op PDDL actions or moves) executed open-loop, with a
+  task-level verdict, the motion outcome and what physically followed, per step;
+- ``score``: `Scorer`, the reader of simulator ground truth in the loop (the goal check and
+  disturbed stacks; ``given`` also reads it, to score each step); an episode locks
+  ``sim.truth`` for the rest;
 - ``recover``: tidying loose blocks, injected nudges, failure descriptions;
 - ``faults``: fault injection settings (drop, nudge, noise).
 """

@@ -179,6 +179,12 @@ class Episode:
         p.disturbed += self.score.disturbed(move, before)
         return done
 
+    def _expect(self, state, move: Move):
+        """The state ``move`` gives from ``state`` (None when it is illegal there)."""
+        if self.domain.check_move(self.target, state, move) is None:
+            return self.domain.apply_move(self.target, state, move)
+        return None
+
     def _check(self, p: Progress, move: Move, done: ExecutionResult, expected) -> None:
         """Read the new state (tidying loose blocks if it is unreadable) and decide: go on,
         replan, or stop."""

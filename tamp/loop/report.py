@@ -18,6 +18,8 @@ class EpisodeStatus(enum.Enum):
     REPLAN_BUDGET = "replan_budget"  # more failures than ``max_replans``
     UNREADABLE = "unreadable"  # the observed poses do not form a blocksworld state
     OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
+    INVALID_PLAN = "invalid_plan"  # a given plan stopped at a step it could not attempt
+    PLAN_ENDED = "plan_ended"  # a given plan ran to its end without reaching the goal
 
 
 @dataclass(frozen=True)
@@ -39,6 +41,7 @@ class EpisodeReport:
     initial_plan_solved: bool = False  # the first task plan reached the goal symbolically
     reason: str = ""
     first_plan: tuple[Move, ...] = ()  # the first task plan's moves (camera: its first window)
+    steps: tuple = ()  # a given plan: one `tamp.loop.given.StepReport` per step
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)

@@ -77,10 +77,11 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
     sims = {"tamp/sim/base.py", "tamp/sim/pybullet_sim.py", "tamp/sim/mujoco_sim.py"}
     assert _uses("_block_poses", "tamp") <= sims
     assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py"}
-    # in the loop: the scorer, the nudge (experimenter) and the state-mode mocap oracle
+    # in the loop: the scorer, the nudge (experimenter), the state-mode mocap oracle and the
+    # per-step verdicts of a given plan (scoring: what the report says, never what the robot does)
     assert _uses("truth", "tamp/loop") <= {
         "tamp/loop/episode.py", "tamp/loop/score.py", "tamp/loop/recover.py",
-        "tamp/loop/sensors.py",
+        "tamp/loop/sensors.py", "tamp/loop/given.py",
     }  # fmt: skip
     for room in ("tamp/camera", "tamp/bench", "tamp/cli", "motion", "perception"):
         assert not _uses("truth", room) | _uses("block_poses", room), room
