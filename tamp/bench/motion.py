@@ -1,32 +1,45 @@
-"""The motion benchmark (``tamp bench motion``): how executable task plans are at motion level.
+"""The motion benchmarks: how executable task plans are at motion level.
 
-`run` plays closed-loop episodes (`tamp.loop`) on a suite in each simulator; `summarise` gives
-the executability figures per simulator: task plans valid, executed moves valid, moves executed,
-episodes reaching the goal (simulator ground truth), failures by kind, replans, disturbed stacks,
-time per move, and with fault injection the recovery rate. `tamp.bench.tables.motion_table`
-prints them.
+``tamp bench motion``: `run` plays closed-loop episodes (`tamp.loop`) on a suite in each
+simulator; `summarise` gives per simulator task plans valid, executed moves valid, moves
+executed, goals reached (simulator ground truth), failures by kind, replans, disturbed stacks,
+time per move, and with faults the recovery rate (printed by `tamp.bench.tables.motion_table`).
 
 "Valid" is a replay through `task.symbolic.validate` against the instance's PDDL problem
 (`tamp.bench.planning.replay`), never the planner's own flag: "plans valid" replays the first
 complete task plan (not applicable with the camera, whose first plan is one window), "executed
 moves valid" the moves that executed ok, in order (every step applicable, the goal at the end).
+
+``tamp bench executability``: `run_given` executes plans of any source (`read_sources`) open-
+loop (`tamp.loop.given`) in each simulator, ours as the reference row: per plan our task-level
+verdict and PlanBench's, the goal reached (ground truth), the first failure, disturbed stacks,
+moves and time (`PlanRow`); `given_summary` and `executability_table` per source.
 """
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
 from motion.ik import IKSolver, top_down_pose
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
+from tamp.bench.tables import table
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
+from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
+from task.config import PlannerConfig
+from task.domains import get_domain
+from task.errors import DataError, TampError
+from task.planner import plan_batch
 from task.symbolic.instances import Instance
+from task.symbolic.validate import validate
 
 EPISODE_COLUMNS = (
     "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
@@ -47,15 +60,11 @@ class MotionBench:
 def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
     """Wall time of one batched IK call on ``n`` random top-down targets in the block area."""
     rng = np.random.default_rng(seed)
-    targets = np.stack(
-        [
-            top_down_pose(
-                (rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), rng.uniform(0.03, 0.3)),
-                rng.uniform(-np.pi / 2, np.pi / 2),
-            )
-            for _ in range(n)
-        ]
-    )
+    targets = np.stack([
+        top_down_pose((rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), rng.uniform(0.03, 0.3)),
+                      rng.uniform(-np.pi / 2, np.pi / 2))
+        for _ in range(n)
+    ])  # fmt: skip
     q0 = np.asarray(solver.spec.q_home)
     solver.solve(targets[:2], q0)  # warm-up
     t0 = time.perf_counter()
@@ -125,18 +134,167 @@ def run(
 def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
     """One ``episodes.csv`` row per episode (columns `EPISODE_COLUMNS`)."""
     return [
-        {
-            "sim": r.sim,
-            "problem": r.problem,
-            "status": r.status.value,
-            "reached_goal": r.reached_goal,
-            "moves": len(r.moves),
-            "moves_ok": sum(m.ok for m in r.moves),
-            "replans": r.replans,
-            "faults": " ".join(r.faults),
-            "disturbed": r.disturbed,
-            "sim_time_s": round(r.sim_time_s, 2),
-            "wall_time_s": round(r.wall_time_s, 2),
-        }
+        {"sim": r.sim, "problem": r.problem, "status": r.status.value,
+         "reached_goal": r.reached_goal, "moves": len(r.moves),
+         "moves_ok": sum(m.ok for m in r.moves), "replans": r.replans,
+         "faults": " ".join(r.faults), "disturbed": r.disturbed,
+         "sim_time_s": round(r.sim_time_s, 2), "wall_time_s": round(r.wall_time_s, 2)}
         for r in reports
-    ]
+    ]  # fmt: skip
+
+
+# --- executability of given plans (``tamp bench executability``) ---------------------------
+OURS = "ours"  # the reference row: our planner's plans, executed the same way
+
+
+@dataclass(frozen=True)
+class PlanRow:
+    """A plan of a source executed open-loop in one simulator (a ``plans.csv`` row)."""
+
+    source: str
+    sim: str
+    problem: str
+    task: str  # our validator's status, or "unparseable" (``error`` says why not valid)
+    planbench_valid: bool | None  # the source's own verdict (None: none given)
+    reached_goal: bool
+    first_failure: str  # "" when none (`first_failure`)
+    failure_at: str  # the step's label
+    disturbed: int  # steps after which another block had moved
+    moves: int  # steps attempted physically
+    wall_time_s: float
+    error: str
+
+
+def read_sources(path: str | Path) -> dict[str, dict[str, tuple[str, bool | None]]]:
+    """``{source: {instance: (plan, PlanBench verdict)}}`` of a CSV (source: its stem) or folder
+    of CSVs: ``file`` (``instances/<name>.pddl``), ``plan`` (``;``-joined), ``llm_correct``."""
+    root = Path(path)
+    files = sorted(root.glob("*.csv")) if root.is_dir() else [root] if root.exists() else []
+    if not files:
+        raise DataError(f"--plans {root}: no such CSV file, or no *.csv files in the folder")
+    out = {}
+    for f in files:
+        with f.open(newline="", encoding="utf-8") as handle:
+            reader = csv.DictReader(handle)
+            missing = [c for c in ("file", "plan") if c not in (reader.fieldnames or ())]
+            if missing:
+                raise DataError(f"{f}: missing column(s) {', '.join(missing)} (file, plan)")
+            plans = {}
+            for row in reader:
+                flag = (row.get("llm_correct") or "").strip()
+                name = (row["file"] or "").strip().removeprefix("instances/").removesuffix(".pddl")
+                plans[name] = (row["plan"] or "", None if not flag else flag == "1")
+        out[f.stem if f.stem != OURS else f"{OURS} (csv)"] = plans
+    return out
+
+
+def our_plans(suite: Suite, config: PlannerConfig, seed: int) -> dict[str, tuple[str, None]]:
+    """Our planner's plan of every instance as 4-op action lines (empty: no plan found)."""
+    results = plan_batch([i.problem for i in suite.instances], config, seed)
+    out = {}
+    for inst, result in zip(suite.instances, results, strict=True):
+        moves = result.plan.moves if result.solved else ()
+        actions = get_domain(inst.problem.domain).to_actions(inst.problem, moves, strict=False)
+        out[inst.name] = ("\n".join(map(str, actions)), None)
+    return out
+
+
+def check_given(text: str | None, instance: Instance, domain, source: str):
+    """``(steps, task status, error)``; ``(None, "unparseable", error)`` for a missing, empty or
+    malformed plan (actions after an unpaired pick/put are dropped: invalid before anyway)."""
+    if text is None:
+        return None, "unparseable", f"{source}: no plan for {instance.name}"
+    try:
+        steps = parse_given(text.replace(";", "\n"), f"{source} {instance.name}", instance.problem)
+        moves, rules = [s.move for s in steps], get_domain(instance.problem.domain)
+        actions = [a for s in steps for a in s.actions] or rules.to_actions(
+            instance.problem, moves, strict=False)  # fmt: skip
+        verdict = validate(domain, instance.pddl, actions)
+    except TampError as exc:
+        return None, "unparseable", str(exc)
+    return steps, verdict.status.value, "" if verdict.valid else verdict.reason
+
+
+def first_failure(steps: Sequence[StepReport], reached: bool) -> tuple[str, str]:
+    """``(kind, label)`` of the first step invalid at task level ("invalid-then-<outcome>"), not
+    attempted ("unpaired-actions") or failed (its kind); else "goal-not-reached" or none."""
+    for s in steps:
+        if not s.attempted:
+            return "unpaired-actions", s.label
+        if s.valid is False:
+            return f"invalid-then-{s.outcome}", s.label
+        if s.outcome != "executed":
+            return s.outcome, s.label
+    return ("", "") if reached else ("goal-not-reached", "end")
+
+
+def run_given(suite: Suite, sources: dict, base: LoopConfig, sims: Sequence[str], seed: int,
+              ours: PlannerConfig | None, progress: Callable | None = None) -> list:  # fmt: skip
+    """`PlanRow` of every source's plan of every instance in each simulator. Instance ``k`` uses
+    episode seed ``seed * 100_003 + k`` (its layout) for every source; a plan executed before
+    on the same instance and simulator is not run again (its row is copied, time included)."""
+    plans = {**sources, **({OURS: our_plans(suite, ours, seed)} if ours is not None else {})}
+    checked = {(src, i.name): check_given(got.get(i.name, (None,))[0], i, suite.domain, src)
+               for src, got in plans.items() for i in suite.instances}  # fmt: skip
+    solver, rows, done = IKSolver(), [], {}
+    for sim in sims:
+        config = replace(base, sim=sim)
+        for k, inst in enumerate(suite.instances):
+            done[sim, k, None] = (False, "unparseable", "", 0, 0, 0.0)
+            for src, got in plans.items():
+                steps, task, error = checked[src, inst.name]
+                flag = got.get(inst.name, ("", None))[1]
+                key = (sim, k, steps and tuple(s.label for s in steps))
+                if key not in done:
+                    r = GivenPlanEpisode(inst.problem, steps, config, seed * 100_003 + k,
+                                         solver=solver).run()  # fmt: skip
+                    done[key] = (r.reached_goal, *first_failure(r.steps, r.reached_goal),
+                                 sum(bool(s.disturbed) for s in r.steps),
+                                 sum(s.attempted for s in r.steps), r.wall_time_s)  # fmt: skip
+                rows.append(PlanRow(src, sim, inst.name, task, flag, *done[key], error))
+                if progress is not None:
+                    progress(sim, rows[-1])
+    return rows
+
+
+def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:
+    """Per source: plans, task-valid, PlanBench-valid, agreement (None: no verdicts); per sim the
+    goals reached, top 3 first failures, disturbed stacks, s/plan (mean over parsed plans)."""
+    out = []
+    for src in dict.fromkeys(r.source for r in rows):
+        mine = [r for r in rows if r.source == src]
+        first = [r for r in mine if r.sim == sims[0]]
+        pb = [r for r in first if r.planbench_valid is not None]
+        by = {s: [r for r in mine if r.sim == s] for s in sims}
+        ran = {s: [r for r in b if r.task != "unparseable"] for s, b in by.items()}
+        out.append({
+            "source": src, "plans": len(first), "task_valid": sum(r.task == "valid" for r in first),
+            "unparseable": sum(r.task == "unparseable" for r in first),
+            "planbench_valid": sum(r.planbench_valid for r in pb) if pb else None,
+            "agree": sum((r.task == "valid") == r.planbench_valid for r in pb) if pb else None,
+            "reached": {s: sum(r.reached_goal for r in b) for s, b in by.items()},
+            "failures": {s: dict(Counter(r.first_failure for r in b if r.first_failure)
+                                 .most_common(3)) for s, b in by.items()},
+            "disturbed": {s: sum(r.disturbed for r in b) for s, b in by.items()},
+            "s_per_plan": {s: sum(r.wall_time_s for r in b) / max(len(b), 1)
+                           for s, b in ran.items()},
+        })  # fmt: skip
+    return out
+
+
+def executability_table(summary: Sequence[dict], sims: Sequence[str]) -> str:
+    """One row per source: our and PlanBench's task-level verdicts, then per simulator the
+    goals reached (ground truth), disturbed stacks, s/plan and the top 3 first failures."""
+    head = ["source", "plans", "task-valid", "PlanBench-valid", "agree",
+            *(f"{h} {s}" for s in sims for h in ("goal", "disturbed", "s/plan"))]  # fmt: skip
+    body, lines = [], ["", "", "first failures (top 3):"]
+    for s in summary:
+        n = s["plans"]
+        flags = ("-" if v is None else f"{v}/{n}" for v in (s["planbench_valid"], s["agree"]))
+        body.append([s["source"], n, f"{s['task_valid']}/{n}", *flags, *(
+            v for sim in sims for v in (f"{s['reached'][sim]}/{n}", s["disturbed"][sim],
+                                        f"{s['s_per_plan'][sim]:.1f}"))])  # fmt: skip
+        for sim in sims:
+            kinds = ", ".join(f"{k} {v}" for k, v in s["failures"][sim].items())
+            lines.append(f"  {s['source']} in {sim}: {kinds or 'none'}")
+    return table(head, body, indent="") + "\n".join(lines)

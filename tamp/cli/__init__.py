@@ -9,6 +9,7 @@
     tamp run [PROBLEM.pddl] [--sim pybullet|mujoco --inject drop:0.2 --seed S --out DIR]
     tamp bench latplan [--checkpoint FILE.pt --res 150x100,45x30 --modes state,frozen --seeds 3]
     tamp bench motion [--sim pybullet,mujoco --data DIR --n 100 --inject drop:0.2 --out DIR]
+    tamp bench executability --plans FILE.csv|DIR [--sim pybullet,mujoco --n 20 --out DIR]
 
 Exit codes: 0 success, 1 no plan or an invalid plan, 2 usage error or bad input (one line on
 stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``).

@@ -1,10 +1,9 @@
-"""``tamp bench planbench|pddl|random|motion|perception|latplan|poses``: options in,
+"""``tamp bench planbench|pddl|random|motion|executability|perception|latplan|poses``: options in,
 `tamp.bench` runs, tables out.
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
-bar on stderr, prints the paper-style table (`tamp.bench.tables`; the ``results.json`` content
-with ``--json``) and, with ``--out DIR``, writes its artefacts through `tamp.bench.results`.
-A benchmark that ran exits 0 whatever its scores; bad options or missing data exit 2.
+bar on stderr, prints its table (``results.json``'s content with ``--json``) and with ``--out
+DIR`` writes its artefacts (`tamp.bench.results`). It exits 0 whatever the scores; 2 on bad input.
 """
 
 from __future__ import annotations
@@ -14,13 +13,11 @@ import json
 import os
 import sys
 import time
-from collections import Counter
 from contextlib import contextmanager
 
 from tqdm import tqdm
 
 from tamp.bench import planning, results, suites, tables
-from tamp.bench.suites import Suite
 from tamp.cli.options import planner_config, sim_list
 from task.errors import TampError
 
@@ -32,14 +29,13 @@ def _bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
         yield bar.update
 
 
-def _run(suite: Suite, args: argparse.Namespace) -> int:
+def _run(suite: suites.Suite, args: argparse.Namespace) -> int:
     import torch
 
     torch.set_num_threads(args.threads)
     rules = {i.problem.domain for i in suite.instances}
     config = planner_config(args, rules.pop() if len(rules) == 1 else None)
-    horizons = args.horizons or (config.horizon,)
-    seeds = tuple(range(args.seeds))
+    horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
     with _bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
         result = planning.run(suite, config, seeds, horizons, args.sequential, update)
@@ -72,8 +68,7 @@ def pddl_command(args: argparse.Namespace) -> int:
 
 @contextmanager
 def _searching(enabled: bool):
-    """A bar for optimal lengths the data lack, opened at the first one searched (nothing is
-    printed when none is)."""
+    """A bar for optimal lengths the data lack, opened at the first one searched (if any)."""
     bars = []
 
     def update(k: int) -> None:
@@ -104,10 +99,8 @@ def motion_command(args: argparse.Namespace) -> int:
     from tamp.bench import motion
     from tamp.cli.run import loop_config
 
-    sims = sim_list(args.sim)
-    suite = suites.planbench(args.data, args.n)
-    base = loop_config(args)
-    goals: Counter[str] = Counter()
+    sims, suite, base = sim_list(args.sim), suites.planbench(args.data, args.n), loop_config(args)
+    goals = dict.fromkeys(sims, 0)
     with tqdm(total=len(sims) * len(suite.instances), desc="motion", unit="episode",
               file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
 
@@ -118,15 +111,12 @@ def motion_command(args: argparse.Namespace) -> int:
 
         result = motion.run(suite, base, sims, args.seed, progress)
     inject = str(base.inject)
-    body = {
-        "config": {"sims": sims, "n": len(suite.instances), "inject": inject,
-                   "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
-                   "observe": base.observe, "perception": base.perception.mode,
-                   "blur": base.perception.blur, "crisp": base.crisp},
-        "machine": results.machine(),
-        "ik_batch": result.ik,
-        "summary": result.summary,
-    }  # fmt: skip
+    body = {"config": {"sims": sims, "n": len(suite.instances), "inject": inject,
+                       "grasp": base.grasp, "seed": args.seed, "data": str(args.data),
+                       "observe": base.observe, "perception": base.perception.mode,
+                       "blur": base.perception.blur, "crisp": base.crisp},
+            "machine": results.machine(), "ik_batch": result.ik,
+            "summary": result.summary}  # fmt: skip
     if args.out:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -145,6 +135,40 @@ def motion_command(args: argparse.Namespace) -> int:
           f"({ik['converged']}/{ik['n']} converged)")  # fmt: skip
     if args.out:
         print(f"wrote results.json, episodes.csv to {args.out}")
+    return 0
+
+
+def executability_command(args: argparse.Namespace) -> int:
+    """Each ``--plans`` source's plans and ours, executed open-loop in each ``--sim``."""
+    import torch
+
+    from tamp.bench import motion
+    from tamp.loop import LoopConfig
+
+    sims, sources = sim_list(args.sim), motion.read_sources(args.plans)
+    suite, out = suites.planbench(args.data, args.n), args.out and results.out_folder(args.out)
+    torch.set_num_threads(args.threads)
+    ours, wall0 = planner_config(args, "blocksworld") if args.ours else None, time.perf_counter()
+    with _bar(len(sims) * len(suite.instances) * (len(sources) + bool(ours)), "executability",
+              args.progress) as update:  # fmt: skip
+        rows = motion.run_given(suite, sources, LoopConfig(grasp=args.grasp), sims, args.seed,
+                                ours, lambda sim, row: update(1))  # fmt: skip
+    summary, wall = motion.given_summary(rows, sims), time.perf_counter() - wall0
+    body = {"config": {"plans": str(args.plans), "sims": sims, "instances": [i.name for i in
+                       suite.instances], "seed": args.seed, "grasp": args.grasp, "ours": args.ours,
+                       "data": str(args.data)}, "machine": results.machine(), "wall_s": wall,
+            "summary": summary}  # fmt: skip
+    if out:
+        results.write_json(out / "results.json", body)
+        results.write_csv(out / "plans.csv", rows, digits=2)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    print(f"executability: {len(suite.instances)} PlanBench instances, open-loop, grasp "
+          f"{args.grasp}, seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
+          motion.executability_table(summary, sims), sep="\n")  # fmt: skip
+    if out:
+        print(f"wrote results.json, plans.csv to {out}")
     return 0
 
 
@@ -168,9 +192,7 @@ def perception_command(args: argparse.Namespace) -> int:
     modes = [  # ground truth (no images) once, as crisp "true"
         PerceptionMode(m, kl_weight=args.kl_weight, blur=r, adapt=args.adapt,
                        crisp="true" if m == "state" else c)
-        for r in args.blur
-        for m in names
-        for c in crisps
+        for r in args.blur for m in names for c in crisps
         if not (m == "state" and (r != args.blur[0] or c != crisps[0]))
     ]  # fmt: skip
     with tqdm(total=len(modes) * len(horizons), desc="perception bench", unit="row",
@@ -180,20 +202,16 @@ def perception_command(args: argparse.Namespace) -> int:
             bar.set_postfix(mode=mode.mode, blur=mode.blur, T=horizon, refresh=False)
             bar.update(1)
 
-        result = bench.run(
-            suite, modes, horizons, config, args.seed, perceiver, args.sim,
-            example_blur=args.blur[-1], progress=progress, corruption=corruption,
-        )  # fmt: skip
+        result = bench.run(suite, modes, horizons, config, args.seed, perceiver, args.sim,
+                           example_blur=args.blur[-1], progress=progress,
+                           corruption=corruption)  # fmt: skip
     split = {str(b): sum(i.blocks == b for i in chosen) for b in bench.sizes(chosen)}
-    body = {
-        "suite": suite.name, "source": suite.source, "n": len(chosen),
-        "instances": [i.name for i in chosen], "split": split,
-        "sim": args.sim, "checkpoint": str(args.checkpoint), "seed": args.seed,
-        "threads": args.threads, "cores": os.cpu_count(), "machine": results.machine(),
-        "date": time.strftime("%Y-%m-%d"), "redrawn_renders": result.redrawn,
-        "corruption": corruption.name,
-        "rows": list(result.summaries),
-    }  # fmt: skip
+    body = {"suite": suite.name, "source": suite.source, "n": len(chosen),
+            "instances": [i.name for i in chosen], "split": split, "sim": args.sim,
+            "checkpoint": str(args.checkpoint), "seed": args.seed, "threads": args.threads,
+            "cores": os.cpu_count(), "machine": results.machine(),
+            "date": time.strftime("%Y-%m-%d"), "redrawn_renders": result.redrawn,
+            "corruption": corruption.name, "rows": list(result.summaries)}  # fmt: skip
     if args.out:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -258,12 +276,9 @@ def poses_command(args: argparse.Namespace) -> int:
               disable=not args.progress) as bar:  # fmt: skip
         result = poses.run(sims, args.n, args.seed, args.min_blocks, args.max_blocks,
                            args.jitter, lambda sim: bar.update(1))  # fmt: skip
-    body = {
-        "config": {"sims": list(sims), "n": args.n, "seed": args.seed,
-                   "blocks": [args.min_blocks, args.max_blocks], "jitter": args.jitter},
-        "machine": results.machine(),
-        "summary": result.summary,
-    }  # fmt: skip
+    body = {"config": {"sims": list(sims), "n": args.n, "seed": args.seed,
+                       "blocks": [args.min_blocks, args.max_blocks], "jitter": args.jitter},
+            "machine": results.machine(), "summary": result.summary}  # fmt: skip
     if args.out:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)

@@ -225,3 +225,49 @@ def run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--stop-at-invalid", action="store_true",
                    help="--plan: stop at the first step invalid at task level instead of "
                    "attempting it")  # fmt: skip
+
+
+def perception_bench_options(p: argparse.ArgumentParser, checkpoint: str) -> None:
+    """``bench perception``'s image options: modes, blur, crisp protocol, corruption, renderer,
+    weights and the optimised mode's settings."""
+    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
+                   help="state (ground truth), frozen, optimised (all three)")  # fmt: skip
+    p.add_argument("--blur", type=radius_list, default=(0,), metavar="R[,R...]",
+                   help="Gaussian blur radii in pixels, 0 = clear (0)")  # fmt: skip
+    p.add_argument("--crisp", default="true", metavar="C[,C...]",
+                   help="what decoded moves are checked against: true (the true state, the "
+                   "paper's) and/or perceived (the state read from the image) (true)")  # fmt: skip
+    p.add_argument("--corrupt", default="", metavar="SPEC", help="degrade every render "
+                   "(stress ladder): noise:SIGMA (grey levels), dim:FACTOR, occlude")  # fmt: skip
+    p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
+    p.add_argument("--checkpoint", default=checkpoint, metavar="FILE.pt",
+                   help="perception weights (the shipped checkpoint)")  # fmt: skip
+    # defaults of tamp.camera.from_images.PerceptionMode (not imported here: it pulls in torch)
+    p.add_argument("--kl-weight", type=float, default=10.0, metavar="W",
+                   help="optimised: weight of each KL anchor (%(default)s)")  # fmt: skip
+    p.add_argument("--adapt", choices=("head", "all"), default="head",
+                   help="optimised: weights to update (%(default)s)")  # fmt: skip
+
+
+def executability_options(p: argparse.ArgumentParser) -> None:
+    """``bench executability``: plan sources, instances, simulators, the reference row."""
+    p.add_argument("--plans", required=True, metavar="FILE.csv|DIR",
+                   help="plans to execute: a CSV (one source, named by its stem) or a folder of "
+                   "CSVs, columns file, plan (actions joined by ';') and optionally llm_correct "
+                   "(PlanBench's verdict), as in ../shared/data/planbench/llm_plans")  # fmt: skip
+    data_option(p)
+    p.add_argument("--n", type=positive, default=20,
+                   help="a spread of N Blocksworld-600 instances over sizes, the same for every "
+                   "source (20; 600 is all)")  # fmt: skip
+    p.add_argument("--sim", default="pybullet", metavar="SIM[,SIM]",
+                   help=f"simulators, comma-separated: {','.join(SIMULATORS)} "
+                   "(pybullet)")  # fmt: skip
+    p.add_argument("--no-ours", dest="ours", action="store_false",
+                   help="leave out the reference row: our planner's plans of the same "
+                   "instances")  # fmt: skip
+    p.add_argument("--grasp", choices=("friction", "weld"), default="friction",
+                   help="physical friction grasp or a weld attach (friction)")  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="scene layout and planner seed (0)")
+    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    progress_option(p)
+    output_options(p, "write results.json and plans.csv into this folder")

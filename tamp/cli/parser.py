@@ -14,13 +14,14 @@ from tamp.cli.options import (
     Parser,
     data_option,
     episode_options,
+    executability_options,
     nonnegative,
     output_options,
+    perception_bench_options,
     planner_options,
     positive,
     positive_list,
     progress_option,
-    radius_list,
     rules_option,
     run_options,
 )
@@ -41,6 +42,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _planning_benchmarks(bench, bench_opts)
     _motion_benchmark(bench, plan_opts)
+    _executability_benchmark(bench, plan_opts)
     _perception_benchmark(bench, bench_opts)
     _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
@@ -178,6 +180,14 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     p.set_defaults(func=_lazy("tamp.cli.bench", "motion_command"))
 
 
+def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
+    p = bench.add_parser("executability", parents=[plan_opts],
+                         help="execute plans of any source (CSV) open-loop in the "
+                         "simulators")  # fmt: skip
+    executability_options(p)
+    p.set_defaults(func=_lazy("tamp.cli.bench", "executability_command"))
+
+
 def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     p = bench.add_parser(
         "perception", parents=[bench_opts], help="planning PlanBench instances from rendered images"
@@ -186,25 +196,7 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--n", type=positive, default=100, help="instances over block counts (100: 17/74/9)"
     )
-    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
-                   help="state (ground truth), frozen, optimised (all three)")  # fmt: skip
-    p.add_argument("--blur", type=radius_list, default=(0,), metavar="R[,R...]",
-                   help="Gaussian blur radii in pixels, 0 = clear (0)")  # fmt: skip
-    p.add_argument("--crisp", default="true", metavar="C[,C...]",
-                   help="what decoded moves are checked against: true (the true state, the "
-                   "paper's) and/or perceived (the state read from the image) (true)")  # fmt: skip
-    p.add_argument("--corrupt", default="", metavar="SPEC", help="degrade every render "
-                   "(stress ladder): noise:SIGMA (grey levels), dim:FACTOR, occlude")  # fmt: skip
-    p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="renderer (pybullet)")
-    p.add_argument(
-        "--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt",
-        help="perception weights (the shipped checkpoint)",
-    )  # fmt: skip
-    # defaults of tamp.camera.from_images.PerceptionMode (not imported here: it pulls in torch)
-    p.add_argument("--kl-weight", type=float, default=10.0, metavar="W",
-                   help="optimised: weight of each KL anchor (%(default)s)")  # fmt: skip
-    p.add_argument("--adapt", choices=("head", "all"), default="head",
-                   help="optimised: weights to update (%(default)s)")  # fmt: skip
+    perception_bench_options(p, str(CHECKPOINT))
     p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
     progress_option(p)
