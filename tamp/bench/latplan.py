@@ -29,7 +29,7 @@ from perception.perceive import Perceiver
 from tamp.bench.planning import check
 from tamp.bench.suites import DEFAULT_DATA, spread
 from tamp.bench.summary import is_optimal
-from tamp.bench.tables import table
+from tamp.bench.tables import LATPLAN_CITED as CITED
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
 from task.config import PlannerConfig
 from task.errors import DataError, PDDLError, ProblemError, TampError
@@ -44,7 +44,6 @@ INSTANCES = "prob-cylinders-4"
 OPTIMAL = "opt_len_4op"  # manifest column: optimal 4-op plan length (2 x optimal moves)
 FILES = {"150x100": ("image_tr/init.png", "image_tr/goal.png"), "45x30": ("init.png", "goal.png")}
 MODES = ("state", "frozen", "optimised")
-CITED = (("LatPlan AMA+4 (as the paper cites it)", "33/40", "-"), ("the paper", "40/40", "31/40"))
 FIX = "get it as ../shared/data/latplan/README.md describes and pass --data DIR"
 
 
@@ -214,28 +213,6 @@ def summaries(rows: Sequence[dict]) -> list[dict]:
             "time_s_per_instance": sum(r["time_s"] for r in group) / len(group),
         })  # fmt: skip
     return out
-
-
-def _count(s: dict, n: int) -> str:
-    mean = f"{s['mean']:.1f}".removesuffix(".0")
-    spread_ = "" if s["min"] == s["max"] else f" ({s['min']}-{s['max']})"
-    return f"{mean}/{n}{spread_}"
-
-
-def latplan_table(summary: Sequence[dict]) -> str:
-    """The issue's table: the cited rows, then ours per mode and resolution (mean over seeds,
-    min-max in brackets when seeds differ)."""
-    head = ["row", "valid", "optimal", "read right", "s/inst", "failures (all seeds)"]
-    body = [[name, valid, optimal, "-", "-", ""] for name, valid, optimal in CITED]
-    for s in summary:
-        what = ("ours, from the true states" if s["mode"] == "state"
-                else f"ours, {s['mode']} perception, {s['resolution']}")  # fmt: skip
-        read = "-" if s["read_right"] is None else _count(s["read_right"], s["n"])
-        fails = ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in sorted(s["statuses"].items())
-                          if k != "valid")  # fmt: skip
-        body.append([what, _count(s["valid"], s["n"]), _count(s["optimal"], s["n"]), read,
-                     f"{s['time_s_per_instance']:.2f}", fails])  # fmt: skip
-    return table(head, body, indent="")
 
 
 def report(data: LatPlanData, rows, summary, options: dict, machine: dict) -> dict:

@@ -13,7 +13,8 @@ moves valid" the moves that executed ok, in order (every step applicable, the go
 ``tamp bench executability``: `run_given` executes plans of any source (`read_sources`) open-
 loop (`tamp.loop.given`) in each simulator, ours as the reference row: per plan our task-level
 verdict and PlanBench's, the goal reached (ground truth), the first failure, disturbed stacks,
-moves and time (`PlanRow`); `given_summary` and `executability_table` per source.
+moves and time (`PlanRow`); `given_summary` per source (printed by
+`tamp.bench.tables.executability_table`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ import numpy as np
 from motion.ik import IKSolver, top_down_pose
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
-from tamp.bench.tables import table
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
 from task.config import PlannerConfig
@@ -280,21 +280,3 @@ def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:
                            for s, b in ran.items()},
         })  # fmt: skip
     return out
-
-
-def executability_table(summary: Sequence[dict], sims: Sequence[str]) -> str:
-    """One row per source: our and PlanBench's task-level verdicts, then per simulator the
-    goals reached (ground truth), disturbed stacks, s/plan and the top 3 first failures."""
-    head = ["source", "plans", "task-valid", "PlanBench-valid", "agree",
-            *(f"{h} {s}" for s in sims for h in ("goal", "disturbed", "s/plan"))]  # fmt: skip
-    body, lines = [], ["", "", "first failures (top 3):"]
-    for s in summary:
-        n = s["plans"]
-        flags = ("-" if v is None else f"{v}/{n}" for v in (s["planbench_valid"], s["agree"]))
-        body.append([s["source"], n, f"{s['task_valid']}/{n}", *flags, *(
-            v for sim in sims for v in (f"{s['reached'][sim]}/{n}", s["disturbed"][sim],
-                                        f"{s['s_per_plan'][sim]:.1f}"))])  # fmt: skip
-        for sim in sims:
-            kinds = ", ".join(f"{k} {v}" for k, v in s["failures"][sim].items())
-            lines.append(f"  {s['source']} in {sim}: {kinds or 'none'}")
-    return table(head, body, indent="") + "\n".join(lines)

@@ -14,6 +14,12 @@ from collections.abc import Sequence
 from tamp.bench.planning import Bench
 from tamp.bench.summary import Summary, main_rows, size_rows
 
+# the rows LatPlan-40 tables cite beside ours: (row, valid, optimal)
+LATPLAN_CITED = (
+    ("LatPlan AMA+4 (as the paper cites it)", "33/40", "-"),
+    ("the paper", "40/40", "31/40"),
+)
+
 
 def table(headers: Sequence[str], rows: Sequence[Sequence[object]], indent: str = "  ") -> str:
     """Columns padded to their widest cell; numbers right-aligned, text left-aligned."""
@@ -190,3 +196,43 @@ def poses_table(summary: dict[str, dict]) -> str:
             label = {"all": "all", "top": "top free", "covered": "covered"}[split]
             rows.append([name, label, f"{s['estimated']}/{s['blocks']}", *cells])
     return table(head, rows, indent="")
+
+
+def executability_table(summary: Sequence[dict], sims: Sequence[str]) -> str:
+    """One row per source: our and PlanBench's task-level verdicts, then per simulator the
+    goals reached (ground truth), disturbed stacks, s/plan and the top 3 first failures."""
+    head = ["source", "plans", "task-valid", "PlanBench-valid", "agree",
+            *(f"{h} {s}" for s in sims for h in ("goal", "disturbed", "s/plan"))]  # fmt: skip
+    body, lines = [], ["", "", "first failures (top 3):"]
+    for s in summary:
+        n = s["plans"]
+        flags = ("-" if v is None else f"{v}/{n}" for v in (s["planbench_valid"], s["agree"]))
+        body.append([s["source"], n, f"{s['task_valid']}/{n}", *flags, *(
+            v for sim in sims for v in (f"{s['reached'][sim]}/{n}", s["disturbed"][sim],
+                                        f"{s['s_per_plan'][sim]:.1f}"))])  # fmt: skip
+        for sim in sims:
+            kinds = ", ".join(f"{k} {v}" for k, v in s["failures"][sim].items())
+            lines.append(f"  {s['source']} in {sim}: {kinds or 'none'}")
+    return table(head, body, indent="") + "\n".join(lines)
+
+
+def latplan_table(summary: Sequence[dict]) -> str:
+    """The issue's table: the cited rows, then ours per mode and resolution (mean over seeds,
+    min-max in brackets when seeds differ)."""
+    head = ["row", "valid", "optimal", "read right", "s/inst", "failures (all seeds)"]
+    body = [[name, valid, optimal, "-", "-", ""] for name, valid, optimal in LATPLAN_CITED]
+    for s in summary:
+        what = ("ours, from the true states" if s["mode"] == "state"
+                else f"ours, {s['mode']} perception, {s['resolution']}")  # fmt: skip
+        read = "-" if s["read_right"] is None else _count(s["read_right"], s["n"])
+        fails = ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in sorted(s["statuses"].items())
+                          if k != "valid")  # fmt: skip
+        body.append([what, _count(s["valid"], s["n"]), _count(s["optimal"], s["n"]), read,
+                     f"{s['time_s_per_instance']:.2f}", fails])  # fmt: skip
+    return table(head, body, indent="")
+
+
+def _count(s: dict, n: int) -> str:
+    mean = f"{s['mean']:.1f}".removesuffix(".0")
+    spread_ = "" if s["min"] == s["max"] else f" ({s['min']}-{s['max']})"
+    return f"{mean}/{n}{spread_}"

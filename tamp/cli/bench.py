@@ -166,7 +166,7 @@ def executability_command(args: argparse.Namespace) -> int:
         return 0
     print(f"executability: {len(suite.instances)} PlanBench instances, open-loop, grasp "
           f"{args.grasp}, seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
-          motion.executability_table(summary, sims), sep="\n")  # fmt: skip
+          tables.executability_table(summary, sims), sep="\n")  # fmt: skip
     if out:
         print(f"wrote results.json, plans.csv to {out}")
     return 0
@@ -261,7 +261,7 @@ def latplan_command(args: argparse.Namespace) -> int:
         return 0
     print(f"LatPlan-40: {len(data.instances)} instances from {data.root}, seeds 0..{seeds[-1]}; "
           "valid and optimal judged against each instance's PDDL (full-state goals)")  # fmt: skip
-    print(latplan.latplan_table(summary))
+    print(tables.latplan_table(summary))
     if args.out is not None:
         print(f"\nwrote results.json, instances.csv to {args.out}")
     return 0
