@@ -25,6 +25,8 @@ class PlannerConfig:
     lookahead: int = 5  # window length of the long-lookahead restarts (an extension, not paper)
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
     max_windows: int = 40  # replanning windows before giving up
+    time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
+    # in one batch start together and share it); None: only max_windows stops the planner
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
 
@@ -53,5 +55,7 @@ class PlannerConfig:
         if not 0.0 <= self.lookahead_share <= 1.0:
             share = self.lookahead_share
             raise TampError(f"PlannerConfig.lookahead_share must be in [0, 1], got {share}")
+        if self.time_limit_s is not None and not self.time_limit_s > 0:
+            raise TampError(f"PlannerConfig.time_limit_s must be > 0, got {self.time_limit_s}")
         if self.tau <= 0 or self.tau_end <= 0 or self.lr <= 0:
             raise TampError("PlannerConfig.tau, tau_end and lr must be > 0")

@@ -119,8 +119,12 @@ def _run(
     illegal: list[str | None] = [None] * len(problems)
     active = [i for i in range(len(problems)) if not solved[i]]
     on_done(len(problems) - len(active))
+    timed_out = False
     for _ in range(config.max_windows):
         if not active:
+            break
+        if config.time_limit_s is not None and time.perf_counter() - start >= config.time_limit_s:
+            timed_out = True  # stop with the moves so far; each unsolved problem says so
             break
         now = [states[i] for i in active]
         beliefs = None if source is None else source([indices[i] for i in active], now)
@@ -163,6 +167,12 @@ def _run(
             "misread_windows": misread[i],  # windows decoded against a state not the world's
         }
         status = PlanStatus.SOLVED if solved[i] else PlanStatus.NO_PLAN
+        if timed_out and not solved[i] and illegal[i] is None:
+            left = domain.lower_bound(p, states[i])
+            stats["time_limit"] = (
+                f"stopped at the {config.time_limit_s:g} s time limit after {windows[i]} "
+                f"windows and {len(moves[i])} moves; at least {left:g} more moves needed"
+            )
         if illegal[i] is not None:
             status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
         results.append(PlanResult(status, Plan(tuple(moves[i])), p, None, stats))

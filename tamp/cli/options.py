@@ -20,7 +20,7 @@ GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
-    "lookahead", "max_windows",
+    "lookahead", "max_windows", "time_limit_s",
 )  # fmt: skip
 
 
@@ -54,6 +54,17 @@ def positive(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
+def seconds(text: str) -> float:
+    """A positive number of seconds."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds > 0, got {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"expected seconds > 0, got {text!r}")
     return value
 
 
@@ -135,6 +146,10 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
     g.add_argument(
         "--max-windows", type=positive, metavar="W",
         help=f"replanning windows before giving up ({d.max_windows})",
+    )  # fmt: skip
+    g.add_argument(
+        "--time-limit", dest="time_limit_s", type=seconds, metavar="SECONDS",
+        help="stop planning at this wall-clock limit with the moves so far, and say so (none)",
     )  # fmt: skip
     g.add_argument(
         "--tau-end",

@@ -86,6 +86,8 @@ def _outcome(result: PlanResult, validation: Validation | None, instance: Instan
     )
     if validation is None:
         left = " ".join(strips.atom_str(a) for a in _unmet(result, instance))
+        if "time_limit" in result.stats:
+            return f"NO PLAN within the limit: {result.stats['time_limit']}; unmet: {left}"
         return f"NO PLAN: goal not reached after {took}; unmet: {left}"
     return f"{report.validation_line(validation)} ({took})"
 

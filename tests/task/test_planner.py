@@ -231,3 +231,17 @@ def test_deep_unstacking_needs_more_moves_than_the_lookahead():
     # seeds 0-9 the planner found 6 moves eight times, 8 (seed 1) and 10 (seed 9); seed 0 finds 6.
     # One two-move detour is tolerated so a harmless numerical change does not flip the test.
     assert optimum <= len(result.plan) <= optimum + 2
+
+
+def test_a_time_limit_stops_the_planner_and_says_how_far_it_got():
+    problem = random_problem(6, 11)
+    slow = PlannerConfig(time_limit_s=1e-9)  # over before the first window
+    result = plan(problem, slow, seed=0)
+    assert not result.solved and result.stats["windows"] == 0
+    assert (
+        "time limit" in result.stats["time_limit"]
+        and "more moves needed" in result.stats["time_limit"]
+    )
+    assert "time_limit" not in plan(problem, PlannerConfig(time_limit_s=600), seed=0).stats
+    with pytest.raises(TampError, match="time_limit_s must be > 0"):
+        PlannerConfig(time_limit_s=0)

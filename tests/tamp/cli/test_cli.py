@@ -184,3 +184,11 @@ def test_bad_run_and_motion_arguments_exit_2_with_one_line(argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "error" in err[0]
+
+
+def test_plan_with_a_time_limit_says_how_far_it_got(capsys, files):
+    assert main(["plan", *map(str, files), "--time-limit", "1e-9"]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("NO PLAN within the limit: stopped at the 1e-09 s time limit")
+    assert main(["plan", *map(str, files), "--time-limit", "0"]) == 2
+    assert "expected seconds > 0" in capsys.readouterr().err
