@@ -11,6 +11,7 @@ World frame = the robot base frame (``panda_link0``); the table surface is z = 0
 
 from __future__ import annotations
 
+import colorsys
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -104,10 +105,13 @@ def cube_yaw(rotation) -> float:
 
 
 def colour(index: int, palette=PALETTE) -> tuple[float, float, float]:
-    """RGB in [0, 1] of the block at ``index`` in the problem's entity order."""
-    if index >= len(palette):
-        raise SceneError(f"the scene has {len(palette)} block colours, block #{index + 1} has none")
-    return palette[index][1]
+    """RGB in [0, 1] of the block at ``index`` in the problem's entity order. Blocks beyond
+    the palette get generated colours (golden-ratio hues, two brightnesses): only the camera
+    tells blocks apart by colour, and it refuses more than `CAMERA_COLOURS` blocks."""
+    if index < len(palette):
+        return palette[index][1]
+    hue, value = (index * 0.618034) % 1.0, 0.85 if index % 2 else 0.55
+    return tuple(float(c) for c in colorsys.hsv_to_rgb(hue, 0.75, value))
 
 
 def towers(entities: Sequence[str], state: Sequence[str]) -> list[list[str]]:
@@ -135,8 +139,6 @@ def layout(
     """Poses for a crisp state: towers on random slots (or tower i, in `towers` order, on slot
     ``slots[i]`` of ``config.slots``), stacked exactly, jittered in xy and yaw."""
     stacks = towers(entities, state)
-    if len(entities) > len(config.palette):
-        raise SceneError(f"{len(entities)} blocks, but the scene has {len(config.palette)} colours")
     if len(stacks) > len(config.slots) - 1:
         raise SceneError(f"{len(stacks)} towers need more than the {len(config.slots)} slots")
     if max(len(t) for t in stacks) > config.max_height:

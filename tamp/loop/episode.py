@@ -32,7 +32,7 @@ from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
 from tamp.loop.score import Scorer
-from tamp.scene import Pose, Reading, layout
+from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from task.domains import get_domain
@@ -63,6 +63,11 @@ class Episode:
         self.target = problem  # what the robot plans for and tests: the goal it perceives
         perceiver = self.goal_image = None
         if config.observe == "camera":
+            if problem.n > CAMERA_COLOURS:
+                raise SceneError(
+                    f"{problem.n} blocks, but the camera tells at most {CAMERA_COLOURS} apart "
+                    "by colour (observe the state instead)"
+                )
             perceiver, self.goal_image, self.target = camera_goal(problem, config, seed)
         self.sim = make_simulator(
             config.sim, problem.entities, poses, config.scene, config.grasp, config.camera

@@ -10,6 +10,7 @@ from tamp.scene import (
     Pose,
     SceneConfig,
     SceneError,
+    colour,
     cube_yaw,
     free_slot,
     layout,
@@ -63,7 +64,7 @@ def test_full_table_has_no_free_slot():
 def test_bad_scene_inputs_are_clear_errors():
     with pytest.raises(ProblemError, match="unknown target"):
         place_pose(Move("a", "zz"), layout(("a",), (TABLE,)))
-    with pytest.raises(SceneError, match="colours"):
+    with pytest.raises(SceneError, match="towers need more than"):
         layout(tuple("abcdefghijk"), (TABLE,) * 11)
     with pytest.raises(ProblemError, match="cycle"):
         towers(("a", "b"), ("b", "a"))
@@ -100,3 +101,26 @@ def test_free_slot_prefers_room_away_from_towers_then_nearness():
     # -0.16 and 0.16 are free and nearest, but right beside the tower
     assert free_slot(poses, (0.5, 0.0), config) in ((0.5, -0.32), (0.5, 0.32))
     assert free_slot(poses, (0.5, 0.3), config) == (0.5, 0.32)
+
+
+def test_blocks_beyond_the_palette_get_distinct_colours():
+    names = tuple(f"b{i}" for i in range(14))
+    state = (
+        TABLE,
+        "b0",
+        "b1",
+        "b2",
+        TABLE,
+        "b4",
+        "b5",
+        "b6",
+        TABLE,
+        "b8",
+        "b9",
+        "b10",
+        TABLE,
+        "b12",
+    )
+    assert len(layout(names, state)) == 14  # more blocks than the 10 palette colours
+    rgbs = [colour(i) for i in range(14)]
+    assert len(set(rgbs)) == 14 and all(0.0 <= c <= 1.0 for rgb in rgbs for c in rgb)

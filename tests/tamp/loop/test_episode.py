@@ -181,3 +181,10 @@ def test_a_loose_block_is_tidied_onto_the_table_and_the_episode_goes_on(solver, 
     assert any(str(m.move) == "move(c -> table)" and m.ok for m in report.moves)
     assert any(e.startswith("tidy c onto the table: ") for e in events)
     assert report.reached_goal, report.reason
+
+
+def test_the_camera_refuses_more_blocks_than_it_has_colours_before_any_simulator_starts():
+    names = tuple("abcdefghi")  # 9 blocks; the camera tells 8 apart by colour
+    problem = Problem("nine", "blocksworld", names, (TABLE,) * 9, (("a", "b"),))
+    with pytest.raises(TampError, match="camera tells at most 8"):
+        Episode(problem, LoopConfig(observe="camera"))
