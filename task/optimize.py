@@ -48,9 +48,9 @@ def optimise_window(
     extra = beliefs.parameters() if beliefs is not None else []
     if extra:
         groups.append({"params": extra, "lr": beliefs.lr})
-    opt = torch.optim.Adam(groups)
+    opt = Adam(groups)
     for k in range(config.iters):
-        opt.zero_grad(set_to_none=True)
+        opt.zero_grad()
         tau = temperature(config, k)
         live, penalty = with_beliefs(batch, beliefs)
         (rollout(domain, logits, live, steps, config, tau).loss.sum() + penalty).backward()
@@ -59,6 +59,36 @@ def optimise_window(
         tau = temperature(config, config.iters - 1)
         live, _ = with_beliefs(batch, beliefs)
         return logits.detach(), rollout(domain, logits, live, steps, config, tau)
+
+
+class Adam:
+    """Adam (Kingma & Ba 2015; betas 0.9, 0.999, eps 1e-8), step for step the arithmetic of
+    `torch.optim.Adam`'s single-tensor path, which planning used before. Written out because
+    every `torch.optim` step imports ``torch._dynamo`` first, 0.8 s of the first plan."""
+
+    def __init__(self, groups: list[dict], betas=(0.9, 0.999), eps: float = 1e-8) -> None:
+        self.groups, (self.beta1, self.beta2), self.eps = groups, betas, eps
+        self.state: dict[int, list] = {}  # id(param) -> [steps, first moment, second moment]
+
+    def zero_grad(self) -> None:
+        for group in self.groups:
+            for p in group["params"]:
+                p.grad = None
+
+    @torch.no_grad()
+    def step(self) -> None:
+        b1, b2 = self.beta1, self.beta2
+        for group in self.groups:
+            for p in group["params"]:
+                if p.grad is None:
+                    continue  # as torch.optim: no gradient, no step
+                state = self.state.setdefault(id(p), [0, torch.zeros_like(p), torch.zeros_like(p)])
+                state[0] += 1
+                k, m, v = float(state[0]), state[1], state[2]
+                m.lerp_(p.grad, 1 - b1)
+                v.mul_(b2).addcmul_(p.grad, p.grad, value=1 - b2)
+                denom = (v.sqrt() / (1 - b2**k) ** 0.5).add_(self.eps)
+                p.addcdiv_(m, denom, value=-(group["lr"] / (1 - b1**k)))
 
 
 def with_beliefs(batch: SoftBatch, beliefs: WindowBeliefs | None) -> tuple[SoftBatch, Tensor]:

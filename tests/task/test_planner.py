@@ -245,3 +245,24 @@ def test_a_time_limit_stops_the_planner_and_says_how_far_it_got():
     assert "time_limit" not in plan(problem, PlannerConfig(time_limit_s=600), seed=0).stats
     with pytest.raises(TampError, match="time_limit_s must be > 0"):
         PlannerConfig(time_limit_s=0)
+
+
+def test_the_planners_adam_is_torch_adam_step_for_step():
+    from task.optimize import Adam
+
+    gen = torch.Generator().manual_seed(0)
+    x0 = torch.randn(4, 3, generator=gen)
+    y0 = torch.randn(5, generator=gen)
+    ours = [x0.clone().requires_grad_(True), y0.clone().requires_grad_(True)]
+    ref = [x0.clone().requires_grad_(True), y0.clone().requires_grad_(True)]
+    opt = Adam([{"params": [ours[0]], "lr": 0.1}, {"params": [ours[1]], "lr": 1e-3}])
+    ref_opt = torch.optim.Adam([{"params": [ref[0]], "lr": 0.1}, {"params": [ref[1]], "lr": 1e-3}])
+    for k in range(30):
+        for params, o in ((ours, opt), (ref, ref_opt)):
+            o.zero_grad()
+            loss = (params[0].sin() * (k + 1)).sum() + (params[1] ** 3).sum()
+            if k % 4 == 3:  # a step where one parameter has no gradient
+                loss = (params[0] ** 2).sum()
+            loss.backward()
+            o.step()
+        assert torch.equal(ours[0], ref[0]) and torch.equal(ours[1], ref[1]), k
