@@ -68,6 +68,7 @@ class Speed:
     sequential_s: float
     batched_valid: int
     sequential_valid: int
+    latency_s: dict[str, float] | None = None  # one problem at a time: p50, p90, max seconds
 
     @property
     def speedup(self) -> float | None:
@@ -173,9 +174,11 @@ def run(
         cfg = replace(config, horizon=horizons[0])
         fast = run_once(suite, replace(cfg, batched=True), seeds[0], progress, subset)
         slow = run_once(suite, replace(cfg, batched=False), seeds[0], progress, subset)
-        speed = Speed(
-            len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s, fast.valid(), slow.valid()
-        )
+        times = sorted(r.time_s for r in slow.rows)
+        latency = {q: times[min(len(times) - 1, int(f * len(times)))] for q, f in
+                   (("p50", 0.5), ("p90", 0.9))} | {"max": times[-1]}  # fmt: skip
+        speed = Speed(len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s,
+                      fast.valid(), slow.valid(), latency)  # fmt: skip
     n = len(suite.instances)
     size_name = get_domain(domain_of(suite)).size_name
     return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed, size_name)

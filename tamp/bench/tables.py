@@ -121,6 +121,10 @@ def planning_report(bench: Bench) -> str:
             f"{sp.seed}): {sp.batched_s:.1f} s vs {sp.sequential_s:.1f} s, batched {ratio} "
             f"faster; valid {sp.batched_valid} vs {sp.sequential_valid}",
         ]
+        if sp.latency_s:
+            q = sp.latency_s
+            lines.append(f"one problem at a time, planning latency: p50 {q['p50']:.3f} s, "
+                         f"p90 {q['p90']:.3f} s, max {q['max']:.3f} s")  # fmt: skip
     return "\n".join(lines)
 
 

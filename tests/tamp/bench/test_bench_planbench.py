@@ -83,6 +83,8 @@ def test_run_ablation_sequential_and_artefacts(tmp_path):
     assert speed.batched_valid == speed.sequential_valid == speed.n
     assert speed.batched_s > 0 and speed.sequential_s > 0
     assert speed.speedup == pytest.approx(speed.sequential_s / speed.batched_s)
+    q = speed.latency_s  # per-problem planning latency of the one-at-a-time run
+    assert 0 < q["p50"] <= q["p90"] <= q["max"] <= speed.sequential_s
     paths = bench_io.write(result, tmp_path / "out")
     report = json.loads(paths[1].read_text())
     assert report["config"]["restarts"] == 4 and report["horizons"] == [1, 3]
