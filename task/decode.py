@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from torch import Tensor
 
@@ -58,10 +58,13 @@ def decode_row(
     threshold: float,
     loss: float,
     check: bool = True,
+    seen: Collection[State] = (),
 ) -> DecodedWindow:
     """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row.
 
-    ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``)."""
+    ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``);
+    ``seen``: states the plan already passed through (the window is a ``revisit`` if it ends
+    in one)."""
     n = gates.shape[1]
     best, flat = gates.flatten(1).max(-1)  # (T,), (T,)
     moves: list = []
@@ -88,8 +91,9 @@ def decode_row(
     remaining = 0 if reached else domain.lower_bound(problem, state)
     estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
     estimated = None if reached or estimate is None else estimate(problem, state)
-    moves_ = tuple(moves)
-    return DecodedWindow(moves_, state, reached, complete, loss, remaining, illegal, estimated)
+    return DecodedWindow(
+        tuple(moves), state, reached, complete, loss, remaining, illegal, estimated, state in seen
+    )
 
 
 def decode_best(
@@ -112,12 +116,11 @@ def decode_best(
     out = []
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
         rows = range(i * restarts, (i + 1) * restarts)
+        seen = () if visited is None else visited[i]
         windows = [
-            decode_row(domain, problem, state, gates[r], threshold, losses[r], check) for r in rows
+            decode_row(domain, problem, state, gates[r], threshold, losses[r], check, seen)
+            for r in rows
         ]
-        if visited is not None:
-            seen = visited[i]
-            windows = [replace(w, revisit=w.state in seen) for w in windows]
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
     return out
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
-import json
 import math
 import os
 import signal
@@ -35,7 +34,7 @@ from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
-from tamp.bench.optimal import digest
+from tamp.bench.optimal import digest, read_cache, write_cache
 from task.errors import DataError
 
 PACKAGE = "up-fast-downward==1.0.0"
@@ -218,28 +217,6 @@ def optimal_length(
     return _solve(driver, domain, problem, time_limit_s, memory_mb)
 
 
-def _load(path: Path) -> dict[str, dict]:
-    """The cache's entries ``{key: FDResult fields + time_limit_s}``; empty if unreadable."""
-    try:
-        cached = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return {}
-    ok = isinstance(cached, dict) and cached.get("method") == METHOD
-    return cached["problems"] if ok and isinstance(cached.get("problems"), dict) else {}
-
-
-def _save(path: Path, entries: dict[str, dict]) -> None:
-    """Replace ``path`` atomically, so an interrupted run never leaves half a file."""
-    text = json.dumps({"method": METHOD, "problems": entries}, indent=1, sort_keys=True)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        partial = path.with_name(f"{path.name}.partial")
-        partial.write_text(text + "\n", encoding="utf-8")
-        os.replace(partial, path)
-    except OSError as exc:
-        raise DataError(f"{path}: cannot write the optimum cache ({exc.strerror or exc})") from None
-
-
 def _reusable(entry: object, time_limit_s: float) -> FDResult | None:
     """A cached result that a run with ``time_limit_s`` would not change, else None: proofs
     (optimal, unsolvable) always, a timeout or memout only if it had at least as much time."""
@@ -273,7 +250,7 @@ def optimal_lengths(
     texts = [(_read(d), _read(p)) for d, p in pairs]
     keys = [digest(f"{digest(d)}:{digest(p)}") for d, p in texts]
     path = None if cache_path is None else Path(cache_path)
-    entries = {} if path is None else _load(path)
+    entries = {} if path is None else read_cache(path, METHOD, "problems")
     results: list[FDResult | None] = [_reusable(entries.get(k), time_limit_s) for k in keys]
     todo = [i for i, r in enumerate(results) if r is None]
     report(len(keys) - len(todo))
@@ -289,7 +266,7 @@ def optimal_lengths(
                     results[jobs[job]] = result = job.result()
                     if path and result.status != "error" and GUARD not in result.detail:
                         entries[keys[jobs[job]]] = {**asdict(result), "time_limit_s": time_limit_s}
-                        _save(path, entries)
+                        write_cache(path, entries, METHOD, "problems")
                     report(1)
         except BaseException:
             stop.set()

@@ -57,17 +57,6 @@ class LatPlanData:
     folders: tuple[Path, ...]
 
 
-def parse_list(text: str, valid: Sequence[str], option: str) -> tuple[str, ...]:
-    """``a,b`` as a tuple of known values; TampError naming an unknown one and the valid ones."""
-    chosen = tuple(dict.fromkeys(t.strip() for t in text.split(",") if t.strip()))
-    for t in chosen:
-        if t not in valid:
-            raise TampError(f"{option}: unknown value {t!r}; expected some of {', '.join(valid)}")
-    if not chosen:
-        raise TampError(f"{option}: expected some of {', '.join(valid)}")
-    return chosen
-
-
 def load(root: str | Path = DEFAULT, limit: int | None = None) -> LatPlanData:
     """The instances of ``root`` listed in its manifest (``limit``: a spread of them)."""
     root = Path(root)

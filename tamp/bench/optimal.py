@@ -35,21 +35,25 @@ def _search(problem: Problem) -> int | None:
     return None if moves is None else 2 * len(moves)
 
 
-def _read(path: Path) -> dict[str, dict]:
-    """The cached entries ``{name: {"sha256": ..., "optimal": ...}}``; empty if unreadable."""
+def read_cache(path: Path, method: str = METHOD, key: str = "instances") -> dict[str, dict]:
+    """A JSON cache's entries (its ``key`` field) when it was written by ``method``; empty if
+    missing, unreadable or made another way (the optimum caches of this module and of
+    `tamp.bench.fast_downward`)."""
     try:
         cached = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return {}
-    if not isinstance(cached, dict) or cached.get("method") != METHOD:
+    if not isinstance(cached, dict) or cached.get("method") != method:
         return {}
-    entries = cached.get("instances")
+    entries = cached.get(key)
     return entries if isinstance(entries, dict) else {}
 
 
-def _write(path: Path, entries: dict[str, dict]) -> None:
+def write_cache(
+    path: Path, entries: dict[str, dict], method: str = METHOD, key: str = "instances"
+) -> None:
     """Replace ``path`` atomically, so an interrupted run never leaves half a file."""
-    text = json.dumps({"method": METHOD, "instances": entries}, indent=1, sort_keys=True)
+    text = json.dumps({"method": method, key: entries}, indent=1, sort_keys=True)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         partial = path.with_name(f"{path.name}.partial")
@@ -76,7 +80,7 @@ def optimal_lengths(
     every length is searched and nothing is written.
     """
     path = None if cache_dir is None else Path(cache_dir) / CACHE_FILE
-    entries = {} if path is None else _read(path)
+    entries = {} if path is None else read_cache(path)
     lengths = []
     changed = False
     for name, key, problem in problems:
@@ -85,5 +89,5 @@ def optimal_lengths(
             changed = True
         lengths.append(entries[name]["optimal"])
     if path is not None and changed:
-        _write(path, entries)
+        write_cache(path, entries)
     return lengths

@@ -132,16 +132,17 @@ def parse_corruption(text: str) -> Corruption:
 
 def parse_modes(text: str) -> tuple[str, ...]:
     """``state,frozen,optimised`` as a tuple; TampError naming an unknown mode."""
-    return _choices(text, MODES, "--modes", "mode")
+    return choices(text, MODES, "--modes", "mode")
 
 
 def parse_crisp(text: str) -> tuple[str, ...]:
     """``true,perceived`` as a tuple; TampError naming an unknown crisp protocol."""
-    return _choices(text, CRISP, "--crisp", "crisp protocol")
+    return choices(text, CRISP, "--crisp", "crisp protocol")
 
 
-def _choices(text: str, valid: Sequence[str], option: str, noun: str) -> tuple[str, ...]:
-    chosen = tuple(dict.fromkeys(m for m in text.split(",") if m))
+def choices(text: str, valid: Sequence[str], option: str, noun: str) -> tuple[str, ...]:
+    """``a,b`` as a tuple of known values; TampError naming an unknown one and the valid ones."""
+    chosen = tuple(dict.fromkeys(m.strip() for m in text.split(",") if m.strip()))
     for m in chosen:
         if m not in valid:
             raise TampError(f"{option}: unknown {noun} {m!r}; expected some of {', '.join(valid)}")

@@ -41,6 +41,24 @@ def sample_scene(rng: np.random.Generator, min_blocks: int, max_blocks: int):
     return names, colours, state
 
 
+def check_settings(sims: Sequence[str], min_blocks: int, max_blocks: int, most: int) -> None:
+    """One-line TampError for an unknown simulator or a block range outside 1..``most``."""
+    for sim in sims:
+        if sim not in SIMULATORS:
+            raise TampError(f"unknown simulator {one_of(sim, SIMULATORS)}")
+    if not 1 <= min_blocks <= max_blocks <= most:
+        raise TampError(f"need 1 <= min_blocks <= max_blocks <= {most}")
+
+
+def label_row(names, colours, state, width: int) -> tuple[np.ndarray, np.ndarray]:
+    """One sample's ``colours`` and ``supports`` rows (`perception.data`), padded to ``width``."""
+    row_c = np.full(width, -1, dtype=np.int8)
+    row_s = np.full(width, pdata.PAD, dtype=np.int8)
+    row_c[: len(names)] = colours
+    row_s[: len(names)] = [pdata.TABLE if s == TABLE else names.index(s) for s in state]
+    return row_c, row_s
+
+
 def generate(
     n: int,
     seed: int = 0,
@@ -52,11 +70,7 @@ def generate(
     meta: dict | None = None,
 ) -> pdata.SupportData:
     """``n`` rendered samples, seeded; ``progress(k)`` reports k more samples done."""
-    for sim in sims:
-        if sim not in SIMULATORS:
-            raise TampError(f"unknown simulator {one_of(sim, SIMULATORS)}")
-    if not 1 <= min_blocks <= max_blocks <= CAMERA_COLOURS:
-        raise TampError(f"need 1 <= min_blocks <= max_blocks <= {CAMERA_COLOURS}")
+    check_settings(sims, min_blocks, max_blocks, CAMERA_COLOURS)
     scene = replace(SceneConfig(), jitter_xy=jitter.place_xy, jitter_yaw=jitter.place_yaw)
     palette = np.asarray(block_colours(CAMERA_COLOURS), dtype=np.float32)
     images, colours_out, supports_out = [], [], []
@@ -79,10 +93,7 @@ def generate(
                     break
                 except PerceptionError:
                     redrawn += 1
-            row_c = np.full(max_blocks, -1, dtype=np.int8)
-            row_s = np.full(max_blocks, pdata.PAD, dtype=np.int8)
-            row_c[: len(names)] = colours
-            row_s[: len(names)] = [pdata.TABLE if s == TABLE else names.index(s) for s in state]
+            row_c, row_s = label_row(names, colours, state, max_blocks)
             images.append(image)
             colours_out.append(row_c)
             supports_out.append(row_s)

@@ -30,11 +30,10 @@ import cv2
 import numpy as np
 
 from perception import data as pdata
+from tamp.camera.dataset import check_settings, label_row
 from tamp.camera.render import StateRenderer, ViewJitter, jitter_camera
 from tamp.scene import SceneConfig, towers
 from tamp.sim.base import SIMULATORS, Camera, Lighting
-from task.errors import TampError, one_of
-from task.problem import TABLE
 from task.symbolic.generate import block_names, random_towers
 
 COLOURS = (("red", (1.0, 0.0, 0.0)), ("blue", (0.0, 0.0, 1.0)), ("green", (0.0, 1.0, 0.0)),
@@ -159,7 +158,7 @@ def _finish(image: np.ndarray, rng: np.random.Generator, rand: Randomisation) ->
 
 def downscale(images: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """(M, H, W, 3) uint8 -> (M, h, w, 3) by area averaging; ``size`` is (w, h)."""
-    return np.stack([cv2.resize(im, size, interpolation=cv2.INTER_AREA) for im in images])
+    return np.stack([pdata.resize_image(im, size[::-1]) for im in images])
 
 
 def generate(
@@ -180,17 +179,14 @@ def generate(
     LatPlan's are). ``exclude``: layouts never to draw (`evaluation_layouts`); ``meta['slots']``
     gives the table slot (0..4, left to right) of each block's tower, -1 for padding.
     """
-    for sim in sims:
-        if sim not in SIMULATORS:
-            raise TampError(f"unknown simulator {one_of(sim, SIMULATORS)}")
-    if not 1 <= min_blocks <= max_blocks <= len(COLOURS):
-        raise TampError(f"need 1 <= min_blocks <= max_blocks <= {len(COLOURS)}")
+    check_settings(sims, min_blocks, max_blocks, len(COLOURS))
     excluded = frozenset(exclude or ())
     scene, camera = latplan_scene(), latplan_camera()
     k = unit(scene.block_size)
     scene = replace(scene, jitter_xy=rand.place_clevr * k)
     jitter = ViewJitter(rand.eye_clevr * k, rand.target_clevr * k, rand.fovy_deg)
     images, colours_out, supports_out, slots_out = [], [], [], []
+    slot_xs = np.asarray(scene.slot_xs)
     redrawn = 0
     renderers = {sim: StateRenderer(sim, scene, camera) for sim in sims}
     try:
@@ -218,11 +214,7 @@ def generate(
                 shade = np.asarray(rgb) * gain + rng.uniform(0.0, rand.shade_offset, 3)
                 sim.set_colour(name, np.clip(shade, 0.0, 1.0))
             images.append(_finish(sim.render(), rng, rand))
-            slot_xs = np.asarray(scene.slot_xs)
-            row_c = np.full(max_blocks, -1, dtype=np.int8)
-            row_s = np.full(max_blocks, pdata.PAD, dtype=np.int8)
-            row_c[:m] = colours
-            row_s[:m] = [pdata.TABLE if s == TABLE else names.index(s) for s in state]
+            row_c, row_s = label_row(names, colours, state, max_blocks)
             colours_out.append(row_c)
             supports_out.append(row_s)
             where = [int(np.abs(slot_xs - poses[x].xyz[0]).argmin()) for x in names]

@@ -235,9 +235,10 @@ def latplan_command(args: argparse.Namespace) -> int:
     import torch
 
     from tamp.bench import latplan
+    from tamp.bench.perception import choices
 
-    res = latplan.parse_list(args.res, tuple(latplan.FILES), "--res")
-    modes = latplan.parse_list(args.modes, latplan.MODES, "--modes")
+    res = choices(args.res, tuple(latplan.FILES), "--res", "resolution")
+    modes = choices(args.modes, latplan.MODES, "--modes", "mode")
     data = latplan.load(args.data, args.limit)
     images = any(m != "state" for m in modes)
     perceiver = latplan.load_perceiver(args.checkpoint) if images else None

@@ -106,11 +106,7 @@ def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None 
 
 def problem_from_text(domain: Domain, text: str, source: str = "<problem>") -> Problem:
     """Parse problem PDDL text (keeping the file's object order) into a `Problem`."""
-    parsed = pddl_io.parse_problem(text, source, domain)
-    try:
-        return from_pddl(domain, parsed, pddl_io.object_order(text))
-    except PDDLError as exc:
-        raise PDDLError(f"{source}: {exc}") from None
+    return pddl_io.problem_with(from_pddl, domain, text, source)
 
 
 # ------------------------------------------------------------------------------ PDDL out

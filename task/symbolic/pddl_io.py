@@ -192,3 +192,14 @@ def write_plan(actions: Iterable[Action], path: str | Path) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(format_plan(actions), encoding="utf-8")
     return out
+
+
+def problem_with(from_pddl, domain, text: str, source: str = "<problem>"):
+    """Problem PDDL ``text`` parsed against ``domain`` and turned into a `Problem` by a domain
+    file's ``from_pddl(domain, parsed, order)`` (the file's object order kept); a PDDLError
+    of either step names ``source``."""
+    parsed = parse_problem(text, source, domain)
+    try:
+        return from_pddl(domain, parsed, object_order(text))
+    except PDDLError as exc:
+        raise PDDLError(f"{source}: {exc}") from None
