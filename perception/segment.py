@@ -147,6 +147,36 @@ def scaled_min_area(shape: Sequence[int], config: SegmentConfig = SegmentConfig(
     return max(config.min_area_floor, round(config.min_area * share))
 
 
+def _largest_regions(image, colours, config: SegmentConfig) -> list[tuple[tuple, int]]:
+    """Per colour, the box (x0, y0, x1, y1) and pixel area of its largest connected region
+    after the small opening (area 0 and a dummy box when the colour shows nowhere)."""
+    labels = colour_labels(image, colours, config)  # (H, W)
+    opening = min(image.shape[:2]) >= config.open_min_side
+    kernel = np.ones((2, 2), np.uint8)
+    out = []
+    for k in range(len(colours)):
+        mask = (labels == k).astype(np.uint8)
+        if opening:
+            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
+        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        if count < 2:
+            out.append(((0.0, 0.0, 1.0, 1.0), 0))
+            continue
+        best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
+        x, y, w, hh, area = (int(v) for v in stats[best])
+        out.append(((float(x), float(y), float(x + w), float(y + hh)), area))
+    return out
+
+
+def present(
+    image: np.ndarray, colours: Sequence[Sequence[float]], config: SegmentConfig = SegmentConfig()
+) -> list[bool]:
+    """Whether each colour shows a region big enough to be a block (as `find_boxes` counts)."""
+    check_image(image)
+    min_area = scaled_min_area(image.shape, config)
+    return [area >= min_area for _, area in _largest_regions(image, colours, config)]
+
+
 def find_boxes(
     image: np.ndarray,
     colours: Sequence[Sequence[float]],
@@ -162,28 +192,12 @@ def find_boxes(
     names = [f"#{i}" for i in range(len(colours))] if names is None else list(names)
     if len(names) != len(colours):
         raise PerceptionError(f"{len(names)} block names for {len(colours)} colours")
-    labels = colour_labels(image, colours, config)  # (H, W)
-    opening = min(image.shape[:2]) >= config.open_min_side
     min_area = scaled_min_area(image.shape, config)
-    kernel = np.ones((2, 2), np.uint8)
-    boxes, missing = [], []
-    for k, name in enumerate(names):
-        mask = (labels == k).astype(np.uint8)
-        if opening:
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, kernel)
-        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        if count < 2:
-            missing.append(name)
-            boxes.append((0.0, 0.0, 1.0, 1.0))
-            continue
-        best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
-        x, y, w, hh, area = (int(v) for v in stats[best])
-        if area < min_area:
-            missing.append(name)
-        boxes.append((float(x), float(y), float(x + w), float(y + hh)))
+    regions = _largest_regions(image, colours, config)
+    missing = [name for name, (_, area) in zip(names, regions, strict=True) if area < min_area]
     if missing:
         raise PerceptionError(
             f"block(s) {', '.join(missing)} not found in the image (occluded, out of view or "
             f"absent): fewer than {min_area} pixels of their colour"
         )
-    return np.asarray(boxes, dtype=np.float32).reshape(len(colours), 4)
+    return np.asarray([box for box, _ in regions], dtype=np.float32).reshape(len(colours), 4)

@@ -22,7 +22,7 @@ import numpy as np
 import torch
 
 from perception.perceive import Perceiver
-from perception.segment import SegmentConfig, colour_labels, scaled_min_area
+from perception.segment import present
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
 from tamp.scene import CAMERA_COLOURS, PALETTE
 from task.config import PlannerConfig
@@ -62,21 +62,6 @@ def read_image(path: str | Path) -> np.ndarray:
     return np.ascontiguousarray(cv2.cvtColor(raw, code))
 
 
-def found_colours(image: np.ndarray, rgbs, config: SegmentConfig = SegmentConfig()) -> list[bool]:
-    """Whether each colour shows a region big enough to be a block (as `find_boxes` counts)."""
-    labels = colour_labels(image, rgbs, config)  # (H, W)
-    min_area = scaled_min_area(image.shape, config)
-    opening = min(image.shape[:2]) >= config.open_min_side
-    out = []
-    for k in range(len(rgbs)):
-        mask = (labels == k).astype(np.uint8)
-        if opening:
-            mask = cv2.morphologyEx(mask, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
-        count, _, stats, _ = cv2.connectedComponentsWithStats(mask, connectivity=8)
-        out.append(count > 1 and int(stats[1:, cv2.CC_STAT_AREA].max()) >= min_area)
-    return out
-
-
 def check_sizes(images: Sequence[np.ndarray], paths: Sequence[str], model) -> None:
     """One-line errors for images of different sizes or a size the model cannot read."""
     (h0, w0), (h1, w1) = images[0].shape[:2], images[1].shape[:2]
@@ -97,7 +82,7 @@ def blocks_in(
     block found in one image only and for images with no block."""
     palette = scene_colours(scene)
     rgbs = [rgb for _, rgb in palette]
-    seen = [found_colours(im, rgbs) for im in images]
+    seen = [present(im, rgbs) for im in images]
     odd = [
         f"{name} is in {paths[0 if a else 1]} but not in {paths[1 if a else 0]}"
         for (name, _), a, b in zip(palette, *seen, strict=True)
