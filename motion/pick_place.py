@@ -41,6 +41,7 @@ class PickPlaceConfig:
     block_size: float = 0.05  # m, cube edge
     max_joint_jump: float = 0.5  # rad, per-joint change between waypoints that triggers a re-solve
     vertical_step: float = 0.02  # m, IK knot spacing on the vertical moves (straight in space)
+    min_approach: float = 0.02  # m, least descent onto a block under a ceiling (no_clearance)
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,8 @@ class PickPlaceRequest:
     place: tuple[float, float, float]  # block centre after placing (on top of the target)
     place_yaw: float  # rad, block yaw after placing (modulo pi/2)
     clear_z: float  # m, height of the highest stack top that transit must clear
+    pick_ceiling: float = math.inf  # m, highest TCP height over the pick point (a shelf above)
+    place_ceiling: float = math.inf  # m, ... over the place point
 
 
 @dataclass(frozen=True)
@@ -65,7 +68,8 @@ class Phase:
 
 @dataclass(frozen=True)
 class MotionResult:
-    """Phases in execution order (empty unless ``ok``); ``failure`` is "ik_infeasible" or None."""
+    """Phases in execution order (empty unless ``ok``); ``failure`` is "ik_infeasible",
+    "no_clearance" (a ceiling leaves the hand no room to come down) or None."""
 
     ok: bool
     phases: tuple[Phase, ...]
@@ -101,11 +105,14 @@ def waypoint_targets(
     pre_grasp = pick + (half + config.approach_height) * up
     retreat = place_tcp + config.approach_height * up
     pre_grasp[2], retreat[2] = max(pre_grasp[2], z_hover), max(retreat[2], z_hover)
+    # under a shelf the hand stays below its ceiling there; transit then leaves sideways
+    top_pick, top_place = request.pick_ceiling, request.place_ceiling
+    pre_grasp[2], retreat[2] = min(pre_grasp[2], top_pick), min(retreat[2], top_place)
     xyz_yaw = (
         (pre_grasp, yaw_grasp),
         (pick, yaw_grasp),
-        ((pick[0], pick[1], z_transit), yaw_grasp),
-        ((place[0], place[1], z_transit), yaw_place),
+        ((pick[0], pick[1], min(z_transit, top_pick)), yaw_grasp),
+        ((place[0], place[1], min(z_transit, top_place)), yaw_place),
         (place_tcp, yaw_place),
         (retreat, yaw_place),
     )
@@ -164,6 +171,14 @@ def plan_pick_place(
     if q_now.shape != (solver.dof,) or not np.isfinite(q_now).all():
         raise MotionError(f"q_now has shape {q_now.shape}; expected finite ({solver.dof},)")
     targets = waypoint_targets(request, pose_yaw(solver.fk(q_now)[0]), config)  # (6, 4, 4)
+    room = min(targets[0, 2, 3] - targets[1, 2, 3], targets[5, 2, 3] - targets[4, 2, 3])
+    if room < config.min_approach:  # a ceiling over the pick or the place is too low
+        evidence = {
+            "pick_ceiling": request.pick_ceiling,
+            "place_ceiling": request.place_ceiling,
+            "approach_m": round(float(room), 4),
+        }
+        return MotionResult(False, (), "no_clearance", evidence)
     start = time.perf_counter()
     ok, q, pos_err, rot_err, resolved = _solve_waypoints(
         solver, targets, q_now, config.max_joint_jump

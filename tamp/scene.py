@@ -81,6 +81,8 @@ class SceneConfig:
     floor_grey: float = 0.45  # RGB level of the floor, in [0, 1]
     backdrop_y: float | None = None  # a vertical backdrop wall across the view at this y, m
     backdrop_grey: float = 0.45
+    obstacles: tuple = ()  # fixed boxes (`tamp.obstacles.Obstacle`); see tamp.obstacles.SCENES
+    name: str = "tabletop"  # the named scene the obstacles come from
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
@@ -89,6 +91,16 @@ class SceneConfig:
     @property
     def slots(self) -> tuple[tuple[float, float], ...]:
         return tuple((x, y) for x in self.slot_xs for y in self.slot_ys)
+
+    def capacity(self, slot: Sequence[float]) -> int:
+        """Blocks a tower on ``slot`` (x, y) may have: ``max_height``, or fewer under an
+        overhead obstacle (`tamp.obstacles.slot_capacity`)."""
+        if not self.obstacles:
+            return self.max_height
+        from tamp.obstacles import slot_capacity
+
+        limit = slot_capacity(slot, self.obstacles, self.block_size)
+        return self.max_height if limit is None else min(limit, self.max_height)
 
 
 def cube_yaw(rotation) -> float:
@@ -146,6 +158,8 @@ def layout(
     rng = np.random.default_rng(seed)
     s = config.block_size
     order = rng.permutation(len(config.slots))[: len(stacks)]
+    if config.obstacles and slots is None:  # each tower on a slot with room for it
+        order = _fit(stacks, rng.permutation(len(config.slots)), config)
     if slots is not None:
         if len(slots) != len(stacks) or len(set(slots)) != len(slots):
             raise SceneError(f"slots must give each of the {len(stacks)} towers its own slot")
@@ -160,6 +174,19 @@ def layout(
             yaw = float(rng.uniform(-config.jitter_yaw, config.jitter_yaw))
             poses[x] = Pose((sx + dx, sy + dy, s / 2 + level * s), yaw)
     return poses
+
+
+def _fit(stacks: list[list[str]], order: np.ndarray, config: SceneConfig) -> list[int]:
+    """Slots (in ``order``'s preference) for the towers, tallest first, each within capacity."""
+    chosen: dict[int, int] = {}
+    for i in sorted(range(len(stacks)), key=lambda i: -len(stacks[i])):
+        room = [k for k in order if k not in chosen.values()]
+        fits = [k for k in room if config.capacity(config.slots[k]) >= len(stacks[i])]
+        if not fits:
+            raise SceneError(f"no slot of scene {config.name!r} has room for a tower of "
+                             f"{len(stacks[i])} blocks")  # fmt: skip
+        chosen[i] = int(fits[0])
+    return [chosen[i] for i in range(len(stacks))]
 
 
 @dataclass(frozen=True)
@@ -217,34 +244,54 @@ def top_z(poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()) -> flo
 def free_slot(
     poses: Mapping[str, Pose], near: Sequence[float], config: SceneConfig = SceneConfig()
 ) -> tuple[float, float] | None:
-    """An unoccupied table slot, or None when all are taken.
+    """The best unoccupied table slot (the first of `free_slots`), or None when all are taken."""
+    slots = free_slots(poses, near, config)
+    return slots[0] if slots else None
+
+
+def free_slots(
+    poses: Mapping[str, Pose], near: Sequence[float], config: SceneConfig = SceneConfig()
+) -> list[tuple[float, float]]:
+    """Unoccupied table slots, best first (the arm tries the next when it cannot reach one).
 
     Slots away from every block come first (a slot next to a tower puts the arm's wrist beside
-    that tower, which it can knock over); among those with ``isolation`` m of room, the one
+    that tower, which it can knock over); among those with ``isolation`` m of room, the ones
     nearest to ``near`` (x, y).
     """
 
     def room(slot) -> float:
         return min((math.dist(slot, p.xy) for p in poses.values()), default=math.inf)
 
-    free = [slot for slot in config.slots if room(slot) > config.slot_radius]
-    if not free:
-        return None
-    return min(free, key=lambda s: (-min(room(s), config.isolation), math.dist(s, near[:2])))
+    free = [
+        slot
+        for slot in config.slots
+        if room(slot) > config.slot_radius and config.capacity(slot) > 0
+    ]
+    # unlimited slots before those under an overhead obstacle, when both are as isolated
+    return sorted(
+        free,
+        key=lambda s: (
+            -min(room(s), config.isolation),
+            config.capacity(s) < config.max_height,
+            math.dist(s, near[:2]),
+        ),
+    )
 
 
 def place_pose(
-    move: Move, poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()
+    move: Move, poses: Mapping[str, Pose], config: SceneConfig = SceneConfig(), rank: int = 0
 ) -> Pose | None:
     """Where the moved block's centre should end: on top of the target block, or on a free
-    table slot (None when the table is full)."""
+    table slot, the ``rank``-th best (None when the table has no more free slots)."""
     if move.entity not in poses:
         raise ProblemError(f"unknown block {one_of(move.entity, sorted(poses))}")
     s = config.block_size
     if move.target == TABLE:
         others = {k: v for k, v in poses.items() if k != move.entity}
-        slot = free_slot(others, poses[move.entity].xyz, config)
-        return None if slot is None else Pose((slot[0], slot[1], s / 2), 0.0)
+        slots = free_slots(others, poses[move.entity].xyz, config)
+        if rank >= len(slots):
+            return None
+        return Pose((slots[rank][0], slots[rank][1], s / 2), 0.0)
     if move.target not in poses:
         raise ProblemError(f"unknown target {one_of(move.target, [*sorted(poses), TABLE])}")
     below = poses[move.target]

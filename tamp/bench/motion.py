@@ -43,7 +43,7 @@ from task.symbolic.validate import validate
 
 EPISODE_COLUMNS = (
     "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
-    "disturbed", "sim_time_s", "wall_time_s",
+    "disturbed", "touched", "sim_time_s", "wall_time_s",
 )  # fmt: skip
 
 
@@ -101,6 +101,11 @@ def summarise(
         "sim_per_move_s": sum(m.sim_time_s for m in moves) / max(len(moves), 1),
         "ik_per_move_s": sum(m.ik_time_s for m in moves) / max(len(moves), 1),
         "wall_s": sum(r.wall_time_s for r in reports),
+        "collided": sum(r.collided for r in reports),  # episodes whose arm touched something
+        "touched": dict(sum((Counter(r.touched) for r in reports), Counter())),
+        "rerouted": sum(m.path_time_s > 0 for m in moves),  # moves the motion planner ran on
+        "check_per_move_s": sum(m.check_time_s for m in moves) / max(len(moves), 1),
+        "path_per_move_s": sum(m.path_time_s for m in moves) / max(len(moves), 1),
     }
 
 
@@ -138,6 +143,7 @@ def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
          "reached_goal": r.reached_goal, "moves": len(r.moves),
          "moves_ok": sum(m.ok for m in r.moves), "replans": r.replans,
          "faults": " ".join(r.faults), "disturbed": r.disturbed,
+         "touched": " ".join(f"{k}:{v}" for k, v in sorted(r.touched.items())),
          "sim_time_s": round(r.sim_time_s, 2), "wall_time_s": round(r.wall_time_s, 2)}
         for r in reports
     ]  # fmt: skip

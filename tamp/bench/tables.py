@@ -148,6 +148,13 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
     for sim, s in rows.items():
         kinds = ", ".join(f"{k} {v}" for k, v in sorted(s["failures"].items())) or "none"
         lines.append(f"{sim}: failures by kind: {kinds}; episode outcomes: {s['statuses']}")
+        if "collided" in s:
+            hit = ", ".join(f"{k} {v}" for k, v in sorted(s["touched"].items())) or "nothing"
+            lines.append(
+                f"{sim}: collisions in executed trajectories: {s['collided']} episodes "
+                f"(touched: {hit}); collision checks {s['check_per_move_s']:.3f} s/move; "
+                f"motion planner on {s['rerouted']} moves, {s['path_per_move_s']:.3f} s/move"
+            )
         if inject != "none":
             lines.append(
                 f"{sim}: faults ({inject}) hit {s['with_faults']} episodes, "

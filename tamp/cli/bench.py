@@ -2,9 +2,8 @@
 `tamp.bench` runs, tables out.
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
-bar on stderr, prints its table (``results.json``'s content with ``--json``) and with ``--out
-DIR`` writes its artefacts (`tamp.bench.results`). It exits 0 whatever the scores; 2 on bad input.
-"""
+bar on stderr, prints its table (``--json``: ``results.json``'s content), and with ``--out DIR``
+writes its artefacts (`tamp.bench.results`). Exit 0 whatever the scores; 2 on bad input."""
 
 from __future__ import annotations
 
@@ -143,7 +142,7 @@ def executability_command(args: argparse.Namespace) -> int:
     import torch
 
     from tamp.bench import motion
-    from tamp.loop import LoopConfig
+    from tamp.cli.run import given_config
 
     sims, sources = sim_list(args.sim), motion.read_sources(args.plans)
     suite, out = suites.planbench(args.data, args.n), args.out and results.out_folder(args.out)
@@ -151,12 +150,13 @@ def executability_command(args: argparse.Namespace) -> int:
     ours, wall0 = planner_config(args, "blocksworld") if args.ours else None, time.perf_counter()
     with _bar(len(sims) * len(suite.instances) * (len(sources) + bool(ours)), "executability",
               args.progress) as update:  # fmt: skip
-        rows = motion.run_given(suite, sources, LoopConfig(grasp=args.grasp), sims, args.seed,
+        rows = motion.run_given(suite, sources, given_config(args), sims, args.seed,
                                 ours, lambda sim, row: update(1))  # fmt: skip
     summary, wall = motion.given_summary(rows, sims), time.perf_counter() - wall0
     body = {"config": {"plans": str(args.plans), "sims": sims, "instances": [i.name for i in
                        suite.instances], "seed": args.seed, "grasp": args.grasp, "ours": args.ours,
-                       "data": str(args.data)}, "machine": results.machine(), "wall_s": wall,
+                       "data": str(args.data), "scene": args.scene, "collision": args.collision},
+            "machine": results.machine(), "wall_s": wall,
             "summary": summary}  # fmt: skip
     if out:
         results.write_json(out / "results.json", body)

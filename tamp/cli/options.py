@@ -225,6 +225,16 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
     p.add_argument("--crisp", choices=("perceived", "true"), default="perceived",
                    help="decode moves against the observed state, or the simulator's true "
                    "state (an oracle) (perceived)")  # fmt: skip
+    scene_options(p)
+
+
+def scene_options(p: argparse.ArgumentParser) -> None:
+    """The scene's obstacles, and what happens to a trajectory that would hit one."""
+    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter"), default="tabletop",
+                   help="obstacles on the table (tabletop: none)")  # fmt: skip
+    p.add_argument("--collision", choices=("plan", "check", "off"), default="plan",
+                   help="check every trajectory and route blocked ones with the motion planner "
+                   "(plan), fail them (check), or run unchecked (off) (plan)")  # fmt: skip
 
 
 def run_options(p: argparse.ArgumentParser) -> None:
@@ -284,5 +294,6 @@ def executability_options(p: argparse.ArgumentParser) -> None:
                    help="physical friction grasp or a weld attach (friction)")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="scene layout and planner seed (0)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    scene_options(p)
     progress_option(p)
     output_options(p, "write results.json and plans.csv into this folder")

@@ -17,8 +17,11 @@ from pathlib import Path
 from tamp.camera.from_images import PerceptionMode
 from tamp.cli.options import planner_config
 from tamp.loop import Episode, EpisodeReport, LoopConfig
+from tamp.loop.execute import ExecConfig
 from tamp.loop.faults import Injection
 from tamp.loop.given import GivenPlanEpisode, read_given
+from tamp.obstacles import with_scene
+from tamp.scene import SceneConfig
 from tamp.video import VideoWriter
 from task import data
 from task.errors import TampError
@@ -56,10 +59,19 @@ def loop_config(args: argparse.Namespace) -> LoopConfig:
         perception=PerceptionMode(args.perception, blur=args.blur),
         checkpoint=args.checkpoint,
         crisp=args.crisp,
+        scene=with_scene(SceneConfig(), args.scene),
+        execution=replace(ExecConfig(), collision=args.collision),
     )
     if args.max_replans is not None:
         config = replace(config, max_replans=args.max_replans)
     return config
+
+
+def given_config(args: argparse.Namespace) -> LoopConfig:
+    """The loop settings of ``bench executability``: grasp, scene and collision mode."""
+    execution = replace(ExecConfig(), collision=args.collision)
+    return LoopConfig(grasp=args.grasp, scene=with_scene(SceneConfig(), args.scene),
+                      execution=execution)  # fmt: skip
 
 
 def summary_lines(report: EpisodeReport) -> list[str]:

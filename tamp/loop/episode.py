@@ -73,6 +73,12 @@ class Episode:
             config.sim, problem.entities, poses, config.scene, config.grasp, config.camera
         )
         self.sim.truth.lock()  # simulator ground truth only scores episodes
+        self.collision = None  # the arm's own collision model: robot geometry + known boxes
+        if config.execution.collision != "off":
+            from robots.collision import PandaCollision
+
+            self.collision = PandaCollision(config.execution.margin)
+        self._acts = 0  # moves attempted: each seeds its motion-planner call differently
         self.score = Scorer(self.sim.truth, problem, config.scene)
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
 
@@ -95,8 +101,14 @@ class Episode:
                 self._step(p)
             reached = self.score.reached(self.domain)
         finally:
-            self.sim.close()
-        return p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
+            self._close()
+        report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
+        return dataclasses.replace(report, touched=dict(self.sim.touched))
+
+    def _close(self) -> None:
+        self.sim.close()
+        if self.collision is not None:
+            self.collision.close()
 
     # --- the steps -------------------------------------------------------------------------
     def _first_observation(self, p: Progress) -> None:
@@ -222,9 +234,10 @@ class Episode:
         """Show ``label`` and execute ``move`` as a pick-and-place."""
         self.status_text = label
         cfg = self.config
+        self._acts += 1
         return execute_move(
             self.sim, self.solver, move, self._poses, cfg.execution, cfg.scene, drop_at,
-            self.on_frame,
+            self.on_frame, self.collision, self.seed * 1000 + self._acts,
         )  # fmt: skip
 
     def _settle(self) -> None:

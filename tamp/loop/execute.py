@@ -15,17 +15,20 @@ from __future__ import annotations
 import enum
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from motion.guard import CollisionModel, GuardConfig, PickPlaceWorld, guard_pick_place
 from motion.ik import IKSolver
 from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
 from motion.trajectory import JointTrajectory
 from perception.errors import PerceptionError
+from tamp.obstacles import ceiling
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Simulator
-from task.problem import Move
+from task.errors import TampError, one_of
+from task.problem import TABLE, Move
 
 
 class Failure(enum.Enum):
@@ -38,6 +41,11 @@ class Failure(enum.Enum):
     MISPLACED = "misplaced"  # after release the block is not where it was to be placed
     TRACKING = "tracking_error"  # the arm could not follow its trajectory (blocked)
     UNOBSERVABLE = "unobservable"  # the camera could not see a block the move needs, from home
+    NO_CLEARANCE = "no_clearance"  # an overhead obstacle leaves the hand no room at a tower
+    COLLISION = "collision"  # a trajectory would hit something, and no detour was found
+
+
+COLLISION_MODES = ("plan", "check", "off")
 
 
 @dataclass(frozen=True)
@@ -50,6 +58,16 @@ class ExecConfig:
     place_tol_xy: float = 0.015  # m: post-place check
     place_tol_z: float = 0.008  # m
     max_tracking: float = 0.3  # rad: beyond this the arm is blocked
+    # "plan": check every trajectory, reroute blocked free-space phases with the motion
+    # planner; "check": a predicted collision fails the move; "off": run unchecked
+    collision: str = "plan"
+    margin: float = 0.01  # m: a trajectory passing closer than this to anything is a collision
+    guard: GuardConfig = GuardConfig()
+    slot_tries: int = 3  # free table slots a move to the table tries before it fails
+
+    def __post_init__(self) -> None:
+        if self.collision not in COLLISION_MODES:
+            raise TampError(f"unknown collision mode {one_of(self.collision, COLLISION_MODES)}")
 
 
 @dataclass(frozen=True)
@@ -63,6 +81,8 @@ class ExecutionResult:
     sim_time_s: float = 0.0
     wall_time_s: float = 0.0
     ik_time_s: float = 0.0
+    check_time_s: float = 0.0  # collision checks of the planned trajectories
+    path_time_s: float = 0.0  # the motion planner's detours
 
 
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
@@ -86,6 +106,28 @@ def _holding(sim: Simulator, config: ExecConfig, fresh: bool) -> dict | None:
     }
 
 
+def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig):
+    """The collision world of a move: the observed blocks as boxes, the scene's obstacles,
+    what the picked block stands on and what it goes onto (block names or "table")."""
+    from robots.collision import Box
+
+    half = (scene.block_size / 2,) * 3
+    blocks = tuple(Box(k, p.xyz, half, p.yaw) for k, p in poses.items())
+    fixed = tuple(Box(o.name, o.centre, o.half, o.yaw) for o in scene.obstacles)
+    pick = poses[move.entity]
+    below = [
+        k for k, p in poses.items()
+        if k != move.entity and np.linalg.norm(p.xy - pick.xy) <= scene.tol_xy
+        and abs(pick.xyz[2] - p.xyz[2] - scene.block_size) <= 2 * scene.tol_z
+    ]  # fmt: skip
+    onto = "table" if move.target == TABLE else move.target
+    placed = Box(move.entity, target.xyz, half, target.yaw)
+    return PickPlaceWorld(
+        blocks + fixed, move.entity, below[0] if below else "table", onto, placed,
+        scene.block_size,
+    )  # fmt: skip
+
+
 def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
     """After a failure at the block: open the gripper and undo the descent (a safe pose)."""
     sim.detach()
@@ -101,6 +143,38 @@ def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
         sim.run(back, "open", on_frame=on_frame)
 
 
+def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
+    """(target pose, phases, IK time) of the move, or (Failure, IK time, evidence). A table
+    placement whose motion fails tries the next free slots (up to ``config.slot_tries``)."""
+    ik, last = 0.0, None
+    for rank in range(config.slot_tries if move.target == TABLE else 1):
+        target = place_pose(move, poses, scene, rank)
+        if target is None:
+            return last or (Failure.NO_FREE_SLOT, ik, {"slots": len(scene.slots)})
+        pick = poses[move.entity]
+        others = {k: v for k, v in poses.items() if k != move.entity}
+        request = PickPlaceRequest(
+            pick.xyz, pick.yaw, target.xyz, target.yaw, top_z(others, scene),
+            ceiling(pick.xyz, scene.obstacles), ceiling(target.xyz, scene.obstacles),
+        )  # fmt: skip
+        planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
+        ik += planned.ik_time_s
+        if not planned.ok:
+            last = (Failure(planned.failure), ik, planned.evidence)
+            continue
+        if collision is None or config.collision == "off":
+            return target, planned.phases, ik
+        world = _world(move, poses, target, scene)
+        guard = replace(config.guard, plan=config.collision == "plan")
+        checked = guard_pick_place(planned.phases, collision, world, guard, seed)
+        times[0] += checked.check_time_s
+        times[1] += checked.plan_time_s
+        if checked.ok:
+            return target, checked.phases, ik
+        last = (Failure.COLLISION, ik, checked.evidence)
+    return last
+
+
 def execute_move(
     sim: Simulator,
     solver: IKSolver,
@@ -110,35 +184,36 @@ def execute_move(
     scene: SceneConfig = SceneConfig(),
     drop_at: float | None = None,
     on_frame: Callable[[Simulator], None] | None = None,
+    collision: CollisionModel | None = None,
+    seed: int = 0,
 ) -> ExecutionResult:
     """Pick ``move.entity`` where it is observed and place it on ``move.target``.
 
     ``drop_at`` in [0, 1] opens the gripper at that fraction of the transit (fault injection).
+    ``collision``: the arm's collision model (`robots.collision.PandaCollision`), which checks
+    the planned phases unless ``config.collision`` is "off"; ``seed`` seeds the motion planner.
     """
     wall0, sim0 = time.perf_counter(), sim.time
+
+    times = [0.0, 0.0]  # collision checks, motion planner
 
     def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
         return ExecutionResult(
             move, failure is None, failure, evidence, sim.time - sim0,
-            time.perf_counter() - wall0, ik_time,
+            time.perf_counter() - wall0, ik_time, *times,
         )  # fmt: skip
 
+    sim.moving = move.entity  # scoring: the arm touching this block is no collision
     try:
         poses = observe()
     except PerceptionError as err:
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
-    target = place_pose(move, poses, scene)
-    if target is None:
-        return result(Failure.NO_FREE_SLOT, slots=len(scene.slots))
-    pick = poses[move.entity]
-    others = {k: v for k, v in poses.items() if k != move.entity}
-    request = PickPlaceRequest(pick.xyz, pick.yaw, target.xyz, target.yaw, top_z(others, scene))
-    planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
-    if not planned.ok:
-        return result(Failure.IK_INFEASIBLE, planned.ik_time_s, **planned.evidence)
-    ik = planned.ik_time_s
+    planned = _plan(sim, solver, move, poses, config, scene, collision, seed, times)
+    if isinstance(planned, tuple) and isinstance(planned[0], Failure):
+        return result(planned[0], planned[1], **planned[2])
+    target, phases, ik = planned
     worst = 0.0
-    for phase in planned.phases:
+    for phase in phases:
         release = None
         if phase.name == "transit" and drop_at is not None:
             release = drop_at * phase.trajectory.duration
@@ -146,12 +221,12 @@ def execute_move(
             sim.detach()
         worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame))
         if worst > config.max_tracking:
-            _back_off(sim, planned.phases, on_frame)
+            _back_off(sim, phases, on_frame)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
             missed = _holding(sim, config, fresh=True)
             if missed is not None:
-                _back_off(sim, planned.phases, on_frame)
+                _back_off(sim, phases, on_frame)
                 return result(Failure.GRASP_MISSED, ik, **missed)
             if sim.grasp == "weld":
                 sim.attach(move.entity)

@@ -224,13 +224,13 @@ class GivenPlanEpisode(Episode):
                 self._step(p)
             reached = self.score.reached(self.domain)
         finally:
-            self.sim.close()
+            self._close()
         if not (p.stopped or handed or reached):
             bad = [r.label for r in self.records if r.valid is False or r.outcome != "executed"]
             why = f"first problem at {bad[0]}" if bad else "every step executed"
             p.stop(EpisodeStatus.PLAN_ENDED, f"the goal does not hold at the end; {why}")
         report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
-        return replace(report, steps=tuple(self.records))
+        return replace(report, steps=tuple(self.records), touched=dict(self.sim.touched))
 
     def _given(self, p: Progress) -> bool:
         """Run the given steps; True when the planner is to take over (``replan``)."""

@@ -42,6 +42,13 @@ class EpisodeReport:
     reason: str = ""
     first_plan: tuple[Move, ...] = ()  # the first task plan's moves (camera: its first window)
     steps: tuple = ()  # a given plan: one `tamp.loop.given.StepReport` per step
+    # scoring: what the arm touched in the simulator other than the block it was moving
+    # (block, obstacle or "table" -> contact samples); `collided` is True when any was touched
+    touched: dict = field(default_factory=dict)
+
+    @property
+    def collided(self) -> bool:
+        return bool(self.touched)
 
     def to_json(self) -> dict:
         out = dataclasses.asdict(self)

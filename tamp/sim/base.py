@@ -91,6 +91,10 @@ class Simulator(abc.ABC):
         self.time = 0.0
         self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
         self.truth = GroundTruth(self._block_poses)  # scoring only; see tamp.sim.truth
+        # scoring only: what the arm touched while running trajectories (name -> samples),
+        # apart from ``moving``, the block the current move handles
+        self.touched: dict[str, int] = {}
+        self.moving: str | None = None
 
     # --- what a backend implements -------------------------------------------------------
     @abc.abstractmethod
@@ -109,6 +113,10 @@ class Simulator(abc.ABC):
     def gripper(self) -> GripperReading:
         """Finger opening and the normal contact force on each finger from anything but the
         robot (the finger sensors)."""
+
+    @abc.abstractmethod
+    def _robot_touching(self) -> set[str]:
+        """Names of what touches the arm or hand now: blocks, obstacles, "table" (scoring)."""
 
     @abc.abstractmethod
     def _block_poses(self) -> dict[str, Pose]:
@@ -182,6 +190,8 @@ class Simulator(abc.ABC):
             self.time += self.dt
             if k % TRACK_EVERY == 0 or k == len(trajectory.times) - 1:
                 worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
+                for name in self._robot_touching() - {self.moving}:
+                    self.touched[name] = self.touched.get(name, 0) + 1
             if on_frame is not None and self.time >= next_frame:
                 on_frame(self)
                 next_frame = self.time + self.frame_period

@@ -61,6 +61,10 @@ class MuJoCoSim(Simulator):
                            size=[3.0, 0.005, 1.5], pos=[0.0, scene.backdrop_y, 1.5],
                            rgba=[*[scene.backdrop_grey] * 3, 1], contype=0,
                            conaffinity=2)  # fmt: skip
+        for o in scene.obstacles:  # fixed boxes (tamp.obstacles)
+            world.add_geom(name=f"obstacle_{o.name}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                           size=list(o.half), pos=list(o.centre), quat=_quat(o.yaw),
+                           rgba=[*o.rgb, 1])  # fmt: skip
         shape, size = mujoco.mjtGeom.mjGEOM_BOX, [scene.block_size / 2] * 3
         if scene.shape == "cylinder":  # radius, half height; matte like LatPlan's rubber
             shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [scene.block_size / 2] * 2
@@ -96,6 +100,9 @@ class MuJoCoSim(Simulator):
         self._block_q = {n: m.joint(f"block_{n}").qposadr[0] for n in self.entities}
         self._block_v = {n: m.joint(f"block_{n}").dofadr[0] for n in self.entities}
         self._weld_ids = {n: m.equality(f"weld_{n}").id for n in self.entities}
+        self._geom_names = {m.geom("floor").id: "table"}
+        self._geom_names |= {m.geom(f"obstacle_{o.name}").id: o.name for o in scene.obstacles}
+        self._geom_names |= {m.geom(f"block_{n}").id: n for n in self.entities}
         d.qpos[self._arm_q] = PANDA.q_home
         d.qpos[self._fingers] = PANDA.finger_open
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
@@ -130,6 +137,18 @@ class MuJoCoSim(Simulator):
                     forces[k] += abs(f6[0])
         width = float(d.qpos[self._fingers].sum())
         return GripperReading(width, forces[0], forces[1])
+
+    def _robot_touching(self) -> set[str]:
+        m, d = self.model, self.data
+        robot = m.body_rootid[self._hand]
+        out = set()
+        for i in range(d.ncon):
+            g = (d.contact[i].geom1, d.contact[i].geom2)
+            roots = [m.body_rootid[m.geom_bodyid[k]] for k in g]
+            if (roots[0] == robot) != (roots[1] == robot):  # the arm and something else
+                other = g[1] if roots[0] == robot else g[0]
+                out.add(self._geom_names.get(int(other), "?"))
+        return out
 
     def _block_poses(self) -> dict[str, Pose]:
         out = {}

@@ -63,6 +63,7 @@ class PyBulletSim(Simulator):
             )  # fmt: skip
             at = [0.0, self.scene.backdrop_y, 1.5]
             self.backdrop = p.createMultiBody(0, -1, wall, at, physicsClientId=c)
+        self.obstacles = [self._obstacle(o) for o in self.scene.obstacles]
         self.robot = load_panda(c)
         self.blocks: dict[str, int] = {}
         for i, name in enumerate(self.entities):
@@ -76,9 +77,21 @@ class PyBulletSim(Simulator):
             )
             self.blocks[name] = body
         self._weld: int | None = None
+        obstacles = zip(self.obstacles, self.scene.obstacles, strict=True)
+        self._names = {self.table: "table", **{b: o.name for b, o in obstacles},
+                       **{b: n for n, b in self.blocks.items()}}  # fmt: skip
         self._finger_command = ""
         self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+
+    def _obstacle(self, o) -> int:
+        """A fixed box of the scene (`tamp.obstacles.Obstacle`)."""
+        c = self.client
+        col = p.createCollisionShape(p.GEOM_BOX, halfExtents=list(o.half), physicsClientId=c)
+        vis = p.createVisualShape(
+            p.GEOM_BOX, halfExtents=list(o.half), rgbaColor=[*o.rgb, 1], physicsClientId=c
+        )
+        return p.createMultiBody(0, col, vis, list(o.centre), _quat(o.yaw), physicsClientId=c)
 
     def _block_shapes(self, rgb) -> tuple[int, int]:
         """Collision and visual shape of one block (a cube, or an upright cylinder)."""
@@ -132,6 +145,11 @@ class PyBulletSim(Simulator):
             for link in r.fingers
         ]
         return GripperReading(width, forces[0], forces[1])
+
+    def _robot_touching(self) -> set[str]:
+        c, names = self.client, self._names
+        found = {pt[2] for pt in p.getContactPoints(self.robot.body, physicsClientId=c)}
+        return {names[b] for b in found if b in names}
 
     def _block_poses(self) -> dict[str, Pose]:
         out = {}

@@ -1,0 +1,182 @@
+"""Collision-check a planned pick-and-place before it runs, and route blocked free-space phases
+around obstacles with the joint-space motion planner.
+
+Each arm phase is checked against the world as it is during that phase (arm, fingers and, once
+grasped, the held block against the table, the blocks and the obstacles), with the contacts the
+move needs allowed: the open fingers around the block they pick (descend, retreat), the held
+block on what it leaves (lift) and on what it is placed onto (lower). A blocked free-space phase
+(``approach`` or ``transit``) is replanned with `motion.rrt.plan_path` and timed along the new
+path with ruckig; a blocked vertical phase, or a free-space phase the planner cannot route, is a
+``collision`` failure with the contact as evidence.
+
+The collision model is anything with `robots.collision.PandaCollision`'s ``set_boxes``,
+``hold``, ``valid`` and ``check_path``; this module never imports a simulator.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+
+from motion.pick_place import Phase
+from motion.trajectory import SpeedLimits
+
+if TYPE_CHECKING:
+    from motion.rrt import PathPlannerConfig
+    from robots.collision import Box, PathCheck
+
+FREE_SPACE = ("approach", "transit")  # phases the motion planner may reroute
+HELD = ("lift", "transit", "lower")  # phases with the block in the hand
+
+
+class CollisionModel(Protocol):
+    margin: float  # m
+
+    def set_boxes(self, boxes: Sequence[Box]) -> None: ...
+    def hold(self, size: float | None) -> None: ...
+    def valid(self, q, fingers: float = ..., ignore=...) -> bool: ...
+    def check_path(self, path, fingers: float = ..., ignore=..., max_step: float = ...
+                   ) -> PathCheck: ...  # fmt: skip
+
+
+@dataclass(frozen=True)
+class GuardConfig:
+    """``plan``: reroute blocked free-space phases with the motion planner (else a blocked phase
+    fails); ``max_step``: joint step (rad) between checked configurations."""
+
+    plan: bool = True
+    max_step: float = 0.02
+    speed: SpeedLimits = SpeedLimits(velocity=0.5, acceleration=0.3, jerk=0.1)
+    rrt: PathPlannerConfig | None = None  # None: motion.rrt's defaults
+    open_width: float = 0.04  # m per finger, open
+    plan_pad: float = 0.01  # m added to the model's margin while the motion planner searches
+    # m, the margin of the vertical phases: a block lifted from beside a touching neighbour
+    # slides along it, which is no collision
+    vertical_margin: float = 0.002
+    dt: float = 0.002
+
+
+@dataclass(frozen=True)
+class PickPlaceWorld:
+    """What the move changes: the boxes before it (blocks and obstacles), the picked block's
+    name, what it stands on and what it is placed onto (box names, or "table"), the placed box,
+    and the block edge (the fingers close to half of it each)."""
+
+    boxes: tuple[Box, ...]
+    picked: str
+    picked_from: str
+    placed_on: str
+    placed: Box
+    block: float
+
+
+@dataclass(frozen=True)
+class Guarded:
+    """The phases to run (rerouted where needed), or the ``collision`` failure and evidence."""
+
+    ok: bool
+    phases: tuple[Phase, ...]
+    failure: str | None = None
+    evidence: dict = field(default_factory=dict)
+    rerouted: tuple[str, ...] = ()
+    check_time_s: float = 0.0
+    plan_time_s: float = 0.0
+
+
+def thin(positions: np.ndarray, step: float) -> np.ndarray:
+    """The samples (K, J) of a densely sampled joint path (S, J) about ``step`` rad apart (the
+    first and last kept): a trajectory sampled every 2 ms repeats nearly the same
+    configuration many times, and the checker interpolates between what is kept."""
+    moved = np.abs(np.diff(positions, axis=0)).max(axis=1)  # (S-1,)
+    ticks = np.floor(np.concatenate([[0.0], np.cumsum(moved)]) / step)  # (S,)
+    keep = np.flatnonzero(np.diff(ticks, prepend=-1.0) > 0)
+    return positions[np.unique(np.concatenate([keep, [len(positions) - 1]]))]
+
+
+def _situation(name: str, world: PickPlaceWorld, open_width: float):
+    """Boxes, held block edge, finger opening and allowed contacts during phase ``name``."""
+    before = tuple(world.boxes)
+    without = tuple(b for b in before if b.name != world.picked)
+    grip = world.block / 2
+    return {
+        "approach": (before, None, open_width, ()),
+        "descend": (before, None, open_width, (("hand", world.picked),)),
+        "lift": (without, world.block, grip, (("held", world.picked_from),)),
+        "transit": (without, world.block, grip, ()),
+        "lower": (without, world.block, grip, (("held", world.placed_on),)),
+        "retreat": ((*without, world.placed), None, open_width, (("hand", world.picked),)),
+    }[name]
+
+
+def guard_pick_place(
+    phases: Sequence[Phase],
+    model: CollisionModel,
+    world: PickPlaceWorld,
+    config: GuardConfig = GuardConfig(),
+    seed: int = 0,
+) -> Guarded:
+    """Check every arm phase of a pick-and-place (see the module docstring); ``seed`` seeds
+    the motion planner, so the same scene and seed give the same detour."""
+    out, rerouted, t_check, t_plan = [], [], 0.0, 0.0
+    for phase in phases:
+        if phase.name in ("close", "open"):  # standstills
+            out.append(phase)
+            continue
+        boxes, held, fingers, ignore = _situation(phase.name, world, config.open_width)
+        model.set_boxes(boxes)
+        model.hold(held)
+        start = time.perf_counter()
+        path = thin(phase.trajectory.positions, config.max_step)
+        margin = model.margin
+        if phase.name not in FREE_SPACE:  # straight up or down beside blocks the move touches
+            model.margin = min(margin, config.vertical_margin)
+        try:
+            found = model.check_path(path, fingers, ignore, config.max_step)
+        finally:
+            model.margin = margin
+        t_check += time.perf_counter() - start
+        if found.ok:
+            out.append(phase)
+            continue
+        evidence = {
+            "phase": phase.name,
+            "part": found.contact.part,
+            "other": found.contact.other,
+            "distance_m": round(found.contact.distance, 4),
+            "q": [round(v, 3) for v in found.q],
+        }
+        if phase.name not in FREE_SPACE or not config.plan:
+            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
+        from motion.rrt import PathPlannerConfig, path_trajectory, plan_path
+
+        # checked every ~0.02 rad (resolution x the joint box's 13 rad diagonal), as is the rest
+        rrt = config.rrt or PathPlannerConfig(resolution=0.0015, simplify_time=5.0)
+        rrt = replace(rrt, seed=seed)
+        q = phase.trajectory.positions  # (S, J)
+
+        def valid(x: np.ndarray, fingers=fingers, ignore=ignore) -> bool:
+            return model.valid(x, fingers, ignore)
+
+        margin = model.margin  # plan with a wider berth: the planner checks every ~0.02 rad
+        model.margin = margin + config.plan_pad
+        try:
+            found_path = plan_path(q[0], q[-1], valid, config=rrt)
+        finally:
+            model.margin = margin
+        t_plan += found_path.time_s
+        if not found_path.ok:
+            evidence |= {"planner": found_path.failure, "checks": found_path.checks}
+            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
+        trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
+        again = model.check_path(thin(trajectory.positions, config.max_step), fingers, ignore,
+                                 config.max_step)  # fmt: skip
+        if not again.ok:  # the planner checks at its own resolution; this is the final word
+            evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
+            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
+        out.append(Phase(phase.name, trajectory, phase.gripper))
+        rerouted.append(phase.name)
+    return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan)

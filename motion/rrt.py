@@ -1,0 +1,298 @@
+"""Joint-space paths for the Panda's free-space phases: OMPL's RRT-Connect plus seeded shortcuts.
+
+``plan_path(start, goal, valid)`` searches the datasheet joint box with OMPL (the only module of
+this repository that imports ``ompl``) against the caller's ``valid(q)`` collision check, then
+shortens the path with our own seeded shortcutting and re-checks every returned segment with
+``valid`` at the checking resolution. ``path_trajectory`` times the polyline with ruckig, one
+rest-to-rest straight segment per piece (an RRT path has sharp corners).
+
+Determinism. OMPL 2.0.1 seeds every ``RNG`` object from one process-global seed generator, and
+its Python bindings cannot replace the planner's state sampler. ``RNG.setSeed`` still re-seeds
+that generator after the first RNG exists (it only logs an error, which we mute), so each call
+re-seeds it with ``config.seed`` right before it builds the planner, under a lock: one seed, one
+path, in any order of calls. The planner stops at its first exact solution (RRT* too: the cost
+threshold is infinite), so the path does not depend on the machine's speed; shortcutting is
+bounded by ``shortcut_attempts``, ``simplify_time`` only caps it (evidence "simplify_capped").
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+from itertools import pairwise
+
+import numpy as np
+from ompl import base as ob
+from ompl import geometric as og
+from ompl import util as ou
+
+from motion.errors import MotionError
+from motion.trajectory import JointTrajectory, SpeedLimits, straight_segment
+from robots.panda import PANDA, PandaSpec
+
+PLANNERS = {"rrt_connect": og.RRTConnect, "rrt": og.RRT, "rrt_star": og.RRTstar}
+_OMPL_LOCK = threading.RLock()  # OMPL's seed generator is process-global
+_BOUND_TOL = 1e-6  # the tolerance of PandaSpec.clamp_error; the OMPL box is widened by it
+ou.setLogLevel(ou.LOG_WARN)  # OMPL logs INFO lines to stderr by default; keep the CLI quiet
+_SEED_RANGE = 2147483562  # OMPL's seed engine (minstd-seeded ranlux24_base): seeds alias mod this
+
+
+@dataclass(frozen=True)
+class PathPlannerConfig:
+    """Settings of `plan_path`; override with ``dataclasses.replace``."""
+
+    planner: str = "rrt_connect"  # one of PLANNERS
+    time_limit: float = 5.0  # s of search before "no_path"
+    seed: int = 0  # >= 0; the same seed gives the same path
+    resolution: float = 0.005  # checking step as a fraction of the joint box's diagonal
+    range: float = 0.0  # RRT extension step in rad; 0: OMPL's default (0.2 x diagonal)
+    simplify: bool = True  # seeded shortcutting and vertex reduction
+    simplify_time: float = 1.0  # s, a cap only: the attempts bound the work
+    shortcut_attempts: int = 50  # random partial shortcuts tried (OMPL's shortcutPath, seeded)
+
+    def __post_init__(self):
+        if self.planner not in PLANNERS:
+            raise MotionError(f"unknown planner {self.planner!r}; valid: {', '.join(PLANNERS)}")
+        checks = {
+            "time_limit": self.time_limit > 0.0,
+            "seed": isinstance(self.seed, int | np.integer) and self.seed >= 0,
+            "resolution": 0.0 < self.resolution < 1.0,
+            "range": self.range >= 0.0,
+            "simplify_time": self.simplify_time >= 0.0,
+            "shortcut_attempts": self.shortcut_attempts >= 0,
+        }
+        for name, ok in checks.items():
+            if not ok:
+                raise MotionError(f"PathPlannerConfig.{name} = {getattr(self, name)!r} is invalid")
+
+
+@dataclass(frozen=True, eq=False)
+class PathResult:
+    """A joint-space path or the reason there is none ("invalid_start", "invalid_goal",
+    "no_path", "invalid_path"); ``checks`` counts calls to the caller's ``valid``."""
+
+    ok: bool
+    path: np.ndarray | None  # (K, J) rad, read-only, start and goal included
+    failure: str | None
+    evidence: dict
+    time_s: float  # planning + simplification + re-validation wall time
+    checks: int
+
+
+class _Checker:
+    """The caller's ``valid`` with a call count; straight segments checked every ``step`` rad."""
+
+    def __init__(self, valid: Callable[[np.ndarray], bool], step: float):
+        self.valid, self.step, self.calls = valid, step, 0
+
+    def __call__(self, q) -> bool:
+        self.calls += 1
+        return bool(self.valid(np.array(q, dtype=np.float64)))
+
+    def segment(self, a: np.ndarray, b: np.ndarray, ends: bool = False) -> bool:
+        """The points ``a + k/n (b - a)``, 0 < k < n = ceil(|b - a| / step), as OMPL's discrete
+        motion validator places them (bisection order); ``ends`` checks a and b as well."""
+        if ends and not (self(a) and self(b)):
+            return False
+        n = max(1, math.ceil(float(np.linalg.norm(b - a)) / self.step))
+        return all(self(a + (k / n) * (b - a)) for k in _bisection_order(n))
+
+
+def _bisection_order(n: int) -> list[int]:
+    order, queue = [], deque([(1, n - 1)])
+    while queue:
+        lo, hi = queue.popleft()
+        if lo <= hi:
+            mid = (lo + hi) // 2
+            order.append(mid)
+            queue.extend([(lo, mid - 1), (mid + 1, hi)])
+    return order
+
+
+def _joint_vector(name: str, q, spec: PandaSpec) -> np.ndarray:
+    q = np.asarray(q, dtype=np.float64)
+    n_joints = len(spec.arm_joints)
+    if q.shape != (n_joints,):
+        raise MotionError(f"{name} has shape {q.shape}; expected ({n_joints},)")
+    if not np.isfinite(q).all():
+        raise MotionError(f"{name} contains NaN or inf: {q.tolist()}")
+    error = spec.clamp_error(q)
+    if error is not None:
+        raise MotionError(f"{name}: {error}")
+    return q
+
+
+def _solve(start, goal, checker: _Checker, lo, hi, config: PathPlannerConfig):
+    """OMPL's search; the (K, J) path of its first exact solution or None, and its status."""
+    n_joints = start.size
+    with _OMPL_LOCK:
+        level = ou.getLogLevel()
+        ou.setLogLevel(ou.LOG_NONE)  # re-seeding after the first RNG logs an error
+        ou.RNG.setSeed(int(config.seed) % _SEED_RANGE + 1)
+        ou.setLogLevel(level)
+        space = ob.RealVectorStateSpace(n_joints)
+        bounds = ob.RealVectorBounds(n_joints)
+        for i in range(n_joints):
+            bounds.setLow(i, float(lo[i]))
+            bounds.setHigh(i, float(hi[i]))
+        space.setBounds(bounds)
+        si = ob.SpaceInformation(space)
+        si.setStateValidityChecker(lambda state: checker(state[0:n_joints]))
+        si.setStateValidityCheckingResolution(config.resolution)
+        si.setup()
+        ends = si.allocState(), si.allocState()
+        for state, q in zip(ends, (start, goal), strict=True):
+            state[0:n_joints] = q.tolist()
+        pdef = ob.ProblemDefinition(si)
+        pdef.setStartAndGoalStates(*ends)
+        objective = ob.PathLengthOptimizationObjective(si)
+        objective.setCostThreshold(ob.Cost(math.inf))  # any solution is good enough: stop at it
+        pdef.setOptimizationObjective(objective)
+        planner = PLANNERS[config.planner](si)
+        if config.range > 0.0:
+            planner.setRange(config.range)
+        planner.setProblemDefinition(pdef)
+        planner.setup()
+        deadline = time.perf_counter() + config.time_limit
+        status = planner.solve(
+            ob.PlannerTerminationCondition(
+                lambda: pdef.hasExactSolution() or time.perf_counter() > deadline
+            )
+        ).asString()
+        if not pdef.hasExactSolution():
+            return None, status
+        states = pdef.getSolutionPath().getStates()
+        return np.array([s[0:n_joints] for s in states], dtype=np.float64), status  # (K, J)
+
+
+def _reduce(path: np.ndarray, checker: _Checker) -> np.ndarray:
+    """Drop each interior vertex whose neighbours see each other (one greedy pass)."""
+    keep = [path[0]]
+    for i in range(1, len(path) - 1):
+        if not checker.segment(keep[-1], path[i + 1]):
+            keep.append(path[i])
+    return np.array([*keep, path[-1]])  # (K', J)
+
+
+def _shortcut(path: np.ndarray, checker: _Checker, rng, attempts: int, deadline: float):
+    """OMPL's shortcutPath, seeded: join two random points of the path when the chord is valid."""
+    for _ in range(attempts):
+        if len(path) < 3 or time.perf_counter() > deadline:
+            break
+        knots = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+        t = np.sort(rng.uniform(0.0, knots[-1], size=2))
+        a, b = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, len(path) - 2)
+        if a == b:
+            continue
+        p, q = _point(path, knots, a, t[0]), _point(path, knots, b, t[1])
+        # the chord and both cut pieces are new segments: check each at the resolution
+        pieces = ((p, q, True), (path[a], p, False), (q, path[b + 1], False))
+        if all(checker.segment(*piece) for piece in pieces):
+            path = np.concatenate([path[: a + 1], [p, q], path[b + 1 :]])  # (K', J)
+    return path
+
+
+def _point(path: np.ndarray, knots: np.ndarray, i: int, s: float) -> np.ndarray:
+    w = (s - knots[i]) / max(knots[i + 1] - knots[i], 1e-300)
+    return path[i] + w * (path[i + 1] - path[i])
+
+
+def _dedupe(path: np.ndarray) -> np.ndarray:
+    """Drop repeated vertices; the first and last stay exactly start and goal."""
+    steps = np.linalg.norm(np.diff(path, axis=0), axis=1)  # (K-1,)
+    out = path[np.concatenate([[True], steps > 1e-9])]
+    if len(out) < 2:
+        return path[[0, -1]].copy()
+    out[-1] = path[-1]
+    return out
+
+
+def plan_path(
+    start,
+    goal,
+    valid: Callable[[np.ndarray], bool],
+    spec: PandaSpec = PANDA,
+    config: PathPlannerConfig = PathPlannerConfig(),
+) -> PathResult:
+    """A collision-free joint path ``start -> goal`` (each (J,)) inside spec's joint limits.
+
+    ``valid(q)`` gets a fresh (J,) float64 array and says whether q is collision-free. Every
+    segment of the returned path is checked with it every ``resolution x diagonal`` rad (and at
+    its ends). Misuse (shapes, NaN, start or goal outside the limits) raises MotionError; an
+    invalid start or goal and a search that runs out of time are failures in the result.
+    """
+    start, goal = _joint_vector("start", start, spec), _joint_vector("goal", goal, spec)
+    if not callable(valid):
+        raise MotionError(f"valid must be a callable q -> bool, got {type(valid).__name__}")
+    t0 = time.perf_counter()
+    lo, hi = np.array(spec.q_min) - _BOUND_TOL, np.array(spec.q_max) + _BOUND_TOL
+    checker = _Checker(valid, config.resolution * float(np.linalg.norm(hi - lo)))
+    evidence = {"planner": config.planner, "seed": config.seed, "step_rad": checker.step}
+
+    def result(path, failure, **extra) -> PathResult:
+        if path is not None:
+            path.flags.writeable = False
+        info = evidence | extra | {"checks": checker.calls}
+        dt = time.perf_counter() - t0
+        return PathResult(failure is None, path, failure, info, dt, checker.calls)
+
+    for name, q in (("start", start), ("goal", goal)):
+        if not checker(q):
+            return result(None, f"invalid_{name}", **{name: q.tolist()})
+    raw, status = _solve(start, goal, checker, lo, hi, config)
+    plan_s, plan_checks = time.perf_counter() - t0, checker.calls
+    if raw is None:
+        return result(None, "no_path", status=status, time_limit=config.time_limit, plan_s=plan_s)
+    raw[0], raw[-1] = start, goal
+    path, deadline = _dedupe(raw), time.perf_counter() + config.simplify_time
+    if config.simplify:
+        rng = np.random.default_rng(config.seed)
+        path = _reduce(path, checker)
+        path = _reduce(_shortcut(path, checker, rng, config.shortcut_attempts, deadline), checker)
+        path = _dedupe(path)
+    capped = config.simplify and time.perf_counter() > deadline  # the path then depends on speed
+    info = {"status": status, "plan_s": plan_s, "plan_checks": plan_checks}
+    info |= {"raw_waypoints": len(raw), "waypoints": len(path), "simplify_capped": capped}
+    info |= {"raw_length": _length(raw), "length": _length(path)}
+    for candidate in (path, raw) if config.simplify else (path,):  # the raw path as fallback
+        if all(checker.segment(a, b, ends=True) for a, b in pairwise(candidate)):
+            return result(candidate, None, **info, simplified=candidate is path)
+    return result(None, "invalid_path", **info)
+
+
+def _length(path: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+
+
+def path_trajectory(
+    path, dt: float = 0.002, spec: PandaSpec = PANDA, limits: SpeedLimits = SpeedLimits()
+) -> JointTrajectory:
+    """Rest-to-rest `straight_segment` along each piece of ``path`` (K >= 2, J), one timeline.
+
+    The trajectory stops at every waypoint (zero velocity), so it never cuts a corner of the
+    validated polyline; zero-length pieces are skipped.
+    """
+    path = np.asarray(path, dtype=np.float64)
+    n_joints = len(spec.arm_joints)
+    if path.ndim != 2 or path.shape[0] < 2 or path.shape[1] != n_joints:
+        raise MotionError(f"path has shape {path.shape}; expected (K >= 2, {n_joints})")
+    if not np.isfinite(path).all():
+        raise MotionError("the path contains NaN or inf")
+    pieces = [straight_segment(a, b, dt, spec, limits) for a, b in pairwise(path)]
+    parts = [p for p in pieces if p.times.size > 1]  # zero-length pieces are a single sample
+    if not parts:
+        return pieces[-1]
+    offsets = np.cumsum([0.0] + [p.duration for p in parts[:-1]])
+    cut = [0] + [1] * (len(parts) - 1)  # a later piece's first sample repeats the previous end
+
+    def joined(name: str) -> np.ndarray:
+        return np.concatenate([getattr(p, name)[c:] for p, c in zip(parts, cut, strict=True)])
+
+    times = np.concatenate([o + p.times[c:] for p, o, c in zip(parts, offsets, cut, strict=True)])
+    return JointTrajectory(
+        times, joined("positions"), joined("velocities"), joined("accelerations")
+    )
