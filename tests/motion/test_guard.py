@@ -1,0 +1,85 @@
+"""`motion.guard`: a planned pick-and-place checked against boxes before it runs, blocked
+free-space phases rerouted by the OMPL motion planner, blocked vertical phases failed."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motion.guard import GuardConfig, PickPlaceWorld, guard_pick_place, thin
+from motion.ik import IKSolver
+from motion.pick_place import PickPlaceRequest, plan_pick_place
+from robots.collision import Box, PandaCollision
+from robots.panda import PANDA
+
+HALF = (0.025, 0.025, 0.025)
+PICK, PLACE = (0.45, -0.2, 0.025), (0.45, 0.2, 0.025)
+WALL = Box("wall", (0.45, 0.0, 0.12), (0.12, 0.01, 0.12))  # between pick and place, 24 cm tall
+
+
+@pytest.fixture(scope="module")
+def model():
+    with PandaCollision(margin=0.01) as m:
+        yield m
+
+
+@pytest.fixture(scope="module")
+def planned():
+    request = PickPlaceRequest(PICK, 0.0, PLACE, 0.0, clear_z=0.05)
+    result = plan_pick_place(IKSolver(), np.asarray(PANDA.q_home), request)
+    assert result.ok
+    return result.phases
+
+
+def _world(*extra: Box) -> PickPlaceWorld:
+    a = Box("a", PICK, HALF)
+    return PickPlaceWorld((a, *extra), "a", "table", "table", Box("a", PLACE, HALF), 0.05)
+
+
+def test_thin_keeps_the_ends_and_bounds_the_step():
+    path = np.linspace(0.0, 1.0, 2000)[:, None] * np.ones((1, 7))  # (S, J)
+    kept = thin(path, 0.02)
+    assert np.array_equal(kept[0], path[0]) and np.array_equal(kept[-1], path[-1])
+    sample = np.abs(np.diff(path, axis=0)).max()  # a kept step may overshoot by one sample
+    assert len(kept) < 200 and np.abs(np.diff(kept, axis=0)).max() <= 0.02 + sample
+
+
+def test_a_free_scene_passes_unchanged(model, planned):
+    out = guard_pick_place(planned, model, _world())
+    assert out.ok and out.rerouted == () and out.phases == tuple(planned)
+
+
+def test_a_transit_through_a_wall_is_predicted_as_a_collision(model, planned):
+    out = guard_pick_place(planned, model, _world(WALL), GuardConfig(plan=False))
+    assert not out.ok and out.failure == "collision"
+    assert out.evidence["phase"] == "transit" and out.evidence["other"] == "wall"
+
+
+def test_the_motion_planner_routes_the_transit_around_the_wall(model, planned):
+    out = guard_pick_place(planned, model, _world(WALL), seed=4)
+    assert out.ok and "transit" in out.rerouted and out.plan_time_s > 0
+    transit = next(p for p in out.phases if p.name == "transit")
+    old = next(p for p in planned if p.name == "transit")
+    assert np.allclose(transit.trajectory.positions[[0, -1]], old.trajectory.positions[[0, -1]])
+    model.set_boxes([b for b in _world(WALL).boxes if b.name != "a"])
+    model.hold(0.05)
+    assert model.check_path(transit.trajectory.positions, 0.025, max_step=0.01).ok
+    again = guard_pick_place(planned, model, _world(WALL), seed=4)  # the same seed, same detour
+    twin = next(p for p in again.phases if p.name == "transit")
+    assert np.array_equal(twin.trajectory.positions, transit.trajectory.positions)
+
+
+def test_a_blocked_vertical_phase_fails_without_a_detour(model, planned):
+    lid = Box("lid", (PICK[0], PICK[1], 0.14), (0.08, 0.08, 0.01))  # over the block to pick
+    out = guard_pick_place(planned, model, _world(lid))
+    assert not out.ok and out.evidence["other"] == "lid"
+    assert out.evidence["phase"] in ("approach", "descend")
+
+
+def test_the_fingers_may_touch_the_block_they_pick_but_not_a_neighbour(model, planned):
+    # a neighbour 4.5 cm beside the picked block: an open finger passes through it
+    side = Box("b", (PICK[0], PICK[1] + 0.045, 0.025), HALF)
+    fine = Box("c", (PICK[0] + 0.3, PICK[1], 0.025), HALF)
+    assert guard_pick_place(planned, model, _world(fine)).ok
+    out = guard_pick_place(planned, model, _world(side), GuardConfig(plan=False))
+    assert not out.ok and out.evidence["other"] == "b"
