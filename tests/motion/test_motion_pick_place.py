@@ -107,6 +107,21 @@ def test_unreachable_place_is_ik_infeasible(solver):
     assert result.evidence["pos_err"] > 0.1
 
 
+def test_a_ceiling_keeps_the_hand_under_it_or_leaves_no_clearance(solver):
+    base = REQUESTS["table_to_stack"]  # the block's top at 5 cm, the stack's top at 10 cm
+    req = dataclasses.replace(base, pick_ceiling=0.12, place_ceiling=0.16)
+    result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    assert result.ok, result.evidence
+    tops = {n: solver.fk(p.trajectory.positions)[:, 2, 3].max() for n, p in  # (S,) TCP heights
+            ((p.name, p) for p in result.phases) if n in ("descend", "lift", "lower")}  # fmt: skip
+    assert tops["descend"] <= 0.12 + 1e-3 and tops["lift"] <= 0.12 + 1e-3
+    assert tops["lower"] <= 0.16 + 1e-3
+    low = dataclasses.replace(base, pick_ceiling=HALF + 0.01)  # no room to come down
+    result = plan_pick_place(solver, PANDA.q_home, low, CONFIG)
+    assert not result.ok and result.failure == "no_clearance" and result.phases == ()
+    assert result.evidence["pick_ceiling"] == HALF + 0.01
+
+
 def test_malformed_request_raises(solver):
     req = dataclasses.replace(REQUESTS["table_to_stack"], pick=(0.5, 0.0))
     with pytest.raises(MotionError):
