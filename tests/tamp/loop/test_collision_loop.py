@@ -59,3 +59,23 @@ def test_an_episode_in_the_clutter_scene_reaches_the_goal_untouched(solver):
     config = LoopConfig(scene=with_scene(SceneConfig(), "clutter"))
     report = run_episode(three, config, seed=1, solver=solver)
     assert report.reached_goal and not report.collided, (report.reason, report.touched)
+
+
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_the_planner_finds_a_way_under_the_shelf_and_runs_it_untouched(sim_name, solver):
+    """Block a sits under the shelf board, the tower b-c-d-e elsewhere: the straight approach
+    from home sweeps the arm through the board; the detour does not."""
+    shelf = with_scene(SceneConfig(), "shelf")
+    entities, state = ("a", "b", "c", "d", "e"), (TABLE, TABLE, "b", "c", "d")
+    poses = layout(entities, state, shelf, seed=0, slots=[8, 0])  # a at (0.56, 0.16)
+    with make_simulator(sim_name, entities, poses, shelf) as sim, PandaCollision() as model:
+        observe = sim.truth._read_poses
+        check = replace(ExecConfig(), collision="check")
+        refused = execute_move(sim, solver, Move("a", "e"), observe, check, shelf, collision=model)
+        assert refused.failure is Failure.COLLISION
+        assert (refused.evidence["phase"], refused.evidence["other"]) == ("approach", "shelf_board")
+        result = execute_move(sim, solver, Move("a", "e"), observe, ExecConfig(), shelf,
+                              collision=model)  # fmt: skip
+        assert result.ok and result.path_time_s > 0, result.evidence
+        assert read_state(entities, observe(), shelf).state == ("e", *state[1:])
+        assert sim.touched == {}
