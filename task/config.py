@@ -19,6 +19,7 @@ class PlannerConfig:
     lambda_move: float = 0.05  # weight of the move-count loss (shorter plans)
     lambda_cycle: float = 1.0  # weight of the direct two-cycle loss
     lambda_fp: float = 1.0  # weight of the fixed-point loss (before refinement)
+    lambda_motion: float = 0.0  # weight of the move costs of a `task.costs.CostSource` (0: none)
     fp_iters: int = 1  # T_P refinement applications between steps
     init_noise: float = 0.5  # std of the Gaussian initial logits (differs per restart)
     restarts: int = 16  # random restarts per problem, optimised in the same tensor program

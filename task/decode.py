@@ -35,19 +35,21 @@ class DecodedWindow:
     illegal: str | None = None  # check=False: why the last move is illegal in ``state``
     estimated: float | None = None  # the domain's ranking estimate (None: ``remaining``)
     revisit: bool = False  # ``state`` was already visited earlier in the plan (a loop)
+    motion: float = 0.0  # the move costs of ``moves`` (`task.costs`; 0 without a cost source)
 
     def key(self) -> tuple:
         """Sort key: the goal reached in fewest moves; else not a dead end (an infinite lower
         bound ranks last, whatever moved), then not back to a state the plan already visited,
         then some progress, then the least estimated total
         (moves + the domain's optional `estimate`, else its lower bound), then the most moves,
-        then the soft objective."""
+        then the least move cost, then the soft objective."""
         g = len(self.moves)
         if self.reached:
-            return (0, g, 0, 0, self.loss)
+            return (0, g, self.motion, 0, 0, self.loss)
         dead = math.isinf(self.remaining)
         rest = self.remaining if self.estimated is None else self.estimated
-        return (1, dead, self.revisit, g == 0, g + rest, -g, not self.complete, self.loss)
+        return (1, dead, self.revisit, g == 0, g + rest, -g, self.motion, not self.complete,
+                self.loss)  # fmt: skip
 
 
 def decode_row(
@@ -59,8 +61,10 @@ def decode_row(
     loss: float,
     check: bool = True,
     seen: Collection[State] = (),
+    costs: Tensor | None = None,
 ) -> DecodedWindow:
-    """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row.
+    """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row; costs:
+    (N, A - 1) its move costs (`task.costs`), summed over the decoded moves.
 
     ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``);
     ``seen``: states the plan already passed through (the window is a ``revisit`` if it ends
@@ -68,7 +72,7 @@ def decode_row(
     n = gates.shape[1]
     best, flat = gates.flatten(1).max(-1)  # (T,), (T,)
     moves: list = []
-    complete, illegal = True, None
+    complete, illegal, motion = True, None, 0.0
     if domain.is_goal(problem, state):  # nothing to do (a perceived state may already be it)
         return DecodedWindow((), state, True, True, loss, 0)
     for value, index in zip(best.tolist(), flat.tolist(), strict=True):
@@ -85,6 +89,7 @@ def decode_row(
             break
         state = domain.apply_move(problem, state, move)
         moves.append(move)
+        motion += 0.0 if costs is None else float(costs[row, col])
         if domain.is_goal(problem, state):
             break
     reached = domain.is_goal(problem, state)
@@ -92,8 +97,9 @@ def decode_row(
     estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
     estimated = None if reached or estimate is None else estimate(problem, state)
     return DecodedWindow(
-        tuple(moves), state, reached, complete, loss, remaining, illegal, estimated, state in seen
-    )
+        tuple(moves), state, reached, complete, loss, remaining, illegal, estimated,
+        state in seen, motion,
+    )  # fmt: skip
 
 
 def decode_best(
@@ -106,20 +112,23 @@ def decode_best(
     threshold: float,
     check: bool = True,
     visited: Sequence[Collection[State]] | None = None,
+    costs: Tensor | None = None,
 ) -> list[DecodedWindow]:
     """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
 
     ``visited``: per problem, the states its plan has passed through (a window that ends in
     one ranks below every window that does not). ``check=False``: illegal moves are kept and
-    the lowest soft objective wins."""
+    the lowest soft objective wins. ``costs``: (P * R, N, A - 1) move costs (`task.costs`)."""
     gates, losses = gates.cpu(), losses.cpu().tolist()
+    costs = None if costs is None else costs.detach().cpu()
     out = []
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
         rows = range(i * restarts, (i + 1) * restarts)
         seen = () if visited is None else visited[i]
+        row_costs = [None if costs is None else costs[r] for r in rows]
         windows = [
-            decode_row(domain, problem, state, gates[r], threshold, losses[r], check, seen)
-            for r in rows
+            decode_row(domain, problem, state, gates[r], threshold, losses[r], check, seen, c)
+            for r, c in zip(rows, row_costs, strict=True)
         ]
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
     return out

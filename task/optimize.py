@@ -14,6 +14,7 @@ from torch import Tensor
 
 from task.beliefs import WindowBeliefs
 from task.config import PlannerConfig
+from task.costs import WindowCosts
 from task.domains.base import Domain, SoftBatch
 from task.errors import TampError
 from task.rollout import Rollout, rollout
@@ -36,29 +37,36 @@ def optimise_window(
     config: PlannerConfig,
     generator: torch.Generator,
     beliefs: WindowBeliefs | None = None,
+    costs: WindowCosts | None = None,
 ) -> tuple[Tensor, Rollout]:
     """Optimise the window's logits; returns them and the final rollout (no grad).
 
     steps: (B, T) bool, the live steps of each row (rows may have shorter windows).
     ``beliefs`` (see `task.beliefs`) replaces the batch's F0 and goal by soft ones, recomputed
     at every step; their parameters, if any, are optimised too, at their own learning rate.
+    ``costs`` (see `task.costs`) adds the expected move cost to the loss, likewise.
     """
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
     groups = [{"params": [logits], "lr": config.lr}]
     extra = beliefs.parameters() if beliefs is not None else []
     if extra:
         groups.append({"params": extra, "lr": beliefs.lr})
+    placed = costs.parameters() if costs is not None else []
+    if placed:
+        groups.append({"params": placed, "lr": costs.lr})
     opt = Adam(groups)
     for k in range(config.iters):
         opt.zero_grad()
         tau = temperature(config, k)
         live, penalty = with_beliefs(batch, beliefs)
-        (rollout(domain, logits, live, steps, config, tau).loss.sum() + penalty).backward()
+        c = with_costs(batch, costs)
+        (rollout(domain, logits, live, steps, config, tau, c).loss.sum() + penalty).backward()
         opt.step()
     with torch.no_grad():
         tau = temperature(config, config.iters - 1)
         live, _ = with_beliefs(batch, beliefs)
-        return logits.detach(), rollout(domain, logits, live, steps, config, tau)
+        c = with_costs(batch, costs)
+        return logits.detach(), rollout(domain, logits, live, steps, config, tau, c)
 
 
 class Adam:
@@ -108,6 +116,18 @@ def with_beliefs(batch: SoftBatch, beliefs: WindowBeliefs | None) -> tuple[SoftB
         batch, F0=F0.repeat_interleave(r, dim=0), goal=goal.repeat_interleave(r, dim=0)
     )
     return soft, r * penalty.sum()
+
+
+def with_costs(batch: SoftBatch, costs: WindowCosts | None) -> Tensor | None:
+    """The window's move costs (P, N, Y), each problem's repeated for its restart rows."""
+    if costs is None:
+        return None
+    c = costs.compute()  # (P, N, Y)
+    rows = batch.F0.shape[0]
+    if c.shape[1:] != batch.F0.shape[1:] or rows % c.shape[0]:
+        raise TampError(f"move costs of shape {tuple(c.shape)} do not fit a batch of "
+                        f"{tuple(batch.F0.shape)}")  # fmt: skip
+    return c.to(batch.F0.dtype).repeat_interleave(rows // c.shape[0], dim=0)  # (B, N, Y)
 
 
 def temperature(config: PlannerConfig, k: int) -> float:

@@ -24,6 +24,7 @@ import torch
 
 from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig
+from task.costs import CostSource, WindowCosts
 from task.decode import decode_best
 from task.domains import get_domain
 from task.domains.base import Domain, State, resolve_goal_loss
@@ -40,14 +41,15 @@ def _window(
     generator: torch.Generator,
     beliefs: WindowBeliefs | None = None,
     visited: Sequence[set] | None = None,
+    costs: WindowCosts | None = None,
 ):
     batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
     horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
     steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
-    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs)
+    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs)
     return decode_best(
         domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold,
-        config.crisp_check, visited,
+        config.crisp_check, visited, roll.costs,
     )  # fmt: skip
 
 
@@ -106,6 +108,7 @@ def _run(
     on_done: Callable[[int], None],
     source: BeliefSource | None = None,
     indices: Sequence[int] = (),
+    costs: CostSource | None = None,
 ) -> list[PlanResult]:
     """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems.
 
@@ -129,9 +132,10 @@ def _run(
         now = [states[i] for i in active]
         beliefs = None if source is None else source([indices[i] for i in active], now)
         crisp, perceived = _crisp_states(beliefs, now)
+        priced = None if costs is None else costs([indices[i] for i in active], crisp)
         decoded = _window(
             domain, [problems[i] for i in active], crisp, config, generator, beliefs,
-            [visited[i] for i in active],
+            [visited[i] for i in active], priced,
         )  # fmt: skip
         _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded)
         hoped = []  # perceived: windows that predict the goal, for a new image to confirm
@@ -185,12 +189,14 @@ def plan_batch(
     seed: int = 0,
     progress: Callable[[int], None] | None = None,
     beliefs: BeliefSource | None = None,
+    costs: CostSource | None = None,
 ) -> list[PlanResult]:
     """Plan every problem (all of one domain). ``progress(k)``: k more problems finished.
 
     Returns one PlanResult per problem, in order; ``stats["time_s"]`` is the wall time per
     problem (the batch's time divided among its problems when batched). ``beliefs`` gives
-    every window soft initial and goal supports (planning from perception, `task.beliefs`).
+    every window soft initial and goal supports (planning from perception, `task.beliefs`);
+    ``costs`` every window move costs (the arm in the objective, `task.costs`).
     """
     if not problems:
         return []
@@ -206,7 +212,7 @@ def plan_batch(
     report = progress or (lambda k: None)
     if not config.batched:
         return [
-            _run(domain, [p], config, generator, report, beliefs, [i])[0]
+            _run(domain, [p], config, generator, report, beliefs, [i], costs)[0]
             for i, p in enumerate(problems)
         ]
     # one tensor program per shape key (the domain's: sizes that pad alike), per-key times
@@ -215,7 +221,7 @@ def plan_batch(
     for key in sorted(set(keys)):
         group = [i for i, k in enumerate(keys) if k == key]
         subset = [problems[i] for i in group]
-        planned = _run(domain, subset, config, generator, report, beliefs, group)
+        planned = _run(domain, subset, config, generator, report, beliefs, group, costs)
         for i, result in zip(group, planned, strict=True):
             results[i] = result
     return results
@@ -226,6 +232,8 @@ def plan(
     config: PlannerConfig = PlannerConfig(),
     seed: int = 0,
     beliefs: BeliefSource | None = None,
+    costs: CostSource | None = None,
 ) -> PlanResult:
-    """Plan one problem (``beliefs``: soft inputs from perception, see `plan_batch`)."""
-    return plan_batch([problem], config, seed, beliefs=beliefs)[0]
+    """Plan one problem (``beliefs``: soft inputs from perception; ``costs``: move costs; see
+    `plan_batch`)."""
+    return plan_batch([problem], config, seed, beliefs=beliefs, costs=costs)[0]

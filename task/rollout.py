@@ -23,6 +23,8 @@ class Rollout:
     loss: Tensor  # (B,) total objective per rollout
     goal: Tensor  # (B,) goal cross-entropy at the window's end
     moves: Tensor  # (B,) expected number of moves, sum_t sum_x m_t(x)
+    motion: Tensor | None = None  # (B,) expected move cost sum_t sum_(x,y) g_t(x,y) c(x,y)
+    costs: Tensor | None = None  # (B, N, Y) the move costs c (`task.costs`), or None
 
 
 def action_probs(logits: Tensor, batch: SoftBatch, tau: float, steps: Tensor) -> Tensor:
@@ -44,10 +46,13 @@ def rollout(
     steps: Tensor,
     config: PlannerConfig,
     tau: float | None = None,
+    costs: Tensor | None = None,
 ) -> Rollout:
     """Roll the window out from ``batch.F0``; logits: (B, T, N, A); steps: (B, T) live steps.
 
-    ``tau`` overrides ``config.tau`` (the optimiser anneals it).
+    ``tau`` overrides ``config.tau`` (the optimiser anneals it). ``costs`` (B, N, Y): move
+    costs, whose expectation under the applied move mass joins the loss with weight
+    ``config.lambda_motion`` (`task.costs`).
     """
     M = action_probs(logits, batch, config.tau if tau is None else tau, steps)  # (B, T, N, A)
     F = batch.F0
@@ -68,4 +73,8 @@ def rollout(
     moves = G.sum((1, 2, 3))
     goal = domain.goal_loss(F, batch, resolve_goal_loss(domain, config.goal_loss))
     loss = goal + config.lambda_move * moves + config.lambda_cycle * cycle + config.lambda_fp * fp
-    return Rollout(torch.stack(states, dim=1), G, loss, goal, moves)
+    motion = None
+    if costs is not None:
+        motion = (G * costs[:, None]).sum((1, 2, 3))  # (B, T, N, Y) * (B, 1, N, Y) -> (B,)
+        loss = loss + config.lambda_motion * motion
+    return Rollout(torch.stack(states, dim=1), G, loss, goal, moves, motion, costs)

@@ -1,0 +1,48 @@
+"""Move costs from outside the planner: the arm inside the planning objective.
+
+A `CostSource` gives every planning window a cost ``c(x, y)`` for each move of an entity ``x``
+onto a target ``y`` in the window's start state, for example the arm's joint-space motion and
+reach of each candidate pick-and-place (`tamp.arm_costs`, computed through pytorch-kinematics).
+The planner adds the expected cost of the committed move mass to its loss,
+
+    L_motion = lambda_motion * sum_t sum_(x, y) g_t(x, y) c(x, y)
+
+(`task.config.PlannerConfig.lambda_motion`), and ranks restarts that are equally good at task
+level (validity, then length) by the crisp cost of their decoded moves. The costs may depend
+on continuous parameters of the source (placements), which the window's Adam then optimises
+with the action logits at the source's own learning rate. The soft machinery never leaves
+`task`; the costs come in as a tensor. The costs are those of the window's start state for
+every step of the window (later steps see the same matrix): an approximation the next window
+corrects, as it starts from the state the executed moves reached.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Protocol
+
+from torch import Tensor
+
+from task.domains.base import State
+
+
+class WindowCosts(Protocol):
+    """The move costs of one planning window for P problems (all of one size N)."""
+
+    lr: float  # Adam learning rate of ``parameters()``
+
+    def compute(self) -> Tensor:
+        """(P, N, Y) cost of moving entity x onto target y; called at every Adam step, so it
+        may depend on ``parameters()`` differentiably."""
+        ...
+
+    def parameters(self) -> list[Tensor]:
+        """Continuous variables to optimise with the logits (placements); may be empty."""
+        ...
+
+
+class CostSource(Protocol):
+    """Makes the costs of a window for the problems ``indices`` (positions in the list given to
+    `task.planner.plan_batch`) in their current crisp ``states``."""
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowCosts: ...

@@ -1,0 +1,96 @@
+"""Move costs in the planning objective (`task.costs`): the loss term, its gradients into the
+action logits and into a cost source's placements (gradcheck, float64), and the planner
+preferring, among equally short plans, the one whose moves cost less."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import pytest
+import torch
+
+from task.config import PlannerConfig
+from task.domains import get_domain
+from task.planner import plan
+from task.problem import TABLE, Problem
+from task.rollout import rollout
+
+BW = get_domain("blocksworld")
+# a sits on b; the goal puts b on c, so a must go first: onto the table or onto d, 2 moves both
+UNSTACK = Problem("unstack", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
+                  (("b", "c"),))  # fmt: skip
+A, D, TABLE_COL = 0, 3, 4  # rows / columns of the cost matrix (targets: a, b, c, d, table)
+
+
+def _setup(dtype=torch.float64):
+    batch = BW.encode([UNSTACK], [BW.initial_state(UNSTACK)], dtype)
+    steps = torch.ones(1, 2, dtype=torch.bool)
+    gen = torch.Generator().manual_seed(0)
+    shape = (1, 2, *batch.action_mask.shape[1:])  # (B, T, N, A)
+    logits = torch.randn(shape, generator=gen, dtype=dtype)
+    return batch, steps, logits
+
+
+def test_the_motion_term_is_the_expected_cost_of_the_applied_move_mass():
+    batch, steps, logits = _setup()
+    config = PlannerConfig(horizon=2, lambda_motion=0.5)
+    costs = torch.rand((1, 4, 5), generator=torch.Generator().manual_seed(1), dtype=torch.float64)
+    plain = rollout(BW, logits, batch, steps, config)
+    priced = rollout(BW, logits, batch, steps, config, costs=costs)
+    expected = (priced.gates * costs[:, None]).sum()
+    assert torch.allclose(priced.motion.sum(), expected)
+    assert torch.allclose(priced.loss - plain.loss, 0.5 * priced.motion)
+
+
+def test_gradients_flow_into_the_logits_and_the_placements_gradcheck():
+    """costs(p) = |places(p) - pick|^2, a stand-in for the arm's cost with placements p."""
+    batch, steps, logits = _setup()
+    config = PlannerConfig(horizon=2, lambda_motion=0.7)
+    picks = torch.rand((4, 2), generator=torch.Generator().manual_seed(2), dtype=torch.float64)
+
+    def loss(lg, places):  # places: (5, 2), one per target
+        costs = (places[None] - picks[:, None]).pow(2).sum(-1)[None]  # (1, N, Y)
+        return rollout(BW, lg, batch, steps, config, costs=costs).loss.sum()
+
+    places = torch.rand((5, 2), generator=torch.Generator().manual_seed(3), dtype=torch.float64)
+    inputs = (logits.requires_grad_(True), places.requires_grad_(True))
+    assert torch.autograd.gradcheck(loss, inputs, eps=1e-6, atol=1e-5)
+
+
+@dataclass
+class FixedCosts:
+    """A cost source with one fixed matrix and no placements."""
+
+    matrix: torch.Tensor
+    lr: float = 0.0
+    calls: list = field(default_factory=list)
+
+    def __call__(self, indices, states):
+        self.calls.append(tuple(states))
+        return self
+
+    def compute(self):
+        return self.matrix
+
+    def parameters(self):
+        return []
+
+
+@pytest.mark.parametrize("cheap", [D, TABLE_COL])
+def test_among_equally_short_plans_the_cheaper_moves_win(cheap):
+    matrix = torch.ones((1, 4, 5))
+    matrix[0, A, D if cheap == TABLE_COL else TABLE_COL] = 10.0  # the other way for a costs 10
+    source = FixedCosts(matrix)
+    config = PlannerConfig(lambda_motion=0.05)
+    result = plan(UNSTACK, config, seed=0, costs=source)
+    first = result.plan.moves[0]
+    assert len(result.plan.moves) == 2 and first.entity == "a"
+    assert first.target == ("d" if cheap == D else TABLE)
+    assert source.calls and source.calls[0][0] == BW.initial_state(UNSTACK)
+
+
+def test_without_costs_the_planner_is_unchanged():
+    """A weight without a cost source changes nothing."""
+    config = PlannerConfig()
+    heavy = replace(config, lambda_motion=3.0)
+    assert plan(UNSTACK, config, 0).plan == plan(UNSTACK, heavy, 0).plan
