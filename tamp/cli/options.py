@@ -20,7 +20,7 @@ GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
-    "lookahead", "max_windows", "time_limit_s",
+    "lookahead", "max_windows", "time_limit_s", "lambda_motion",
 )  # fmt: skip
 
 
@@ -151,13 +151,9 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         "--time-limit", dest="time_limit_s", type=seconds, metavar="SECONDS",
         help="stop planning at this wall-clock limit with the moves so far, and say so (none)",
     )  # fmt: skip
-    g.add_argument(
-        "--tau-end",
-        type=positive_float,
-        metavar="TAU",
-        help=f"softmax temperature at the last Adam step, annealed from {d.tau:g} "
-        f"({d.tau_end:g}; {d.tau:g} = no annealing, the paper's planner)",
-    )
+    g.add_argument("--tau-end", type=positive_float, metavar="TAU",
+                   help=f"softmax temperature at the last Adam step, annealed from {d.tau:g} "
+                   f"({d.tau_end:g}; {d.tau:g} = no annealing, the paper's planner)")  # fmt: skip
     return p
 
 
@@ -235,6 +231,9 @@ def scene_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--collision", choices=("plan", "check", "off"), default="plan",
                    help="check every trajectory and route blocked ones with the motion planner "
                    "(plan), fail them (check), or run unchecked (off) (plan)")  # fmt: skip
+    p.add_argument("--motion-aware", dest="lambda_motion", action="store_const", const=0.05,
+                   help="put the arm's cost of each move into the planner's objective, weight "
+                   "0.05 (off: task-only planning)")  # fmt: skip
 
 
 def run_options(p: argparse.ArgumentParser) -> None:

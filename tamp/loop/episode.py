@@ -24,6 +24,7 @@ from contextlib import contextmanager
 import numpy as np
 
 from motion.ik import IKSolver
+from tamp.arm_costs import ArmCosts
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import ExecutionResult, execute_move
@@ -167,15 +168,19 @@ class Episode:
     def _plan_window(self, state, seed: int):
         """Plan from ``state``; with the camera, one window from the current image."""
         current = dataclasses.replace(self.target, init=state)
+        costs = None  # motion-aware planning: the arm's cost of each move, from what it sees
+        if self.config.planner.lambda_motion > 0:
+            costs = ArmCosts([current], [self._poses()], self.config.scene, self.solver,
+                             self.sim.arm_q())  # fmt: skip
         if self.config.observe == "state":
-            return plan(current, self.config.planner, seed=seed)
+            return plan(current, self.config.planner, seed=seed, costs=costs)
         image = self.eyes.image
         mode = dataclasses.replace(self.config.perception, crisp="true")  # checked against init
         beliefs = ImageBeliefs(
             [current], self.eyes.perceiver, lambda i, s: image, [self.goal_image], mode
         )
         window = dataclasses.replace(self.config.planner, max_windows=1)
-        return plan(current, window, seed=seed, beliefs=beliefs)
+        return plan(current, window, seed=seed, beliefs=beliefs, costs=costs)
 
     def _execute_next(self, p: Progress, move: Move) -> ExecutionResult:
         """Execute ``move`` with the injected faults (a drop in transit, a nudge after), let

@@ -83,6 +83,7 @@ class ExecutionResult:
     ik_time_s: float = 0.0
     check_time_s: float = 0.0  # collision checks of the planned trajectories
     path_time_s: float = 0.0  # the motion planner's detours
+    path_rad: float = 0.0  # joint-space length (rad) of the arm phases started: sum of |dq|
 
 
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
@@ -195,7 +196,7 @@ def execute_move(
     """
     wall0, sim0 = time.perf_counter(), sim.time
 
-    times = [0.0, 0.0]  # collision checks, motion planner
+    times = [0.0, 0.0, 0.0]  # collision checks, motion planner, path run (rad)
 
     def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
         return ExecutionResult(
@@ -219,6 +220,8 @@ def execute_move(
             release = drop_at * phase.trajectory.duration
         if phase.name == "open":
             sim.detach()
+        q = phase.trajectory.positions  # (S, J)
+        times[2] += float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum())
         worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame))
         if worst > config.max_tracking:
             _back_off(sim, phases, on_frame)

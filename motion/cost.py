@@ -1,0 +1,134 @@
+"""Differentiable motion cost of every candidate block move, for joint task-motion optimisation.
+
+A task planner that moves block ``x`` onto target ``y`` can add the arm's effort to its
+objective. For picks ``p_x`` (block centres now) and places ``u_y`` (where a block's centre goes
+when placed onto ``y``), with top-down TCP targets ``T(.)`` and IK solutions ``q(.)``:
+
+    c(x, y) = joint_weight * ||q(u_y) - q(p_x)||_2                      (rad, over the J joints)
+            + reach_weight * (r(p_x) + r(u_y))                          (m, IK position residual)
+            + infeasible * ([IK of p_x failed] + [IK of u_y failed])    (constant, no gradient)
+
+    r(t) = ||FK(q(t))[:3, 3] - t||_2
+
+All ``N + Y`` targets are solved in one batched, detached `IKSolver.solve` call; the solutions
+then pass through one differentiable Gauss-Newton step (`motion.ik.ik_refine`), so the cost is
+differentiable in the picks and places with ``d q / d t = pinv(J)`` at the detached solution.
+The gradient is that of the refined cost with the detached solution held fixed: where the IK
+solver switches branch under a perturbation of a target the cost itself jumps. A target whose
+IK failed skips the refinement (the pinv step near the stretched-arm singularity is unbounded)
+and keeps its best attempt q*, so r(t) = ||FK(q*) - t|| still pulls it toward the workspace.
+
+It is an approximation of a `motion.pick_place` move: only the transit from the grasp
+configuration to the release configuration counts (approach, descend, lift, lower and retreat
+are ignored), the hand yaw is 0 everywhere (a cube's yaw barely changes the joint distance),
+the release gap is ignored, and the straight joint segment stands in for the timed trajectory.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from motion.errors import MotionError
+from motion.ik import IKSolver, ik_refine
+
+_TOP_DOWN = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0))  # Rz(0) Rx(pi)
+
+
+@dataclass(frozen=True)
+class MoveCostConfig:
+    """Weights of the move cost (see the module docstring for the equation)."""
+
+    joint_weight: float = 1.0  # cost per rad of L2 joint distance, grasp -> release configuration
+    reach_weight: float = 10.0  # cost per m of IK position residual at the pick or the place
+    infeasible: float = 10.0  # added per pick or place whose IK does not converge (no gradient)
+    block_size: float = 0.05  # m, cube edge; a place on a block is its centre + block_size up
+
+
+def top_down_targets(xyz: torch.Tensor) -> torch.Tensor:
+    """Top-down TCP poses (..., 4, 4) at ``xyz`` (..., 3), yaw 0, differentiable in ``xyz``.
+
+    The rotation is that of `motion.ik.top_down_pose` with yaw 0: R = Rx(pi) = diag(1, -1, -1).
+    """
+    if xyz.ndim < 1 or xyz.shape[-1] != 3:
+        raise MotionError(f"xyz has shape {tuple(xyz.shape)}; expected (..., 3)")
+    lead = xyz.shape[:-1]
+    rot = torch.tensor(_TOP_DOWN, dtype=xyz.dtype, device=xyz.device).expand(*lead, 3, 3)
+    top = torch.cat([rot, xyz[..., :, None]], dim=-1)  # (..., 3, 4)
+    last = torch.tensor((0.0, 0.0, 0.0, 1.0), dtype=xyz.dtype, device=xyz.device)
+    return torch.cat([top, last.expand(*lead, 1, 4)], dim=-2)  # (..., 4, 4)
+
+
+def _points(x, ndim: int, name: str) -> torch.Tensor:
+    """``x`` as a finite float64 tensor of ``ndim`` axes ending in 3 (keeps the autograd graph)."""
+    t = torch.as_tensor(x).to(torch.float64)
+    if t.ndim != ndim or t.shape[-1] != 3:
+        want = "(P, N, 3)" if ndim == 3 else "(N, 3)"
+        raise MotionError(f"{name} has shape {tuple(t.shape)}; expected {want}")
+    if not torch.isfinite(t).all():
+        raise MotionError(f"{name} contains NaN or inf")
+    return t
+
+
+def move_costs_batch(
+    solver: IKSolver,
+    q_ref,
+    picks: torch.Tensor,
+    places: torch.Tensor,
+    config: MoveCostConfig = MoveCostConfig(),
+) -> torch.Tensor:
+    """Costs (P, N, Y) float64 of P problems at once: picks (P, N, 3), places (P, Y, 3).
+
+    One batched IK call covers all ``P * (N + Y)`` targets, seeded from ``q_ref`` (J,) plus the
+    solver's own seeds; see `move_costs` for one problem and the module docstring for c(x, y).
+    """
+    picks = _points(picks, 3, "picks")  # (P, N, 3)
+    places = _points(places, 3, "places")  # (P, Y, 3)
+    if picks.shape[0] != places.shape[0]:
+        raise MotionError(
+            f"picks has {picks.shape[0]} problems and places {places.shape[0]}; expected equal"
+        )
+    p, n, y = picks.shape[0], picks.shape[1], places.shape[1]
+    if p * (n + y) == 0:
+        return torch.zeros((p, n, y), dtype=torch.float64)
+    xyz = torch.cat([picks, places], dim=1).reshape(-1, 3)  # (P * (N + Y), 3)
+    targets = top_down_targets(xyz)  # (B, 4, 4), B = P * (N + Y)
+    found = solver.solve(targets.detach().numpy(), np.asarray(q_ref, dtype=np.float64))
+    q_star = torch.from_numpy(np.array(found.q))  # (B, J), detached
+    ok = torch.from_numpy(np.array(found.ok))  # (B,)
+    # A failed row keeps its best attempt: the arm is stretched near a singularity there, where
+    # the pinv step is unbounded; its residual still pulls the target back toward the workspace.
+    q = torch.where(ok[:, None], ik_refine(solver, q_star, targets), q_star)  # (B, J)
+    reached = solver.fk_tensor(q)[:, :3, 3]  # (B, 3)
+    residual = torch.linalg.vector_norm(reached - xyz, dim=-1)  # (B,)
+    failed = (~ok).to(torch.float64)  # (B,)
+    site = config.reach_weight * residual + config.infeasible * failed  # (B,)
+    site = site.reshape(p, n + y)  # (P, N + Y)
+    q = q.reshape(p, n + y, -1)  # (P, N + Y, J)
+    q_pick, q_place = q[:, :n], q[:, n:]  # (P, N, J), (P, Y, J)
+    dist = torch.linalg.vector_norm(q_place[:, None] - q_pick[:, :, None], dim=-1)  # (P, N, Y)
+    return config.joint_weight * dist + site[:, :n, None] + site[:, None, n:]  # (P, N, Y)
+
+
+def move_costs(
+    solver: IKSolver,
+    q_ref,
+    picks: torch.Tensor,
+    places: torch.Tensor,
+    config: MoveCostConfig = MoveCostConfig(),
+) -> torch.Tensor:
+    """Costs (N, Y) float64 of moving the block at picks[x] so that its centre ends at places[y].
+
+    ``picks`` (N, 3) are block centres now; ``places`` (Y, 3) are where a block's centre goes
+    when placed onto target y (the caller computes them: on a block, its centre + block_size up;
+    on the table, a free spot). ``q_ref`` (J,) seeds the IK. Differentiable w.r.t. picks and
+    places through `motion.ik.ik_refine`:
+
+        c(x, y) = joint_weight * ||q(place_y) - q(pick_x)||
+                + reach_weight * (r(pick_x) + r(place_y)) + infeasible * (not converged)
+    """
+    picks = _points(picks, 2, "picks")  # (N, 3)
+    places = _points(places, 2, "places")  # (Y, 3)
+    return move_costs_batch(solver, q_ref, picks[None], places[None], config)[0]  # (N, Y)

@@ -1,0 +1,132 @@
+"""The arm's cost of every candidate move, for motion-aware task planning (`task.costs`).
+
+`ArmCosts` is a `task.costs.CostSource` for Blocksworld problems laid out on a table scene.
+For a window starting in a crisp state it predicts where every block stands (blocks keep their
+observed places; a tower moved to the table stands on a free slot, `predict_poses`), then prices
+each move x -> y with `motion.cost.move_costs`: the joint-space distance between the grasp
+configuration at x and the release configuration on y (through pytorch-kinematics, with
+gradients to the targets), plus the reach residual and an infeasibility penalty. A place onto
+a tower that its slot's clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf
+over it) and a move to a full table get ``blocked`` on top. The matrix is computed once per
+state (no placements are optimised here: the table placement is the scene's free slot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import torch
+
+from motion.cost import MoveCostConfig, move_costs_batch
+from motion.ik import IKSolver
+from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
+from task.domains.base import State
+from task.problem import TABLE, Problem
+
+BLOCKED = 10.0  # added to a move the scene cannot take (no clearance, no free slot)
+
+
+def predict_poses(
+    entities: Sequence[str], state: State, poses: Mapping[str, Pose], scene: SceneConfig
+) -> dict[str, Pose]:
+    """Block poses after the plan reached ``state`` from the observed ``poses``: a block with
+    the same blocks under it as observed keeps its observed pose; otherwise its tower keeps
+    the base block's observed table position when that base was on the table, else it stands
+    on a free slot, and the block stands exactly above the base."""
+    s, out = scene.block_size, {}
+    stacks = towers(entities, state)
+    seen = read_state(entities, poses, scene).state
+    before = {} if seen is None else {x: tuple(t[:k]) for t in towers(entities, seen)
+                                      for k, x in enumerate(t)}  # fmt: skip
+    grounded = [t for t in stacks if abs(poses[t[0]].xyz[2] - s / 2) <= scene.tol_z]
+    for tower in grounded:
+        for level, x in enumerate(tower):
+            base = poses[tower[0]]
+            out[x] = Pose((base.xyz[0], base.xyz[1], s / 2 + level * s), base.yaw)
+            if before.get(x) == tuple(tower[:level]):
+                out[x] = poses[x]  # nothing under it changed
+    for tower in (t for t in stacks if t not in grounded):
+        taken = {k: v for k, v in out.items()}
+        slot = free_slot(taken, poses[tower[0]].xyz, scene) or scene.slots[0]
+        for level, x in enumerate(tower):
+            out[x] = Pose((slot[0], slot[1], s / 2 + level * s), 0.0)
+    return out
+
+
+class _Fixed:
+    """The costs of one window: a fixed (P, N, Y) matrix and no parameters."""
+
+    lr = 0.0
+
+    def __init__(self, matrix: torch.Tensor) -> None:
+        self.matrix = matrix
+
+    def compute(self) -> torch.Tensor:
+        return self.matrix
+
+    def parameters(self) -> list[torch.Tensor]:
+        return []
+
+
+class ArmCosts:
+    """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
+    ``poses[k]`` (block -> `Pose`), priced for the arm now at ``q_now`` (J,)."""
+
+    def __init__(
+        self,
+        problems: Sequence[Problem],
+        poses: Sequence[Mapping[str, Pose]],
+        scene: SceneConfig,
+        solver: IKSolver,
+        q_now,
+        config: MoveCostConfig = MoveCostConfig(),
+    ) -> None:
+        self.problems, self.poses, self.scene = list(problems), list(poses), scene
+        self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
+        self._cache: dict[tuple[int, State], torch.Tensor] = {}
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> _Fixed:
+        todo = [(i, s) for i, s in zip(indices, states, strict=True) if (i, s) not in self._cache]
+        if todo:
+            for key, matrix in zip(todo, self._price(todo), strict=True):
+                self._cache[key] = matrix
+        keys = zip(indices, states, strict=True)
+        return _Fixed(torch.stack([self._cache[key] for key in keys]))  # (P, N, Y)
+
+    def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
+        """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
+        picks, places, extra = [], [], []
+        s = self.scene.block_size
+        for i, state in todo:
+            problem = self.problems[i]
+            now = predict_poses(problem.entities, state, self.poses[i], self.scene)
+            xyz = np.array([now[x].xyz for x in problem.entities])  # (N, 3)
+            slot = free_slot(now, xyz.mean(0), self.scene)
+            table = (slot[0], slot[1], s / 2) if slot is not None else tuple(xyz.mean(0))
+            picks.append(xyz)
+            up = xyz + np.array([0.0, 0.0, s])  # onto each block
+            places.append(np.vstack([up, [table]]))  # (Y, 3), Y = N + 1
+            extra.append(self._blocked(problem, state, now, slot is None))
+        with torch.no_grad():
+            c = move_costs_batch(
+                self.solver, self.q_now, torch.tensor(np.stack(picks)),
+                torch.tensor(np.stack(places)), self.config,
+            )  # fmt: skip  # (P, N, Y)
+        return list(c + torch.tensor(np.stack(extra)))
+
+    def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
+        """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no
+        free table slot."""
+        n = problem.n
+        out = np.zeros((n, n + 1))
+        support = dict(zip(problem.entities, state, strict=True))
+        for j, y in enumerate(problem.entities):
+            height, below = 1, support[y]
+            while below != TABLE:
+                height, below = height + 1, support[below]
+            if height + 1 > self.scene.capacity(now[y].xy):
+                out[:, j] = BLOCKED
+        if table_full:
+            out[:, n] = BLOCKED
+        return out

@@ -1,0 +1,66 @@
+"""Motion-aware planning's move costs from the scene (`tamp.arm_costs`): predicted poses, the
+cost matrix's shape and meaning, blocked places under a shelf, and an episode planned with
+them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from motion.ik import IKSolver
+from robots.panda import PANDA
+from tamp.arm_costs import BLOCKED, ArmCosts, predict_poses
+from tamp.loop import LoopConfig, run_episode
+from tamp.obstacles import with_scene
+from tamp.scene import SceneConfig, layout
+from task.config import PlannerConfig
+from task.problem import TABLE, Problem
+
+SCENE = SceneConfig()
+FOUR = Problem("four", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
+               (("b", "c"),))  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def solver() -> IKSolver:
+    return IKSolver()
+
+
+def test_predicted_poses_keep_towers_in_place_and_put_new_ones_on_free_slots():
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
+    same = predict_poses(FOUR.entities, FOUR.init, poses, SCENE)
+    for x in FOUR.entities:
+        assert np.allclose(same[x].xyz, poses[x].xyz, atol=1e-9)
+    moved = predict_poses(FOUR.entities, (TABLE, "c", TABLE, TABLE), poses, SCENE)
+    assert np.allclose(moved["b"].xyz[:2], poses["c"].xyz[:2])  # b now stands on c
+    assert moved["b"].xyz[2] == pytest.approx(0.075)
+    assert min(np.linalg.norm(moved["a"].xy - p.xy) for k, p in moved.items() if k != "a") > 0.1
+
+
+def test_costs_are_one_matrix_per_problem_and_a_far_place_costs_more(solver):
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])  # a-b, c, d
+    source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)
+    window = source([0], [FOUR.init])
+    c = window.compute()
+    assert c.shape == (1, 4, 5) and torch.isfinite(c).all() and window.parameters() == []
+    # c stands next to a's tower (slot 1), d at the far end (slot 9)
+    assert c[0, 0, 2] < c[0, 0, 3]
+    assert source([0], [FOUR.init]).compute() is not c  # a new window, the cached matrix
+    assert torch.equal(source([0], [FOUR.init]).compute(), c)
+
+
+def test_a_tower_at_its_slots_clearance_blocks_one_more_block(solver):
+    shelf = with_scene(SCENE, "shelf")
+    five = Problem("five", "blocksworld", tuple("abcdef"), (TABLE, "a", "b", "c", "d", TABLE),
+                   (("f", "e"),))  # fmt: skip
+    poses = layout(five.entities, five.init, SCENE, seed=0, slots=[8, 0])  # the tower under it
+    c = ArmCosts([five], [poses], shelf, solver, PANDA.q_home)([0], [five.init]).compute()
+    assert shelf.capacity(poses["a"].xy) == 5
+    assert c[0, 5, 4] >= BLOCKED and c[0, 5, 6] < BLOCKED  # f onto e (6th), f onto the table
+
+
+def test_a_motion_aware_episode_reaches_the_goal(solver):
+    config = LoopConfig(planner=PlannerConfig(lambda_motion=0.05))
+    report = run_episode(FOUR, config, seed=0, solver=solver)
+    assert report.reached_goal and len(report.moves) == 2
