@@ -55,6 +55,7 @@ class PickPlaceRequest:
     clear_z: float  # m, height of the highest stack top that transit must clear
     pick_ceiling: float = math.inf  # m, highest TCP height over the pick point (a shelf above)
     place_ceiling: float = math.inf  # m, ... over the place point
+    turn: bool = False  # grasp the other pair of faces (the hand turned a quarter turn)
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ def waypoint_targets(
     half = config.block_size / 2
     highest = max(request.clear_z, pick[2] + half, place[2] - half)  # stack tops to clear
     z_transit = highest + config.lift_clearance + config.block_size  # TCP = held block centre
-    yaw_grasp = grasp_yaw(request.pick_yaw, hand_yaw)
+    yaw_grasp = grasp_yaw(request.pick_yaw, hand_yaw) + (math.pi / 2 if request.turn else 0.0)
     yaw_place = grasp_yaw(request.place_yaw, yaw_grasp)
     up = np.array([0.0, 0.0, 1.0])
     place_tcp = place + config.place_gap * up

@@ -145,10 +145,13 @@ def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
 
 
 def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
-    """(target pose, phases, IK time) of the move, or (Failure, IK time, evidence). A table
-    placement whose motion fails tries the next free slots (up to ``config.slot_tries``)."""
+    """(target pose, phases, IK time) of the move, or (Failure, IK time, evidence). A move
+    whose motion fails tries the quarter-turned grasp (a neighbour touching the block on one
+    side leaves the other pair of faces free), and a table placement the next free slots (up
+    to ``config.slot_tries``)."""
     ik, last = 0.0, None
-    for rank in range(config.slot_tries if move.target == TABLE else 1):
+    tries = range(config.slot_tries if move.target == TABLE else 1)
+    for rank, turn in ((r, t) for r in tries for t in (False, True)):
         target = place_pose(move, poses, scene, rank)
         if target is None:
             return last or (Failure.NO_FREE_SLOT, ik, {"slots": len(scene.slots)})
@@ -156,7 +159,7 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
         others = {k: v for k, v in poses.items() if k != move.entity}
         request = PickPlaceRequest(
             pick.xyz, pick.yaw, target.xyz, target.yaw, top_z(others, scene),
-            ceiling(pick.xyz, scene.obstacles), ceiling(target.xyz, scene.obstacles),
+            ceiling(pick.xyz, scene.obstacles), ceiling(target.xyz, scene.obstacles), turn,
         )  # fmt: skip
         planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
         ik += planned.ik_time_s

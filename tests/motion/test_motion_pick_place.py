@@ -122,6 +122,15 @@ def test_a_ceiling_keeps_the_hand_under_it_or_leaves_no_clearance(solver):
     assert result.evidence["pick_ceiling"] == HALF + 0.01
 
 
+def test_a_turned_grasp_takes_the_other_pair_of_faces(solver):
+    base = REQUESTS["table_to_stack"]
+    plain = plan_pick_place(solver, PANDA.q_home, base, CONFIG)
+    turned = plan_pick_place(solver, PANDA.q_home, dataclasses.replace(base, turn=True), CONFIG)
+    assert plain.ok and turned.ok
+    quarter = (turned.evidence["yaws"]["grasp"] - plain.evidence["yaws"]["grasp"]) % math.pi
+    assert quarter == pytest.approx(math.pi / 2, abs=1e-3)
+
+
 def test_malformed_request_raises(solver):
     req = dataclasses.replace(REQUESTS["table_to_stack"], pick=(0.5, 0.0))
     with pytest.raises(MotionError):
