@@ -11,5 +11,8 @@ The one package that sees every other one. Its rooms:
   one table printer;
 - ``tamp.cli``: the ``tamp`` command (parsing and printing only);
 - ``tamp.scene``: the table, its slots and block poses <-> symbolic states;
+  ``tamp.obstacles``: the named scenes and the clearance they leave;
+  ``tamp.arm_costs``: the arm's cost of each move, for motion-aware planning;
+  ``tamp.sweep``: independent items (episodes) in local processes or on a Ray cluster;
   ``tamp.video``: episode videos.
 """

@@ -13,8 +13,8 @@ moves valid" the moves that executed ok, in order (every step applicable, the go
 ``tamp bench executability``: `run_given` executes plans of any source (`read_sources`) open-
 loop (`tamp.loop.given`) in each simulator, ours as the reference row: per plan our task-level
 verdict and PlanBench's, the goal reached (ground truth), the first failure, disturbed stacks,
-moves and time (`PlanRow`); `given_summary` per source (printed by
-`tamp.bench.tables.executability_table`).
+moves and time (`PlanRow`); `given_summary` per source (`tables.executability_table`). Both
+sweep their episodes with `tamp.sweep.run_items`: in this process, in N processes or on Ray.
 """
 
 from __future__ import annotations
@@ -34,6 +34,7 @@ from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
+from tamp.sweep import process_solver, run_items
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.errors import DataError, TampError
@@ -109,31 +110,26 @@ def summarise(
     }
 
 
-def run(
-    suite: Suite,
-    base: LoopConfig,
-    sims: Sequence[str],
-    seed: int,
-    progress: Callable[[str, EpisodeReport], None] | None = None,
-) -> MotionBench:
-    """One closed-loop episode per instance in each simulator; ``progress(sim, report)`` after
-    each. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
-    reproducible from ``seed``."""
-    solver = IKSolver()
-    ik = time_ik(solver)
-    summary, every = {}, []
-    for name in sims:
-        config = replace(base, sim=name)
-        reports = []
-        for k, inst in enumerate(suite.instances):
-            report = run_episode(inst.problem, config, seed=seed * 100_003 + k, solver=solver)
-            reports.append(dataclasses.replace(report, problem=inst.name))
-            if progress is not None:
-                progress(name, reports[-1])
-        camera = config.observe == "camera"
-        summary[name] = summarise(reports, suite.instances, suite.domain, camera)
-        every += reports
+def run(suite: Suite, base: LoopConfig, sims: Sequence[str], seed: int,
+        progress: Callable[[str, EpisodeReport], None] | None = None, workers: int = 1,
+        ray_address: str | None = None) -> MotionBench:  # fmt: skip
+    """One closed-loop episode per instance in each simulator; ``progress(sim, report)`` as
+    each ends. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
+    reproducible from ``seed`` whatever ``workers``/``ray_address`` (`tamp.sweep.run_items`)."""
+    ik = time_ik(process_solver())
+    items = [(inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name)
+             for name in sims for k, inst in enumerate(suite.instances)]  # fmt: skip
+    done = None if progress is None else lambda k, report: progress(report.sim, report)
+    every, n = run_items(_episode, items, workers, ray_address, done), len(suite.instances)
+    summary = {s: summarise(every[j * n : (j + 1) * n], suite.instances, suite.domain,
+                            base.observe == "camera") for j, s in enumerate(sims)}  # fmt: skip
     return MotionBench(tuple(sims), tuple(every), summary, ik)
+
+
+def _episode(item: tuple) -> EpisodeReport:
+    """`run`'s episode ``(problem, config, seed, name)``, in the process that runs it."""
+    report = run_episode(*item[:3], solver=process_solver())
+    return dataclasses.replace(report, problem=item[3])
 
 
 def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
@@ -235,32 +231,47 @@ def first_failure(steps: Sequence[StepReport], reached: bool) -> tuple[str, str]
 
 
 def run_given(suite: Suite, sources: dict, base: LoopConfig, sims: Sequence[str], seed: int,
-              ours: PlannerConfig | None, progress: Callable | None = None) -> list:  # fmt: skip
+              ours: PlannerConfig | None, progress: Callable | None = None, workers: int = 1,
+              ray_address: str | None = None) -> list:  # fmt: skip
     """`PlanRow` of every source's plan of every instance in each simulator. Instance ``k`` uses
-    episode seed ``seed * 100_003 + k`` (its layout) for every source; a plan executed before
-    on the same instance and simulator is not run again (its row is copied, time included)."""
+    episode seed ``seed * 100_003 + k`` (its layout) for every source; a plan met before on the
+    same instance and simulator is run once (the rows share its outcome, time included): the
+    distinct runs are the sweep's items. ``progress(sim, row)`` as each row's run ends."""
     plans = {**sources, **({OURS: our_plans(suite, ours, seed)} if ours is not None else {})}
     checked = {(src, i.name): check_given(got.get(i.name, (None,))[0], i, suite.domain, src)
                for src, got in plans.items() for i in suite.instances}  # fmt: skip
-    solver, rows, done = IKSolver(), [], {}
+    specs, runs, waiting = [], {}, {}  # rows' given columns; key -> run's item; key -> rows
     for sim in sims:
         config = replace(base, sim=sim)
         for k, inst in enumerate(suite.instances):
-            done[sim, k, None] = (False, "unparseable", "", 0, 0, 0.0)
             for src, got in plans.items():
                 steps, task, error = checked[src, inst.name]
-                flag = got.get(inst.name, ("", None))[1]
                 key = (sim, k, steps and tuple(s.label for s in steps))
-                if key not in done:
-                    r = GivenPlanEpisode(inst.problem, steps, config, seed * 100_003 + k,
-                                         solver=solver).run()  # fmt: skip
-                    done[key] = (r.reached_goal, *first_failure(r.steps, r.reached_goal),
-                                 sum(bool(s.disturbed) for s in r.steps),
-                                 sum(s.attempted for s in r.steps), r.wall_time_s)  # fmt: skip
-                rows.append(PlanRow(src, sim, inst.name, task, flag, *done[key], error))
-                if progress is not None:
-                    progress(sim, rows[-1])
+                if key[2] is not None:
+                    runs.setdefault(key, (inst.problem, steps, config, seed * 100_003 + k))
+                waiting.setdefault(key, []).append(len(specs))
+                specs.append((src, sim, inst.name, task, got.get(inst.name, ("", None))[1], error))
+    rows, keys = [None] * len(specs), list(runs)
+
+    def finish(key: tuple, outcome: tuple) -> None:
+        for j in waiting[key]:
+            *head, error = specs[j]
+            rows[j] = PlanRow(*head, *outcome, error)
+            if progress is not None:
+                progress(head[1], rows[j])
+
+    for key in [key for key in waiting if key[2] is None]:
+        finish(key, (False, "unparseable", "", 0, 0, 0.0))
+    run_items(_given, runs.values(), workers, ray_address, lambda j, r: finish(keys[j], r))
     return rows
+
+
+def _given(item: tuple) -> tuple:
+    """`run_given`'s run ``(problem, steps, config, seed)``: its row's outcome columns."""
+    r = GivenPlanEpisode(*item, solver=process_solver()).run()
+    return (r.reached_goal, *first_failure(r.steps, r.reached_goal),
+            sum(bool(s.disturbed) for s in r.steps), sum(s.attempted for s in r.steps),
+            r.wall_time_s)  # fmt: skip
 
 
 def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:

@@ -10,6 +10,7 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.suites import DEFAULT_DATA
+from tamp.cli.bench_motion import sweep_options
 from tamp.cli.options import (
     Parser,
     data_option,
@@ -175,6 +176,7 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     data_option(p)
     p.add_argument("--n", type=positive, default=100, help="instances, spread over sizes (100)")
     p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    sweep_options(p)
     progress_option(p)
     output_options(p, "write results.json and episodes.csv into this folder")
     p.set_defaults(func=_lazy("tamp.cli.bench", "motion_command"))
@@ -185,6 +187,7 @@ def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
                          help="execute plans of any source (CSV) open-loop in the "
                          "simulators")  # fmt: skip
     executability_options(p)
+    sweep_options(p)
     p.set_defaults(func=_lazy("tamp.cli.bench", "executability_command"))
 
 
