@@ -98,15 +98,16 @@ def summarise(
         "statuses": dict(Counter(r.status.value for r in reports)),
         "with_faults": len(injected),
         "recovered": sum(r.reached_goal for r in injected),
-        "wall_per_move_s": sum(m.wall_time_s for m in moves) / max(len(moves), 1),
-        "sim_per_move_s": sum(m.sim_time_s for m in moves) / max(len(moves), 1),
-        "ik_per_move_s": sum(m.ik_time_s for m in moves) / max(len(moves), 1),
+        **{
+            f"{k}_per_move_s": sum(getattr(m, f"{k}_time_s") for m in moves) / max(len(moves), 1)
+            for k in ("wall", "sim", "ik", "check", "path")
+        },
         "wall_s": sum(r.wall_time_s for r in reports),
         "collided": sum(r.collided for r in reports),  # episodes whose arm touched something
         "touched": dict(sum((Counter(r.touched) for r in reports), Counter())),
         "rerouted": sum(m.path_time_s > 0 for m in moves),  # moves the motion planner ran on
-        "check_per_move_s": sum(m.check_time_s for m in moves) / max(len(moves), 1),
-        "path_per_move_s": sum(m.path_time_s for m in moves) / max(len(moves), 1),
+        "arm_path_rad": sum(m.path_rad for m in moves) / max(len(reports), 1),  # per episode
+        "plan_per_episode_s": sum(r.plan_time_s for r in reports) / max(len(reports), 1),
     }
 
 

@@ -155,6 +155,9 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
                 f"(touched: {hit}); collision checks {s['check_per_move_s']:.3f} s/move; "
                 f"motion planner on {s['rerouted']} moves, {s['path_per_move_s']:.3f} s/move"
             )
+        if "arm_path_rad" in s:
+            lines.append(f"{sim}: arm path {s['arm_path_rad']:.2f} rad per episode; task "
+                         f"planning {s['plan_per_episode_s']:.2f} s per episode")  # fmt: skip
         if inject != "none":
             lines.append(
                 f"{sim}: faults ({inject}) hit {s['with_faults']} episodes, "
