@@ -64,3 +64,33 @@ def test_a_motion_aware_episode_reaches_the_goal(solver):
     config = LoopConfig(planner=PlannerConfig(lambda_motion=0.05))
     report = run_episode(FOUR, config, seed=0, solver=solver)
     assert report.reached_goal and len(report.moves) == 2
+
+
+def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places(monkeypatch):
+    """End to end in float64: the rollout loss with the arm's move costs (pytorch-kinematics,
+    one differentiable IK step) has the gradient finite differences give, for the action
+    logits and for the place positions (the detached IK solution held fixed, as in
+    tests/motion/test_cost.py: the gradient is that of the refined cost at fixed q*)."""
+    from motion.cost import move_costs
+    from task.domains import get_domain
+    from task.rollout import rollout
+
+    solver, bw = IKSolver(), get_domain("blocksworld")
+    real, cache = solver.solve, []
+    monkeypatch.setattr(solver, "solve", lambda t, q: cache[0] if cache else
+                        cache.append(real(t, q)) or cache[0])  # fmt: skip
+    batch = bw.encode([FOUR], [bw.initial_state(FOUR)], torch.float64)
+    steps = torch.ones(1, 2, dtype=torch.bool)
+    logits = torch.randn((1, 2, 4, 6), generator=torch.Generator().manual_seed(0),
+                         dtype=torch.float64).requires_grad_(True)  # fmt: skip
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0)
+    picks = torch.tensor([poses[x].xyz for x in FOUR.entities], dtype=torch.float64)
+    places = torch.cat([picks + torch.tensor([0.0, 0.0, 0.05]),
+                        torch.tensor([[0.45, 0.3, 0.025]])]).requires_grad_(True)  # fmt: skip
+    config = PlannerConfig(horizon=2, lambda_motion=0.5)
+
+    def loss(lg, pl):
+        costs = move_costs(solver, PANDA.q_home, picks, pl)[None]  # (1, N, Y)
+        return rollout(bw, lg, batch, steps, config, costs=costs).loss.sum()
+
+    assert torch.autograd.gradcheck(loss, (logits, places), eps=1e-6, atol=1e-4)
