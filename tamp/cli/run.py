@@ -144,6 +144,8 @@ def run_command(args: argparse.Namespace) -> int:
         "seed": args.seed, "max_replans": config.max_replans, "observe": config.observe,
         "perception": config.perception.mode, "blur": config.perception.blur,
         "plan": args.plan, "replan": args.replan, "stop_at_invalid": args.stop_at_invalid,
+        "scene": config.scene.name, "collision": config.execution.collision,
+        "lambda_motion": config.planner.lambda_motion,
     }  # fmt: skip
     if out is not None:
         (out / "report.json").write_text(json.dumps(body, indent=2))
