@@ -59,7 +59,13 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument("domain", metavar="DOMAIN.pddl")
     p.add_argument("problem", metavar="PROBLEM.pddl")
-    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    p.add_argument("--seed", type=int, default=0, help="planner seed (0) and, with "
+                   "--motion-aware, the scene layout's")  # fmt: skip
+    p.add_argument("--motion-aware", dest="lambda_motion", action="store_const", const=0.05,
+                   help="blocksworld: the arm's cost of each move in the objective, for the "
+                   "problem laid out on --scene (off)")  # fmt: skip
+    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter"), default="tabletop",
+                   help="--motion-aware: the table scene (tabletop)")  # fmt: skip
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
     p.set_defaults(func=_lazy("tamp.cli.plan", "plan_command"))

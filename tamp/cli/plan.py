@@ -38,7 +38,7 @@ def _write(path: Path, text: str) -> None:
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan)."""
     config = planner_config(args, instance.problem.domain)
-    result = plan(instance.problem, config, args.seed)
+    result = plan(instance.problem, config, args.seed, costs=_arm_costs(instance.problem, args))
     actions: tuple = ()
     validation = None
     if result.solved:
@@ -47,6 +47,25 @@ def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
         )
         validation = validate(domain, instance.pddl, actions)
     return config, result, actions, validation
+
+
+def _arm_costs(problem, args: argparse.Namespace):
+    """``--motion-aware``: the arm's move costs with the problem laid out on ``--scene``
+    (seeded by ``--seed``), the arm at home; None otherwise."""
+    if not getattr(args, "lambda_motion", None):
+        return None
+    if problem.domain != "blocksworld":
+        raise TampError(f"--motion-aware prices arm moves of blocksworld problems on a table; "
+                        f"this is a {problem.domain} problem")  # fmt: skip
+    from motion.ik import IKSolver
+    from robots.panda import PANDA
+    from tamp.arm_costs import ArmCosts
+    from tamp.obstacles import with_scene
+    from tamp.scene import SceneConfig, layout
+
+    scene = with_scene(SceneConfig(), args.scene)
+    poses = layout(problem.entities, problem.init, scene, args.seed)
+    return ArmCosts([problem], [poses], scene, IKSolver(), PANDA.q_home)
 
 
 def _plan_json(

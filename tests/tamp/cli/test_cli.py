@@ -62,6 +62,25 @@ def test_plan_json_parses(capsys, files):
     assert report["config"]["horizon"] == 2 and report["config"]["restarts"] == 8
 
 
+def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(capsys, files, tmp_path):
+    args = ["plan", *map(str, files), *FAST, "--motion-aware", "--scene", "shelf", "--json"]
+    assert main(args) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["status"] == "solved" and report["valid"]
+    assert report["config"]["lambda_motion"] == 0.05
+    gripper = tmp_path / "gripper.pddl"  # a STRIPS domain: not blocks on a table
+    gripper.write_text(
+        "(define (domain g) (:requirements :strips) (:predicates (at ?b) (held ?b) (free))\n"
+        " (:action pick :parameters (?b) :precondition (and (at ?b) (free))"
+        " :effect (and (held ?b) (not (at ?b)) (not (free)))))"
+    )
+    problem = tmp_path / "g1.pddl"
+    problem.write_text("(define (problem g1) (:domain g) (:objects b1) (:init (at b1) (free))"
+                       " (:goal (and (held b1))))")  # fmt: skip
+    assert main(["plan", str(gripper), str(problem), "--motion-aware"]) == 2
+    assert "blocksworld problems on a table" in _one_line_error(capsys)
+
+
 def test_plan_without_a_plan_exits_1(capsys, files, monkeypatch):
     def no_plan(problem, config, seed):
         return PlanResult(PlanStatus.NO_PLAN, Plan(), problem, None, {"windows": 12, "time_s": 1})
