@@ -56,11 +56,12 @@ class Obstacle:
 
 WOOD = (0.55, 0.5, 0.42)
 # over the far row's y = 0.16 and 0.32 slots, 64 cm up (room for towers of 5 under it, the
-# tallest in PlanBench, but not for the usual hover over them); legs behind the arm's reach
+# tallest in PlanBench, but not for the usual hover over them); both legs at its outer side,
+# out of the arm's reach and of the camera's line of sight to the slots
 SHELF = (
-    Obstacle("shelf_board", (0.63, 0.27, 0.65), (0.15, 0.19, 0.01), rgb=WOOD),
-    Obstacle("shelf_leg_a", (0.765, 0.10, 0.32), (0.012, 0.012, 0.32), rgb=WOOD),
-    Obstacle("shelf_leg_b", (0.765, 0.44, 0.32), (0.012, 0.012, 0.32), rgb=WOOD),
+    Obstacle("shelf_board", (0.63, 0.285, 0.65), (0.15, 0.205, 0.01), rgb=WOOD),
+    Obstacle("shelf_leg_a", (0.50, 0.475, 0.32), (0.012, 0.012, 0.32), rgb=WOOD),
+    Obstacle("shelf_leg_b", (0.765, 0.475, 0.32), (0.012, 0.012, 0.32), rgb=WOOD),
 )
 POST = (0.015, 0.015, 0.075)  # half extents: 3 cm square, 15 cm tall
 POSTS_Y = (-0.24, -0.08, 0.08, 0.24)  # between the slot columns, between the two rows
