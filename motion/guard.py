@@ -180,3 +180,18 @@ def guard_pick_place(
         out.append(Phase(phase.name, trajectory, phase.gripper))
         rerouted.append(phase.name)
     return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan)
+
+
+def guard_free_move(
+    trajectory,
+    model: CollisionModel,
+    boxes: Sequence[Box],
+    config: GuardConfig = GuardConfig(),
+    seed: int = 0,
+):
+    """An empty-handed free-space move (fingers open, e.g. the trip home to look again)
+    checked against ``boxes`` and rerouted by the motion planner when blocked: the
+    `JointTrajectory` to run, or None when no collision-free way was found."""
+    world = PickPlaceWorld(tuple(boxes), "", "table", "table", boxes[0] if boxes else None, 0.0)
+    out = guard_pick_place([Phase("approach", trajectory, "open")], model, world, config, seed)
+    return out.phases[0].trajectory if out.ok else None

@@ -23,6 +23,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from motion.guard import guard_free_move
 from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts
 from tamp.camera.from_images import ImageBeliefs
@@ -82,6 +83,8 @@ class Episode:
         self._acts = 0  # moves attempted: each seeds its motion-planner call differently
         self.score = Scorer(self.sim.truth, problem, config.scene)
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
+        if self.collision is not None:
+            self.eyes.home_guard = self._home_guard
 
     def belief_lines(self) -> list[str]:
         """The last perceived soft state, one line per block (see `Observer.belief_lines`)."""
@@ -105,6 +108,14 @@ class Episode:
             self._close()
         report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
         return dataclasses.replace(report, touched=dict(self.sim.touched))
+
+    def _home_guard(self, way):
+        """The trip home to look again, checked against the scene's obstacles (the blocks are
+        what the camera failed to see) and rerouted when blocked; None: no safe way."""
+        from robots.collision import Box
+
+        fixed = [Box(o.name, o.centre, o.half, o.yaw) for o in self.config.scene.obstacles]
+        return guard_free_move(way, self.collision, fixed, self.config.execution.guard, self.seed)
 
     def _close(self) -> None:
         self.sim.close()

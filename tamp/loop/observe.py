@@ -76,6 +76,9 @@ class Observer:
         self.sim, self.problem, self.config, self.rng = sim, problem, config, rng
         self.target, self.perceiver = target, perceiver
         self.image = None  # camera: the last camera image
+        # checks (and reroutes) the trip home against the known obstacles: None when no safe
+        # way is found; unset, the arm goes home on a straight joint segment
+        self.home_guard: Callable[[JointTrajectory], JointTrajectory | None] | None = None
         self.perceived = None  # camera: the last perceived soft supports F (N, N + 1)
         if config.observe == "state":
             self.sensor = MocapPoses(sim)
@@ -132,9 +135,13 @@ class Observer:
         except PerceptionError:
             if np.abs(self.sim.arm_q() - home).max() < HOME_TOL:
                 raise
+            way = straight_segment(self.sim.arm_q(), home, self.sim.dt)
+            if self.home_guard is not None:
+                way = self.home_guard(way)
+                if way is None:  # no collision-free way home: the block stays unseen
+                    raise
         show("home to look again")
-        self.sim.run(straight_segment(self.sim.arm_q(), home, self.sim.dt), "open",
-                     on_frame=on_frame)  # fmt: skip
+        self.sim.run(way, "open", on_frame=on_frame)
         return look()
 
     def belief_lines(self) -> list[str]:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motion.guard import GuardConfig, PickPlaceWorld, guard_pick_place, thin
+from motion.guard import GuardConfig, PickPlaceWorld, guard_free_move, guard_pick_place, thin
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceRequest, plan_pick_place
 from robots.collision import Box, PandaCollision
@@ -83,3 +83,16 @@ def test_the_fingers_may_touch_the_block_they_pick_but_not_a_neighbour(model, pl
     assert guard_pick_place(planned, model, _world(fine)).ok
     out = guard_pick_place(planned, model, _world(side), GuardConfig(plan=False))
     assert not out.ok and out.evidence["other"] == "b"
+
+
+def test_a_free_move_through_a_wall_is_rerouted_or_refused(model, planned):
+    transit = next(p for p in planned if p.name == "transit").trajectory
+    way = guard_free_move(transit, model, [WALL], seed=1)
+    assert way is not None and not np.array_equal(way.positions, transit.positions)
+    model.set_boxes([WALL])
+    model.hold(None)
+    assert not model.check_path(transit.positions, 0.04, max_step=0.01).ok
+    assert model.check_path(way.positions, 0.04, max_step=0.01).ok
+    assert np.allclose(way.positions[[0, -1]], transit.positions[[0, -1]])
+    box = Box("box", PICK, (0.6, 0.6, 0.6))  # swallows the whole workspace: no way at all
+    assert guard_free_move(transit, model, [box], seed=1) is None
