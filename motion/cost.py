@@ -44,7 +44,6 @@ class MoveCostConfig:
     joint_weight: float = 1.0  # cost per rad of L2 joint distance, grasp -> release configuration
     reach_weight: float = 10.0  # cost per m of IK position residual at the pick or the place
     infeasible: float = 10.0  # added per pick or place whose IK does not converge (no gradient)
-    block_size: float = 0.05  # m, cube edge; a place on a block is its centre + block_size up
 
 
 def top_down_targets(xyz: torch.Tensor) -> torch.Tensor:

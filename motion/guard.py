@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Protocol
 
@@ -30,7 +31,6 @@ if TYPE_CHECKING:
     from robots.collision import Box, PathCheck
 
 FREE_SPACE = ("approach", "transit")  # phases the motion planner may reroute
-HELD = ("lift", "transit", "lower")  # phases with the block in the hand
 
 
 class CollisionModel(Protocol):
@@ -112,6 +112,62 @@ def _situation(name: str, world: PickPlaceWorld, open_width: float):
     }[name]
 
 
+@contextmanager
+def _margin(model: CollisionModel, value: float):
+    """The model's margin set to ``value`` for the block, restored after."""
+    before, model.margin = model.margin, value
+    try:
+        yield
+    finally:
+        model.margin = before
+
+
+def _guard_phase(phase: Phase, model: CollisionModel, fingers: float, ignore, config: GuardConfig,
+                 seed: int):  # fmt: skip
+    """One arm phase against the model's current boxes and held block: (the phase to run, or a
+    rerouted one, or None), the evidence of a collision, check and planning seconds."""
+    start = time.perf_counter()
+    free = phase.name in FREE_SPACE
+    # the vertical phases move straight up or down beside blocks the move touches
+    with _margin(model, model.margin if free else min(model.margin, config.vertical_margin)):
+        found = model.check_path(thin(phase.trajectory.positions, config.max_step), fingers,
+                                 ignore, config.max_step)  # fmt: skip
+    t_check = time.perf_counter() - start
+    if found.ok:
+        return phase, {}, t_check, 0.0
+    evidence = {
+        "phase": phase.name,
+        "part": found.contact.part,
+        "other": found.contact.other,
+        "distance_m": round(found.contact.distance, 4),
+        "q": [round(v, 3) for v in found.q],
+    }
+    if not free or not config.plan:
+        return None, evidence, t_check, 0.0
+    from motion.rrt import PathPlannerConfig, path_trajectory, plan_path
+
+    # checked every ~0.02 rad (resolution x the joint box's 13 rad diagonal), as is the rest
+    rrt = replace(config.rrt or PathPlannerConfig(resolution=0.0015, simplify_time=5.0), seed=seed)
+    q = phase.trajectory.positions  # (S, J)
+
+    def valid(x: np.ndarray) -> bool:
+        return model.valid(x, fingers, ignore)
+
+    # plan with a wider berth: the planner checks only every ~0.02 rad
+    with _margin(model, model.margin + config.plan_pad):
+        found_path = plan_path(q[0], q[-1], valid, config=rrt)
+    if not found_path.ok:
+        evidence |= {"planner": found_path.failure, "checks": found_path.checks}
+        return None, evidence, t_check, found_path.time_s
+    trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
+    again = model.check_path(thin(trajectory.positions, config.max_step), fingers, ignore,
+                             config.max_step)  # fmt: skip
+    if not again.ok:  # the planner checks at its own resolution; this is the final word
+        evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
+        return None, evidence, t_check, found_path.time_s
+    return Phase(phase.name, trajectory, phase.gripper), {}, t_check, found_path.time_s
+
+
 def guard_pick_place(
     phases: Sequence[Phase],
     model: CollisionModel,
@@ -129,56 +185,13 @@ def guard_pick_place(
         boxes, held, fingers, ignore = _situation(phase.name, world, config.open_width)
         model.set_boxes(boxes)
         model.hold(held)
-        start = time.perf_counter()
-        path = thin(phase.trajectory.positions, config.max_step)
-        margin = model.margin
-        if phase.name not in FREE_SPACE:  # straight up or down beside blocks the move touches
-            model.margin = min(margin, config.vertical_margin)
-        try:
-            found = model.check_path(path, fingers, ignore, config.max_step)
-        finally:
-            model.margin = margin
-        t_check += time.perf_counter() - start
-        if found.ok:
-            out.append(phase)
-            continue
-        evidence = {
-            "phase": phase.name,
-            "part": found.contact.part,
-            "other": found.contact.other,
-            "distance_m": round(found.contact.distance, 4),
-            "q": [round(v, 3) for v in found.q],
-        }
-        if phase.name not in FREE_SPACE or not config.plan:
+        run, evidence, checked, planned = _guard_phase(phase, model, fingers, ignore, config, seed)
+        t_check, t_plan = t_check + checked, t_plan + planned
+        if run is None:
             return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
-        from motion.rrt import PathPlannerConfig, path_trajectory, plan_path
-
-        # checked every ~0.02 rad (resolution x the joint box's 13 rad diagonal), as is the rest
-        rrt = config.rrt or PathPlannerConfig(resolution=0.0015, simplify_time=5.0)
-        rrt = replace(rrt, seed=seed)
-        q = phase.trajectory.positions  # (S, J)
-
-        def valid(x: np.ndarray, fingers=fingers, ignore=ignore) -> bool:
-            return model.valid(x, fingers, ignore)
-
-        margin = model.margin  # plan with a wider berth: the planner checks every ~0.02 rad
-        model.margin = margin + config.plan_pad
-        try:
-            found_path = plan_path(q[0], q[-1], valid, config=rrt)
-        finally:
-            model.margin = margin
-        t_plan += found_path.time_s
-        if not found_path.ok:
-            evidence |= {"planner": found_path.failure, "checks": found_path.checks}
-            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
-        trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
-        again = model.check_path(thin(trajectory.positions, config.max_step), fingers, ignore,
-                                 config.max_step)  # fmt: skip
-        if not again.ok:  # the planner checks at its own resolution; this is the final word
-            evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
-            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
-        out.append(Phase(phase.name, trajectory, phase.gripper))
-        rerouted.append(phase.name)
+        out.append(run)
+        if run is not phase:
+            rerouted.append(phase.name)
     return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan)
 
 
@@ -192,6 +205,8 @@ def guard_free_move(
     """An empty-handed free-space move (fingers open, e.g. the trip home to look again)
     checked against ``boxes`` and rerouted by the motion planner when blocked: the
     `JointTrajectory` to run, or None when no collision-free way was found."""
-    world = PickPlaceWorld(tuple(boxes), "", "table", "table", boxes[0] if boxes else None, 0.0)
-    out = guard_pick_place([Phase("approach", trajectory, "open")], model, world, config, seed)
-    return out.phases[0].trajectory if out.ok else None
+    model.set_boxes(boxes)
+    model.hold(None)
+    phase = Phase("approach", trajectory, "open")
+    run, _, _, _ = _guard_phase(phase, model, config.open_width, (), config, seed)
+    return None if run is None else run.trajectory

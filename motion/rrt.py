@@ -31,7 +31,7 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from motion.errors import MotionError
-from motion.trajectory import JointTrajectory, SpeedLimits, straight_segment
+from motion.trajectory import JointTrajectory, SpeedLimits, as_path, straight_segment
 from robots.panda import PANDA, PandaSpec
 
 PLANNERS = {"rrt_connect": og.RRTConnect, "rrt": og.RRT, "rrt_star": og.RRTstar}
@@ -276,12 +276,7 @@ def path_trajectory(
     The trajectory stops at every waypoint (zero velocity), so it never cuts a corner of the
     validated polyline; zero-length pieces are skipped.
     """
-    path = np.asarray(path, dtype=np.float64)
-    n_joints = len(spec.arm_joints)
-    if path.ndim != 2 or path.shape[0] < 2 or path.shape[1] != n_joints:
-        raise MotionError(f"path has shape {path.shape}; expected (K >= 2, {n_joints})")
-    if not np.isfinite(path).all():
-        raise MotionError("the path contains NaN or inf")
+    path = as_path(path, spec)
     pieces = [straight_segment(a, b, dt, spec, limits) for a, b in pairwise(path)]
     parts = [p for p in pieces if p.times.size > 1]  # zero-length pieces are a single sample
     if not parts:

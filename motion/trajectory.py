@@ -127,6 +127,17 @@ def straight_segment(
     return polyline_segment(np.stack([q0, q1]), dt, spec, limits)
 
 
+def as_path(path, spec: PandaSpec = PANDA) -> np.ndarray:
+    """``path`` as a float64 joint-space polyline (K >= 2, J); MotionError when it is not one."""
+    path = np.asarray(path, dtype=np.float64)
+    n_joints = len(spec.arm_joints)
+    if path.ndim != 2 or path.shape[0] < 2 or path.shape[1] != n_joints:
+        raise MotionError(f"path has shape {path.shape}; expected (K >= 2, {n_joints})")
+    if not np.isfinite(path).all():
+        raise MotionError("the path contains NaN or inf")
+    return path
+
+
 def polyline_segment(
     path, dt: float = 0.002, spec: PandaSpec = PANDA, limits: SpeedLimits = SpeedLimits()
 ) -> JointTrajectory:
@@ -137,12 +148,7 @@ def polyline_segment(
     piece. Dense knots from IK along a Cartesian line make the tool move (nearly) straight in
     Cartesian space; with two knots this is `straight_segment`.
     """
-    path = np.asarray(path, dtype=np.float64)
-    n_joints = len(spec.arm_joints)
-    if path.ndim != 2 or path.shape[0] < 2 or path.shape[1] != n_joints:
-        raise MotionError(f"path has shape {path.shape}; expected (K >= 2, {n_joints})")
-    if not np.isfinite(path).all():
-        raise MotionError("the path contains NaN or inf")
+    path, n_joints = as_path(path, spec), len(spec.arm_joints)
     if dt <= 0.0:
         raise MotionError(f"dt = {dt}; expected dt > 0")
     d = np.diff(path, axis=0)  # (K-1, J)

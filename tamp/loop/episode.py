@@ -28,7 +28,7 @@ from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
-from tamp.loop.execute import ExecutionResult, execute_move
+from tamp.loop.execute import ExecutionResult, execute_move, obstacle_boxes
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
@@ -112,9 +112,7 @@ class Episode:
     def _home_guard(self, way):
         """The trip home to look again, checked against the scene's obstacles (the blocks are
         what the camera failed to see) and rerouted when blocked; None: no safe way."""
-        from robots.collision import Box
-
-        fixed = [Box(o.name, o.centre, o.half, o.yaw) for o in self.config.scene.obstacles]
+        fixed = obstacle_boxes(self.config.scene)
         return guard_free_move(way, self.collision, fixed, self.config.execution.guard, self.seed)
 
     def _close(self) -> None:

@@ -107,6 +107,13 @@ def _holding(sim: Simulator, config: ExecConfig, fresh: bool) -> dict | None:
     }
 
 
+def obstacle_boxes(scene: SceneConfig):
+    """The scene's fixed obstacles as boxes of the arm's collision model."""
+    from robots.collision import Box
+
+    return tuple(Box(o.name, o.centre, o.half, o.yaw) for o in scene.obstacles)
+
+
 def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig):
     """The collision world of a move: the observed blocks as boxes, the scene's obstacles,
     what the picked block stands on and what it goes onto (block names or "table")."""
@@ -114,7 +121,7 @@ def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig)
 
     half = (scene.block_size / 2,) * 3
     blocks = tuple(Box(k, p.xyz, half, p.yaw) for k, p in poses.items())
-    fixed = tuple(Box(o.name, o.centre, o.half, o.yaw) for o in scene.obstacles)
+    fixed = obstacle_boxes(scene)
     pick = poses[move.entity]
     below = [
         k for k, p in poses.items()
@@ -151,14 +158,14 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
     to ``config.slot_tries``)."""
     ik, last = 0.0, None
     tries = range(config.slot_tries if move.target == TABLE else 1)
+    pick = poses[move.entity]
+    clear_z = top_z({k: v for k, v in poses.items() if k != move.entity}, scene)
     for rank, turn in ((r, t) for r in tries for t in (False, True)):
         target = place_pose(move, poses, scene, rank)
         if target is None:
             return last or (Failure.NO_FREE_SLOT, ik, {"slots": len(scene.slots)})
-        pick = poses[move.entity]
-        others = {k: v for k, v in poses.items() if k != move.entity}
         request = PickPlaceRequest(
-            pick.xyz, pick.yaw, target.xyz, target.yaw, top_z(others, scene),
+            pick.xyz, pick.yaw, target.xyz, target.yaw, clear_z,
             ceiling(pick.xyz, scene.obstacles), ceiling(target.xyz, scene.obstacles), turn,
         )  # fmt: skip
         planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)

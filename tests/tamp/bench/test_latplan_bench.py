@@ -20,6 +20,7 @@ from tamp.cli import main
 from task import data
 from task.domains.blocksworld_pddl import to_pddl
 from task.problem import TABLE, Problem
+from tests.cli_check import one_line_error
 
 NAMES = ("red", "blue", "green", "black")  # palette indices 0..3 of the latplan scene
 FAST = ["--iters", "20", "--restarts", "4", "--max-windows", "6", "--threads", "1"]
@@ -61,13 +62,6 @@ def folder(tmp_path_factory):
         writer.writeheader()
         writer.writerows(rows)
     return root
-
-
-def _one_line_error(capsys) -> str:
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "Traceback" not in err, err
-    assert err.startswith("tamp: error:"), err
-    return err
 
 
 @pytest.mark.sim
@@ -151,13 +145,13 @@ def test_state_mode_needs_no_checkpoint_and_json(folder, tmp_path, capsys):
 
 def test_missing_data_checkpoint_and_bad_options(folder, tmp_path, capsys):
     assert main(["bench", "latplan", "--data", str(tmp_path / "none")]) == 2
-    err = _one_line_error(capsys)
+    err = one_line_error(capsys, "tamp: error:")
     assert "LatPlan-40 data not found" in err and "--data DIR" in err
     missing = str(tmp_path / "none.pt")
     assert main(["bench", "latplan", "--data", str(folder), "--checkpoint", missing]) == 2
-    err = _one_line_error(capsys)
+    err = one_line_error(capsys, "tamp: error:")
     assert missing in err and "--checkpoint FILE.pt" in err
     assert main(["bench", "latplan", "--data", str(folder), "--res", "64x64"]) == 2
-    assert "150x100, 45x30" in _one_line_error(capsys)
+    assert "150x100, 45x30" in one_line_error(capsys, "tamp: error:")
     assert main(["bench", "latplan", "--data", str(folder), "--modes", "frozen,blurry"]) == 2
-    assert "'blurry'" in _one_line_error(capsys)
+    assert "'blurry'" in one_line_error(capsys, "tamp: error:")

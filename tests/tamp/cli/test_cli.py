@@ -13,16 +13,10 @@ from task import data
 from task.domains import blocksworld
 from task.problem import Plan, PlanResult, PlanStatus
 from task.symbolic.generate import random_problem
+from tests.cli_check import one_line_error
 
 FAST = ["--restarts", "8", "--iters", "60"]
 ARTEFACTS = ("instances.csv", "results.json", "steps.png")
-
-
-def _one_line_error(capsys) -> str:
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "Traceback" not in err, err
-    assert err.startswith("tamp") and "error:" in err, err
-    return err
 
 
 @pytest.fixture
@@ -78,7 +72,7 @@ def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(capsys, file
     problem.write_text("(define (problem g1) (:domain g) (:objects b1) (:init (at b1) (free))"
                        " (:goal (and (held b1))))")  # fmt: skip
     assert main(["plan", str(gripper), str(problem), "--motion-aware"]) == 2
-    assert "blocksworld problems on a table" in _one_line_error(capsys)
+    assert "blocksworld problems on a table" in one_line_error(capsys)
 
 
 def test_plan_without_a_plan_exits_1(capsys, files, monkeypatch):
@@ -128,7 +122,7 @@ def test_bad_input_exits_2_with_one_line(capsys, files, tmp_path, argv, expected
         "malformed": malformed,
     }
     assert main([a.format(**paths) for a in argv]) == 2
-    assert expected in _one_line_error(capsys)
+    assert expected in one_line_error(capsys)
 
 
 def test_help_exits_0(capsys):

@@ -10,13 +10,7 @@ import pytest
 from perception import CHECKPOINT
 from perception import data as pdata
 from tamp.cli import main
-
-
-def _one_line_error(capsys) -> str:
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "Traceback" not in err, err
-    assert err.startswith("tamp") and "error:" in err, err
-    return err
+from tests.cli_check import one_line_error
 
 
 @pytest.mark.sim
@@ -83,7 +77,7 @@ def test_dataset_then_eval_with_the_shipped_checkpoint(capsys, tmp_path):
 )
 def test_bad_input_is_one_line(capsys, argv, needle):
     assert main(argv) == 2
-    assert needle in _one_line_error(capsys)
+    assert needle in one_line_error(capsys)
 
 
 def test_bad_blur_is_a_usage_error(capsys):

@@ -17,6 +17,7 @@ from tamp.scene import PALETTE
 from task import data
 from task.domains.blocksworld_pddl import to_pddl
 from task.problem import TABLE, Problem
+from tests.cli_check import one_line_error
 
 COLOURS = (4, 5, 0)  # green, purple, red: not the first palette colours
 NAMES = tuple(PALETTE[c][0] for c in COLOURS)
@@ -49,13 +50,6 @@ def scenes(tmp_path_factory):
         "two": _save(root / "two.png", two),
         "root": root,
     }
-
-
-def _one_line_error(capsys) -> str:
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "Traceback" not in err, err
-    assert err.startswith("tamp: error:"), err
-    return err
 
 
 @pytest.mark.sim
@@ -94,7 +88,7 @@ def test_json_record_of_optimised_perception_over_several_windows(scenes, capsys
 @pytest.mark.sim
 def test_a_block_missing_from_one_image_is_named(scenes, capsys):
     assert main(["plan-images", scenes["init"], scenes["two"]]) == 2
-    err = _one_line_error(capsys)
+    err = one_line_error(capsys, "tamp: error:")
     assert f"red is in {scenes['init']} but not in {scenes['two']}" in err
 
 
@@ -104,7 +98,7 @@ def test_images_of_different_sizes(scenes, capsys):
     path = scenes["root"] / "small.png"
     cv2.imwrite(str(path), small)
     assert main(["plan-images", scenes["init"], str(path)]) == 2
-    assert "320x240" in _one_line_error(capsys)
+    assert "320x240" in one_line_error(capsys, "tamp: error:")
 
 
 def _grey(tmp_path, name: str, size: tuple[int, int] = (160, 120)) -> str:
@@ -114,20 +108,20 @@ def _grey(tmp_path, name: str, size: tuple[int, int] = (160, 120)) -> str:
 def test_missing_and_unreadable_images(tmp_path, capsys):
     grey = _grey(tmp_path, "grey.png")
     assert main(["plan-images", str(tmp_path / "nothing.png"), grey]) == 2
-    assert "no image file at" in _one_line_error(capsys)
+    assert "no image file at" in one_line_error(capsys, "tamp: error:")
     text = tmp_path / "text.png"
     text.write_text("not an image")
     assert main(["plan-images", grey, str(text)]) == 2
-    assert "cannot read" in _one_line_error(capsys)
+    assert "cannot read" in one_line_error(capsys, "tamp: error:")
 
 
 def test_no_blocks_and_too_small_images(tmp_path, capsys):
     grey = _grey(tmp_path, "grey.png")
     assert main(["plan-images", grey, grey]) == 2
-    assert "no blocks found" in _one_line_error(capsys)
+    assert "no blocks found" in one_line_error(capsys, "tamp: error:")
     tiny = _grey(tmp_path, "tiny.png", (6, 4))
     assert main(["plan-images", tiny, tiny]) == 2
-    assert "6x4" in _one_line_error(capsys)
+    assert "6x4" in one_line_error(capsys, "tamp: error:")
 
 
 def test_missing_checkpoints(tmp_path, capsys, monkeypatch):
@@ -137,8 +131,8 @@ def test_missing_checkpoints(tmp_path, capsys, monkeypatch):
     grey = _grey(tmp_path, "grey.png")
     missing = str(tmp_path / "none.pt")
     assert main(["plan-images", grey, grey, "--checkpoint", missing]) == 2
-    assert missing in _one_line_error(capsys)
+    assert missing in one_line_error(capsys, "tamp: error:")
     monkeypatch.setattr(images, "LATPLAN_CHECKPOINT", tmp_path / "support-latplan.pt")
     assert main(["plan-images", grey, grey, "--scene", "latplan"]) == 2
-    err = _one_line_error(capsys)
+    err = one_line_error(capsys, "tamp: error:")
     assert "support-latplan.pt" in err and "--checkpoint" in err
