@@ -76,3 +76,24 @@ def goal_cross_entropy(F: Tensor, goal: Tensor) -> Tensor:
     """
     eps = torch.finfo(F.dtype).tiny
     return -(goal * torch.log(F.clamp_min(eps))).sum((-1, -2))
+
+
+def exclusive_columns(F: Tensor, one: Tensor, rows: Tensor) -> Tensor:
+    """Target exclusivity on every capacity-one column (blocks and table slots).
+
+    Eq. T_P: T_P(F)[z, y] = F[z, y] * prod_{z' != z, z' real} (1 - F[z', y]) where ``one[y]``,
+    else F[z, y] (an unlimited table). F: (B, N, Y); one: (B, Y) bool; rows: (B, N) bool, the
+    real rows (padding never occupies a column). -> (B, N, Y).
+    """
+    occ = F * rows.unsqueeze(-1).to(F.dtype)  # (B, N, Y)
+    others_free = prod_others(1.0 - occ.transpose(-1, -2)).transpose(-1, -2)  # (B, N, Y)
+    return torch.where(one.unsqueeze(-2), F * others_free, F)
+
+
+def log_any(F: Tensor, goal: Tensor) -> Tensor:
+    """log sum_y goal[x, y] F[x, y] per row, for goals that accept any of several targets
+    ("on the table": on any of its slots). F, goal: (B, N, Y) -> (B, N); rows with no goal
+    target give a large negative number (finite, so gradients stay finite)."""
+    tiny = torch.finfo(F.dtype).tiny
+    log_f = torch.log(F.clamp_min(tiny))
+    return torch.logsumexp(log_f.masked_fill(goal <= 0, -1e30), dim=-1)

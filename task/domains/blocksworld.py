@@ -5,14 +5,14 @@ Relational view: each block rests on one support (another block or the table); t
 PDDL view: the 4-operator PlanBench domain ``blocksworld-4ops`` (pick-up, put-down, stack,
 unstack), where each move is two actions: ``(unstack x s)`` or ``(pick-up x)``, then
 ``(stack x y)`` or ``(put-down x)``. A crisp state is the support of every entity, in
-``problem.entities`` order. All functions are pure. Reading and writing problem PDDL is
-`task.domains.blocksworld_pddl` (re-exported here); full goal scenes and the most likely state
-of a perceived soft state are `tamp.camera.states` (the camera's side).
+``problem.entities`` order. The table is one unlimited target, or K slots of capacity one
+(`with_slots`). Problem PDDL is `task.domains.blocksworld_pddl` (re-exported here).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 
 import torch
 from torch import Tensor
@@ -21,16 +21,28 @@ from task.domains import blocksworld_pddl as _pddl
 from task.domains.base import SoftBatch, encode_supports, relational_decode, relational_step
 from task.errors import ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
-from task.soft import column_free, exclusive_support, goal_cross_entropy, row_normalise
+from task.soft import (
+    column_free,
+    exclusive_columns,
+    exclusive_support,
+    goal_cross_entropy,
+    log_any,
+    row_normalise,
+)
 from task.symbolic.search import moves_lower_bound
 
 State = tuple[str, ...]
 # the domain's PDDL mapping, re-exported
 NAME, PDDL_DOMAIN, OPERATORS = _pddl.NAME, _pddl.PDDL_DOMAIN, _pddl.OPERATORS
 from_pddl, to_pddl, support_error = _pddl.from_pddl, _pddl.to_pddl, _pddl.support_error
+actions_to_moves, to_atoms, slotted = _pddl.actions_to_moves, _pddl.to_atoms, _pddl.slotted
 problem_from_text, problem_from_files = _pddl.problem_from_text, _pddl.problem_from_files
 
 # -------------------------------------------------------------------------------------- crisp
+
+
+def _on(problem: Problem, support: str, y: str) -> bool:  # support satisfies goal support y
+    return support == y or (y == TABLE and support in problem.fixed)
 
 
 def _entity(problem: Problem, x: str) -> int:
@@ -49,9 +61,9 @@ def _above(problem: Problem, state: State, x: str) -> str | None:
 
 
 def is_clear(problem: Problem, state: State, x: str) -> bool:
-    """Whether nothing rests on ``x`` (a fixed target such as the table is always clear)."""
+    """Whether nothing rests on ``x`` (the unlimited table is always clear, a slot if empty)."""
     problem.index(x)
-    return x in problem.fixed or x not in state
+    return x == TABLE or x not in state
 
 
 def check_move(problem: Problem, state: State, move: Move) -> str | None:
@@ -80,7 +92,7 @@ def apply_move(problem: Problem, state: State, move: Move) -> State:
 
 def unsatisfied_goals(problem: Problem, state: State) -> tuple[tuple[str, str], ...]:
     """The goal atoms ``(x, support)`` that do not hold in ``state``."""
-    return tuple((x, y) for x, y in problem.goal if state[_entity(problem, x)] != y)
+    return tuple((x, y) for x, y in problem.goal if not _on(problem, state[_entity(problem, x)], y))
 
 
 def is_goal(problem: Problem, state: State) -> bool:
@@ -109,35 +121,10 @@ def moves_to_actions(
             problem.index(move.target)
             state = (*state[:i], move.target, *state[i + 1 :])
         x, y = move.entity, move.target
-        out.append(Action("pick-up", (x,)) if source == TABLE else Action("unstack", (x, source)))
-        out.append(Action("put-down", (x,)) if y == TABLE else Action("stack", (x, y)))
+        on_table = source in problem.fixed
+        out.append(Action("pick-up", (x,)) if on_table else Action("unstack", (x, source)))
+        out.append(Action("put-down", (x,)) if y in problem.fixed else Action("stack", (x, y)))
     return tuple(out)
-
-
-def actions_to_moves(problem: Problem, actions: Sequence[Action]) -> tuple[Move, ...]:
-    """Pair a 4-op plan into moves; ProblemError unless it alternates pick and put."""
-    picks, puts = {"pick-up": 1, "unstack": 2}, {"put-down": 1, "stack": 2}
-    moves: list[Move] = []
-    held = ""
-    for k, action in enumerate(actions, start=1):
-        name, args = action.name.lower(), tuple(a.lower() for a in action.args)
-        kinds = puts if held else picks
-        if kinds.get(name) != len(args):
-            wanted = "(put-down x) or (stack x y)" if held else "(pick-up x) or (unstack x y)"
-            raise ProblemError(f"action {k} {action}: expected {wanted} (pick and put alternate)")
-        _entity(problem, args[0])
-        if not held:
-            held = args[0]
-            continue
-        if args[0] != held:
-            raise ProblemError(f"action {k} {action}: the hand holds {held}, not {args[0]}")
-        target = args[1] if name == "stack" else TABLE
-        problem.index(target)
-        moves.append(Move(held, target))
-        held = ""
-    if held:
-        raise ProblemError(f"plan ends holding {held} (after {actions[-1]})")
-    return tuple(moves)
 
 
 # ------------------------------------------------------------------------------------ soft
@@ -146,18 +133,26 @@ def actions_to_moves(problem: Problem, actions: Sequence[Action]) -> tuple[Move,
 def soft_legality(F: Tensor, batch: SoftBatch) -> Tensor:
     """Eq. gate factors: legal(x, y) = c(x) * cbar(y) * e(x, y) * (1 - F[x, y]).
 
-    c is the soft clear (product t-norm), cbar(table) = 1, e masks self-support and padding,
-    and (1 - F[x, y]) removes the null move onto the current support. (B, N, Y) -> (B, N, Y).
+    c is the soft clear (product t-norm), cbar(table) = 1 (a slot's: prod_z (1 - F[z, slot])),
+    e masks self-support and padding, and (1 - F[x, y]) removes the null move onto the current
+    support. (B, N, Y) -> (B, N, Y).
     """
     n = batch.n
     c = column_free(F, n)  # (B, N)
-    cbar = torch.cat([c, torch.ones_like(F[:, 0, n:])], dim=-1)  # (B, Y)
+    fixed = torch.ones_like(F[:, 0, n:])  # (B, K)
+    if "one" in batch.static:  # table slots: clear when nothing real rests on them
+        real = batch.entity_mask.unsqueeze(-1).to(F.dtype)
+        empty = (1.0 - F[..., n:] * real).prod(-2)  # (B, K)
+        fixed = torch.where(batch.static["one"][:, n:], empty, fixed)
+    cbar = torch.cat([c, fixed], dim=-1)  # (B, Y)
     e = batch.action_mask[..., :-1].to(F.dtype)  # (B, N, Y)
     return c.unsqueeze(-1) * cbar.unsqueeze(-2) * e * (1.0 - F)
 
 
 def consistency(F: Tensor, batch: SoftBatch) -> Tensor:
-    """Eq. T_P: target exclusivity on block columns, then row normalisation. (B, N, Y)."""
+    """Eq. T_P: target exclusivity on block (and slot) columns, then row normalisation."""
+    if "one" in batch.static:
+        return row_normalise(exclusive_columns(F, batch.static["one"], batch.entity_mask))
     return row_normalise(exclusive_support(F, batch.n))
 
 
@@ -180,6 +175,8 @@ def log_well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
     has_goal = batch.goal.sum(-1) > 0  # (B, N)
     log_f = torch.log(F.clamp_min(torch.finfo(F.dtype).tiny))  # (B, N, Y)
     log_on_goal = (log_f * batch.goal).sum(-1)  # log F[x, g(x)], (B, N)
+    if "one" in batch.static:
+        log_on_goal = log_any(F, batch.goal)  # "on the table": on any slot
     lw = torch.zeros_like(log_on_goal)
     zeros = torch.zeros_like(F[:, 0, n:])  # (B, K): log wbar(table) = 0
     for k in range(n):
@@ -202,11 +199,33 @@ GOAL_LOSSES = ("towers", "atoms")  # the first is the default
 def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     """The goal term of the objective: ``atoms`` (the paper's CE) or ``towers`` (default).
     -> (B,)."""
+    if kind == "atoms" and "one" in batch.static:  # a table goal: on any slot
+        return -(log_any(F, batch.goal) * (batch.goal.sum(-1) > 0)).sum(-1)
     if kind == "atoms":
         return goal_cross_entropy(F, batch.goal)
     if kind in ("towers", "default"):
         return tower_cross_entropy(F, batch)
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
+
+
+def encode(
+    problems: Sequence[Problem], states: Sequence[State], dtype: torch.dtype = torch.float32
+) -> SoftBatch:
+    """`encode_supports`; with table slots (`slotted`), a goal on the table marks every slot
+    of the row and ``static["one"]`` (B, Y) marks the capacity-one columns."""
+    if not any(slotted(p) for p in problems):
+        return encode_supports(problems, states, dtype)
+    free = [replace(p, goal=tuple(g for g in p.goal if g[1] != TABLE)) for p in problems]
+    batch = encode_supports(free, states, dtype)
+    n, y = batch.n, batch.F0.shape[-1]
+    one = torch.zeros(len(problems), y, dtype=torch.bool)
+    for i, p in enumerate(problems):
+        k = len(p.fixed)
+        one[i, : p.n] = True
+        one[i, n : n + k] = slotted(p)
+        for x, _ in (g for g in p.goal if g[1] == TABLE):
+            batch.goal[i, p.entities.index(x), n : n + (k if slotted(p) else 1)] = 1.0
+    return replace(batch, static={**batch.static, "one": one})
 
 
 def legal_moves(problem: Problem, state: State) -> list[Move]:
@@ -215,22 +234,30 @@ def legal_moves(problem: Problem, state: State) -> list[Move]:
     return [m for m in moves if check_move(problem, state, m) is None]
 
 
-def to_atoms(problem: Problem, state: State) -> frozenset[tuple[str, ...]]:
-    """The 4-op PDDL atoms of ``state`` (hand empty between moves)."""
-    atoms = {("handempty",)}
-    for x, s in zip(problem.entities, state, strict=True):
-        atoms.add(("ontable", x) if s == TABLE else ("on", x, s))
-        if is_clear(problem, state, x):
-            atoms.add(("clear", x))
-    return frozenset(atoms)
+def with_slots(problem: Problem, slots: Sequence[str], bases: dict | None = None) -> Problem:
+    """``problem`` on a table of capacity-one ``slots`` (`slotted`): each block on the table
+    stands on ``bases[block]`` (default: the slots in order, blocks in entity order)."""
+    rows = list(zip(problem.entities, problem.init, strict=True))
+    on_table = [x for x, s in rows if s == TABLE]
+    bases = dict(zip(on_table, slots, strict=False)) if bases is None else bases
+    if set(slots) & {*problem.entities, TABLE} or len(set(slots)) != len(slots) or not slots:
+        raise ProblemError(f"slot names {tuple(slots)} must be distinct, new and not {TABLE}")
+    if len({bases.get(x) for x in on_table} & set(slots)) != len(on_table):
+        raise ProblemError(f"{len(on_table)} towers need their own slots of {tuple(slots)}")
+    init = tuple(bases[x] if s == TABLE else s for x, s in rows)
+    return replace(problem, init=init, fixed=tuple(slots))
 
 
 def samples(seed: int):
-    """Random problems of 3 to 6 blocks (`task.symbolic.generate.random_problem`)."""
+    """Random problems of 3 to 6 blocks (`task.symbolic.generate.random_problem`), and one of
+    5 blocks on a table of 4 slots (`with_slots`) when its towers fit."""
     from task.symbolic.generate import random_problem
 
     for n_blocks in (3, 4, 5, 6):
         yield random_problem(n_blocks, seed)
+    small = random_problem(5, seed + 100)
+    if sum(s == TABLE for s in small.init) <= 4:
+        yield with_slots(small, ("s0", "s1", "s2", "s3"))
 
 
 class Blocksworld:
@@ -240,7 +267,7 @@ class Blocksworld:
     size_name = "blocks"
     goal_losses = GOAL_LOSSES
     distributions = True
-    encode = staticmethod(encode_supports)
+    encode = staticmethod(encode)
     soft_legality = staticmethod(soft_legality)
     step = staticmethod(relational_step(soft_legality))
     decode = staticmethod(relational_decode)
@@ -262,8 +289,8 @@ class Blocksworld:
     pddl_domain_text = staticmethod(_pddl.pddl_domain_text)
 
     @staticmethod
-    def shape_key(problem: Problem) -> int:
-        return problem.n
+    def shape_key(problem: Problem) -> tuple[int, int]:
+        return problem.n, len(problem.fixed)
 
     @staticmethod
     def size(problem: Problem) -> int:

@@ -15,8 +15,8 @@ from pathlib import Path
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
-from task.errors import PDDLError, one_of
-from task.problem import TABLE, Problem
+from task.errors import PDDLError, ProblemError, one_of
+from task.problem import TABLE, Action, Move, Problem
 from task.symbolic import pddl_io, strips
 from task.symbolic.signature import signature
 
@@ -139,7 +139,7 @@ def to_pddl(problem: Problem) -> str:
     lines = [f"(define (problem {problem.name})", f"(:domain {PDDL_DOMAIN})"]
     lines += [f"(:objects {objects})", "(:init", "(handempty)"]
     for x, s in zip(problem.entities, problem.init, strict=True):
-        lines.append(f"(ontable {x})" if s == TABLE else f"(on {x} {s})")
+        lines.append(f"(ontable {x})" if s in problem.fixed else f"(on {x} {s})")
     lines += [f"(clear {x})" for x in problem.entities if x not in problem.init]
     goal = [f"(ontable {x})" if y == TABLE else f"(on {x} {y})" for x, y in problem.goal]
     lines += [")", "(:goal"]
@@ -160,3 +160,51 @@ def matches(domain: Domain) -> bool:
     from task import data
 
     return signature(domain) == signature(data.domain())
+
+
+def slotted(problem: Problem) -> bool:
+    """Whether the table is K named slots of capacity one (``problem.fixed``, the paper's K
+    base slots) instead of one unlimited table; a goal ``(x, "table")`` then means x on any
+    slot, and a move names the slot it puts a block on."""
+    return problem.fixed != (TABLE,)
+
+
+def actions_to_moves(problem: Problem, actions: Sequence[Action]) -> tuple[Move, ...]:
+    """Pair a 4-op plan into moves; ProblemError unless it alternates pick and put."""
+    if slotted(problem):
+        raise ProblemError(
+            f"{problem.name} has table slots {problem.fixed}: give moves, not actions"
+        )
+    picks, puts = {"pick-up": 1, "unstack": 2}, {"put-down": 1, "stack": 2}
+    moves: list[Move] = []
+    held = ""
+    for k, action in enumerate(actions, start=1):
+        name, args = action.name.lower(), tuple(a.lower() for a in action.args)
+        kinds = puts if held else picks
+        if kinds.get(name) != len(args):
+            wanted = "(put-down x) or (stack x y)" if held else "(pick-up x) or (unstack x y)"
+            raise ProblemError(f"action {k} {action}: expected {wanted} (pick and put alternate)")
+        if args[0] not in problem.entities:
+            raise ProblemError(f"unknown block {one_of(args[0], problem.entities)}")
+        if not held:
+            held = args[0]
+            continue
+        if args[0] != held:
+            raise ProblemError(f"action {k} {action}: the hand holds {held}, not {args[0]}")
+        target = args[1] if name == "stack" else TABLE
+        problem.index(target)
+        moves.append(Move(held, target))
+        held = ""
+    if held:
+        raise ProblemError(f"plan ends holding {held} (after {actions[-1]})")
+    return tuple(moves)
+
+
+def to_atoms(problem: Problem, state: Sequence[str]) -> frozenset[tuple[str, ...]]:
+    """The 4-op PDDL atoms of ``state`` (hand empty between moves)."""
+    atoms = {("handempty",)}
+    for x, s in zip(problem.entities, state, strict=True):
+        atoms.add(("ontable", x) if s in problem.fixed else ("on", x, s))
+        if x not in state:
+            atoms.add(("clear", x))
+    return frozenset(atoms)

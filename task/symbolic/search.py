@@ -20,7 +20,7 @@ from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
 from task.errors import ProblemError
-from task.problem import Move, Problem
+from task.problem import TABLE, Move, Problem
 from task.symbolic import strips
 
 _Code = tuple[int, ...]  # support index of each entity; n (== len) stands for the table
@@ -52,8 +52,12 @@ def _heuristic(state: _Code, goal: dict[int, int], claimed: dict[int, int]) -> i
 
 
 def moves_lower_bound(problem: Problem, state: tuple[str, ...]) -> int:
-    """Admissible lower bound on the moves still needed from ``state`` (crisp supports)."""
-    names = {name: i for i, name in enumerate(problem.targets)}
+    """Admissible lower bound on the moves still needed from ``state`` (crisp supports).
+
+    Table slots (`task.domains.blocksworld.slotted`) count as the table: the bound ignores
+    their capacity (a relaxation, so it stays admissible)."""
+    n = problem.n
+    names = {name: min(i, n) for i, name in enumerate(problem.targets)} | {TABLE: n}
     code = tuple(names[s] for s in state)
     goal = {names[x]: names[y] for x, y in problem.goal}
     return _heuristic(code, goal, {y: x for x, y in goal.items() if y < len(code)})
