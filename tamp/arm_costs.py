@@ -13,6 +13,7 @@ state (no placements are optimised here: the table placement is the scene's free
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -21,30 +22,42 @@ import torch
 from motion.cost import MoveCostConfig, move_costs_batch
 from motion.ik import IKSolver
 from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
+from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Problem
 
-BLOCKED = 10.0  # added to a move the scene cannot take (no clearance, no free slot)
+BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refuses it
 
 
 def predict_poses(
-    entities: Sequence[str], state: State, poses: Mapping[str, Pose], scene: SceneConfig
+    entities: Sequence[str],
+    state: State,
+    poses: Mapping[str, Pose],
+    scene: SceneConfig,
+    bases: Mapping[str, tuple[float, float]] | None = None,
 ) -> dict[str, Pose]:
     """Block poses after the plan reached ``state`` from the observed ``poses``: a block with
     the same blocks under it as observed keeps its observed pose; otherwise its tower keeps
     the base block's observed table position when that base was on the table, else it stands
-    on a free slot, and the block stands exactly above the base."""
+    on a free slot, and the block stands exactly above the base. ``bases``: where each tower
+    base stands (a planned table place, `tamp.slots`) instead."""
     s, out = scene.block_size, {}
     stacks = towers(entities, state)
     seen = read_state(entities, poses, scene).state
     before = {} if seen is None else {x: tuple(t[:k]) for t in towers(entities, seen)
                                       for k, x in enumerate(t)}  # fmt: skip
     grounded = [t for t in stacks if abs(poses[t[0]].xyz[2] - s / 2) <= scene.tol_z]
+    if bases is not None:
+        grounded = stacks
     for tower in grounded:
+        base, stays = poses[tower[0]], True
+        if bases is not None:  # moved onto its planned place unless it stands there already
+            xy = bases[tower[0]]
+            if before.get(tower[0]) != () or math.dist(base.xy, xy) > scene.slot_radius:
+                base, stays = Pose((*xy, s / 2), 0.0), False
         for level, x in enumerate(tower):
-            base = poses[tower[0]]
             out[x] = Pose((base.xyz[0], base.xyz[1], s / 2 + level * s), base.yaw)
-            if before.get(x) == tuple(tower[:level]):
+            if stays and before.get(x) == tuple(tower[:level]):
                 out[x] = poses[x]  # nothing under it changed
     for tower in (t for t in stacks if t not in grounded):
         taken = {k: v for k, v in out.items()}
@@ -81,8 +94,12 @@ class ArmCosts:
         solver: IKSolver,
         q_now,
         config: MoveCostConfig = MoveCostConfig(),
+        places: Sequence[Mapping[str, tuple[float, float]]] | None = None,
+        avoid: Mapping[State, set] | None = None,
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
+        self.places = places  # per problem: table place -> (x, y), for slotted problems
+        self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
 
@@ -99,15 +116,26 @@ class ArmCosts:
         picks, places, extra = [], [], []
         s = self.scene.block_size
         for i, state in todo:
-            problem = self.problems[i]
-            now = predict_poses(problem.entities, state, self.poses[i], self.scene)
+            problem, at = self.problems[i], None if self.places is None else self.places[i]
+            plain = state if at is None else tuple(TABLE if x in at else x for x in state)
+            bases = None if at is None else {
+                x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at
+            }  # fmt: skip
+            now = predict_poses(problem.entities, plain, self.poses[i], self.scene, bases)
             xyz = np.array([now[x].xyz for x in problem.entities])  # (N, 3)
-            slot = free_slot(now, xyz.mean(0), self.scene)
-            table = (slot[0], slot[1], s / 2) if slot is not None else tuple(xyz.mean(0))
-            picks.append(xyz)
             up = xyz + np.array([0.0, 0.0, s])  # onto each block
-            places.append(np.vstack([up, [table]]))  # (Y, 3), Y = N + 1
-            extra.append(self._blocked(problem, state, now, slot is None))
+            if at is None:
+                slot = free_slot(now, xyz.mean(0), self.scene)
+                table = [(slot[0], slot[1], s / 2) if slot is not None else tuple(xyz.mean(0))]
+            else:  # every place of the slotted problem, K = len(problem.fixed)
+                table = [(*at[k], s / 2) for k in problem.fixed]
+            picks.append(xyz)
+            places.append(np.vstack([up, table]))  # (Y, 3), Y = N + K
+            extra.append(self._blocked(problem, plain, now, at is None and slot is None))
+            for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
+                j = _column(problem, key, at)
+                if j is not None:
+                    extra[-1][problem.entities.index(x), j] += BLOCKED
         with torch.no_grad():
             c = move_costs_batch(
                 self.solver, self.q_now, torch.tensor(np.stack(picks)),
@@ -119,7 +147,7 @@ class ArmCosts:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no
         free table slot."""
         n = problem.n
-        out = np.zeros((n, n + 1))
+        out = np.zeros((n, len(problem.targets)))
         support = dict(zip(problem.entities, state, strict=True))
         for j, y in enumerate(problem.entities):
             height, below = 1, support[y]
@@ -128,5 +156,27 @@ class ArmCosts:
             if height + 1 > self.scene.capacity(now[y].xy):
                 out[:, j] = BLOCKED
         if table_full:
-            out[:, n] = BLOCKED
+            out[:, n:] = BLOCKED
         return out
+
+
+def failed_key(move) -> tuple[str, object]:
+    """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
+    ("at", x, y) for a move onto a planned table place (`tamp.slots.PlacedMove`)."""
+    at = getattr(move, "at", None)
+    if at is not None:
+        return move.entity, ("at", round(at[0], 3), round(at[1], 3))
+    return move.entity, move.target
+
+
+def _column(problem: Problem, key, at) -> int | None:
+    """The action column of a `failed_key` target in ``problem`` (a place: by position; None
+    when the problem has no such target)."""
+    if isinstance(key, str) and key != TABLE:
+        return problem.entities.index(key)
+    if at is None:  # the one table column
+        return problem.n
+    if isinstance(key, str):
+        return None  # "somewhere on the table": no one place to blame
+    near = [j for j, k in enumerate(problem.fixed) if math.dist(at[k], key[1:]) < 1e-3]
+    return problem.n + near[0] if near else None

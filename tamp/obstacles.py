@@ -2,7 +2,8 @@
 
 A scene is the table, its slot grid and the boxes in `SceneConfig.obstacles`: ``tabletop`` has
 none, ``shelf`` a board on two legs over the far row's ``y = 0.16`` and ``0.32`` slots,
-``clutter`` thin posts between the slots and a wall close beside the ``y = -0.32`` column.
+``clutter`` thin posts between the slots and a wall close beside the ``y = -0.32`` column,
+``cramped`` no obstacle but only 6 slots, two of them far from the robot.
 Both simulators build the boxes, the camera sees them, and the arm's collision model checks
 every trajectory against them (`motion.guard`, `robots.collision`). Obstacles are fixed and
 known, like a map of the workcell; the blocks still come from observation.
@@ -69,14 +70,21 @@ CLUTTER = (
     *(Obstacle(f"post_{i}", (0.48, y, 0.075), POST) for i, y in enumerate(POSTS_Y)),
     Obstacle("wall", (0.48, -0.455, 0.15), (0.2, 0.01, 0.15)),  # beside the y = -0.32 column
 )
-SCENES: dict[str, tuple[Obstacle, ...]] = {"tabletop": (), "shelf": SHELF, "clutter": CLUTTER}
+SCENES: dict[str, tuple[Obstacle, ...]] = {
+    "tabletop": (), "shelf": SHELF, "clutter": CLUTTER, "cramped": (),
+}  # fmt: skip
+# scenes with their own slot grid (x values, y values): ``cramped`` has 6 slots in 3 rows, the
+# far one (x = 0.72 m) near the end of the arm's comfortable reach
+GRIDS = {"cramped": ((0.40, 0.56, 0.72), (-0.12, 0.12))}
 
 
 def with_scene(config, name: str):
-    """``config`` (a `tamp.scene.SceneConfig`) with the obstacles of the named scene."""
+    """``config`` (a `tamp.scene.SceneConfig`) with the obstacles (and slot grid) of the named
+    scene."""
     if name not in SCENES:
         raise TampError(f"unknown scene {one_of(name, tuple(SCENES))}")
-    return replace(config, obstacles=SCENES[name], name=name)
+    grid = dict(zip(("slot_xs", "slot_ys"), GRIDS[name], strict=True)) if name in GRIDS else {}
+    return replace(config, obstacles=SCENES[name], name=name, **grid)
 
 
 def ceiling(xy: Sequence[float], obstacles: Sequence[Obstacle]) -> float:

@@ -1,10 +1,10 @@
 """The scene model: a symbolic Blocksworld state <-> block poses on a table, and back.
 
 Blocks are cubes (5 cm by default), or upright cylinders as tall as they are wide, with distinct
-colours from the scene's palette. Each tower stands on a *table slot*,
-a fixed grid of positions in front of the robot; a block moved onto the table goes to a free
-slot. ``layout`` turns a state into poses (with small seeded jitter); ``read_state`` turns
-observed poses into a state, with tolerances, and says which block it cannot explain.
+colours from the scene's palette. Each tower stands on a *table slot*, a fixed grid of positions
+in front of the robot; a block moved onto the table goes to a free slot. ``layout`` turns a
+state into poses (with small seeded jitter); ``read_state`` turns observed poses into a state,
+with tolerances, and says which block it cannot explain.
 
 World frame = the robot base frame (``panda_link0``); the table surface is z = 0.
 """
@@ -104,11 +104,8 @@ class SceneConfig:
 
 
 def cube_yaw(rotation) -> float:
-    """Yaw of a cube's side faces from its rotation matrix (3, 3), in [-pi/4, pi/4).
-
-    Whichever block axis points most nearly up, the next axis projected on the table gives the
-    yaw; a cube that fell on its side gets the right grasp angle (Euler yaw would not).
-    """
+    """Yaw of a cube's side faces from its rotation matrix (3, 3), in [-pi/4, pi/4): the axis
+    after the one most nearly up, projected on the table (right for a cube on its side too)."""
     r = np.asarray(rotation, dtype=float).reshape(3, 3)  # columns: block axes in the world
     up = int(np.argmax(np.abs(r[2])))
     side = r[:, (up + 1) % 3]
@@ -117,9 +114,8 @@ def cube_yaw(rotation) -> float:
 
 
 def colour(index: int, palette=PALETTE) -> tuple[float, float, float]:
-    """RGB in [0, 1] of the block at ``index`` in the problem's entity order. Blocks beyond
-    the palette get generated colours (golden-ratio hues, two brightnesses): only the camera
-    tells blocks apart by colour, and it refuses more than `CAMERA_COLOURS` blocks."""
+    """RGB in [0, 1] of the block at ``index`` in entity order; beyond the palette, golden-ratio
+    hues (the camera, which tells blocks by colour, refuses over `CAMERA_COLOURS` blocks)."""
     if index < len(palette):
         return palette[index][1]
     hue, value = (index * 0.618034) % 1.0, 0.85 if index % 2 else 0.55
@@ -282,13 +278,19 @@ def place_pose(
     move: Move, poses: Mapping[str, Pose], config: SceneConfig = SceneConfig(), rank: int = 0
 ) -> Pose | None:
     """Where the moved block's centre should end: on top of the target block, or on a free
-    table slot, the ``rank``-th best (None when the table has no more free slots)."""
+    table slot, the ``rank``-th best (None when the table has no more free slots); a move
+    that names its table place (``move.at``, `tamp.slots.PlacedMove`) tries that first."""
     if move.entity not in poses:
         raise ProblemError(f"unknown block {one_of(move.entity, sorted(poses))}")
     s = config.block_size
     if move.target == TABLE:
         others = {k: v for k, v in poses.items() if k != move.entity}
         slots = free_slots(others, poses[move.entity].xyz, config)
+        at = getattr(move, "at", None)
+        if at is not None and all(
+            math.dist(at, p.xy) > config.slot_radius for p in others.values()
+        ):
+            slots = [tuple(at), *(k for k in slots if math.dist(k, at) > 1e-6)]
         if rank >= len(slots):
             return None
         return Pose((slots[rank][0], slots[rank][1], s / 2), 0.0)

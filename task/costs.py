@@ -25,6 +25,10 @@ from torch import Tensor
 
 from task.domains.base import State
 
+# a move costing this much or more is one the source says cannot be executed (the arm cannot
+# reach it, it failed there before): the decoder refuses it like an illegal move
+IMPOSSIBLE = 10.0
+
 
 class WindowCosts(Protocol):
     """The move costs of one planning window for P problems (all of one size N)."""

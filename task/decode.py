@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 from torch import Tensor
 
+from task.costs import IMPOSSIBLE
 from task.domains.base import Domain, State
 from task.problem import Problem
 
@@ -64,7 +65,8 @@ def decode_row(
     costs: Tensor | None = None,
 ) -> DecodedWindow:
     """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row; costs:
-    (N, A - 1) its move costs (`task.costs`), summed over the decoded moves.
+    (N, A - 1) its move costs (`task.costs`), summed over the decoded moves; a move costing
+    `task.costs.IMPOSSIBLE` or more is refused like an illegal one.
 
     ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``);
     ``seen``: states the plan already passed through (the window is a ``revisit`` if it ends
@@ -81,6 +83,8 @@ def decode_row(
         row, col = divmod(index, gates.shape[2])
         move = domain.decode(problem, row, col, n)  # None: padding, never a legal move
         reason = "padding" if move is None else domain.check_move(problem, state, move)
+        if reason is None and costs is not None and float(costs[row, col]) >= IMPOSSIBLE:
+            reason = f"the cost source rules {move} out (cost {float(costs[row, col]):.3g})"
         if reason is not None:
             complete = False
             if not check and move is not None:

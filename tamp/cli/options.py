@@ -226,7 +226,8 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
 
 def scene_options(p: argparse.ArgumentParser) -> None:
     """The scene's obstacles, and what happens to a trajectory that would hit one."""
-    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter"), default="tabletop",
+    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter", "cramped"),
+                   default="tabletop",
                    help="obstacles on the table (tabletop: none)")  # fmt: skip
     p.add_argument("--collision", choices=("plan", "check", "off"), default="plan",
                    help="check every trajectory and route blocked ones with the motion planner "

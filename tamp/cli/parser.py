@@ -64,7 +64,8 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("--motion-aware", dest="lambda_motion", action="store_const", const=0.05,
                    help="blocksworld: the arm's cost of each move in the objective, for the "
                    "problem laid out on --scene (off)")  # fmt: skip
-    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter"), default="tabletop",
+    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter", "cramped"),
+                   default="tabletop",
                    help="--motion-aware: the table scene (tabletop)")  # fmt: skip
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")

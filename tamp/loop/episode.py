@@ -25,10 +25,10 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts
+from tamp.arm_costs import ArmCosts, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
-from tamp.loop.execute import ExecutionResult, execute_move, obstacle_boxes
+from tamp.loop.execute import ExecutionResult, Failure, execute_move, obstacle_boxes
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
@@ -37,9 +37,14 @@ from tamp.loop.score import Scorer
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
+from tamp.slots import plan_on_places
 from task.domains import get_domain
 from task.planner import plan
 from task.problem import Move, Problem
+
+# what the arm could not do (not a fault of the world): motion-aware planning prices the move out
+ARM_FAILURES = frozenset({Failure.IK_INFEASIBLE, Failure.NO_FREE_SLOT, Failure.NO_CLEARANCE,
+                          Failure.COLLISION, Failure.TRACKING})  # fmt: skip
 
 
 class Episode:
@@ -81,6 +86,7 @@ class Episode:
 
             self.collision = PandaCollision(config.execution.margin)
         self._acts = 0  # moves attempted: each seeds its motion-planner call differently
+        self._avoid: dict = {}  # state -> moves the arm failed there (`ArmCosts` avoid)
         self.score = Scorer(self.sim.truth, problem, config.scene)
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
         if self.collision is not None:
@@ -138,9 +144,11 @@ class Episode:
             p.stop(EpisodeStatus.REPLAN_BUDGET, f"{self.config.max_moves} moves used")
             return
         move = p.queue.pop(0)
-        expected = self.domain.apply_move(self.problem, p.planned, move)
+        start, expected = p.planned, self.domain.apply_move(self.problem, p.planned, move)
         p.planned = expected
         done = self._execute_next(p, move)
+        if not done.ok and done.failure in ARM_FAILURES:  # motion-aware: priced out next time
+            self._avoid.setdefault(start, set()).add(failed_key(move))
         self._check(p, move, done, expected)
 
     def _next_plan(self, p: Progress) -> bool:
@@ -175,12 +183,17 @@ class Episode:
         return observed if truth is None else truth
 
     def _plan_window(self, state, seed: int):
-        """Plan from ``state``; with the camera, one window from the current image."""
+        """Plan from ``state``; with the camera, one window from the current image. Motion-aware
+        planning prices each move for the arm (`ArmCosts`) and, with state observation, plans
+        on the scene's table places (`tamp.slots`): moves onto the table name their place."""
         current = dataclasses.replace(self.target, init=state)
         costs = None  # motion-aware planning: the arm's cost of each move, from what it sees
         if self.config.planner.lambda_motion > 0:
-            costs = ArmCosts([current], [self._poses()], self.config.scene, self.solver,
-                             self.sim.arm_q())  # fmt: skip
+            poses, scene, q = self._poses(), self.config.scene, self.sim.arm_q()
+            if self.config.observe == "state":
+                return plan_on_places(current, poses, scene, self.solver, q,
+                                      self.config.planner, seed, self._avoid)  # fmt: skip
+            costs = ArmCosts([current], [poses], scene, self.solver, q, avoid=self._avoid)
         if self.config.observe == "state":
             return plan(current, self.config.planner, seed=seed, costs=costs)
         image = self.eyes.image

@@ -22,7 +22,7 @@ SHELF, CLUTTER = with_scene(SceneConfig(), "shelf"), with_scene(SceneConfig(), "
 
 
 def test_the_named_scenes_and_an_unknown_name():
-    assert set(SCENES) == {"tabletop", "shelf", "clutter"}
+    assert set(SCENES) == {"tabletop", "shelf", "clutter", "cramped"}
     assert with_scene(SceneConfig(), "tabletop") == replace(SceneConfig(), name="tabletop")
     with pytest.raises(TampError, match=r"unknown scene 'attic' \(valid: tabletop, shelf"):
         with_scene(SceneConfig(), "attic")

@@ -1,0 +1,108 @@
+"""The table as the planner's K base slots: a scene's places, each holding one tower.
+
+Motion-aware planning (`tamp.arm_costs`) plans on the table the arm really has: every table
+slot of the scene with room for a block (`tamp.scene.SceneConfig.slots`, not under a board too
+low for one) is a capacity-one target named ``slot<k>`` (`task.domains.blocksworld.with_slots`),
+so a plan never needs more free places than the table has and each move onto the table names
+its place. A tower standing off every slot (nudged, or laid out elsewhere) keeps its own place,
+named ``spot_<base>``, which other towers may use once it is empty. The observed state reads
+each tower base's place from its observed pose, nothing else.
+
+The loop stays on the plain problem: `plain_move` turns a planned move onto a place into a
+move onto the table that carries the place's position (`PlacedMove.at`), where the executor
+puts the block (`tamp.scene.place_pose`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+
+from motion.ik import IKSolver
+from tamp.arm_costs import ArmCosts
+from tamp.scene import Pose, SceneConfig
+from task.config import PlannerConfig
+from task.domains.blocksworld import with_slots
+from task.planner import plan
+from task.problem import TABLE, Move, Plan, PlanResult, Problem
+
+XY = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class PlacedMove(Move):
+    """A move onto the table with the table position ``at`` (x, y) the plan chose for it."""
+
+    at: XY | None = field(default=None, compare=False)
+
+
+def places(
+    problem: Problem, state: Sequence[str], poses: Mapping[str, Pose], scene: SceneConfig
+) -> tuple[dict[str, XY], dict[str, str]]:
+    """The table places of the scene (name -> (x, y)) and the place of every tower base
+    (block -> place name) in the observed ``state``, read from the ``poses``."""
+    bases = [x for x, s in zip(problem.entities, state, strict=True) if s == TABLE]
+    usable = {f"slot{k}": xy for k, xy in enumerate(scene.slots) if scene.capacity(xy) > 0}
+    reach = _half_spacing(scene)
+    out: dict[str, XY] = dict(usable)
+    where: dict[str, str] = {}
+    for base in bases:
+        xy = (float(poses[base].xyz[0]), float(poses[base].xyz[1]))
+        near = min(usable, key=lambda k: math.dist(usable[k], xy), default=None)
+        if near is not None and near not in where.values() and math.dist(usable[near], xy) < reach:
+            where[base] = near
+        else:
+            where[base] = f"spot_{base}"
+            out[where[base]] = xy
+    for name, xy in usable.items():  # a slot crowded by a tower standing off it is no place
+        crowded = any(
+            math.dist(xy, out[p]) < 2 * scene.slot_radius for p in where.values() if p != name
+        )
+        if crowded and name not in where.values():
+            del out[name]
+    return out, where
+
+
+def _half_spacing(scene: SceneConfig) -> float:
+    """Half the least distance between two slots (a base nearer than this is on the slot)."""
+    slots = scene.slots
+    gaps = [math.dist(a, b) for i, a in enumerate(slots) for b in slots[i + 1 :]]
+    return min(gaps, default=1.0) / 2
+
+
+def slotted(
+    problem: Problem, state: Sequence[str], poses: Mapping[str, Pose], scene: SceneConfig
+) -> tuple[Problem, dict[str, XY]]:
+    """``problem`` in the observed ``state`` on the scene's table places (see `places`):
+    the slotted problem and the position of each place."""
+    at, where = places(problem, state, poses, scene)
+    current = Problem(problem.name, problem.domain, problem.entities, tuple(state),
+                      problem.goal, data=problem.data)  # fmt: skip
+    return with_slots(current, tuple(at), where), at
+
+
+def plain_move(move: Move, at: Mapping[str, XY]) -> Move:
+    """A planned move onto a place as a move onto the table at that place (`PlacedMove`)."""
+    if move.target in at:
+        return PlacedMove(move.entity, TABLE, at[move.target])
+    return move
+
+
+def plan_on_places(
+    problem: Problem,
+    poses: Mapping[str, Pose],
+    scene: SceneConfig,
+    solver: IKSolver,
+    q_now,
+    config: PlannerConfig,
+    seed: int = 0,
+    avoid: Mapping | None = None,
+) -> PlanResult:
+    """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
+    table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
+    the arm failed, priced out); the plan's moves are plain (`plain_move`)."""
+    current, at = slotted(problem, problem.init, poses, scene)
+    costs = ArmCosts([current], [poses], scene, solver, q_now, places=[at], avoid=avoid)
+    result = plan(current, config, seed=seed, costs=costs)
+    return replace(result, plan=Plan(tuple(plain_move(m, at) for m in result.plan)))

@@ -1,0 +1,131 @@
+"""The table as the planner's K base slots (`tamp.slots`): places read from observed poses,
+moves onto a place carried to the executor, failed moves priced out, and a cramped scene where
+the unlimited-table plan runs out of slots and the slotted one does not."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from motion.ik import IKSolver
+from robots.panda import PANDA
+from tamp.arm_costs import BLOCKED, ArmCosts, failed_key
+from tamp.loop import LoopConfig, run_episode
+from tamp.obstacles import with_scene
+from tamp.scene import Pose, SceneConfig, layout, place_pose
+from tamp.slots import PlacedMove, places, plain_move, plan_on_places, slotted
+from task.config import PlannerConfig
+from task.domains import blocksworld as bw
+from task.problem import TABLE, Move, Problem
+
+SCENE = SceneConfig()
+FOUR = Problem("four", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
+               (("b", "c"),))  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def solver() -> IKSolver:
+    return IKSolver()
+
+
+def test_every_tower_base_is_on_the_slot_it_stands_on_and_free_slots_are_places():
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[3, 5, 9])  # a-b, c, d
+    at, where = places(FOUR, FOUR.init, poses, SCENE)
+    assert where == {"b": "slot3", "c": "slot5", "d": "slot9"}
+    assert len(at) == len(SCENE.slots) and at["slot9"] == SCENE.slots[9]
+    problem, at2 = slotted(FOUR, FOUR.init, poses, SCENE)
+    assert problem.init == ("b", "slot3", "slot5", "slot9") and at2 == at
+    assert bw.slotted(problem) and problem.fixed == tuple(at)
+
+
+def test_a_tower_off_every_slot_keeps_its_own_place_and_crowds_the_slot_beside_it():
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    poses["d"] = Pose((0.48, 0.08, 0.025), 0.0)  # amid slots 2, 3, 7 and 8, 11 cm from each
+    at, where = places(FOUR, FOUR.init, poses, SCENE)
+    assert where["d"] == "spot_d" and at["spot_d"] == (0.48, 0.08) and len(at) == 11
+    poses["d"] = Pose((0.44, 0.0, 0.025), 0.0)  # 4 cm from slot 2
+    at, where = places(FOUR, FOUR.init, poses, SCENE)
+    assert where["d"] == "slot2"  # within half the slot spacing: on the slot
+    poses["d"] = Pose((0.40, 0.08, 0.025), 0.0)  # halfway between slots 2 and 3 in y
+    at, where = places(FOUR, FOUR.init, poses, SCENE)
+    assert where["d"] == "spot_d" and "slot2" not in at and "slot3" not in at
+
+
+def test_a_place_goes_to_the_executor_as_a_table_move_at_its_position():
+    at = {"slot4": (0.4, 0.32)}
+    move = plain_move(Move("a", "slot4"), at)
+    assert isinstance(move, PlacedMove) and move.target == TABLE and move.at == (0.4, 0.32)
+    assert str(move) == "move(a -> table)" and plain_move(Move("a", "b"), at) == Move("a", "b")
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    chosen = place_pose(PlacedMove("a", TABLE, SCENE.slots[6]), poses, SCENE)
+    assert np.allclose(chosen.xyz, (*SCENE.slots[6], 0.025))
+    default = place_pose(Move("a", TABLE), poses, SCENE)
+    assert not np.allclose(default.xy, SCENE.slots[6])  # the hint, not the default, chose it
+    taken = place_pose(PlacedMove("a", TABLE, SCENE.slots[9]), poses, SCENE)  # d stands there
+    assert np.allclose(taken.xyz, default.xyz)  # falls back to the best free slot
+
+
+def test_slot_columns_are_priced_at_their_own_places(solver):
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
+    c = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])([0], [problem.init])
+    c = c.compute()[0]
+    assert c.shape == (4, 4 + len(at))
+    col = {k: 4 + j for j, k in enumerate(problem.fixed)}
+    # a stands on slot 0's tower: the slot beside it is cheaper than the far end of the table
+    assert c[0, col["slot1"] if "slot1" in col else col["slot2"]] < c[0, col["slot8"]]
+
+
+def test_a_move_the_arm_failed_is_priced_out_in_that_state_only(solver):
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
+    failed = PlacedMove("a", TABLE, at["slot7"])
+    avoid = {FOUR.init: {failed_key(failed), failed_key(Move("a", "d"))}}
+    plain = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
+    priced = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], avoid=avoid)
+    before, after = plain([0], [problem.init]).compute()[0], priced([0], [problem.init]).compute()
+    diff = (after[0] - before).numpy()
+    j = 4 + problem.fixed.index("slot7")
+    assert diff[0, j] == pytest.approx(BLOCKED) and diff[0, 3] == pytest.approx(BLOCKED)
+    assert np.count_nonzero(diff) == 2
+    other = bw.apply_move(problem, problem.init, Move("a", "slot2"))
+    assert priced([0], [other]).compute()[0, 0, j] < BLOCKED
+
+
+def test_planning_on_places_names_them_and_never_needs_more_than_the_table_has(solver):
+    # five single blocks on a 6-slot table; the goal is one tower: no place is needed beyond
+    five = Problem("five", "blocksworld", tuple("abcde"), (TABLE,) * 5,
+                   (("a", "b"), ("b", "c"), ("c", "d"), ("d", "e")))  # fmt: skip
+    scene = with_scene(SCENE, "cramped")
+    poses = layout(five.entities, five.init, scene, seed=1)
+    config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
+    result = plan_on_places(five, poses, scene, solver, PANDA.q_home, config, seed=0)
+    assert result.solved and [str(m) for m in result.plan] == [
+        "move(d -> e)", "move(c -> d)", "move(b -> c)", "move(a -> b)"]  # fmt: skip
+
+
+@pytest.mark.sim
+def test_a_cramped_table_the_unlimited_plan_overflows_is_solved_on_its_places():
+    """Ten blocks in five towers on the 6-slot ``cramped`` scene: the task-only plan puts more
+    blocks on the table than there are slots and fails at motion level; motion-aware planning
+    on the places reaches the goal with every table move at a planned place."""
+    import random
+
+    from task.symbolic.generate import random_problem
+
+    seeds = random.Random("0:10")
+    problem = [random_problem(10, seeds.randrange(2**31)) for _ in range(8)][7]
+    base = LoopConfig()
+    base = dataclasses.replace(base, scene=with_scene(base.scene, "cramped"))
+    aware = dataclasses.replace(base, planner=dataclasses.replace(base.planner, lambda_motion=0.05))
+    blind = run_episode(problem, base, seed=0)
+    assert not blind.reached_goal and "no_free_slot" in {m.failure.value for m in blind.moves if
+                                                    not m.ok}  # fmt: skip
+    report = run_episode(problem, aware, seed=0)
+    assert report.reached_goal and report.replans == 0
+    table = [m.move for m in report.moves if m.move.target == TABLE]
+    assert table and all(isinstance(m, PlacedMove) for m in table)
+    assert all(min(math.dist(m.at, s) for s in aware.scene.slots) < 1e-9 for m in table)
