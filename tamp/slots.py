@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 
 from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts
-from tamp.scene import Pose, SceneConfig
+from tamp.scene import Pose, SceneConfig, SceneError, layout
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
 from task.planner import plan
@@ -106,3 +106,13 @@ def plan_on_places(
     costs = ArmCosts([current], [poses], scene, solver, q_now, places=[at], avoid=avoid)
     result = plan(current, config, seed=seed, costs=costs)
     return replace(result, plan=Plan(tuple(plain_move(m, at) for m in result.plan)))
+
+
+def fits(problem: Problem, scene: SceneConfig) -> bool:
+    """Whether ``problem``'s initial towers can be laid out on ``scene`` (`tamp.scene.layout`:
+    a slot each, one slot to spare, none taller than the arm can clear)."""
+    try:
+        layout(problem.entities, problem.init, scene, 0)
+    except SceneError:
+        return False
+    return True

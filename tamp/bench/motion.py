@@ -1,9 +1,8 @@
 """The motion benchmarks: how executable task plans are at motion level.
 
 ``tamp bench motion``: `run` plays closed-loop episodes (`tamp.loop`) on a suite in each
-simulator; `summarise` gives per simulator task plans valid, executed moves valid, moves
-executed, goals reached (simulator ground truth), failures by kind, replans, disturbed stacks,
-time per move, and with faults the recovery rate (printed by `tamp.bench.tables.motion_table`).
+simulator; `summarise` gives per simulator plans valid, executed moves valid, moves, goals
+reached (ground truth), failures by kind, replans, disturbed stacks, time per move, recovery.
 
 "Valid" is a replay through `task.symbolic.validate` against the instance's PDDL problem
 (`tamp.bench.planning.replay`), never the planner's own flag: "plans valid" replays the first
@@ -11,10 +10,9 @@ complete task plan (not applicable with the camera, whose first plan is one wind
 moves valid" the moves that executed ok, in order (every step applicable, the goal at the end).
 
 ``tamp bench executability``: `run_given` executes plans of any source (`read_sources`) open-
-loop (`tamp.loop.given`) in each simulator, ours as the reference row: per plan our task-level
-verdict and PlanBench's, the goal reached (ground truth), the first failure, disturbed stacks,
-moves and time (`PlanRow`); `given_summary` per source (`tables.executability_table`). Both
-sweep their episodes with `tamp.sweep.run_items`: in this process, in N processes or on Ray.
+loop (`tamp.loop.given`) in each simulator, ours as the reference row: per plan our verdict and
+PlanBench's, the goal reached (ground truth), the first failure, disturbed stacks, moves, time
+(`PlanRow`); `given_summary` per source. Both sweep with `tamp.sweep.run_items`.
 """
 
 from __future__ import annotations
@@ -44,7 +42,8 @@ from task.symbolic.validate import validate
 
 EPISODE_COLUMNS = (
     "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
-    "disturbed", "touched", "sim_time_s", "wall_time_s",
+    "disturbed", "touched", "sim_time_s", "wall_time_s", "plan_time_s", "first_plan_moves",
+    "arm_path_rad", "failures",
 )  # fmt: skip
 
 
@@ -61,11 +60,9 @@ class MotionBench:
 def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
     """Wall time of one batched IK call on ``n`` random top-down targets in the block area."""
     rng = np.random.default_rng(seed)
-    targets = np.stack([
-        top_down_pose((rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), rng.uniform(0.03, 0.3)),
-                      rng.uniform(-np.pi / 2, np.pi / 2))
-        for _ in range(n)
-    ])  # fmt: skip
+    targets = np.stack([top_down_pose((rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3),
+                        rng.uniform(0.03, 0.3)), rng.uniform(-np.pi / 2, np.pi / 2))
+                        for _ in range(n)])  # fmt: skip
     q0 = np.asarray(solver.spec.q_home)
     solver.solve(targets[:2], q0)  # warm-up
     t0 = time.perf_counter()
@@ -141,7 +138,10 @@ def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
          "moves_ok": sum(m.ok for m in r.moves), "replans": r.replans,
          "faults": " ".join(r.faults), "disturbed": r.disturbed,
          "touched": " ".join(f"{k}:{v}" for k, v in sorted(r.touched.items())),
-         "sim_time_s": round(r.sim_time_s, 2), "wall_time_s": round(r.wall_time_s, 2)}
+         "sim_time_s": round(r.sim_time_s, 2), "wall_time_s": round(r.wall_time_s, 2),
+         "plan_time_s": round(r.plan_time_s, 3), "first_plan_moves": len(r.first_plan),
+         "arm_path_rad": round(sum(m.path_rad for m in r.moves), 3),
+         "failures": " ".join(m.failure.value for m in r.moves if m.failure is not None)}
         for r in reports
     ]  # fmt: skip
 

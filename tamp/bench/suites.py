@@ -4,9 +4,8 @@ PlanBench (Blocksworld-600, Logistics-200, Sokoban-55; `OFFICIAL`) is read throu
 ``manifest.csv`` where there is one, else the official files are picked by name. Lengths the
 data lack come from A* for Blocksworld (`tamp.bench.optimal`), else Fast Downward when the
 benchmark extra is installed (`tamp.bench.fast_downward`), cached in the output folder.
-`pddl_folder` reads a domain file and its problems (the IPC sets); ``generated`` makes seeded
-random Blocksworld problems. A `Suite`'s instances all validate against one PDDL domain.
-"""
+`pddl_folder` reads a domain and its problems (the IPC sets); ``generated`` makes seeded random
+Blocksworld problems. A `Suite`'s instances all validate against one PDDL domain."""
 
 from __future__ import annotations
 
@@ -78,19 +77,16 @@ class Suite:
 
 
 def spread(items: Sequence, limit: int | None, key: Callable) -> list:
-    """``limit`` items spread evenly over ``items`` stably sorted by ``key`` (all if None).
-
-    Item ``i`` of the result is the middle of the ``i``-th of ``limit`` equal slices, so every
-    size gets its share: ``--limit 6`` of Blocksworld-600 gives one 3-, four 4- and one 5-block.
-    """
+    """``limit`` items spread evenly over ``items`` stably sorted by ``key`` (all if None):
+    item ``i`` is the middle of the ``i``-th of ``limit`` equal slices, so every size gets its
+    share (``--limit 6`` of Blocksworld-600 gives one 3-, four 4- and one 5-block)."""
     ordered = sorted(items, key=key)
     if limit is None or limit >= len(ordered):
         return ordered
     return [ordered[(2 * i + 1) * len(ordered) // (2 * limit)] for i in range(limit)]
 
 
-def default_data(domain: str) -> Path:
-    """Where `planbench` looks by default for ``domain``'s set."""
+def default_data(domain: str) -> Path:  # where `planbench` looks by default
     return DEFAULT_DATA / "planbench" / domain
 
 
@@ -271,26 +267,30 @@ def generated(
     seed: int,
     max_nodes: int = 20_000,
     progress: Callable[[int], None] | None = None,
+    keep: Callable | None = None,
 ) -> Suite:
-    """``n`` random problems per block count; optimal lengths from A* within ``max_nodes``.
-
-    Instance ``i`` of ``b`` blocks uses the ``i``-th seed drawn from ``Random(f"{seed}:{b}")``,
-    so adding a block count leaves the others unchanged. Each problem goes through its PDDL
-    text (`blocksworld.to_pddl`), so validation sees exactly what a PDDL file would hold.
-    """
+    """``n`` random problems per block count (only those ``keep`` accepts, if given: a scene
+    they must fit); optimal lengths from A* within ``max_nodes``. Instance ``i`` of ``b``
+    blocks uses the ``i``-th kept seed drawn from ``Random(f"{seed}:{b}")``, so adding a block
+    count leaves the others unchanged. Each problem goes through its PDDL text."""
     report = progress or (lambda k: None)
     domain = data.domain()
     instances = []
     for b in blocks:
-        seeds = random.Random(f"{seed}:{b}")
-        for i in range(1, n + 1):
+        seeds, kept = random.Random(f"{seed}:{b}"), 0
+        for _ in range(100 * n):
             problem = random_problem(b, seeds.randrange(2**31))
+            if keep is not None and not keep(problem):
+                continue
+            kept += 1
             moves = optimal_moves(problem, max_nodes)
-            name = f"random-{b}/instance-{i}"
+            name = f"random-{b}/instance-{kept}"
             text = blocksworld.to_pddl(problem)
             optimal = None if moves is None else 2 * len(moves)
             instances.append(from_text(domain, text, name, name, optimal))
             report(1)
+            if kept == n:
+                break
     source = f"task.symbolic.generate.random_problem, seed {seed}, A* budget {max_nodes} nodes"
     return Suite("random", domain, tuple(instances), source)
 

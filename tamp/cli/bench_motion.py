@@ -10,11 +10,12 @@ import argparse
 import json
 import sys
 import time
+from functools import partial
 
 from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
-from tamp.cli.options import planner_config, positive, sim_list
+from tamp.cli.options import data_option, planner_config, positive, positive_list, sim_list
 
 
 def sweep_options(p: argparse.ArgumentParser) -> None:
@@ -28,12 +29,38 @@ def sweep_options(p: argparse.ArgumentParser) -> None:
                    "machine only) or HOST:6379; needs pip install 'soft-tamp[ray]'")  # fmt: skip
 
 
+def suite_options(p: argparse.ArgumentParser) -> None:
+    """What ``bench motion`` runs: a spread of PlanBench, or random problems (``--blocks``)."""
+    data_option(p)
+    p.add_argument(
+        "--n",
+        type=positive,
+        default=100,
+        help="instances, spread over sizes; with --blocks, per block count (100)",
+    )
+    p.add_argument(
+        "--blocks",
+        type=positive_list,
+        metavar="B[,B...]",
+        help="random problems of these block counts instead of PlanBench, seeded by --seed, "
+        "those whose towers fit --scene (episodes.csv lists them)",
+    )
+
+
 def motion_command(args: argparse.Namespace) -> int:
-    """Closed-loop episodes on a ``--n`` spread of PlanBench in each ``--sim``."""
+    """Closed-loop episodes on a ``--n`` spread of PlanBench (or random ``--blocks``
+    problems) in each ``--sim``."""
     from tamp.bench import motion
     from tamp.cli.run import loop_config
+    from tamp.slots import fits
 
-    sims, suite, base = sim_list(args.sim), suites.planbench(args.data, args.n), loop_config(args)
+    sims, base = sim_list(args.sim), loop_config(args)
+    if args.blocks:
+        suite = suites.generated(
+            args.blocks, args.n, args.seed, keep=partial(fits, scene=base.scene)
+        )
+    else:
+        suite = suites.planbench(args.data, args.n)
     goals = dict.fromkeys(sims, 0)
     with tqdm(total=len(sims) * len(suite.instances), desc="motion", unit="episode",
               file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
@@ -51,7 +78,8 @@ def motion_command(args: argparse.Namespace) -> int:
                        "blur": base.perception.blur, "crisp": base.crisp,
                        "scene": base.scene.name, "collision": base.execution.collision,
                        "lambda_motion": base.planner.lambda_motion,
-                       "workers": args.workers, "ray": args.ray},
+                       "workers": args.workers, "ray": args.ray, "blocks": args.blocks,
+                       "source": suite.source},
             "machine": results.machine(), "ik_batch": result.ik,
             "summary": result.summary}  # fmt: skip
     if args.out:
@@ -64,7 +92,8 @@ def motion_command(args: argparse.Namespace) -> int:
         return 0
     seen = base.observe + (f" ({base.perception.mode} perception)" if base.observe == "camera"
                            else "")  # fmt: skip
-    print(f"motion benchmark: {len(suite.instances)} PlanBench instances, grasp {base.grasp}, "
+    kind = "PlanBench" if not args.blocks else f"random ({base.scene.name} scene)"
+    print(f"motion benchmark: {len(suite.instances)} {kind} instances, grasp {base.grasp}, "
           f"observe {seen}, crisp {base.crisp}, faults {inject}, seed {args.seed}")  # fmt: skip
     print(tables.motion_table(result.summary, inject))
     ik = result.ik
@@ -96,7 +125,8 @@ def executability_command(args: argparse.Namespace) -> int:
     body = {"config": {"plans": str(args.plans), "sims": sims, "instances": [i.name for i in
                        suite.instances], "seed": args.seed, "grasp": args.grasp, "ours": args.ours,
                        "data": str(args.data), "scene": args.scene, "collision": args.collision,
-                       "workers": args.workers, "ray": args.ray},
+                       "workers": args.workers, "ray": args.ray, "blocks": args.blocks,
+                       "source": suite.source},
             "machine": results.machine(), "wall_s": wall,
             "summary": summary}  # fmt: skip
     if out:

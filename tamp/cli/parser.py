@@ -10,7 +10,7 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.suites import DEFAULT_DATA
-from tamp.cli.bench_motion import sweep_options
+from tamp.cli.bench_motion import suite_options, sweep_options
 from tamp.cli.options import (
     Parser,
     data_option,
@@ -180,8 +180,7 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
         "motion", parents=[plan_opts], help="motion-level executability in the simulators"
     )
     episode_options(p, multi_sim=True)
-    data_option(p)
-    p.add_argument("--n", type=positive, default=100, help="instances, spread over sizes (100)")
+    suite_options(p)
     p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
     sweep_options(p)
     progress_option(p)

@@ -129,3 +129,22 @@ def test_a_cramped_table_the_unlimited_plan_overflows_is_solved_on_its_places():
     table = [m.move for m in report.moves if m.move.target == TABLE]
     assert table and all(isinstance(m, PlacedMove) for m in table)
     assert all(min(math.dist(m.at, s) for s in aware.scene.slots) < 1e-9 for m in table)
+
+
+def test_random_suites_keep_the_problems_that_fit_the_scene():
+    from tamp.bench.suites import generated
+    from tamp.slots import fits
+    from task.symbolic.generate import random_problem
+
+    cramped = with_scene(SCENE, "cramped")
+    spread = random_problem(10, 3)
+    assert not fits(dataclasses.replace(spread, init=(TABLE,) * 10), cramped)  # 10 towers
+    assert fits(dataclasses.replace(spread, init=(TABLE,) * 10), SceneConfig()) is False
+    suite = generated([10], 3, seed=0, max_nodes=10, keep=lambda p: fits(p, cramped))
+    assert len(suite.instances) == 3
+    assert all(fits(i.problem, cramped) for i in suite.instances)
+    assert [i.name for i in suite.instances] == [f"random-10/instance-{k}" for k in (1, 2, 3)]
+    stream = [i.problem for i in generated([10], 12, seed=0, max_nodes=10).instances]
+    fitting = [p.init for p in stream if fits(p, cramped)]
+    assert len(fitting) < len(stream)  # the scene does reject some
+    assert [i.problem.init for i in suite.instances] == fitting[:3]  # the first that fit
