@@ -10,6 +10,14 @@ when placed onto ``y``), with top-down TCP targets ``T(.)`` and IK solutions ``q
 
     r(t) = ||FK(q(t))[:3, 3] - t||_2
 
+With obstacle boxes and ``collision_weight > 0`` the move also pays for the arm's clearance along
+the straight joint segment from the grasp to the release configuration, S points, ends included:
+
+            + collision_weight * (1/S) sum_{k=0}^{S-1} Phi(q(p_x) + k/(S-1) (q(u_y) - q(p_x)))
+
+with Phi the CHOMP cost of the sphere model against the boxes (`motion.spheres`, in m: summed
+over spheres and boxes, linear in penetration depth, zero beyond ``collision_margin``).
+
 All ``N + Y`` targets are solved in one batched, detached `IKSolver.solve` call; the solutions
 then pass through one differentiable Gauss-Newton step (`motion.ik.ik_refine`), so the cost is
 differentiable in the picks and places with ``d q / d t = pinv(J)`` at the detached solution.
@@ -22,6 +30,8 @@ It is an approximation of a `motion.pick_place` move: only the transit from the 
 configuration to the release configuration counts (approach, descend, lift, lower and retreat
 are ignored), the hand yaw is 0 everywhere (a cube's yaw barely changes the joint distance),
 the release gap is ignored, and the straight joint segment stands in for the timed trajectory.
+That segment runs from block to block at table height, where the real move lifts first: the
+collision term prices a low sweep (the sphere model has open fingers and no held block).
 """
 
 from __future__ import annotations
@@ -33,6 +43,7 @@ import torch
 
 from motion.errors import MotionError
 from motion.ik import IKSolver, ik_refine
+from motion.spheres import boxes, collision_cost
 
 _TOP_DOWN = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0))  # Rz(0) Rx(pi)
 
@@ -44,6 +55,9 @@ class MoveCostConfig:
     joint_weight: float = 1.0  # cost per rad of L2 joint distance, grasp -> release configuration
     reach_weight: float = 10.0  # cost per m of IK position residual at the pick or the place
     infeasible: float = 10.0  # added per pick or place whose IK does not converge (no gradient)
+    collision_weight: float = 0.0  # cost per m of Phi, the sphere model's obstacle cost (0: off)
+    collision_margin: float = 0.02  # m, eps of Phi: the clearance below which a sphere costs
+    collision_points: int = 5  # S configurations along the grasp -> release segment, ends included
 
 
 def top_down_targets(xyz: torch.Tensor) -> torch.Tensor:
@@ -77,11 +91,14 @@ def move_costs_batch(
     picks: torch.Tensor,
     places: torch.Tensor,
     config: MoveCostConfig = MoveCostConfig(),
+    obstacles: tuple | None = None,
 ) -> torch.Tensor:
     """Costs (P, N, Y) float64 of P problems at once: picks (P, N, 3), places (P, Y, 3).
 
     One batched IK call covers all ``P * (N + Y)`` targets, seeded from ``q_ref`` (J,) plus the
     solver's own seeds; see `move_costs` for one problem and the module docstring for c(x, y).
+    ``obstacles`` is (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the base
+    frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing.
     """
     picks = _points(picks, 3, "picks")  # (P, N, 3)
     places = _points(places, 3, "places")  # (P, Y, 3)
@@ -108,7 +125,34 @@ def move_costs_batch(
     q = q.reshape(p, n + y, -1)  # (P, N + Y, J)
     q_pick, q_place = q[:, :n], q[:, n:]  # (P, N, J), (P, Y, J)
     dist = torch.linalg.vector_norm(q_place[:, None] - q_pick[:, :, None], dim=-1)  # (P, N, Y)
-    return config.joint_weight * dist + site[:, :n, None] + site[:, None, n:]  # (P, N, Y)
+    cost = config.joint_weight * dist + site[:, :n, None] + site[:, None, n:]  # (P, N, Y)
+    if config.collision_weight == 0.0 or obstacles is None:
+        return cost
+    centres, half = boxes(*obstacles)
+    if centres.shape[0] == 0:
+        return cost
+    return cost + config.collision_weight * _sweep(solver, q, n, centres, half, config)
+
+
+def _sweep(solver, q, n: int, centres, half, config: MoveCostConfig) -> torch.Tensor:
+    """(P, N, Y) mean of Phi over the S points of each grasp -> release joint segment.
+
+    ``q`` (P, N + Y, J) holds the grasp then the release configurations; the ends are priced
+    once per site, the S - 2 inner points once per move, all in one batched call.
+    """
+    n_s = config.collision_points
+    if n_s < 2:
+        raise MotionError(f"collision_points is {n_s}; expected >= 2 (the segment's two ends)")
+    p, y, j = q.shape[0], q.shape[1] - n, q.shape[2]
+    q_pick, q_place = q[:, :n, None, None], q[:, None, n:, None]  # (P, N, 1, 1, J), (P, 1, Y, 1, J)
+    t = torch.linspace(0.0, 1.0, n_s, dtype=q.dtype)[1:-1, None]  # (S - 2, 1)
+    inner = q_pick + t * (q_place - q_pick)  # (P, N, Y, S - 2, J)
+    qs = torch.cat([q.reshape(-1, j), inner.reshape(-1, j)])  # (P (N + Y) + P N Y (S - 2), J)
+    m = config.collision_margin
+    phi = collision_cost(solver, qs, centres, half, m)  # (P (N + Y) + P N Y (S - 2),)
+    ends = phi[: p * (n + y)].reshape(p, n + y)  # (P, N + Y)
+    mid = phi[p * (n + y) :].reshape(p, n, y, n_s - 2).sum(-1)  # (P, N, Y)
+    return (ends[:, :n, None] + ends[:, None, n:] + mid) / n_s  # (P, N, Y)
 
 
 def move_costs(
@@ -117,6 +161,7 @@ def move_costs(
     picks: torch.Tensor,
     places: torch.Tensor,
     config: MoveCostConfig = MoveCostConfig(),
+    obstacles: tuple | None = None,
 ) -> torch.Tensor:
     """Costs (N, Y) float64 of moving the block at picks[x] so that its centre ends at places[y].
 
@@ -127,7 +172,9 @@ def move_costs(
 
         c(x, y) = joint_weight * ||q(place_y) - q(pick_x)||
                 + reach_weight * (r(pick_x) + r(place_y)) + infeasible * (not converged)
+                + collision_weight * mean_k Phi(q_k)    (boxes ``obstacles``, see move_costs_batch)
     """
     picks = _points(picks, 2, "picks")  # (N, 3)
     places = _points(places, 2, "places")  # (Y, 3)
-    return move_costs_batch(solver, q_ref, picks[None], places[None], config)[0]  # (N, Y)
+    c = move_costs_batch(solver, q_ref, picks[None], places[None], config, obstacles)
+    return c[0]  # (N, Y)

@@ -26,6 +26,10 @@ from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Problem
 
+# the move cost with the sphere model's clearance to the scene's obstacles (weight 5 per m of
+# CHOMP cost: 0.2-0.9 for a move sweeping past clutter's posts, next to about 1 per move of
+# joint distance; `motion.cost`)
+ARM = MoveCostConfig(collision_weight=5.0)
 BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refuses it
 
 
@@ -93,7 +97,7 @@ class ArmCosts:
         scene: SceneConfig,
         solver: IKSolver,
         q_now,
-        config: MoveCostConfig = MoveCostConfig(),
+        config: MoveCostConfig = ARM,
         places: Sequence[Mapping[str, tuple[float, float]]] | None = None,
         avoid: Mapping[State, set] | None = None,
     ) -> None:
@@ -139,7 +143,7 @@ class ArmCosts:
         with torch.no_grad():
             c = move_costs_batch(
                 self.solver, self.q_now, torch.tensor(np.stack(picks)),
-                torch.tensor(np.stack(places)), self.config,
+                torch.tensor(np.stack(places)), self.config, obstacle_boxes(self.scene),
             )  # fmt: skip  # (P, N, Y)
         return list(c + torch.tensor(np.stack(extra)))
 
@@ -180,3 +184,15 @@ def _column(problem: Problem, key, at) -> int | None:
         return None  # "somewhere on the table": no one place to blame
     near = [j for j, k in enumerate(problem.fixed) if math.dist(at[k], key[1:]) < 1e-3]
     return problem.n + near[0] if near else None
+
+
+def obstacle_boxes(scene: SceneConfig) -> tuple[torch.Tensor, torch.Tensor]:
+    """The scene's obstacles as axis-aligned boxes (centres (O, 3), half extents (O, 3)) for
+    the collision proxy; a turned box is replaced by its axis-aligned bounding box."""
+    centres, half = [], []
+    for o in scene.obstacles:
+        c, s = abs(math.cos(o.yaw)), abs(math.sin(o.yaw))
+        centres.append(o.centre)
+        half.append((c * o.half[0] + s * o.half[1], s * o.half[0] + c * o.half[1], o.half[2]))
+    as_boxes = torch.tensor(centres + half, dtype=torch.float64).reshape(2, len(centres), 3)
+    return as_boxes[0], as_boxes[1]

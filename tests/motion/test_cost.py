@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -103,6 +105,60 @@ def test_a_step_against_the_gradient_lowers_the_cost(solver):
     assert (grad * toward).sum() < 0  # descending moves the place toward the pick
     step = places.detach() - 0.005 * grad / grad.norm()  # 5 mm, IK re-solved from scratch
     assert move_costs(solver, PANDA.q_home, picks, step)[0, 0] < c.detach()
+
+
+POST = (_t([[0.5, 0.0, 0.1]]), _t([[0.03, 0.03, 0.1]]))  # a 20 cm post at y = 0
+FAR = (_t([[2.0, 2.0, 0.1]]), _t([[0.03, 0.03, 0.1]]))
+SWEPT = _t([(0.5, -0.2, 0.025), (0.45, 0.25, 0.025)])  # (2, 3): one each side of the post
+ACROSS = _t([(0.5, 0.2, 0.075), (0.4, 0.35, 0.025)])  # (2, 3): both on the second one's side
+
+
+@pytest.mark.parametrize("obstacles", [None, POST, FAR], ids=["none", "post", "far"])
+def test_a_collision_weight_of_zero_or_no_obstacles_leave_the_costs_unchanged(solver, obstacles):
+    old = move_costs(solver, PANDA.q_home, SWEPT, ACROSS)
+    off = move_costs(solver, PANDA.q_home, SWEPT, ACROSS, MoveCostConfig(), obstacles)
+    assert torch.equal(off, old)
+    on = MoveCostConfig(collision_weight=1.0)
+    if obstacles is not POST:  # nothing there, or nothing within the margin: exactly no change
+        assert torch.equal(move_costs(solver, PANDA.q_home, SWEPT, ACROSS, on, obstacles), old)
+
+
+def test_a_post_across_the_transit_raises_only_the_moves_past_it(solver):
+    config = MoveCostConfig(collision_weight=1.0)
+    old = move_costs(solver, PANDA.q_home, SWEPT, ACROSS)
+    extra = move_costs(solver, PANDA.q_home, SWEPT, ACROSS, config, POST) - old  # (2, 2)
+    assert (extra[0] > 0.05).all()  # from y = -0.2 across the post
+    assert (extra[1] == 0).all()  # on its own side, more than the margin away
+    # the ends alone do not see it: only the inner points of the joint segment do
+    ends = replace(config, collision_points=2)
+    assert torch.equal(move_costs(solver, PANDA.q_home, SWEPT, ACROSS, ends, POST), old)
+
+
+def test_gradient_of_the_collision_term_matches_finite_differences(solver, monkeypatch):
+    _freeze_ik(monkeypatch, solver)  # the detached q* held fixed, as above
+    config = MoveCostConfig(collision_weight=1.0)
+    picks = SWEPT.clone().requires_grad_()
+    places = ACROSS.clone().requires_grad_()
+
+    def cost(a, b):
+        on = move_costs(solver, PANDA.q_home, a, b, config, POST)
+        return on - move_costs(solver, PANDA.q_home, a, b)  # the collision term alone
+
+    assert (cost(picks, places)[0] > 0).all()
+    assert torch.autograd.gradcheck(cost, (picks, places), eps=1e-6, atol=1e-4)
+
+
+@pytest.mark.parametrize(
+    ("config", "obstacles", "message"),
+    [
+        (MoveCostConfig(collision_weight=1.0, collision_points=1), POST, "collision_points"),
+        (MoveCostConfig(collision_weight=1.0), (torch.zeros(1, 2), torch.ones(1, 3)), "centres"),
+        (MoveCostConfig(collision_weight=1.0), (torch.zeros(1, 3), -torch.ones(1, 3)), "> 0"),
+    ],
+)
+def test_collision_misuse_names_the_bad_input(solver, config, obstacles, message):
+    with pytest.raises(MotionError, match=message):
+        move_costs(solver, PANDA.q_home, _t(PICKS), _t(PLACES), config, obstacles)
 
 
 @pytest.mark.parametrize(

@@ -93,3 +93,20 @@ def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places
         return rollout(bw, lg, batch, steps, config, costs=costs).loss.sum()
 
     assert torch.autograd.gradcheck(loss, (logits, places), eps=1e-6, atol=1e-4)
+
+
+def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver):
+    from motion.cost import MoveCostConfig
+    from tamp.arm_costs import ARM, obstacle_boxes
+
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
+    costs = {}
+    for name in ("tabletop", "clutter"):
+        scene = with_scene(SCENE, name)
+        for cfg in (ARM, MoveCostConfig()):
+            source = ArmCosts([FOUR], [poses], scene, solver, PANDA.q_home, config=cfg)
+            costs[name, cfg.collision_weight] = source([0], [FOUR.init]).compute()[0]
+    assert obstacle_boxes(with_scene(SCENE, "tabletop"))[0].shape == (0, 3)
+    assert torch.equal(costs["tabletop", 5.0], costs["tabletop", 0.0])
+    extra = costs["clutter", 5.0] - costs["clutter", 0.0]
+    assert (extra >= 0).all() and (extra > 0.05).any()
