@@ -92,13 +92,16 @@ def move_costs_batch(
     places: torch.Tensor,
     config: MoveCostConfig = MoveCostConfig(),
     obstacles: tuple | None = None,
+    solved: tuple[torch.Tensor, torch.Tensor] | None = None,
 ) -> torch.Tensor:
     """Costs (P, N, Y) float64 of P problems at once: picks (P, N, 3), places (P, Y, 3).
 
     One batched IK call covers all ``P * (N + Y)`` targets, seeded from ``q_ref`` (J,) plus the
     solver's own seeds; see `move_costs` for one problem and the module docstring for c(x, y).
     ``obstacles`` is (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the base
-    frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing.
+    frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing. ``solved``:
+    the detached solutions of targets near these (`site_solutions`), reused instead of solving
+    (an optimiser moving the places a little calls this at every step).
     """
     picks = _points(picks, 3, "picks")  # (P, N, 3)
     places = _points(places, 3, "places")  # (P, Y, 3)
@@ -111,9 +114,7 @@ def move_costs_batch(
         return torch.zeros((p, n, y), dtype=torch.float64)
     xyz = torch.cat([picks, places], dim=1).reshape(-1, 3)  # (P * (N + Y), 3)
     targets = top_down_targets(xyz)  # (B, 4, 4), B = P * (N + Y)
-    found = solver.solve(targets.detach().numpy(), np.asarray(q_ref, dtype=np.float64))
-    q_star = torch.from_numpy(np.array(found.q))  # (B, J), detached
-    ok = torch.from_numpy(np.array(found.ok))  # (B,)
+    q_star, ok = solved if solved is not None else site_solutions(solver, q_ref, picks, places)
     # A failed row keeps its best attempt: the arm is stretched near a singularity there, where
     # the pinv step is unbounded; its residual still pulls the target back toward the workspace.
     q = torch.where(ok[:, None], ik_refine(solver, q_star, targets), q_star)  # (B, J)
@@ -153,6 +154,17 @@ def _sweep(solver, q, n: int, centres, half, config: MoveCostConfig) -> torch.Te
     ends = phi[: p * (n + y)].reshape(p, n + y)  # (P, N + Y)
     mid = phi[p * (n + y) :].reshape(p, n, y, n_s - 2).sum(-1)  # (P, N, Y)
     return (ends[:, :n, None] + ends[:, None, n:] + mid) / n_s  # (P, N, Y)
+
+
+def site_solutions(
+    solver: IKSolver, q_ref, picks: torch.Tensor, places: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Detached IK solutions q* (P * (N + Y), J) and their success flags (P * (N + Y),) of the
+    top-down grasps at picks (P, N, 3) then places (P, Y, 3), one batched call."""
+    xyz = torch.cat([_points(picks, 3, "picks"), _points(places, 3, "places")], dim=1)
+    targets = top_down_targets(xyz.detach().reshape(-1, 3))  # (B, 4, 4)
+    found = solver.solve(targets.numpy(), np.asarray(q_ref, dtype=np.float64))
+    return torch.from_numpy(np.array(found.q)), torch.from_numpy(np.array(found.ok))
 
 
 def move_costs(

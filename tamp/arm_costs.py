@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import torch
 
-from motion.cost import MoveCostConfig, move_costs_batch
+from motion.cost import MoveCostConfig, move_costs_batch, site_solutions
 from motion.ik import IKSolver
 from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
 from task.costs import IMPOSSIBLE
@@ -86,6 +86,30 @@ class _Fixed:
         return []
 
 
+class _Placed:
+    """The costs of one window whose K table places move: place k of problem p sits at its
+    centre + ``reach * tanh(u[p][k])`` in x and y; the IK solutions at the centres are reused
+    (`motion.cost.site_solutions`), refined differentiably at every step."""
+
+    lr = 0.05  # Adam learning rate of the unbounded offsets u
+
+    def __init__(self, owner: ArmCosts, picks, places, extra, solved, offsets) -> None:
+        self.owner, self.picks, self.places, self.extra = owner, picks, places, extra
+        self.solved, self.offsets = solved, offsets
+
+    def compute(self) -> torch.Tensor:
+        o, n = self.owner, self.picks.shape[1]
+        shift = torch.stack([o.reach * torch.tanh(u) for u in self.offsets])  # (P, K, 2)
+        table = self.places[:, n:] + torch.nn.functional.pad(shift, (0, 1))  # (P, K, 3)
+        places = torch.cat([self.places[:, :n], table], dim=1)  # (P, Y, 3)
+        c = move_costs_batch(o.solver, o.q_now, self.picks, places, o.config,
+                             obstacle_boxes(o.scene), self.solved)  # fmt: skip
+        return c + self.extra  # (P, N, Y)
+
+    def parameters(self) -> list[torch.Tensor]:
+        return list({id(u): u for u in self.offsets}.values())
+
+
 class ArmCosts:
     """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
     ``poses[k]`` (block -> `Pose`), priced for the arm now at ``q_now`` (J,)."""
@@ -100,14 +124,27 @@ class ArmCosts:
         config: MoveCostConfig = ARM,
         places: Sequence[Mapping[str, tuple[float, float]]] | None = None,
         avoid: Mapping[State, set] | None = None,
+        reach: float = 0.0,
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
         self.places = places  # per problem: table place -> (x, y), for slotted problems
         self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
+        self.reach = reach  # m: how far a block may go from its place's centre (0: fixed)
+        self._offsets: dict[int, torch.Tensor] = {}  # problem -> (K, 2) unbounded parameters
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
 
-    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> _Fixed:
+    def offset(self, index: int, place: str) -> tuple[float, float]:
+        """The optimised (dx, dy) of ``place`` in problem ``index`` (m; 0 before planning)."""
+        u = self._offsets.get(index)
+        if u is None:
+            return 0.0, 0.0
+        dx, dy = (self.reach * torch.tanh(u[self.problems[index].fixed.index(place)])).tolist()
+        return dx, dy
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State]):
+        if self.reach > 0 and self.places is not None:
+            return self._placed(indices, states)
         todo = [(i, s) for i, s in zip(indices, states, strict=True) if (i, s) not in self._cache]
         if todo:
             for key, matrix in zip(todo, self._price(todo), strict=True):
@@ -115,8 +152,29 @@ class ArmCosts:
         keys = zip(indices, states, strict=True)
         return _Fixed(torch.stack([self._cache[key] for key in keys]))  # (P, N, Y)
 
+    def _placed(self, indices: Sequence[int], states: Sequence[State]) -> _Placed:
+        """A window whose table places move within ``reach`` of their centres: continuous
+        placements, optimised with the logits (each problem's offsets carry over windows)."""
+        picks, places, extra = self._inputs(list(zip(indices, states, strict=True)))
+        solved = site_solutions(self.solver, self.q_now, picks, places)
+        offsets = [
+            self._offsets.setdefault(i, torch.zeros(len(self.problems[i].fixed), 2,
+                                                    dtype=torch.float64, requires_grad=True))
+            for i in indices
+        ]  # fmt: skip
+        return _Placed(self, picks, places, extra, solved, offsets)
+
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
         """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
+        picks, places, extra = self._inputs(todo)
+        with torch.no_grad():
+            c = move_costs_batch(
+                self.solver, self.q_now, picks, places, self.config, obstacle_boxes(self.scene)
+            )  # (P, N, Y)
+        return list(c + extra)
+
+    def _inputs(self, todo: list[tuple[int, State]]):
+        """Picks (P, N, 3), places (P, Y, 3) and the added costs (P, N, Y) of the pairs."""
         picks, places, extra = [], [], []
         s = self.scene.block_size
         for i, state in todo:
@@ -140,12 +198,7 @@ class ArmCosts:
                 j = _column(problem, key, at)
                 if j is not None:
                     extra[-1][problem.entities.index(x), j] += BLOCKED
-        with torch.no_grad():
-            c = move_costs_batch(
-                self.solver, self.q_now, torch.tensor(np.stack(picks)),
-                torch.tensor(np.stack(places)), self.config, obstacle_boxes(self.scene),
-            )  # fmt: skip  # (P, N, Y)
-        return list(c + torch.tensor(np.stack(extra)))
+        return tuple(torch.tensor(np.stack(a)) for a in (picks, places, extra))
 
     def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no

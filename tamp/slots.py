@@ -98,14 +98,20 @@ def plan_on_places(
     config: PlannerConfig,
     seed: int = 0,
     avoid: Mapping | None = None,
+    reach: float = 0.0,
 ) -> PlanResult:
     """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
     table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
-    the arm failed, priced out); the plan's moves are plain (`plain_move`)."""
+    the arm failed, priced out); the plan's moves are plain (`plain_move`). ``reach`` > 0:
+    continuous placements, each place's position optimised within ``reach`` m of its centre
+    with the logits (the plan's moves carry the optimised positions)."""
     current, at = slotted(problem, problem.init, poses, scene)
-    costs = ArmCosts([current], [poses], scene, solver, q_now, places=[at], avoid=avoid)
+    costs = ArmCosts([current], [poses], scene, solver, q_now, places=[at], avoid=avoid,
+                     reach=reach)  # fmt: skip
     result = plan(current, config, seed=seed, costs=costs)
-    return replace(result, plan=Plan(tuple(plain_move(m, at) for m in result.plan)))
+    moved = {k: (xy[0] + costs.offset(0, k)[0], xy[1] + costs.offset(0, k)[1])
+             for k, xy in at.items()}  # fmt: skip
+    return replace(result, plan=Plan(tuple(plain_move(m, moved) for m in result.plan)))
 
 
 def fits(problem: Problem, scene: SceneConfig) -> bool:

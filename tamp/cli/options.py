@@ -51,18 +51,17 @@ def positive(text: str) -> int:
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+        value = 0
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
     return value
 
 
-def seconds(text: str) -> float:
-    """A positive number of seconds."""
+def seconds(text: str) -> float:  # a positive number of seconds
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected seconds > 0, got {text!r}") from None
+        value = -1.0
     if not value > 0 or value == float("inf"):
         raise argparse.ArgumentTypeError(f"expected seconds > 0, got {text!r}")
     return value
@@ -234,7 +233,9 @@ def scene_options(p: argparse.ArgumentParser) -> None:
                    "(plan), fail them (check), or run unchecked (off) (plan)")  # fmt: skip
     p.add_argument("--motion-aware", dest="lambda_motion", action="store_const", const=0.05,
                    help="put the arm's cost of each move into the planner's objective, weight "
-                   "0.05 (off: task-only planning)")  # fmt: skip
+                   "0.05, and plan on the table's slots (off: task-only planning)")  # fmt: skip
+    p.add_argument("--placements", type=float, default=0.0, metavar="M", help="--motion-aware: "
+                   "blocks up to M m (<= 0.03) off a slot's centre, where planned (0)")  # fmt: skip
 
 
 def run_options(p: argparse.ArgumentParser) -> None:

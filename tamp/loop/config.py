@@ -38,11 +38,16 @@ class LoopConfig:
     perception: PerceptionMode = PerceptionMode()  # camera only: frozen or optimised
     checkpoint: str | None = None  # camera only: perception weights (None: the shipped ones)
     crisp: str = "perceived"  # decode against the observed state; "true": against the truth
+    placements: float = 0.0  # m: motion-aware, state: a block may go this far from a place's
+    # centre, where the planner's Adam puts it (continuous placements; 0: the centre)
 
     def __post_init__(self) -> None:
         if self.observe not in OBSERVE:
             raise TampError(f"unknown observation {one_of(self.observe, OBSERVE)}")
         if self.crisp not in CRISP:
             raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
+        if not 0.0 <= self.placements <= 0.03:
+            raise TampError(f"placements must lie in [0, 0.03] m (a block stays on its slot), "
+                            f"got {self.placements}")  # fmt: skip
         if self.observe == "camera" and self.perception.mode == "state":
             raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

@@ -191,8 +191,8 @@ class Episode:
         if self.config.planner.lambda_motion > 0:
             poses, scene, q = self._poses(), self.config.scene, self.sim.arm_q()
             if self.config.observe == "state":
-                return plan_on_places(current, poses, scene, self.solver, q,
-                                      self.config.planner, seed, self._avoid)  # fmt: skip
+                return plan_on_places(current, poses, scene, self.solver, q, self.config.planner,
+                                      seed, self._avoid, self.config.placements)  # fmt: skip
             costs = ArmCosts([current], [poses], scene, self.solver, q, avoid=self._avoid)
         if self.config.observe == "state":
             return plan(current, self.config.planner, seed=seed, costs=costs)

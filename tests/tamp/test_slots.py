@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
@@ -148,3 +149,55 @@ def test_random_suites_keep_the_problems_that_fit_the_scene():
     fitting = [p.init for p in stream if fits(p, cramped)]
     assert len(fitting) < len(stream)  # the scene does reject some
     assert [i.problem.init for i in suite.instances] == fitting[:3]  # the first that fit
+
+
+def test_continuous_placements_are_differentiable_offsets_the_planner_optimises(solver):
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
+    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=0.02)
+    window = source([0], [problem.init])
+    (u,) = window.parameters()
+    assert u.shape == (len(at), 2) and source.offset(0, "slot2") == (0.0, 0.0)
+    fixed = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
+    start = window.compute()
+    assert torch.allclose(start, fixed([0], [problem.init]).compute(), atol=1e-6)
+
+    def table_cost(v):  # the cost of moving block a onto every place, as a function of u
+        with torch.no_grad():
+            u.copy_(v)
+            return float(window.compute()[0, 0, 4:].sum())
+
+    v = torch.full_like(u, 0.3).requires_grad_(True)
+    with torch.no_grad():
+        u.copy_(v)
+    grad = torch.autograd.grad(window.compute()[0, 0, 4:].sum(), u)[0]  # (K, 2)
+    eps = 1e-6
+    for k, d in ((0, 0), (3, 1), (7, 0)):
+        up, down = v.detach().clone(), v.detach().clone()
+        up[k, d] += eps
+        down[k, d] -= eps
+        numeric = (table_cost(up) - table_cost(down)) / (2 * eps)
+        assert float(grad[k, d]) == pytest.approx(numeric, rel=1e-3, abs=1e-6)
+    with torch.no_grad():
+        u.zero_()
+    opt = torch.optim.SGD(window.parameters(), lr=window.lr)
+    for _ in range(20):
+        opt.zero_grad()
+        window.compute()[0, 0, 4:].sum().backward()
+        opt.step()
+    assert window.compute()[0, 0, 4:].sum() < start[0, 0, 4:].sum()
+    dx, dy = source.offset(0, "slot2")
+    assert 0 < math.hypot(dx, dy) <= 0.02 * math.sqrt(2)
+
+
+def test_planned_moves_carry_the_optimised_placements(solver):
+    five = Problem("five", "blocksworld", tuple("abcde"), ("b", "c", TABLE, "e", TABLE),
+                   (("c", "a"), ("e", "b")))  # fmt: skip
+    poses = layout(five.entities, five.init, SCENE, seed=1)
+    config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
+    result = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, config, reach=0.02)
+    table = [m for m in result.plan if m.target == TABLE]
+    assert result.solved and table
+    for m in table:
+        off = min(math.dist(m.at, s) for s in SCENE.slots)
+        assert 1e-4 < off <= 0.02 * math.sqrt(2) + 1e-9  # moved off the centre, within reach
