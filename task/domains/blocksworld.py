@@ -51,8 +51,7 @@ def _entity(problem: Problem, x: str) -> int:
     return problem.entities.index(x)
 
 
-def initial_state(problem: Problem) -> State:
-    """The support of every entity at the start."""
+def initial_state(problem: Problem) -> State:  # the support of every entity at the start
     return tuple(problem.init)
 
 
@@ -73,8 +72,8 @@ def check_move(problem: Problem, state: State, move: Move) -> str | None:
     x, y = move.entity, move.target
     if x == y:
         return f"{x} cannot be moved onto itself"
-    if state[i] == y:
-        return f"{x} is already on {y}"
+    if state[i] == y or (slotted(problem) and {state[i], y} <= set(problem.fixed)):
+        return f"{x} is already on {'the table' if state[i] != y else y}"
     for z, label in ((x, x), (y, f"target {y}")):
         if not is_clear(problem, state, z):
             return f"{label} is not clear ({_above(problem, state, z)} is on it)"
@@ -133,20 +132,22 @@ def moves_to_actions(
 def soft_legality(F: Tensor, batch: SoftBatch) -> Tensor:
     """Eq. gate factors: legal(x, y) = c(x) * cbar(y) * e(x, y) * (1 - F[x, y]).
 
-    c is the soft clear (product t-norm), cbar(table) = 1 (a slot's: prod_z (1 - F[z, slot])),
-    e masks self-support and padding, and (1 - F[x, y]) removes the null move onto the current
-    support. (B, N, Y) -> (B, N, Y).
+    c is the soft clear (product t-norm), cbar(table) = 1, e masks self-support and padding,
+    (1 - F[x, y]) removes the null move onto the current support. Table slots: cbar(slot) =
+    prod_z (1 - F[z, slot]), times 1 - sum_k F[x, slot_k] (no slot-to-slot move). -> (B, N, Y).
     """
     n = batch.n
     c = column_free(F, n)  # (B, N)
-    fixed = torch.ones_like(F[:, 0, n:])  # (B, K)
-    if "one" in batch.static:  # table slots: clear when nothing real rests on them
-        real = batch.entity_mask.unsqueeze(-1).to(F.dtype)
-        empty = (1.0 - F[..., n:] * real).prod(-2)  # (B, K)
-        fixed = torch.where(batch.static["one"][:, n:], empty, fixed)
-    cbar = torch.cat([c, fixed], dim=-1)  # (B, Y)
     e = batch.action_mask[..., :-1].to(F.dtype)  # (B, N, Y)
-    return c.unsqueeze(-1) * cbar.unsqueeze(-2) * e * (1.0 - F)
+    if "one" not in batch.static:
+        cbar = torch.cat([c, torch.ones_like(F[:, 0, n:])], dim=-1)  # (B, Y)
+        return c.unsqueeze(-1) * cbar.unsqueeze(-2) * e * (1.0 - F)
+    one = batch.static["one"][:, n:].unsqueeze(-2)  # (B, 1, K) table slots
+    empty = (1.0 - F[..., n:] * batch.entity_mask.unsqueeze(-1).to(F.dtype)).prod(-2)  # (B, K)
+    cbar = torch.cat([c, torch.where(one[:, 0], empty, 1.0)], dim=-1)  # (B, Y)
+    off = 1.0 - (F[..., n:] * one).sum(-1, keepdim=True)  # (B, N, 1): x on no slot
+    stay = torch.cat([torch.ones_like(F[..., :n]), torch.where(one, off, 1.0)], dim=-1)
+    return c.unsqueeze(-1) * cbar.unsqueeze(-2) * e * (1.0 - F) * stay
 
 
 def consistency(F: Tensor, batch: SoftBatch) -> Tensor:
@@ -249,8 +250,7 @@ def with_slots(problem: Problem, slots: Sequence[str], bases: dict | None = None
 
 
 def samples(seed: int):
-    """Random problems of 3 to 6 blocks (`task.symbolic.generate.random_problem`), and one of
-    5 blocks on a table of 4 slots (`with_slots`) when its towers fit."""
+    """Random problems of 3 to 6 blocks, and one of 5 blocks on 4 slots when its towers fit."""
     from task.symbolic.generate import random_problem
 
     for n_blocks in (3, 4, 5, 6):

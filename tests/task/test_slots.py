@@ -53,8 +53,9 @@ def test_a_slot_holds_one_block_and_a_table_goal_means_any_slot():
     assert bw.unsatisfied_goals(p, state) == (("b", "c"),)  # a on s2 is "a on the table"
     state = bw.apply_move(p, state, Move("b", "c"))
     assert bw.is_goal(p, state) and bw.is_clear(p, state, "s0")
-    legal = [Move("a", "b"), Move("a", "s0"), Move("b", "a"), Move("b", "s0")]
+    legal = [Move("a", "b"), Move("b", "a"), Move("b", "s0")]  # a on s2 stays off s0
     assert bw.legal_moves(p, state) == legal
+    assert bw.check_move(p, state, Move("a", "s0")) == "a is already on the table"
 
 
 def test_slot_moves_are_4op_put_downs_and_pick_ups():
