@@ -3,7 +3,7 @@
 # pinned to 2.13.0, which these machines serve as a local CPU build (no CUDA packages are pulled).
 PYTHON ?= python3
 SIM ?= pybullet
-# Mesa EGL for MuJoCo's headless rendering (PyBullet's renderer needs no GL)
+# Mesa EGL for headless rendering: MuJoCo, and the PyBullet video (its camera needs no GL)
 SYSDEPS := libegl1 libegl-mesa0 libgl1-mesa-dri libgbm1
 VENV := .venv
 PY := $(VENV)/bin/python

@@ -13,7 +13,7 @@ from __future__ import annotations
 import abc
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -26,6 +26,7 @@ from task.errors import TampError, one_of
 SIMULATORS = ("pybullet", "mujoco")
 DT = 0.002  # s, physics step of both backends
 TRACK_EVERY = 5  # steps between tracking-error samples
+VIDEO_SIZE = (640, 480)  # (width, height) of `Simulator.render_video` frames
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,16 @@ class GripperReading:
     right_force: float
 
 
+class Snapshot(NamedTuple):
+    """What a video frame shows (`Simulator.snapshot`, `Simulator.show`), in any backend:
+    arm and finger joint positions (J + 2,), block centres (N, 3) and orientations (N, 4) as
+    quaternions (w, x, y, z), blocks in ``entities`` order."""
+
+    joints: np.ndarray
+    centres: np.ndarray
+    quats: np.ndarray
+
+
 class Simulator(abc.ABC):
     """A headless world: the Panda (at home, fingers open), a table, and blocks at ``poses``
     (cubes or cylinders, as ``scene.shape`` says; block i has ``scene.palette[i]``'s colour)."""
@@ -80,6 +91,7 @@ class Simulator(abc.ABC):
         scene: SceneConfig = SceneConfig(),
         grasp: str = "friction",
         camera: Camera = Camera(),
+        video: bool = False,
     ) -> None:
         if grasp not in ("friction", "weld"):
             raise TampError(f"unknown grasp mode {one_of(grasp, ('friction', 'weld'))}")
@@ -87,9 +99,11 @@ class Simulator(abc.ABC):
         self.scene = scene
         self.grasp = grasp
         self.camera = camera
+        self.video = video  # a world for `show` and `render_video` only (see `render_video`)
         self.lighting = Lighting()
         self.time = 0.0
         self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
+        self._next_frame = 0.0  # simulated time of the next ``on_frame`` call, across runs
         self.truth = GroundTruth(self._block_poses)  # scoring only; see tamp.sim.truth
         # scoring only: what the arm touched while running trajectories (name -> samples),
         # apart from ``moving``, the block the current move handles
@@ -148,6 +162,22 @@ class Simulator(abc.ABC):
         """
 
     @abc.abstractmethod
+    def render_video(self, size: tuple[int, int] = VIDEO_SIZE) -> np.ndarray:
+        """An RGB image (H, W, 3) uint8 of ``size`` (W, H) from ``camera``'s viewpoint, for
+        people to watch. It never changes what `render` gives perception: a backend may draw it
+        with another renderer (PyBullet: OpenGL through its EGL plugin in a world made with
+        ``video=True``, which then draws nothing else; TinyRenderer otherwise)."""
+
+    @abc.abstractmethod
+    def snapshot(self) -> Snapshot:
+        """The arm, fingers and blocks as they are now (for videos, not a sensor)."""
+
+    @abc.abstractmethod
+    def show(self, snapshot: Snapshot) -> None:
+        """Put the arm, fingers and blocks where ``snapshot`` says (kinematics only, no physics
+        step): a second world renders another's frames this way."""
+
+    @abc.abstractmethod
     def set_view(self, camera: Camera, lighting: Lighting) -> None:
         """Move the camera and change the light for the next ``render``."""
 
@@ -176,11 +206,11 @@ class Simulator(abc.ABC):
         """Track ``trajectory`` step by step with the gripper held at ``gripper``.
 
         ``release_at`` (s into the trajectory) opens the gripper there (fault injection: a
-        drop). ``on_frame(self)`` is called every ``self.frame_period`` simulated seconds. Returns
+        drop). ``on_frame(self)`` is called every ``self.frame_period`` simulated seconds, on
+        one clock across runs (a video's frames stay evenly spaced over many moves). Returns
         the largest joint tracking error (rad) seen every ``TRACK_EVERY`` steps and at the end.
         """
         worst = 0.0
-        next_frame = self.time
         for k in range(len(trajectory.times)):
             if release_at is not None and trajectory.times[k] >= release_at:
                 gripper = "open"
@@ -192,9 +222,9 @@ class Simulator(abc.ABC):
                 worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
                 for name in self._robot_touching() - {self.moving}:
                     self.touched[name] = self.touched.get(name, 0) + 1
-            if on_frame is not None and self.time >= next_frame:
+            if on_frame is not None and self.time >= self._next_frame:
                 on_frame(self)
-                next_frame = self.time + self.frame_period
+                self._next_frame = max(self._next_frame + self.frame_period, self.time)
         return worst
 
     def __enter__(self) -> Simulator:

@@ -20,11 +20,12 @@ import numpy as np
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import Camera, GripperReading, Lighting, Simulator
+from tamp.sim.base import VIDEO_SIZE, Camera, GripperReading, Lighting, Simulator, Snapshot
 from task.errors import TampError
 
 FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
 HAND_BODY = PANDA.tcp_link
+VIDEO_SHADOW_MAP = 1024  # texels a side in a world made for videos: 36 ms a 640x480 frame, not 80
 
 
 def _quat(yaw: float) -> list[float]:
@@ -50,8 +51,10 @@ class MuJoCoSim(Simulator):
         super().__init__(entities, poses, *args, **kwargs)
         s = panda_spec(timestep=self.dt)
         cam = self.camera
-        s.visual.global_.offwidth = max(cam.width, 640)
-        s.visual.global_.offheight = max(cam.height, 480)
+        s.visual.global_.offwidth = max(cam.width, VIDEO_SIZE[0])
+        s.visual.global_.offheight = max(cam.height, VIDEO_SIZE[1])
+        if self.video:  # llvmpipe spends most of a frame on the 4096^2 default shadow map
+            s.visual.quality.shadowsize = VIDEO_SHADOW_MAP
         world, scene = s.worldbody, self.scene
         world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01],
                        rgba=[*[scene.floor_grey] * 3, 1])  # fmt: skip
@@ -108,6 +111,7 @@ class MuJoCoSim(Simulator):
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
         mujoco.mj_forward(m, d)
         self._renderer: mujoco.Renderer | None = None
+        self._video: mujoco.Renderer | None = None  # render_video's, its own GL context
         self.set_view(self.camera, self.lighting)
 
     def _command(self, q, qd, gripper) -> None:
@@ -224,6 +228,35 @@ class MuJoCoSim(Simulator):
             renderer.disable_depth_rendering()
         return rgb, depth
 
+    def render_video(self, size: tuple[int, int] = VIDEO_SIZE) -> np.ndarray:
+        m, (w, h) = self.model, size
+        if self._video is None or (self._video.width, self._video.height) != (w, h):
+            most = (m.vis.global_.offwidth, m.vis.global_.offheight)
+            if w > most[0] or h > most[1]:
+                raise TampError(
+                    f"video size {w}x{h} exceeds the offscreen buffer {most[0]}x{most[1]}"
+                )
+            if self._video is not None:
+                self._video.close()
+            self._video = mujoco.Renderer(m, h, w)
+        self._video.update_scene(self.data, camera="scene")
+        return self._video.render().copy()
+
+    def snapshot(self) -> Snapshot:
+        q = self.data.qpos
+        joints = np.concatenate([q[self._arm_q], q[self._fingers]])  # (J + 2,)
+        free = np.array([q[a : a + 7] for a in self._block_q.values()]).reshape(-1, 7)  # (N, 7)
+        return Snapshot(joints, free[:, :3].copy(), free[:, 3:].copy())
+
+    def show(self, snapshot: Snapshot) -> None:
+        q = self.data.qpos
+        q[self._arm_q], q[self._fingers] = snapshot.joints[:-2], snapshot.joints[-2:]
+        places = zip(self._block_q.values(), snapshot.centres, snapshot.quats, strict=True)
+        for adr, xyz, quat in places:
+            q[adr : adr + 3], q[adr + 3 : adr + 7] = xyz, quat
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_camlight(self.model, self.data)
+
     def _scene_renderer(self) -> mujoco.Renderer:
         """The offscreen renderer (made on first use) with the scene camera's current view."""
         if self._renderer is None:
@@ -232,6 +265,7 @@ class MuJoCoSim(Simulator):
         return self._renderer
 
     def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        for renderer in (self._renderer, self._video):
+            if renderer is not None:
+                renderer.close()
+        self._renderer = self._video = None

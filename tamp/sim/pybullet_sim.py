@@ -3,9 +3,14 @@
 Settings follow shared/notes/motion-research.md section 4: finger gear constraint (in the
 loader), position control of the arm with the trajectory's positions and velocities, 40 N per
 finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no GL needed).
+A world made for videos (``video=True``) draws with OpenGL instead, through PyBullet's EGL
+plugin (Mesa llvmpipe on a CPU machine): a 640x480 frame costs about 35 ms of CPU there, about
+120 ms with TinyRenderer (measured on the 2-core development machine).
 """
 
 from __future__ import annotations
+
+import pkgutil
 
 import numpy as np
 import pybullet as p
@@ -13,16 +18,27 @@ import pybullet as p
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import Camera, GripperReading, Lighting, Simulator
+from tamp.sim.base import VIDEO_SIZE, Camera, GripperReading, Lighting, Simulator, Snapshot
+from task.errors import TampError
 
 FINGER_FORCE = 40.0  # N per finger
 ARM_KP, ARM_KD = 0.3, 1.0  # PyBullet position-control gains
 NEAR, FAR = 0.05, 3.0  # m, the camera's clipping planes
+LIGHT_DISTANCE = 40.0  # m, OpenGL's light from the camera target (40 m: shadows, no acne)
 EDGE = 1.02  # depths this far apart (ratio) in a 2x2 window straddle an edge: not interpolated
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
     return p.getQuaternionFromEuler((0.0, 0.0, yaw))
+
+
+def _egl_plugin(client: int) -> bool:
+    """Load the EGL renderer plugin into ``client`` (before any body: it draws only the bodies
+    made after it) so that every ``getCameraImage`` of the client goes through OpenGL."""
+    egl = pkgutil.get_loader("eglRenderer")
+    if egl is None:
+        return False
+    return p.loadPlugin(egl.get_filename(), "_eglRendererPlugin", physicsClientId=client) >= 0
 
 
 def _at_pixel_centres(z: np.ndarray) -> np.ndarray:
@@ -46,13 +62,16 @@ class PyBulletSim(Simulator):
     def __init__(self, entities, poses, *args, **kwargs) -> None:
         super().__init__(entities, poses, *args, **kwargs)
         self.client = c = p.connect(p.DIRECT)
+        self._gl = self.video and _egl_plugin(c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setTimeStep(self.dt, physicsClientId=c)
         plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
         grey = [self.scene.floor_grey] * 3
+        half = 0.05 if self._gl else 0.001  # top at z = 0.001; OpenGL's shadows need depth
         look = p.createVisualShape(
-            p.GEOM_BOX, halfExtents=[3.0, 3.0, 0.001], rgbaColor=[*grey, 1], physicsClientId=c
-        )
+            p.GEOM_BOX, halfExtents=[3.0, 3.0, half], rgbaColor=[*grey, 1],
+            visualFramePosition=[0, 0, 0.001 - half], physicsClientId=c,
+        )  # fmt: skip
         self.table = p.createMultiBody(0, plane, look, [0, 0, 0], physicsClientId=c)
         p.changeDynamics(self.table, -1, lateralFriction=1.0, physicsClientId=c)
         self.backdrop = None
@@ -83,6 +102,8 @@ class PyBulletSim(Simulator):
         self._finger_command = ""
         self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+        for _ in range(2 if self._gl else 0):  # the plugin's light lags two images (measured)
+            self.render_video((8, 6))
 
     def _obstacle(self, o) -> int:
         """A fixed box of the scene (`tamp.obstacles.Obstacle`)."""
@@ -201,6 +222,38 @@ class PyBulletSim(Simulator):
     def render(self) -> np.ndarray:
         return self._camera_image()[0]
 
+    def render_video(self, size: tuple[int, int] = VIDEO_SIZE) -> np.ndarray:
+        (w, h), cam, light, c = size, self.camera, self.lighting, self.client
+        proj = p.computeProjectionMatrixFOV(cam.fovy, w / h, NEAR, FAR, physicsClientId=c)
+        # OpenGL takes the light's position from the target (its shadow map's eye): far away
+        # along the light; TinyRenderer normalises it. OpenGL ignores the coefficients.
+        _, _, rgb, _, _ = p.getCameraImage(
+            w, h, self._view, proj, flags=p.ER_NO_SEGMENTATION_MASK,
+            renderer=p.ER_BULLET_HARDWARE_OPENGL if self._gl else p.ER_TINY_RENDERER,
+            lightDirection=[-LIGHT_DISTANCE * v for v in light.direction],
+            lightColor=[1.0, 1.0, 1.0], lightAmbientCoeff=light.ambient,
+            lightDiffuseCoeff=light.diffuse, lightSpecularCoeff=0.05, shadow=0, physicsClientId=c,
+        )  # fmt: skip
+        return np.asarray(rgb, dtype=np.uint8).reshape(h, w, 4)[..., :3].copy()
+
+    def snapshot(self) -> Snapshot:
+        r, c = self.robot, self.client
+        joints = [s[0] for s in p.getJointStates(r.body, [*r.arm, *r.fingers], physicsClientId=c)]
+        bases = [
+            p.getBasePositionAndOrientation(b, physicsClientId=c) for b in self.blocks.values()
+        ]
+        centres = np.array([xyz for xyz, _ in bases]).reshape(-1, 3)  # (N, 3)
+        quats = np.array([(w, x, y, z) for _, (x, y, z, w) in bases]).reshape(-1, 4)  # (N, 4)
+        return Snapshot(np.array(joints), centres, quats)
+
+    def show(self, snapshot: Snapshot) -> None:
+        r, c = self.robot, self.client
+        for j, q in zip([*r.arm, *r.fingers], snapshot.joints, strict=True):
+            p.resetJointState(r.body, j, q, physicsClientId=c)
+        places = zip(self.blocks.values(), snapshot.centres, snapshot.quats, strict=True)
+        for body, xyz, (w, x, y, z) in places:
+            p.resetBasePositionAndOrientation(body, xyz, (x, y, z, w), physicsClientId=c)
+
     def render_rgbd(self) -> tuple[np.ndarray, np.ndarray]:
         rgb, buffer = self._camera_image()
         # the OpenGL depth buffer d in [0, 1] -> z-depth: z = far near / (far - (far - near) d)
@@ -209,6 +262,8 @@ class PyBulletSim(Simulator):
 
     def _camera_image(self) -> tuple[np.ndarray, np.ndarray]:
         """RGB (H, W, 3) uint8 and the raw depth buffer (H, W) in [0, 1]."""
+        if self._gl:
+            raise TampError("a world made for videos (video=True) renders no camera images")
         cam, light = self.camera, self.lighting
         _, _, rgb, buffer, _ = p.getCameraImage(
             cam.width, cam.height, self._view, self._proj, renderer=p.ER_TINY_RENDERER,

@@ -1,19 +1,25 @@
 """Both simulators: one pick-and-place (friction and weld grasps), an unreachable block, renders
-that look alike, and ``tamp run`` writing its video. Each takes seconds. Whole episodes of the
+that look alike, video frames (their size, a second world posed from a snapshot, one frame clock
+across runs) and ``tamp run`` writing its video. Each takes seconds. Whole episodes of the
 closed loop are tested in ``tests/tamp/loop/test_episode.py``."""
 
 from __future__ import annotations
 
 import json
 
+import cv2
 import numpy as np
 import pytest
 
 from motion.ik import IKSolver
+from motion.trajectory import JointTrajectory
+from robots.panda import PANDA
 from tamp.cli import main
+from tamp.cli.run import FRAME_PERIOD
 from tamp.loop.execute import Failure, execute_move
 from tamp.scene import Pose, layout, read_state
 from tamp.sim import SIMULATORS, make_simulator
+from task.errors import TampError
 from task.problem import TABLE, Move
 
 pytestmark = pytest.mark.sim
@@ -74,4 +80,72 @@ def test_tamp_run_writes_video_and_report(tmp_path):
     report = json.loads((tmp_path / "report.json").read_text())
     assert code == (0 if report["reached_goal"] else 1)
     assert report["status"] == "goal_reached" and report["config"]["sim"] == "pybullet"
-    assert (tmp_path / "episode.mp4").stat().st_size > 10_000
+    capture = cv2.VideoCapture(str(tmp_path / "episode.mp4"))
+    frames = []
+    while (read := capture.read())[0]:
+        frames.append(read[1])
+    capture.release()
+    assert frames[0].shape == (480, 640, 3)
+    # one frame every FRAME_PERIOD simulated seconds, on one clock over the whole episode
+    assert abs(len(frames) - report["sim_time_s"] / FRAME_PERIOD) <= 2
+    assert all(f[40:].std() > 10 for f in frames[:: len(frames) // 5])  # a scene, not blank
+
+
+def _red(img: np.ndarray) -> np.ndarray:
+    """Pixels (H, W) of the red block."""
+    return (img[..., 0] > 120) & (img[..., 1] < 80) & (img[..., 2] < 80)
+
+
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+@pytest.mark.parametrize("video", [False, True])
+def test_video_frames_are_640x480_and_show_the_scene(sim_name, video):
+    entities = ("a", "b")
+    poses = layout(entities, (TABLE, "a"), seed=1)
+    with make_simulator(sim_name, entities, poses, video=video) as sim:
+        frame = sim.render_video()
+        small = None if video else sim.render()
+    assert frame.shape == (480, 640, 3) and frame.dtype == np.uint8
+    assert frame.std() > 10  # not blank
+    if small is not None:  # the same view, twice the size each way
+        assert small.shape == (240, 320, 3)
+        ratio = _red(frame).sum() / _red(small).sum()
+        assert 3 < ratio < 5
+        centre, centre_small = np.argwhere(_red(frame)).mean(0), np.argwhere(_red(small)).mean(0)
+        assert np.linalg.norm(centre - 2 * centre_small) < 6
+    else:
+        assert _red(frame).sum() > 400
+
+
+def test_a_pybullet_world_made_for_videos_renders_no_camera_images():
+    sim = make_simulator("pybullet", ("a",), {"a": Pose((0.5, 0.0, 0.025))}, video=True)
+    with sim, pytest.raises(TampError, match="video"):
+        sim.render()
+
+
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_a_second_world_posed_from_a_snapshot_renders_the_same_image(sim_name):
+    entities = ("a", "b")
+    poses = layout(entities, (TABLE, "a"), seed=1)
+    elsewhere = layout(entities, (TABLE, TABLE), seed=5)
+    reach = np.asarray(PANDA.q_home) + np.array([0.4, 0.3, 0.0, 0.2, 0.0, 0.0, 0.0])
+    with make_simulator(sim_name, entities, poses) as sim:
+        sim.run(JointTrajectory.hold(reach, 0.3, sim.dt), "closed")
+        sim.set_block_pose("b", Pose((0.45, 0.2, 0.025), 0.4))
+        with make_simulator(sim_name, entities, elsewhere) as copy:
+            before = copy.render()
+            copy.show(sim.snapshot())
+            np.testing.assert_allclose(copy.snapshot().joints, sim.snapshot().joints, atol=1e-9)
+            shown, original = copy.render().astype(int), sim.render().astype(int)
+    assert np.abs(before - original).mean() > 1  # the arm and the blocks moved (2.3, 5.6)
+    assert np.abs(shown - original).mean() < 0.5  # 0.0 in both when written
+
+
+def test_frames_keep_one_clock_across_runs():
+    times = []
+    with make_simulator("pybullet", ("a",), {"a": Pose((0.5, 0.0, 0.025))}) as sim:
+        sim.frame_period = 0.1
+        for _ in range(3):  # three short runs of 0.15 s
+            sim.run(JointTrajectory.hold(PANDA.q_home, 0.15, sim.dt), "open",
+                    on_frame=lambda s: times.append(s.time))  # fmt: skip
+    np.testing.assert_allclose(np.diff(times), 0.1, atol=1.5 * sim.dt)
+    assert len(times) == 5  # 0.45 s: frames at 0.0, 0.1, 0.2, 0.3, 0.4 (plus a step)

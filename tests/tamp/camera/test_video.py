@@ -1,4 +1,5 @@
-"""Episode videos: MP4 and GIF files are written frame by frame; bad frames are clear errors."""
+"""Episode videos: MP4 and GIF files are written frame by frame; bad frames are clear errors;
+an episode's video is rendered at 640x480 by a process of its own from the world's snapshots."""
 
 from __future__ import annotations
 
@@ -7,8 +8,13 @@ import numpy as np
 import pytest
 from PIL import Image, ImageSequence
 
-from tamp.video import VideoWriter
+from motion.trajectory import JointTrajectory
+from robots.panda import PANDA
+from tamp.scene import Pose, layout
+from tamp.sim import SIMULATORS, make_simulator
+from tamp.video import EpisodeVideo, VideoWriter
 from task.errors import TampError
+from task.problem import TABLE
 
 COLOURS = ((200, 30, 30), (30, 200, 30), (30, 30, 200), (200, 200, 30), (30, 200, 200))  # RGB
 H, W = 48, 64
@@ -56,3 +62,42 @@ def test_bad_video_inputs_are_clear_errors(tmp_path):
         VideoWriter(tmp_path / "clip.avi")
     with pytest.raises(TampError, match="uint8"):
         VideoWriter(tmp_path / "clip.mp4").write(np.zeros((4, 4), dtype=np.float32))
+
+
+def test_captions_scale_with_the_frame_width(tmp_path):
+    video = VideoWriter(tmp_path / "wide.mp4", fps=10)
+    video.write(np.full((480, 640, 3), COLOURS[1], dtype=np.uint8), "a caption", ["a note"])
+    (frame,) = _decode(video.close())
+    assert frame.shape == (480, 640, 3)
+    band = frame[2:32]  # 36 rows at twice the base width
+    assert band.mean() < 60 and (band > 200).any()  # dark, with white text
+    np.testing.assert_allclose(frame[44:400].reshape(-1, 3).mean(0), COLOURS[1], atol=12)
+    assert frame[450:470, 4:100].mean() < 100  # the note's dark box at the bottom left
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_an_episode_video_is_rendered_at_640x480_in_its_own_process(tmp_path, sim_name):
+    entities = ("a", "b")
+    video = EpisodeVideo(tmp_path / "clip.mp4", fps=10)
+    with make_simulator(sim_name, entities, layout(entities, (TABLE, TABLE), seed=1)) as sim:
+        for k in range(3):
+            video.write(sim, f"frame {k}", ["a on table 1.00"])
+            sim.set_block_pose("a", Pose((0.45, -0.15 + 0.15 * k, 0.025)))  # red, along +y
+            sim.run(JointTrajectory.hold(PANDA.q_home, 0.1, sim.dt), "open")
+        frames = _decode(video.close())
+    assert video.frames == len(frames) == 3
+    assert all(f.shape == (480, 640, 3) and f[40:440].std() > 10 for f in frames)  # not blank
+    red = [np.argwhere((f[..., 0] > 120) & (f[..., 1] < 80) & (f[..., 2] < 80)) for f in frames]
+    assert all(len(r) > 400 for r in red)  # the red block, about 0.1% of the frame or more
+    assert red[2][:, 1].mean() > red[1][:, 1].mean() + 20  # +y is to the right in the picture
+
+
+@pytest.mark.sim
+def test_a_failing_video_renderer_is_a_clear_error(tmp_path):
+    video = EpisodeVideo(tmp_path / "huge.mp4", size=(4000, 3000))
+    with make_simulator("mujoco", ("a",), layout(("a",), (TABLE,), seed=0)) as sim:
+        video.write(sim)
+        with pytest.raises(TampError, match=r"huge\.mp4.*offscreen buffer"):
+            video.close()
+    assert EpisodeVideo(tmp_path / "none.mp4").close() is None
