@@ -19,8 +19,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import torch
 
-from motion.cost import MoveCostConfig, move_costs_batch, site_solutions
+from motion.cost import MoveCostConfig, move_costs_batch, site_solutions, top_down_targets
 from motion.ik import IKSolver
+from motion.pick_place import PickPlaceConfig
 from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
@@ -30,6 +31,7 @@ from task.problem import TABLE, Problem
 # CHOMP cost: 0.2-0.9 for a move sweeping past clutter's posts, next to about 1 per move of
 # joint distance; `motion.cost`)
 ARM = MoveCostConfig(collision_weight=5.0)
+HOVER = PickPlaceConfig()  # the executor's hover and transit heights
 BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refuses it
 
 
@@ -194,11 +196,26 @@ class ArmCosts:
             picks.append(xyz)
             places.append(np.vstack([up, table]))  # (Y, 3), Y = N + K
             extra.append(self._blocked(problem, plain, now, at is None and slot is None))
+            self._hover(extra[-1], xyz, places[-1], now)
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
                 j = _column(problem, key, at)
                 if j is not None:
                     extra[-1][problem.entities.index(x), j] += BLOCKED
         return tuple(torch.tensor(np.stack(a)) for a in (picks, places, extra))
+
+    def _hover(self, extra: np.ndarray, picks: np.ndarray, places: np.ndarray, now) -> None:
+        """Add BLOCKED (in place) to the moves whose pick or place the hand cannot reach from
+        above: a pick-and-place hovers and carries the block over the highest stack top
+        (`motion.pick_place`), where a far slot may be out of the arm's reach. One batched,
+        detached IK call; the hand's yaw is taken as 0."""
+        top = max(p.xyz[2] for p in now.values()) + self.scene.block_size / 2
+        hover = top + HOVER.lift_clearance + self.scene.block_size  # TCP holding a block
+        points = np.vstack([picks, places])  # (N + Y, 3)
+        points[:, 2] = np.maximum(points[:, 2], hover)
+        ok = self.solver.solve(top_down_targets(torch.tensor(points)).numpy(), self.q_now).ok
+        n = picks.shape[0]
+        extra[~np.asarray(ok[:n]), :] += BLOCKED
+        extra[:, ~np.asarray(ok[n:])] += BLOCKED
 
     def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no
