@@ -110,3 +110,24 @@ def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver
     assert torch.equal(costs["tabletop", 5.0], costs["tabletop", 0.0])
     extra = costs["clutter", 5.0] - costs["clutter", 0.0]
     assert (extra >= 0).all() and (extra > 0.05).any()
+
+
+def test_a_place_the_hand_cannot_reach_at_hover_height_is_ruled_out(solver):
+    """On the cramped scene the far row (x = 0.72 m) is reachable over a low scene but not
+    over a 7-block tower, which the hand must clear while carrying a block."""
+    from tamp.slots import slotted
+
+    cramped = with_scene(SCENE, "cramped")
+    low = Problem("low", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    tall = Problem("tall", "blocksworld", tuple("abcdefg"), (TABLE, "a", "b", "c", "d", "e", "f"),
+                   (("a", "g"),))  # fmt: skip
+    for problem, blocked in ((low, False), (tall, True)):
+        slots = [0] if problem is tall else [0, 1]
+        poses = layout(problem.entities, problem.init, cramped, seed=0, slots=slots)
+        current, at = slotted(problem, problem.init, poses, cramped)
+        source = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at])
+        matrix = source([0], [current.init]).compute()[0]
+        far = [problem.n + j for j, k in enumerate(current.fixed) if at[k][0] > 0.7]
+        assert len(far) == 2
+        top = problem.entities[-1]  # the block on top, free to move
+        assert (matrix[problem.entities.index(top), far] >= BLOCKED).all() == blocked
