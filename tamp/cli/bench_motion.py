@@ -125,8 +125,7 @@ def executability_command(args: argparse.Namespace) -> int:
     body = {"config": {"plans": str(args.plans), "sims": sims, "instances": [i.name for i in
                        suite.instances], "seed": args.seed, "grasp": args.grasp, "ours": args.ours,
                        "data": str(args.data), "scene": args.scene, "collision": args.collision,
-                       "workers": args.workers, "ray": args.ray, "blocks": args.blocks,
-                       "source": suite.source},
+                       "workers": args.workers, "ray": args.ray},
             "machine": results.machine(), "wall_s": wall,
             "summary": summary}  # fmt: skip
     if out:
