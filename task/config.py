@@ -14,6 +14,8 @@ class PlannerConfig:
     iters: int = 60  # Adam steps per window
     tau: float = 0.5  # softmax temperature of the action logits
     tau_end: float = 0.05  # temperature at the last Adam step (geometric annealing from tau)
+    decode_tau: float | None = 0.005  # temperature of the rollout that is decoded, sharper than
+    # tau_end so that hedged soft plans (two moves at once, each half) commit; None: tau_end
     threshold: float = 0.3  # decoding confidence: a step's move mass must reach this
     goal_loss: str = "default"  # the domain's first goal loss; "atoms": the paper's goal CE
     lambda_move: float = 0.05  # weight of the move-count loss (shorter plans)
@@ -29,6 +31,8 @@ class PlannerConfig:
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
     # in one batch start together and share it); None: only max_windows stops the planner
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
+    rank_prefixes: bool = True  # rank (and cut) each window by its best prefix (`task.decode`)
+    park_free: bool = False  # count parking moves (to the table) as free in that ranking
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
 
     @classmethod
@@ -58,5 +62,6 @@ class PlannerConfig:
             raise TampError(f"PlannerConfig.lookahead_share must be in [0, 1], got {share}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:
             raise TampError(f"PlannerConfig.time_limit_s must be > 0, got {self.time_limit_s}")
-        if self.tau <= 0 or self.tau_end <= 0 or self.lr <= 0:
-            raise TampError("PlannerConfig.tau, tau_end and lr must be > 0")
+        sharp = self.decode_tau if self.decode_tau is not None else self.tau_end
+        if self.tau <= 0 or self.tau_end <= 0 or self.lr <= 0 or sharp <= 0:
+            raise TampError("PlannerConfig.tau, tau_end, decode_tau and lr must be > 0")

@@ -6,6 +6,17 @@ crisp state reached so far (the planner passes the true state, or under the perc
 the state read from the current image); decoding stops at the first illegal one, so only legal
 moves are returned. Among a problem's restarts the best decoded window is kept.
 
+With ``prefix`` (`task.config.PlannerConfig.rank_prefixes`, for domains ranked by their lower
+bound) a window is cut to its best prefix first: the least moves + lower bound after them, then
+the fewest *buried* moves (a move that leaves the bound where it was and puts an entity on
+another entity rather than on a fixed target, such as a block on a block that is not its goal),
+then the most moves. The bound drops by at most one a move, so this keeps the moves up to the
+first one that makes no progress: a 5-move window whose third move wastes a move executes two
+moves, and the next window plans again from there. With ``park`` (`PlannerConfig.park_free`) a
+*parking* move (the bound unchanged, the entity put on a fixed target: a block to the table)
+costs nothing in that sum: the bound counts a block that must move once, while a block that is
+in the way and whose place is not ready moves twice, first to the table.
+
 Without the crisp check (``check=False``, `task.config.PlannerConfig.crisp_check`) the first
 illegal move is kept as the window's last move, and the restart with the lowest soft objective
 wins (ranking restarts by their crisp replay would be the check again); the planner then finds
@@ -37,20 +48,22 @@ class DecodedWindow:
     estimated: float | None = None  # the domain's ranking estimate (None: ``remaining``)
     revisit: bool = False  # ``state`` was already visited earlier in the plan (a loop)
     motion: float = 0.0  # the move costs of ``moves`` (`task.costs`; 0 without a cost source)
+    buried: int = 0  # moves that left the bound unchanged, putting an entity on an entity
 
     def key(self) -> tuple:
         """Sort key: the goal reached in fewest moves; else not a dead end (an infinite lower
         bound ranks last, whatever moved), then not back to a state the plan already visited,
         then some progress, then the least estimated total
-        (moves + the domain's optional `estimate`, else its lower bound), then the most moves,
-        then the least move cost, then the soft objective."""
+        (moves + the domain's optional `estimate`, else its lower bound, less the parking moves
+        under ``park``), then the fewest buried moves, then the most moves, then the least move
+        cost, then the soft objective."""
         g = len(self.moves)
         if self.reached:
             return (0, g, self.motion, 0, 0, self.loss)
         dead = math.isinf(self.remaining)
         rest = self.remaining if self.estimated is None else self.estimated
-        return (1, dead, self.revisit, g == 0, g + rest, -g, self.motion, not self.complete,
-                self.loss)  # fmt: skip
+        return (1, dead, self.revisit, g == 0, g + rest, self.buried, -g, self.motion,
+                not self.complete, self.loss)  # fmt: skip
 
 
 def decode_row(
@@ -63,10 +76,13 @@ def decode_row(
     check: bool = True,
     seen: Collection[State] = (),
     costs: Tensor | None = None,
+    prefix: bool = False,
+    park: bool = False,
 ) -> DecodedWindow:
     """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row; costs:
     (N, A - 1) its move costs (`task.costs`), summed over the decoded moves; a move costing
-    `task.costs.IMPOSSIBLE` or more is refused like an illegal one.
+    `task.costs.IMPOSSIBLE` or more is refused like an illegal one. ``prefix`` and ``park``:
+    rank its prefixes (see the module docstring).
 
     ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``);
     ``seen``: states the plan already passed through (the window is a ``revisit`` if it ends
@@ -77,6 +93,8 @@ def decode_row(
     complete, illegal, motion = True, None, 0.0
     if domain.is_goal(problem, state):  # nothing to do (a perceived state may already be it)
         return DecodedWindow((), state, True, True, loss, 0)
+    trail: list[tuple[State, float]] = []  # (state, move cost so far) after each move
+    start = state
     for value, index in zip(best.tolist(), flat.tolist(), strict=True):
         if value < threshold:
             continue  # a STAY step
@@ -94,16 +112,47 @@ def decode_row(
         state = domain.apply_move(problem, state, move)
         moves.append(move)
         motion += 0.0 if costs is None else float(costs[row, col])
+        trail.append((state, motion))
         if domain.is_goal(problem, state):
             break
     reached = domain.is_goal(problem, state)
-    remaining = 0 if reached else domain.lower_bound(problem, state)
     estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
+    if prefix and check and estimate is None and moves and not reached:
+        return _best_prefix(domain, problem, start, moves, trail, seen, park, complete, loss)
+    remaining = 0 if reached else domain.lower_bound(problem, state)
     estimated = None if reached or estimate is None else estimate(problem, state)
     return DecodedWindow(
         tuple(moves), state, reached, complete, loss, remaining, illegal, estimated,
         state in seen, motion,
     )  # fmt: skip
+
+
+def _best_prefix(
+    domain: Domain,
+    problem: Problem,
+    start: State,
+    moves: Sequence,
+    trail: Sequence[tuple[State, float]],
+    seen: Collection[State],
+    park: bool,
+    complete: bool,
+    loss: float,
+) -> DecodedWindow:
+    """The best prefix (see the module docstring) of a window that makes ``moves`` from
+    ``start``, passing through ``trail`` (the state and the move cost so far after each)."""
+    before = domain.lower_bound(problem, start)
+    best, buried, parked = None, 0, 0
+    for k, (move, (state, motion)) in enumerate(zip(moves, trail, strict=True), start=1):
+        bound = domain.lower_bound(problem, state)
+        fixed = getattr(move, "target", None) in problem.fixed
+        buried += bound >= before and not fixed
+        parked += park and bound == before and fixed
+        window = DecodedWindow(tuple(moves[:k]), state, False, complete, loss, bound, None,
+                               bound - parked, state in seen, motion, buried)  # fmt: skip
+        if best is None or window.key() < best.key():
+            best = window
+        before = bound
+    return best
 
 
 def decode_best(
@@ -117,6 +166,8 @@ def decode_best(
     check: bool = True,
     visited: Sequence[Collection[State]] | None = None,
     costs: Tensor | None = None,
+    prefix: bool = False,
+    park: bool = False,
 ) -> list[DecodedWindow]:
     """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
 
@@ -131,7 +182,9 @@ def decode_best(
         seen = () if visited is None else visited[i]
         row_costs = [None if costs is None else costs[r] for r in rows]
         windows = [
-            decode_row(domain, problem, state, gates[r], threshold, losses[r], check, seen, c)
+            decode_row(
+                domain, problem, state, gates[r], threshold, losses[r], check, seen, c, prefix, park
+            )
             for r, c in zip(rows, row_costs, strict=True)
         ]
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))

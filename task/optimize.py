@@ -39,7 +39,8 @@ def optimise_window(
     beliefs: WindowBeliefs | None = None,
     costs: WindowCosts | None = None,
 ) -> tuple[Tensor, Rollout]:
-    """Optimise the window's logits; returns them and the final rollout (no grad).
+    """Optimise the window's logits; returns them and the final rollout (no grad; at
+    ``config.decode_tau`` when set, the temperature the decoder reads the moves at).
 
     steps: (B, T) bool, the live steps of each row (rows may have shorter windows).
     ``beliefs`` (see `task.beliefs`) replaces the batch's F0 and goal by soft ones, recomputed
@@ -63,7 +64,8 @@ def optimise_window(
         (rollout(domain, logits, live, steps, config, tau, c).loss.sum() + penalty).backward()
         opt.step()
     with torch.no_grad():
-        tau = temperature(config, config.iters - 1)
+        tau = config.decode_tau
+        tau = temperature(config, config.iters - 1) if tau is None else tau
         live, _ = with_beliefs(batch, beliefs)
         c = with_costs(batch, costs)
         return logits.detach(), rollout(domain, logits, live, steps, config, tau, c)

@@ -49,7 +49,7 @@ def _window(
     _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs)
     return decode_best(
         domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold,
-        config.crisp_check, visited, roll.costs,
+        config.crisp_check, visited, roll.costs, config.rank_prefixes, config.park_free,
     )  # fmt: skip
 
 

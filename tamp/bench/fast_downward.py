@@ -15,6 +15,8 @@ subprocesses, in a temporary directory that is always removed:
 Time limits are CPU seconds (Fast Downward's own), memory limits an address-space cap; a
 wall-clock guard (`GUARD_FACTOR`) kills the process group if the machine stalls. ``optimal_lengths``
 caches results in a JSON file keyed by the domain and problem texts: a rerun costs nothing.
+`lama_length` runs LAMA's first plan (``--alias lama-first``, satisficing, not optimal) for a
+classical planner's length and time beside ours (``tamp bench random --lama``).
 """
 
 from __future__ import annotations
@@ -46,7 +48,7 @@ _MERGE_AND_SHRINK = (
 )
 SEARCHES = (("merge-and-shrink", _MERGE_AND_SHRINK), ("lmcut", "astar(lmcut())"))
 METHOD = f"Fast Downward ({PACKAGE}), unit costs, " + " then ".join(c for _, c in SEARCHES)
-STATUSES = ("optimal", "unsolvable", "timeout", "memout", "error")
+STATUSES = ("optimal", "solved", "unsolvable", "timeout", "memout", "error")  # solved: LAMA
 GUARD = "killed by the wall-clock guard"  # results whose detail says so are never cached
 GUARD_FACTOR = 5  # wall-clock guard: 5 x the CPU limit + 60 s (2 busy cores can stretch it)
 # Fast Downward's exit codes (https://www.fast-downward.org/latest/documentation/exit-codes/);
@@ -146,9 +148,11 @@ def _last_message(log: Path) -> str:
     return " | ".join(useful[-3:])[:300] if useful else "no output"
 
 
-def _outcome(code: int | None, seconds: float, start: float, work: Path, step: str) -> FDResult:
+def _outcome(
+    code: int | None, seconds: float, start: float, work: Path, step: str, found: str = "optimal"
+) -> FDResult:
     """The result of a run that stopped at ``step`` with exit ``code`` after ``seconds`` of CPU
-    (``code`` None: a guard kill, timed in wall seconds since ``start``)."""
+    (``code`` None: a guard kill, timed in wall seconds since ``start``); a plan is ``found``."""
     if code is None:
         wall = time.monotonic() - start
         return FDResult(None, "timeout", wall, f"{step} {GUARD} after {wall:.0f} s wall")
@@ -156,12 +160,36 @@ def _outcome(code: int | None, seconds: float, start: float, work: Path, step: s
     if code == 0 and plan.is_file():  # one action a line, then "; cost = ..." comments
         lines = plan.read_text(encoding="utf-8").splitlines()
         length = sum(1 for s in lines if s.strip() and not s.lstrip().startswith(";"))
-        return FDResult(length, "optimal", seconds, f"{step} exit 0: optimal plan")
+        return FDResult(length, found, seconds, f"{step} exit 0: {found} plan")
     status = _EXIT.get(code, "error")
     detail = f"{step} exit {code}"
     if status in ("unsolvable", "error"):
         detail += f": {_last_message(work / 'log.txt')}"
     return FDResult(None, status, seconds, detail)
+
+
+@contextlib.contextmanager
+def _folder(domain: str, problem: str):
+    """A temporary folder holding ``domain.pddl`` and ``problem.pddl``; removed afterwards."""
+    with tempfile.TemporaryDirectory(prefix="fast-downward-") as tmp:
+        (Path(tmp) / "domain.pddl").write_text(domain, encoding="utf-8")
+        (Path(tmp) / "problem.pddl").write_text(problem, encoding="utf-8")
+        yield Path(tmp)
+
+
+def lama_length(
+    domain: str, problem: str, time_limit_s: float = 60.0, memory_mb: int = 4096
+) -> FDResult:
+    """LAMA's first plan (``--alias lama-first``) for the PDDL texts ``domain`` and ``problem``:
+    status "solved" with its length in actions, or why not; ``seconds``: CPU seconds of the
+    translator and the search. One-line DataError if the ``bench`` extra is missing."""
+    driver, limit = _require_driver(), max(1, math.ceil(time_limit_s))
+    start = time.monotonic()
+    with _folder(domain, problem) as work:
+        args = [str(driver), "--alias", "lama-first", "--plan-file", "plan.txt"]
+        args += ["--overall-time-limit", f"{limit}s", "--overall-memory-limit", f"{memory_mb}M"]
+        code, spent = _call([*args, "domain.pddl", "problem.pddl"], work, start + 2 * limit + 60)
+        return _outcome(code, spent, start, work, "lama-first", "solved")
 
 
 def _solve(
@@ -176,10 +204,7 @@ def _solve(
     limit = max(1, math.ceil(time_limit_s))
     start = time.monotonic()
     deadline = start + GUARD_FACTOR * limit + 60
-    with tempfile.TemporaryDirectory(prefix="fast-downward-") as tmp:
-        work = Path(tmp)
-        (work / "domain.pddl").write_text(domain, encoding="utf-8")
-        (work / "problem.pddl").write_text(problem, encoding="utf-8")
+    with _folder(domain, problem) as work:
         memory = ["--overall-memory-limit", f"{memory_mb}M"]
         translate = [str(driver), "--translate", "--sas-file", "task.sas"]
         translate += ["--translate-time-limit", f"{limit}s", *memory, "domain.pddl", "problem.pddl"]

@@ -42,6 +42,8 @@ class Row:
     status: str
     time_s: float
     windows: int
+    lama_length: int | None = None  # LAMA's first plan, PDDL actions (``--lama``; None: none)
+    lama_s: float | None = None  # LAMA's wall seconds, translator and search
 
 
 @dataclass(frozen=True)
@@ -182,6 +184,35 @@ def run(
     n = len(suite.instances)
     size_name = get_domain(domain_of(suite)).size_name
     return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed, size_name)
+
+
+def with_lama(
+    bench: Bench,
+    suite: Suite,
+    time_limit_s: float = 60.0,
+    progress: Callable[[int], None] | None = None,
+) -> Bench:
+    """``bench`` with LAMA's plan length and wall time on every row (`fast_downward.lama_length`
+    on each instance's PDDL, the domain's own text; benchmark-only, needs the ``bench`` extra).
+    LAMA runs once per instance, one instance at a time; ``progress(1)`` after each."""
+    from tamp.bench import fast_downward
+
+    report = progress or (lambda k: None)
+    found = {}
+    for instance in suite.instances:
+        rules = get_domain(instance.problem.domain)
+        start = time.perf_counter()
+        result = fast_downward.lama_length(
+            rules.pddl_domain_text(), rules.to_pddl(instance.problem), time_limit_s
+        )
+        found[instance.name] = (result.length, time.perf_counter() - start)
+        report(1)
+    runs = tuple(
+        replace(run, rows=tuple(replace(r, lama_length=found[r.instance][0],
+                                        lama_s=found[r.instance][1]) for r in run.rows))
+        for run in bench.runs
+    )  # fmt: skip
+    return replace(bench, runs=runs)
 
 
 def total(n: int, seeds: int, horizons: int, sequential: int = 0) -> int:

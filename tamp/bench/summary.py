@@ -40,6 +40,13 @@ class Summary:
     at_most_ref: float = 0.0  # valid plans no longer than the reference
     at_most_ref_pct: float | None = None  # 100 * at_most_ref / valid plans with a reference
     shorter_than_ref: float = 0.0  # valid plans shorter than the reference
+    length: float | None = None  # mean length of the valid plans (PDDL actions)
+    ratio: float | None = None  # mean length / optimum over valid plans with a known optimum
+    lama: float | None = None  # instances LAMA solved (None: LAMA did not run)
+    lama_length: float | None = None  # mean length of LAMA's plans (PDDL actions)
+    lama_ratio: float | None = None  # mean LAMA length / optimum where the optimum is known
+    lama_s: float | None = None  # LAMA's mean wall seconds per instance
+    vs_lama: float | None = None  # mean our length / LAMA's, where both have a plan
 
     def asdict(self) -> dict:
         return asdict(self)
@@ -61,6 +68,11 @@ def _fmean(values: Sequence[float]) -> float:
     return statistics.fmean(values) if values else 0.0
 
 
+def _mean(values: Sequence[float]) -> float | None:
+    """The mean, or None when there is nothing to average."""
+    return statistics.fmean(values) if values else None
+
+
 def summarise(
     rows: Sequence[Row], horizon: int, seed: int | None, size: int | None, wall: float | None
 ) -> Summary:
@@ -70,6 +82,9 @@ def summarise(
     optimal = sum(is_optimal(r.length, r.optimal, r.instance) for r in scored)
     refs = [r for r in rows if r.status == "valid" and r.reference is not None]
     at_most = sum(r.length <= r.reference for r in refs)
+    valid = [r for r in rows if r.status == "valid"]
+    lama = [r for r in rows if r.lama_length is not None]
+    ran = any(r.lama_s is not None for r in rows)
     return Summary(
         horizon=horizon,
         seed=seed,
@@ -89,6 +104,13 @@ def summarise(
         at_most_ref=at_most,
         at_most_ref_pct=100.0 * at_most / len(refs) if refs else None,
         shorter_than_ref=sum(r.length < r.reference for r in refs),
+        length=_mean([r.length for r in valid]),
+        ratio=_mean([r.length / r.optimal for r in scored]),
+        lama=len(lama) if ran else None,
+        lama_length=_mean([r.lama_length for r in lama]),
+        lama_ratio=_mean([r.lama_length / r.optimal for r in lama if r.optimal]),
+        lama_s=_mean([r.lama_s for r in rows if r.lama_s is not None]),
+        vs_lama=_mean([r.length / r.lama_length for r in valid if r.lama_length]),
     )
 
 

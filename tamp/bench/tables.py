@@ -250,3 +250,26 @@ def _count(s: dict, n: int) -> str:
     mean = f"{s['mean']:.1f}".removesuffix(".0")
     spread_ = "" if s["min"] == s["max"] else f" ({s['min']}-{s['max']})"
     return f"{mean}/{n}{spread_}"
+
+
+def lengths_table(bench: Bench) -> str:
+    """Plan lengths by size, mean over seeds: ours (valid plans) and, where ``--lama`` ran,
+    LAMA's first plan beside them. Lengths in moves (4-op actions / 2; blocksworld only)."""
+    lama = any(s.lama is not None for s in size_rows(bench))
+    head = ["T", bench.size_name, "valid", "moves", "x opt", "s/inst"]
+    head += ["LAMA solved", "LAMA moves", "LAMA x opt", "LAMA s", "ours/LAMA"] if lama else []
+    body = []
+    for s in size_rows(bench):
+        row = [str(s.horizon), str(s.size), f"{count(s.valid)}/{s.n}", _num(s.length, 0.5),
+               _num(s.ratio), f"{s.time_s:.2f}"]  # fmt: skip
+        if lama:
+            row += [f"{count(s.lama or 0)}/{s.n}", _num(s.lama_length, 0.5), _num(s.lama_ratio),
+                    _num(s.lama_s), _num(s.vs_lama)]  # fmt: skip
+        body.append(row)
+    note = "moves: mean over plans found; x opt: mean length / optimum where the optimum is known"
+    note += "; ours/LAMA: mean length ratio where both found a plan" if lama else ""
+    return table(head, body) + "\n" + note
+
+
+def _num(value: float | None, scale: float = 1.0) -> str:
+    return "-" if value is None else f"{value * scale:.2f}"

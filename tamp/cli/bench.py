@@ -14,6 +14,7 @@ import os
 import sys
 import time
 from contextlib import contextmanager
+from dataclasses import replace
 
 from tqdm import tqdm
 
@@ -35,16 +36,22 @@ def _bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
         yield bar.update
 
 
-def _run(suite: suites.Suite, args: argparse.Namespace) -> int:
+def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -> int:
+    """Plan ``suite`` as ``args`` say; ``lengths``: also print the plan-length table (and run
+    LAMA beside with ``args.lama``)."""
     import torch
 
     torch.set_num_threads(args.threads)
     rules = {i.problem.domain for i in suite.instances}
     config = planner_config(args, rules.pop() if len(rules) == 1 else None)
+    if getattr(args, "one_at_a_time", False):
+        config = replace(config, batched=False)
     horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
     with _bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
         result = planning.run(suite, config, seeds, horizons, args.sequential, update)
+    if getattr(args, "lama", False):
+        result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
     body = results.results(result)
     if args.out is not None:
         paths = results.write(result, args.out, body)
@@ -52,9 +59,25 @@ def _run(suite: suites.Suite, args: argparse.Namespace) -> int:
         print(json.dumps(body, indent=2))
     else:
         print(tables.planning_report(result))
+        if lengths:
+            print(f"\nplan lengths by {result.size_name} (mean over seeds):")
+            print(tables.lengths_table(result))
         if args.out is not None:
             print(f"\nwrote {', '.join(p.name for p in paths)} to {args.out}")
     return 0
+
+
+def _lama(suite: suites.Suite, bench: planning.Bench, limit: float, progress: bool):
+    """``bench`` with LAMA's lengths and times; unchanged, and one line on stderr, when the
+    ``bench`` extra (Fast Downward) is not installed."""
+    from tamp.bench import fast_downward
+
+    if not fast_downward.available():
+        print(f"LAMA skipped: Fast Downward is not installed (pip install 'soft-tamp[bench]', "
+              f"the package {fast_downward.PACKAGE})", file=sys.stderr)  # fmt: skip
+        return bench
+    with _bar(len(suite.instances), "LAMA (lama-first)", progress, "instance") as update:
+        return planning.with_lama(bench, suite, limit, update)
 
 
 def planbench_command(args: argparse.Namespace) -> int:
@@ -97,7 +120,7 @@ def random_command(args: argparse.Namespace) -> int:
     total = len(args.blocks) * args.n
     with _bar(total, "instances, A* optima", args.progress, "instance") as update:
         suite = suites.generated(args.blocks, args.n, args.seed, args.max_nodes, update)
-    return _run(suite, args)
+    return _run(suite, args, lengths=True)
 
 
 def perception_command(args: argparse.Namespace) -> int:

@@ -156,22 +156,19 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         )  # fmt: skip
     planbench.set_defaults(func=_lazy("tamp.cli.bench", "planbench_command"))
     folder.set_defaults(func=_lazy("tamp.cli.bench", "pddl_command"))
-    random_.add_argument(
-        "--blocks",
-        type=positive_list,
-        default=(6, 8, 10, 15, 20),
-        metavar="B[,B...]",
-        help="block counts (6,8,10,15,20)",
-    )
+    random_.add_argument("--blocks", type=positive_list, default=(6, 8, 10, 15, 20),
+                         metavar="B[,B...]", help="block counts (6,8,10,15,20)")  # fmt: skip
     random_.add_argument("--n", type=positive, default=50, help="instances per block count (50)")
     random_.add_argument("--seed", type=int, default=0, help="instance generator seed (0)")
-    random_.add_argument(
-        "--max-nodes",
-        type=positive,
-        default=20_000,
-        metavar="N",
-        help="A* expansion budget for the optimal lengths (20000)",
-    )
+    random_.add_argument("--max-nodes", type=positive, default=20_000, metavar="N",
+                         help="A* expansion budget for the optimal lengths (20000)")  # fmt: skip
+    random_.add_argument("--one-at-a-time", action="store_true",
+                         help="plan one instance at a time, each within its own --time-limit "
+                         "(default: batched, a batch shares the limit)")  # fmt: skip
+    random_.add_argument("--lama", action="store_true",
+                         help="also run Fast Downward's LAMA (first plan, --time-limit or "
+                         "60 s) on every instance: its length and time beside ours (needs the "
+                         "bench extra)")  # fmt: skip
     random_.set_defaults(func=_lazy("tamp.cli.bench", "random_command"))
 
 

@@ -9,7 +9,7 @@ import pytest
 
 from tamp.bench import planning as bench
 from tamp.bench import results as bench_io
-from tamp.bench import suites
+from tamp.bench import suites, tables
 from tamp.bench.planning import Row
 from tamp.bench.summary import main_rows, size_rows, summarise
 from task import data
@@ -116,3 +116,22 @@ def test_planbench_official_600(planbench_dir):
     assert all(i.optimal is not None and i.optimal % 2 == 0 for i in suite.instances)
     limited = suites.planbench(planbench_dir / "blocksworld", limit=6)
     assert [i.blocks for i in limited.instances] == [3, 4, 4, 4, 4, 5]
+
+
+def test_lengths_are_summarised_against_the_optimum_and_lama():
+    def row(length, optimal, lama, status="valid"):
+        return Row("i", 5, optimal, None, 3, 0, length, status, 0.5, 1, lama, 0.25)
+
+    rows = (row(6, 6, 8), row(12, 8, 8), row(None, 4, None, "no_plan"))
+    result = bench.Bench(
+        "t", "synthetic", 3, PlannerConfig(), (0,), (3,), (bench.Run(3, 0, 1.0, rows),)
+    )
+    (s,) = size_rows(result)
+    assert (s.length, s.ratio, s.lama, s.lama_length) == (9.0, 1.25, 2, 8.0)
+    assert (s.lama_s, s.vs_lama) == (0.25, 1.125) and s.lama_ratio == pytest.approx(7 / 6)
+    text = tables.lengths_table(result)
+    assert "LAMA moves" in text and "2/3" in text and "4.50" in text  # 9 actions = 4.5 moves
+    bare = tuple(dataclasses.replace(r, lama_length=None, lama_s=None) for r in rows)
+    assert summarise(bare, 3, 0, None, None).lama is None  # LAMA did not run
+    without = dataclasses.replace(result, runs=(bench.Run(3, 0, 1.0, bare),))
+    assert "LAMA" not in tables.lengths_table(without)

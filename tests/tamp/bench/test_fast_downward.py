@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 import tempfile
 import time
@@ -10,6 +11,7 @@ from pathlib import Path
 import pytest
 
 from tamp.bench import fast_downward
+from tamp.cli import main
 from task import data
 from task.domains import blocksworld
 from task.errors import DataError
@@ -148,3 +150,42 @@ def _dead(pid: int) -> bool:
     except FileNotFoundError:
         return True
     return stat.rsplit(")", 1)[1].split()[0] in ("Z", "X")
+
+
+@_installed
+def test_lama_plans_a_tiny_problem(tmp_path, monkeypatch):
+    """LAMA's first plan (satisficing; under a second): a length no shorter than the optimum."""
+    problem = random_problem(4, 5)
+    (tmp_path / "tmp").mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    result = fast_downward.lama_length(
+        data.read_text(data.DOMAIN_FILE), blocksworld.to_pddl(problem), time_limit_s=20
+    )
+    assert result.status == "solved", result.detail
+    assert result.length % 2 == 0 and result.length >= 2 * len(optimal_moves(problem)) > 0
+    assert not any((tmp_path / "tmp").iterdir())  # Fast Downward's files are gone
+
+
+@_installed
+def test_bench_random_puts_lama_beside_ours(tmp_path, capsys):
+    argv = ["bench", "random", "--blocks", "3", "--n", "2", "--restarts", "8", "--lama"]
+    assert main([*argv, "--one-at-a-time", "--no-progress", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "LAMA moves" in out and "ours/LAMA" in out
+    with (tmp_path / "instances.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert all(int(r["lama_length"]) >= int(r["optimal"]) and float(r["lama_s"]) > 0 for r in rows)
+    by_size = json.loads((tmp_path / "results.json").read_text())["by_size"]
+    assert by_size[0]["lama"] == 2 and by_size[0]["lama_ratio"] >= 1.0
+    assert json.loads((tmp_path / "results.json").read_text())["config"]["batched"] is False
+
+
+def test_bench_random_without_fast_downward_skips_lama(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(fast_downward, "_driver", lambda: None)
+    argv = ["bench", "random", "--blocks", "3", "--n", "1", "--restarts", "8", "--lama"]
+    assert main([*argv, "--no-progress", "--out", str(tmp_path)]) == 0
+    captured = capsys.readouterr()
+    assert "LAMA skipped: Fast Downward is not installed" in captured.err
+    assert "LAMA" not in captured.out
+    with (tmp_path / "instances.csv").open(newline="") as handle:
+        assert [r["lama_length"] for r in csv.DictReader(handle)] == [""]
