@@ -105,7 +105,7 @@ class _Placed:
         table = self.places[:, n:] + torch.nn.functional.pad(shift, (0, 1))  # (P, K, 3)
         places = torch.cat([self.places[:, :n], table], dim=1)  # (P, Y, 3)
         c = move_costs_batch(o.solver, o.q_now, self.picks, places, o.config,
-                             obstacle_boxes(o.scene), self.solved)  # fmt: skip
+                             o.boxes, self.solved)  # fmt: skip
         return c + self.extra  # (P, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
@@ -133,6 +133,7 @@ class ArmCosts:
         self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
         self.reach = reach  # m: how far a block may go from its place's centre (0: fixed)
+        self.boxes = obstacle_tensors(scene)  # the collision proxy's obstacles, made once
         self._offsets: dict[int, torch.Tensor] = {}  # problem -> (K, 2) unbounded parameters
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
 
@@ -171,7 +172,7 @@ class ArmCosts:
         picks, places, extra = self._inputs(todo)
         with torch.no_grad():
             c = move_costs_batch(
-                self.solver, self.q_now, picks, places, self.config, obstacle_boxes(self.scene)
+                self.solver, self.q_now, picks, places, self.config, self.boxes
             )  # (P, N, Y)
         return list(c + extra)
 
@@ -256,7 +257,7 @@ def _column(problem: Problem, key, at) -> int | None:
     return problem.n + near[0] if near else None
 
 
-def obstacle_boxes(scene: SceneConfig) -> tuple[torch.Tensor, torch.Tensor]:
+def obstacle_tensors(scene: SceneConfig) -> tuple[torch.Tensor, torch.Tensor]:
     """The scene's obstacles as axis-aligned boxes (centres (O, 3), half extents (O, 3)) for
     the collision proxy; a turned box is replaced by its axis-aligned bounding box."""
     centres, half = [], []

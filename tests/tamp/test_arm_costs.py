@@ -97,7 +97,7 @@ def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places
 
 def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver):
     from motion.cost import MoveCostConfig
-    from tamp.arm_costs import ARM, obstacle_boxes
+    from tamp.arm_costs import ARM, obstacle_tensors
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
     costs = {}
@@ -106,7 +106,7 @@ def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver
         for cfg in (ARM, MoveCostConfig()):
             source = ArmCosts([FOUR], [poses], scene, solver, PANDA.q_home, config=cfg)
             costs[name, cfg.collision_weight] = source([0], [FOUR.init]).compute()[0]
-    assert obstacle_boxes(with_scene(SCENE, "tabletop"))[0].shape == (0, 3)
+    assert obstacle_tensors(with_scene(SCENE, "tabletop"))[0].shape == (0, 3)
     assert torch.equal(costs["tabletop", 5.0], costs["tabletop", 0.0])
     extra = costs["clutter", 5.0] - costs["clutter", 0.0]
     assert (extra >= 0).all() and (extra > 0.05).any()

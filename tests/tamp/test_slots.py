@@ -21,10 +21,7 @@ from tamp.slots import PlacedMove, places, plain_move, plan_on_places, slotted
 from task.config import PlannerConfig
 from task.domains import blocksworld as bw
 from task.problem import TABLE, Move, Problem
-
-SCENE = SceneConfig()
-FOUR = Problem("four", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
-               (("b", "c"),))  # fmt: skip
+from tests.tamp.test_arm_costs import FOUR, SCENE  # the same four-block layout
 
 
 @pytest.fixture(scope="module")
