@@ -97,3 +97,44 @@ def log_any(F: Tensor, goal: Tensor) -> Tensor:
     tiny = torch.finfo(F.dtype).tiny
     log_f = torch.log(F.clamp_min(tiny))
     return torch.logsumexp(log_f.masked_fill(goal <= 0, -1e30), dim=-1)
+
+
+def log_chain(
+    log_f: Tensor, log_on_goal: Tensor, has_goal: Tensor, goal_block: Tensor, sweeps: Tensor
+) -> Tensor:
+    """A soft "never has to move again", log w (B, N), by its recursion in log space.
+
+    log_f: (B, N, Y) log support matrix, Y = N + K (the K fixed targets have log wbar = 0);
+    log_on_goal: (B, N) the log mass of each goal row on its goal; has_goal: (B, N) bool, the
+    goal rows; goal_block: (B, N, N) one-hot goal support of goal rows whose goal is a block
+    (zero rows otherwise); sweeps: (B, 1) how many sweeps each batch row gets. Starting from
+    lw = 0, every sweep sets
+
+        goal rows:  lw(x) = log_on_goal(x) + lw(g(x))        (lw(fixed target) = 0)
+        free rows:  lw(x) = logsumexp_y (log_f[x, y] + lw(y))
+
+    Goal rows read lw(g(x)) by a gather, O(N) a sweep, and only the free rows pay the
+    logsumexp over Y: a sweep costs O(B F Y) for F free rows instead of O(B N Y). The sweeps
+    stop early once an iterate equals the one before exactly: every later one would be the
+    same, so the result is that of all ``sweeps`` sweeps.
+    """
+    b, n, y = log_f.shape
+    block_goal = goal_block.sum(-1) > 0  # (B, N)
+    target = goal_block.argmax(-1)  # (B, N) g(x) where it is a block
+    order = torch.argsort(has_goal.to(torch.int8), dim=-1, stable=True)  # free rows first
+    n_free = int((~has_goal).sum(-1).max()) if n else 0
+    rows = order[:, :n_free]  # (B, F): every free row, padded with goal rows
+    log_f_free = log_f.gather(1, rows[..., None].expand(b, n_free, y))  # (B, F, Y)
+    zeros = torch.zeros_like(log_f[:, 0, n:])  # (B, K): lw of the fixed targets
+    lw = torch.zeros_like(log_on_goal)
+    for k in range(n):
+        below = torch.where(block_goal, lw.gather(-1, target), torch.zeros_like(lw))
+        goal_term = log_on_goal + below  # (B, N)
+        lwbar = torch.cat([lw, zeros], dim=-1).unsqueeze(-2)  # (B, 1, Y)
+        free = torch.logsumexp(log_f_free + lwbar, dim=-1)  # (B, F)
+        free_term = torch.zeros_like(lw).scatter(1, rows, free)  # (B, N), goal rows unused
+        new = torch.where(k < sweeps, torch.where(has_goal, goal_term, free_term), lw)
+        if torch.equal(new, lw):
+            break
+        lw = new
+    return lw

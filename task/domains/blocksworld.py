@@ -27,6 +27,7 @@ from task.soft import (
     exclusive_support,
     goal_cross_entropy,
     log_any,
+    log_chain,
     row_normalise,
 )
 from task.symbolic.search import moves_lower_bound
@@ -169,7 +170,7 @@ def log_well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
     Goal blocks: w(x) = F[x, g(x)] * wbar(g(x)); blocks the goal leaves free:
     w(x) = sum_y F[x, y] wbar(y); wbar(table) = 1. Computed in log space (products along a
     tower of N blocks underflow otherwise). A problem of n blocks gets exactly n sweeps of the
-    recursion (its fixed point on crisp towers), whatever the padding.
+    recursion (its fixed point on crisp towers), whatever the padding (`task.soft.log_chain`).
     """
     n = batch.n
     sweeps = batch.entity_mask.sum(-1, keepdim=True)  # (B, 1) real blocks per row
@@ -178,14 +179,7 @@ def log_well_placed(F: Tensor, batch: SoftBatch) -> Tensor:
     log_on_goal = (log_f * batch.goal).sum(-1)  # log F[x, g(x)], (B, N)
     if "one" in batch.static:
         log_on_goal = log_any(F, batch.goal)  # "on the table": on any slot
-    lw = torch.zeros_like(log_on_goal)
-    zeros = torch.zeros_like(F[:, 0, n:])  # (B, K): log wbar(table) = 0
-    for k in range(n):
-        lwbar = torch.cat([lw, zeros], dim=-1).unsqueeze(-2)  # (B, 1, Y)
-        goal_term = log_on_goal + (batch.goal * lwbar).sum(-1)  # (B, N)
-        free_term = torch.logsumexp(log_f + lwbar, dim=-1)  # (B, N)
-        lw = torch.where(k < sweeps, torch.where(has_goal, goal_term, free_term), lw)
-    return lw
+    return log_chain(log_f, log_on_goal, has_goal, batch.goal[..., :n], sweeps)
 
 
 def tower_cross_entropy(F: Tensor, batch: SoftBatch) -> Tensor:
