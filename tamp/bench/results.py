@@ -20,7 +20,7 @@ from dataclasses import asdict, fields
 from pathlib import Path
 
 from tamp.bench.planning import Bench, Row
-from tamp.bench.summary import main_rows, size_rows
+from tamp.bench.summary import latency_rows, main_rows, size_rows
 from task.errors import TampError
 
 
@@ -56,6 +56,7 @@ def results(bench: Bench) -> dict:
         "summary": [s.asdict() for s in main_rows(bench)],
         "size_name": bench.size_name,
         "by_size": [s.asdict() for s in size_rows(bench)],
+        "latency_by_size": latency_rows(bench),
         "speed": speed,
     }
 

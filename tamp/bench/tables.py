@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from tamp.bench.planning import Bench
-from tamp.bench.summary import Summary, main_rows, size_rows
+from tamp.bench.summary import Summary, latency_rows, main_rows, size_rows
 
 # the rows LatPlan-40 tables cite beside ours: (row, valid, optimal)
 LATPLAN_CITED = (
@@ -268,6 +268,12 @@ def lengths_table(bench: Bench) -> str:
         body.append(row)
     note = "moves: mean over plans found; x opt: mean length / optimum where the optimum is known"
     note += "; ours/LAMA: mean length ratio where both found a plan" if lama else ""
+    latency = latency_rows(bench)
+    if latency:
+        rows = [[str(r["horizon"]), str(r["size"]), str(r["n"])]
+                + [f"{r[q]:.3f}" for q in ("p50", "p90", "max")] for r in latency]  # fmt: skip
+        note += f"\n\nplanning latency by {bench.size_name}, one problem at a time (s):\n"
+        note += table(["T", bench.size_name, "plans", "p50", "p90", "max"], rows)
     return table(head, body) + "\n" + note
 
 

@@ -11,7 +11,7 @@ from tamp.bench import planning as bench
 from tamp.bench import results as bench_io
 from tamp.bench import suites, tables
 from tamp.bench.planning import Row
-from tamp.bench.summary import main_rows, size_rows, summarise
+from tamp.bench.summary import latency_rows, main_rows, size_rows, summarise
 from task import data
 from task.config import PlannerConfig
 from task.errors import DataError
@@ -135,3 +135,19 @@ def test_lengths_are_summarised_against_the_optimum_and_lama():
     assert summarise(bare, 3, 0, None, None).lama is None  # LAMA did not run
     without = dataclasses.replace(result, runs=(bench.Run(3, 0, 1.0, bare),))
     assert "LAMA" not in tables.lengths_table(without)
+
+
+def test_one_at_a_time_runs_report_latency_percentiles_per_size():
+    def row(size, seconds):
+        return Row("i", size, None, None, 3, 0, 4, "valid", seconds, 1)
+
+    rows = tuple(row(5, 0.1 * k) for k in range(1, 11)) + (row(10, 2.0),)
+    alone = bench.Bench("t", "synthetic", 11, PlannerConfig(batched=False), (0,), (3,),
+                        (bench.Run(3, 0, 1.0, rows),))  # fmt: skip
+    five, ten = latency_rows(alone)
+    assert (five["size"], five["n"], five["max"]) == (5, 10, pytest.approx(1.0))
+    assert (five["p50"], five["p90"]) == (pytest.approx(0.6), pytest.approx(1.0))
+    assert ten == {"horizon": 3, "size": 10, "n": 1, "p50": 2.0, "p90": 2.0, "max": 2.0}
+    assert "planning latency by blocks" in tables.lengths_table(alone)
+    batched = dataclasses.replace(alone, config=PlannerConfig())
+    assert latency_rows(batched) == [] and "latency" not in tables.lengths_table(batched)
