@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 from pddl.core import Domain
@@ -38,7 +38,10 @@ def _write(path: Path, text: str) -> None:
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan)."""
     config = planner_config(args, instance.problem.domain)
-    result = plan(instance.problem, config, args.seed, costs=_arm_costs(instance.problem, args))
+    if getattr(args, "lambda_motion", None):
+        result = _plan_on_table(instance.problem, config, args)
+    else:
+        result = plan(instance.problem, config, args.seed)
     actions: tuple = ()
     validation = None
     if result.solved:
@@ -49,23 +52,23 @@ def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     return config, result, actions, validation
 
 
-def _arm_costs(problem, args: argparse.Namespace):
-    """``--motion-aware``: the arm's move costs with the problem laid out on ``--scene``
-    (seeded by ``--seed``), the arm at home; None otherwise."""
-    if not getattr(args, "lambda_motion", None):
-        return None
+def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> PlanResult:
+    """``--motion-aware``: plan with the arm's move costs, the problem laid out on ``--scene``
+    (seeded by ``--seed``), the arm at home, on the scene's table slots (`tamp.slots`): a
+    move onto the table carries the place it goes to."""
     if problem.domain != "blocksworld":
         raise TampError(f"--motion-aware prices arm moves of blocksworld problems on a table; "
                         f"this is a {problem.domain} problem")  # fmt: skip
     from motion.ik import IKSolver
     from robots.panda import PANDA
-    from tamp.arm_costs import ArmCosts
     from tamp.obstacles import with_scene
     from tamp.scene import SceneConfig, layout
+    from tamp.slots import plan_on_places
 
     scene = with_scene(SceneConfig(), args.scene)
     poses = layout(problem.entities, problem.init, scene, args.seed)
-    return ArmCosts([problem], [poses], scene, IKSolver(), PANDA.q_home)
+    found = plan_on_places(problem, poses, scene, IKSolver(), PANDA.q_home, config, args.seed)
+    return replace(found, problem=problem)
 
 
 def _plan_json(
@@ -93,8 +96,21 @@ def _plan_json(
 
 
 def _move_json(move: object) -> object:
-    """A relational move as ``[entity, target]``; any other move (a ground action) as text."""
-    return [move.entity, move.target] if isinstance(move, Move) else str(move).lower()
+    """A relational move as ``[entity, target]`` (``[entity, "table", [x, y]]`` when it names
+    its table place); any other move (a ground action) as text."""
+    if not isinstance(move, Move):
+        return str(move).lower()
+    at = getattr(move, "at", None)
+    return [move.entity, move.target] + ([[round(v, 4) for v in at]] if at is not None else [])
+
+
+def _places(result: PlanResult) -> str:
+    """One line naming where each move onto the table puts its block ("" when none does)."""
+    placed = [m for m in result.plan.moves if getattr(m, "at", None) is not None]
+    if not placed:
+        return ""
+    where = ", ".join(f"{m.entity} at ({m.at[0]:.2f}, {m.at[1]:.2f})" for m in placed)
+    return f"table places (m, base frame): {where}\n"
 
 
 def _outcome(result: PlanResult, validation: Validation | None, instance: Instance) -> str:
@@ -134,6 +150,7 @@ def plan_command(args: argparse.Namespace) -> int:
     else:
         if actions:
             print(pddl_io.format_plan(actions), end="")
+            print(_places(result), end="")
         print(_outcome(result, validation, instance))
     return 0 if validation is not None and validation.valid else 1
 

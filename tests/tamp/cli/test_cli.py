@@ -57,11 +57,18 @@ def test_plan_json_parses(capsys, files):
 
 
 def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(capsys, files, tmp_path):
+    files[1].write_text(data.read_text(data.EXAMPLE_FILE))  # unstacks onto the table
     args = ["plan", *map(str, files), *FAST, "--motion-aware", "--scene", "shelf", "--json"]
     assert main(args) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["status"] == "solved" and report["valid"]
     assert report["config"]["lambda_motion"] == 0.05
+    onto_table = [m for m in report["moves"] if m[1] == "table"]
+    assert onto_table and all(len(m) == 3 and len(m[2]) == 2 for m in onto_table)  # its place
+    places = {tuple(m[2]) for m in onto_table}
+    assert len(places) == len(onto_table)  # the example's blocks stay apart: one place each
+    assert main(["plan", *map(str, files), *FAST, "--motion-aware"]) == 0
+    assert "table places (m, base frame):" in capsys.readouterr().out
     gripper = tmp_path / "gripper.pddl"  # a STRIPS domain: not blocks on a table
     gripper.write_text(
         "(define (domain g) (:requirements :strips) (:predicates (at ?b) (held ?b) (free))\n"
