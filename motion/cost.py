@@ -32,18 +32,33 @@ are ignored), the hand yaw is 0 everywhere (a cube's yaw barely changes the join
 the release gap is ignored, and the straight joint segment stands in for the timed trajectory.
 That segment runs from block to block at table height, where the real move lifts first: the
 collision term prices a low sweep (the sphere model has open fingers and no held block).
+
+With ``blocks`` (the problems' blocks as axis-aligned boxes) and ``block_weight > 0`` the move
+also pays for the arm's clearance to the other blocks at its two ends only, Phi_b being the part
+of Phi due to block b (`motion.spheres.box_contacts`):
+
+            + block_weight * (sum_{b not in {x, under(x)}} Phi_b(q(p_x))
+                              + sum_{b not in {x, y}} Phi_b(q(u_y)))
+
+(a table target y stands for no block). At the grasp the fingers straddle x and come within
+the margin of the block under it; at the release x is in the hand and y under it. The segment
+between the ends is not priced against blocks: at table height it would cross towers the real
+move lifts over. The fingers are open at both ends: the hand comes down open to the grasp and
+opens at the release before it retreats (`motion.pick_place`). `block_term` also gives the
+deepest penetration into a counted block at either end, for a caller that rules moves out.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import torch
 
 from motion.errors import MotionError
 from motion.ik import IKSolver, ik_refine
-from motion.spheres import boxes, collision_cost
+from motion.spheres import box_contacts, boxes, collision_cost
 
 _TOP_DOWN = ((1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0))  # Rz(0) Rx(pi)
 
@@ -58,6 +73,18 @@ class MoveCostConfig:
     collision_weight: float = 0.0  # cost per m of Phi, the sphere model's obstacle cost (0: off)
     collision_margin: float = 0.02  # m, eps of Phi: the clearance below which a sphere costs
     collision_points: int = 5  # S configurations along the grasp -> release segment, ends included
+    block_weight: float = 0.0  # cost per m of Phi against the blocks at the two ends (0: off)
+
+
+class Blocks(NamedTuple):
+    """The N blocks of P problems as axis-aligned boxes, for the block term (module docstring).
+
+    Block x of problem p is the one picked at ``picks[p, x]``; a target y < N is that block.
+    """
+
+    centres: torch.Tensor  # (P, N, 3) m
+    half: torch.Tensor  # (P, N, 3) m, half extents (a turned block: its bounding box's)
+    under: torch.Tensor  # (P, N) long: the block x stands on, -1 on the table
 
 
 def top_down_targets(xyz: torch.Tensor) -> torch.Tensor:
@@ -93,6 +120,7 @@ def move_costs_batch(
     config: MoveCostConfig = MoveCostConfig(),
     obstacles: tuple | None = None,
     solved: tuple[torch.Tensor, torch.Tensor] | None = None,
+    blocks: Blocks | None = None,
 ) -> torch.Tensor:
     """Costs (P, N, Y) float64 of P problems at once: picks (P, N, 3), places (P, Y, 3).
 
@@ -101,7 +129,9 @@ def move_costs_batch(
     ``obstacles`` is (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the base
     frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing. ``solved``:
     the detached solutions of targets near these (`site_solutions`), reused instead of solving
-    (an optimiser moving the places a little calls this at every step).
+    (an optimiser moving the places a little calls this at every step). ``blocks``: the
+    problems' blocks, priced at the grasp and release configurations when
+    ``config.block_weight > 0`` (`block_term`).
     """
     picks = _points(picks, 3, "picks")  # (P, N, 3)
     places = _points(places, 3, "places")  # (P, Y, 3)
@@ -127,12 +157,17 @@ def move_costs_batch(
     q_pick, q_place = q[:, :n], q[:, n:]  # (P, N, J), (P, Y, J)
     dist = torch.linalg.vector_norm(q_place[:, None] - q_pick[:, :, None], dim=-1)  # (P, N, Y)
     cost = config.joint_weight * dist + site[:, :n, None] + site[:, None, n:]  # (P, N, Y)
-    if config.collision_weight == 0.0 or obstacles is None:
-        return cost
-    centres, half = boxes(*obstacles)
-    if centres.shape[0] == 0:
-        return cost
-    return cost + config.collision_weight * _sweep(solver, q, n, centres, half, config)
+    if config.collision_weight != 0.0 and obstacles is not None:
+        centres, half = boxes(*obstacles)
+        if centres.shape[0] > 0:
+            cost = cost + config.collision_weight * _sweep(solver, q, n, centres, half, config)
+    if config.block_weight != 0.0 and blocks is not None:
+        if torch.as_tensor(blocks.centres).shape[1:2] != (n,):
+            raise MotionError(f"blocks have centres {tuple(blocks.centres.shape)}; expected "
+                              f"({p}, {n}, 3), one per pick")  # fmt: skip
+        term = block_term(solver, q, blocks, config.collision_margin)
+        cost = cost + config.block_weight * term.cost
+    return cost
 
 
 def _sweep(solver, q, n: int, centres, half, config: MoveCostConfig) -> torch.Tensor:
@@ -154,6 +189,60 @@ def _sweep(solver, q, n: int, centres, half, config: MoveCostConfig) -> torch.Te
     ends = phi[: p * (n + y)].reshape(p, n + y)  # (P, N + Y)
     mid = phi[p * (n + y) :].reshape(p, n, y, n_s - 2).sum(-1)  # (P, N, Y)
     return (ends[:, :n, None] + ends[:, None, n:] + mid) / n_s  # (P, N, Y)
+
+
+class BlockTerm(NamedTuple):
+    """The block term of every move x -> y (see the module docstring)."""
+
+    cost: torch.Tensor  # (P, N, Y) m: Phi against the counted blocks, grasp plus release end
+    depth: torch.Tensor  # (P, N, Y) m, detached: the deepest penetration into a counted block
+
+
+def block_term(solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float = 0.02
+               ) -> BlockTerm:  # fmt: skip
+    """`BlockTerm` of the grasp configurations ``q[:, :N]`` and the release configurations
+    ``q[:, N:]`` (q: (P, N + Y, J)) against ``blocks``, fingers open at both ends.
+
+    One `motion.spheres.box_contacts` call over the P (N + Y) configurations, each against its
+    own problem's N boxes; the sums over the counted blocks are masked (P, N, Y, N) sums.
+    """
+    c, h = (torch.as_tensor(t, dtype=torch.float64) for t in blocks[:2])
+    under, (p, sites, j) = torch.as_tensor(blocks.under), q.shape
+    n = c.shape[1] if c.ndim == 3 else -1
+    if tuple(c.shape) != (p, n, 3) or tuple(h.shape) != (p, n, 3) or n > sites:
+        raise MotionError(f"blocks have centres {tuple(c.shape)}, half extents {tuple(h.shape)}"
+                          f"; expected (P, N, 3) each, P = {p}, N <= {sites}")  # fmt: skip
+    if tuple(under.shape) != (p, n) or not ((under >= -1) & (under < n)).all():
+        raise MotionError(f"blocks.under must be (P, N) = {(p, n)} indices in -1..{n - 1}")
+    y = sites - n
+    if n == 0:
+        zero = torch.zeros((p, 0, y), dtype=torch.float64)
+        return BlockTerm(zero, zero)
+    expand = (p, sites, n, 3)
+    found = box_contacts(solver, q.reshape(-1, j), c[:, None].expand(expand).reshape(-1, n, 3),
+                         h[:, None].expand(expand).reshape(-1, n, 3), margin)  # fmt: skip
+    cost, depth = (t.reshape(p, sites, n) for t in found)  # (P, N + Y, N): site by block
+    eye = torch.eye(n, dtype=torch.bool)  # (N, N): x == b
+    b = torch.arange(n)
+    keep_pick = ~eye & (under[:, :, None] != b)  # (P, N, N): neither x nor the block under x
+    keep_place = ~eye[:, None] & (torch.arange(y)[:, None] != b)  # (N, Y, N): neither x nor y
+    pick_cost = torch.where(keep_pick, cost[:, :n], 0.0).sum(-1)  # (P, N)
+    place_cost = torch.where(keep_place, cost[:, None, n:], 0.0).sum(-1)  # (P, N, Y)
+    pick_depth = torch.where(keep_pick, depth[:, :n], 0.0).amax(-1)  # (P, N)
+    place_depth = torch.where(keep_place, depth[:, None, n:], 0.0).amax(-1)  # (P, N, Y)
+    return BlockTerm(pick_cost[:, :, None] + place_cost,
+                     torch.maximum(pick_depth[:, :, None], place_depth))  # fmt: skip
+
+
+def block_depths(solver: IKSolver, solved, blocks: Blocks) -> torch.Tensor:
+    """(P, N, Y) `BlockTerm.depth` at the detached solutions ``solved`` (`site_solutions`),
+    0 for a move whose grasp or release IK failed (the arm never takes that configuration)."""
+    q_star, ok = solved
+    p, n = blocks.centres.shape[:2]
+    with torch.no_grad():
+        depth = block_term(solver, q_star.reshape(p, -1, q_star.shape[-1]), blocks).depth
+    ok = ok.reshape(p, -1)  # (P, N + Y)
+    return torch.where(ok[:, :n, None] & ok[:, None, n:], depth, 0.0)  # (P, N, Y)
 
 
 def site_solutions(

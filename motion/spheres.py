@@ -21,9 +21,15 @@ differentiable, exactly zero with more than ``eps`` clearance, and with a bounde
 however deep a sphere is. Every vertex of the collision meshes lies within 2 cm of a sphere
 (1.7 cm at most at q_home; tests/motion/test_spheres.py), so with ``eps`` of 2 cm Phi is > 0
 about when the meshes come within reach of a box. A held block is not modelled.
+
+`box_contacts` splits Phi by box, Phi_o(q) = sum_s h(sdf_o(x_s(q)) - r_s) (so Phi = sum_o Phi_o),
+and gives the deepest penetration max_s (r_s - sdf_o(x_s(q))) (0 when clear) of each box, for
+boxes shared by all configurations (O, 3) or one set per configuration (B, O, 3).
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import torch
 
@@ -109,6 +115,41 @@ def chomp_potential(dist: torch.Tensor, margin: float) -> torch.Tensor:
     return torch.where(dist < 0, margin / 2.0 - dist, quad)
 
 
+class Contacts(NamedTuple):
+    """The sphere model at B configurations against O boxes, box by box."""
+
+    cost: torch.Tensor  # (B, O) m: sum_s h(sdf_o(x_s(q)) - r_s), Phi split by box
+    depth: torch.Tensor  # (B, O) m, detached: max_s (r_s - sdf_o(x_s(q))), 0 when clear
+
+
+def _pairs(solver, q, centres, half, margin: float, finger: float):
+    """Flat indices (M,) into B * O and the CHOMP cost (M,) of the M (configuration, box) pairs
+    with a sphere closer than ``margin``, and the detached depth (B, O); ``centres`` and
+    ``half`` are (O, 3), or (B, O, 3) for boxes of each configuration's own."""
+    x = sphere_positions(solver, q, finger)  # (B, G, 3)
+    c, h = _batched_boxes(centres, half, x.shape[0])  # (B, O, 3) each
+    o_count = c.shape[1]
+    with torch.no_grad():
+        gap = _sdf(x[:, :, None], c[:, None], h[:, None]) - RADII[:, None]  # (B, G, O)
+        near = gap < margin
+        depth = (-gap).amax(1).clamp(min=0.0)  # (B, O)
+    b, s, o = near.nonzero(as_tuple=True)  # (M,) each: the M pairs that cost
+    clearance = _sdf(x[b, s], c[b, o], h[b, o]) - RADII[s]  # (M,)
+    return b, b * o_count + o, chomp_potential(clearance, margin), depth
+
+
+def _batched_boxes(centres, half, n: int) -> tuple[torch.Tensor, torch.Tensor]:
+    """Checked boxes as (B, O, 3) each from (O, 3) (shared) or (B, O, 3) (one set per row)."""
+    c = torch.as_tensor(centres)
+    if c.ndim != 3:
+        return tuple(t.expand(n, -1, -1) for t in boxes(centres, half))
+    c = _tensor(c, (n, None, 3), "box centres")
+    h = _tensor(half, tuple(c.shape), "box half extents")
+    if (h <= 0).any():
+        raise MotionError("box half extents must be > 0 m")
+    return c, h
+
+
 def collision_cost(
     solver: IKSolver,
     q: torch.Tensor,
@@ -121,12 +162,37 @@ def collision_cost(
 
     All (sphere, box) pairs are measured without a graph; only the pairs closer than the margin
     (h > 0) are measured again with one, so the gradient costs little and is still exact.
+    The boxes may also be (B, O, 3) each: row b of q against its own O boxes.
     """
-    c, h = boxes(centres, half)
-    x = sphere_positions(solver, q, finger)  # (B, G, 3)
-    with torch.no_grad():
-        near = box_sdf(x, c, h) - RADII[:, None] < margin  # (B, G, O)
-    b, s, o = near.nonzero(as_tuple=True)  # (M,) each: the M pairs that cost
-    clearance = _sdf(x[b, s], c[o], h[o]) - RADII[s]  # (M,)
-    phi = chomp_potential(clearance, margin)  # (M,)
-    return torch.zeros(x.shape[0], dtype=x.dtype).index_add(0, b, phi)  # (B,)
+    b, _, phi, depth = _pairs(solver, q, centres, half, margin, finger)
+    return torch.zeros(depth.shape[0], dtype=phi.dtype).index_add(0, b, phi)  # (B,)
+
+
+def box_contacts(
+    solver: IKSolver,
+    q: torch.Tensor,
+    centres: torch.Tensor,
+    half: torch.Tensor,
+    margin: float = 0.02,
+    finger: float = PANDA.finger_open,
+) -> Contacts:
+    """`collision_cost` box by box: Phi_o(q) (B, O), with sum_o Phi_o(q) = Phi(q), and the
+    deepest sphere's penetration into each box (B, O), one forward kinematics for both.
+
+    Boxes (O, 3) each, or (B, O, 3) each for one set per configuration (e.g. per problem).
+    """
+    _, flat, phi, depth = _pairs(solver, q, centres, half, margin, finger)
+    cost = torch.zeros(depth.numel(), dtype=phi.dtype).index_add(0, flat, phi)  # (B * O,)
+    return Contacts(cost.reshape(depth.shape), depth)  # (B, O) each
+
+
+def collision_cost_per_box(
+    solver: IKSolver,
+    q: torch.Tensor,
+    centres: torch.Tensor,
+    half: torch.Tensor,
+    margin: float = 0.02,
+    finger: float = PANDA.finger_open,
+) -> torch.Tensor:
+    """Phi_o(q) (B, O) in m: `collision_cost` split by box (see `box_contacts`)."""
+    return box_contacts(solver, q, centres, half, margin, finger).cost

@@ -9,7 +9,15 @@ import pytest
 import torch
 
 from motion.errors import MotionError
-from motion.spheres import RADII, box_sdf, chomp_potential, collision_cost, sphere_positions
+from motion.spheres import (
+    RADII,
+    box_contacts,
+    box_sdf,
+    chomp_potential,
+    collision_cost,
+    collision_cost_per_box,
+    sphere_positions,
+)
 from robots.panda import PANDA, data_dir
 from robots.panda_spheres import FINGERS, SPHERES
 
@@ -98,6 +106,41 @@ def test_a_step_against_the_gradient_moves_the_arm_out_of_the_box(solver):
     assert collision_cost(solver, step, centre, half)[0] < phi.detach()
 
 
+def _three_boxes(solver):
+    """Boxes (3, 3) x 2: one deep in the arm at q_home, one grazing it, one far away."""
+    centre, half = _box_at_link4(solver, half=0.04)
+    x = sphere_positions(solver, HOME)[0]  # (G, 3)
+    k = int((x[:, 2] - RADII).argmin())  # the lowest sphere: a fingertip
+    graze = x[k : k + 1] - _t([[0.0, 0.0, RADII[k] + 0.01 + 0.04]])  # 1 cm under it
+    centres = torch.cat([centre + _t([[0.01, -0.02, 0.0]]), graze, _t([[2.0, 2.0, 0.5]])])
+    return centres, half.expand(3, 3)
+
+
+def test_the_per_box_costs_sum_to_phi_and_the_depth_is_the_deepest_sphere(solver):
+    centres, half = _three_boxes(solver)
+    q = torch.cat([HOME, _t([Q_SOME])])  # (2, J)
+    per_box = collision_cost_per_box(solver, q, centres, half)  # (2, 3)
+    assert per_box.shape == (2, 3) and per_box[0, 0] > 0 and per_box[0, 1] > 0
+    assert (per_box[:, 2] == 0).all()
+    torch.testing.assert_close(per_box.sum(1), collision_cost(solver, q, centres, half),
+                               atol=1e-14, rtol=0)  # fmt: skip
+    depth = box_contacts(solver, q, centres, half).depth  # (2, 3)
+    gap = box_sdf(sphere_positions(solver, q), centres, half) - RADII[:, None]  # (2, G, 3)
+    torch.testing.assert_close(depth, (-gap).amax(1).clamp(min=0.0), atol=0, rtol=0)
+    assert depth[0, 0] > 0.05 and depth[0, 1] == 0 and not depth.requires_grad
+
+
+def test_boxes_of_each_configuration_match_shared_boxes_row_by_row(solver):
+    centres, half = _three_boxes(solver)
+    q = torch.cat([HOME, _t([Q_SOME])]).requires_grad_()  # (2, J)
+    own = torch.stack([centres, centres + _t([[0.0, 0.0, 5.0]])])  # (2, 3, 3): row 1's far off
+    got = collision_cost_per_box(solver, q, own, half.expand(2, 3, 3))  # (2, 3)
+    torch.testing.assert_close(got[0], collision_cost_per_box(solver, q[:1], centres, half)[0])
+    assert (got[1] == 0).all()
+    (grad,) = torch.autograd.grad(got.sum(), q)
+    assert grad[0].norm() > 0 and (grad[1] == 0).all()
+
+
 @pytest.mark.parametrize(
     ("q", "centres", "half", "message"),
     [
@@ -106,11 +149,15 @@ def test_a_step_against_the_gradient_moves_the_arm_out_of_the_box(solver):
         (HOME, torch.zeros(2, 3), torch.ones(1, 3), "box half extents has shape"),
         (HOME, torch.zeros(1, 3), torch.zeros(1, 3), "must be > 0"),
         (HOME, torch.full((1, 3), math.nan), torch.ones(1, 3), "contains NaN"),
+        (HOME, torch.zeros(2, 1, 3), torch.ones(2, 1, 3), "box centres has shape"),
+        (HOME, torch.zeros(1, 2, 3), torch.ones(1, 3, 3), "box half extents has shape"),
     ],
 )
 def test_misuse_names_the_bad_input(solver, q, centres, half, message):
     with pytest.raises(MotionError, match=message):
         collision_cost(solver, q, centres, half)
+    with pytest.raises(MotionError, match=message):
+        collision_cost_per_box(solver, q, centres, half)
 
 
 def test_a_margin_of_zero_is_refused():

@@ -4,13 +4,15 @@ them."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, ArmCosts, predict_poses
+from tamp.arm_costs import ARM, BLOCKED, ArmCosts, predict_poses
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
 from tamp.scene import SceneConfig, layout
@@ -96,14 +98,13 @@ def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places
 
 
 def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver):
-    from motion.cost import MoveCostConfig
-    from tamp.arm_costs import ARM, obstacle_tensors
+    from tamp.arm_costs import obstacle_tensors
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
     costs = {}
     for name in ("tabletop", "clutter"):
         scene = with_scene(SCENE, name)
-        for cfg in (ARM, MoveCostConfig()):
+        for cfg in (ARM, replace(ARM, collision_weight=0.0)):
             source = ArmCosts([FOUR], [poses], scene, solver, PANDA.q_home, config=cfg)
             costs[name, cfg.collision_weight] = source([0], [FOUR.init]).compute()[0]
     assert obstacle_tensors(with_scene(SCENE, "tabletop"))[0].shape == (0, 3)
@@ -131,3 +132,45 @@ def test_a_place_the_hand_cannot_reach_at_hover_height_is_ruled_out(solver):
         assert len(far) == 2
         top = problem.entities[-1]  # the block on top, free to move
         assert (matrix[problem.entities.index(top), far] >= BLOCKED).all() == blocked
+
+
+def _behind(near: int):
+    """On the cramped table: a tower of ``near`` blocks in the middle row (0.56, -0.12), one
+    block behind it in the far row (0.72, -0.12) and one to move at (0.40, 0.12); the slotted
+    problem, its places, the poses, and the indices of the moving block and the far one."""
+    from tamp.slots import slotted
+
+    cramped = with_scene(SCENE, "cramped")
+    names = tuple("abcdefgh"[: near + 2])
+    init = (TABLE, *names[: near - 1], TABLE, TABLE)  # the tower, the far block, the mover
+    problem = Problem("behind", "blocksworld", names, init, ((names[-1], names[-2]),))
+    poses = layout(names, init, cramped, seed=0, slots=[2, 4, 1])
+    current, at = slotted(problem, init, poses, cramped)
+    return cramped, current, at, poses, near + 1, near
+
+
+@pytest.mark.parametrize(("near", "blocked"), [(6, True), (3, False)])
+def test_a_release_behind_a_tall_near_tower_is_ruled_out(solver, near, blocked):
+    # the executor's guard finds the forearm in the near tower for 6 blocks (both grasps)
+    cramped, current, at, poses, mover, far = _behind(near)
+    costs = {}
+    for weight in (ARM.block_weight, 0.0):
+        source = ArmCosts([current], [poses], cramped, solver, PANDA.q_home,
+                          config=replace(ARM, block_weight=weight), places=[at])  # fmt: skip
+        costs[weight] = source([0], [current.init]).compute()[0]
+    assert bool(costs[ARM.block_weight][mover, far] >= BLOCKED) == blocked
+    assert costs[0.0][mover, far] < BLOCKED  # without the blocks in the proxy: never
+    extra = costs[ARM.block_weight] - costs[0.0]
+    assert (extra >= 0).all() and (extra[mover, far] > 0) == blocked
+
+
+def test_a_placed_window_at_zero_offsets_prices_like_a_fixed_one_blocks_included(solver):
+    cramped, current, at, poses, mover, far = _behind(6)
+    fixed = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at])
+    placed = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at], reach=0.03)
+    window = placed([0], [current.init])
+    c = window.compute()
+    torch.testing.assert_close(c, fixed([0], [current.init]).compute(), atol=1e-9, rtol=0)
+    assert c[0, mover, far] >= BLOCKED
+    (grad,) = torch.autograd.grad(c[0, mover, current.n :].sum(), window.parameters())
+    assert torch.isfinite(grad).all()

@@ -141,7 +141,7 @@ def test_one_at_a_time_runs_report_latency_percentiles_per_size():
     def row(size, seconds):
         return Row("i", size, None, None, 3, 0, 4, "valid", seconds, 1)
 
-    rows = tuple(row(5, 0.1 * k) for k in range(1, 11)) + (row(10, 2.0),)
+    rows = (*(row(5, 0.1 * k) for k in range(1, 11)), row(10, 2.0))
     alone = bench.Bench("t", "synthetic", 11, PlannerConfig(batched=False), (0,), (3,),
                         (bench.Run(3, 0, 1.0, rows),))  # fmt: skip
     five, ten = latency_rows(alone)
