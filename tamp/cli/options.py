@@ -20,7 +20,7 @@ GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
 
 _OVERRIDES = (
     "horizon", "restarts", "iters", "goal_loss", "lookahead_share", "tau_end", "crisp_check",
-    "lookahead", "max_windows", "time_limit_s", "lambda_motion",
+    "lookahead", "max_windows", "time_limit_s", "lambda_motion", "park_free",
 )  # fmt: skip
 
 
@@ -138,14 +138,13 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         help=f"share of restarts whose window is {d.lookahead} moves long "
         f"({d.lookahead_share:g}; 0 = the paper's planner)",
     )
-    g.add_argument(
-        "--lookahead", type=positive, metavar="T",
-        help=f"window length of the long-lookahead restarts ({d.lookahead})",
-    )  # fmt: skip
-    g.add_argument(
-        "--max-windows", type=positive, metavar="W",
-        help=f"replanning windows before giving up ({d.max_windows})",
-    )  # fmt: skip
+    g.add_argument("--lookahead", type=positive, metavar="T",
+                   help=f"length of the long-lookahead windows ({d.lookahead})")  # fmt: skip
+    g.add_argument("--max-windows", type=positive, metavar="W",
+                   help=f"replanning windows before giving up ({d.max_windows})")  # fmt: skip
+    g.add_argument("--park-free", action="store_const", const=True, help="rank windows with "
+                   "moves to the table free (faster on big Blocksworld problems, plans a little "
+                   "longer; off)")  # fmt: skip
     g.add_argument(
         "--time-limit", dest="time_limit_s", type=seconds, metavar="SECONDS",
         help="stop planning at this wall-clock limit with the moves so far, and say so (none)",

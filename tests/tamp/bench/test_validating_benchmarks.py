@@ -122,6 +122,9 @@ def test_no_crisp_check_reaches_the_planner_config(suite):
     assert planner_config(parser.parse_args(["bench", suite])).crisp_check is True
     off = parser.parse_args(["bench", suite, "--no-crisp-check"])
     assert planner_config(off).crisp_check is False
+    assert planner_config(parser.parse_args(["bench", suite])).park_free is False
+    parked = parser.parse_args(["bench", suite, "--park-free"])
+    assert planner_config(parked, "blocksworld").park_free is True
 
 
 def test_crisp_protocols_parse_and_unknown_ones_are_named():
