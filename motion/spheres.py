@@ -184,15 +184,3 @@ def box_contacts(
     _, flat, phi, depth = _pairs(solver, q, centres, half, margin, finger)
     cost = torch.zeros(depth.numel(), dtype=phi.dtype).index_add(0, flat, phi)  # (B * O,)
     return Contacts(cost.reshape(depth.shape), depth)  # (B, O) each
-
-
-def collision_cost_per_box(
-    solver: IKSolver,
-    q: torch.Tensor,
-    centres: torch.Tensor,
-    half: torch.Tensor,
-    margin: float = 0.02,
-    finger: float = PANDA.finger_open,
-) -> torch.Tensor:
-    """Phi_o(q) (B, O) in m: `collision_cost` split by box (see `box_contacts`)."""
-    return box_contacts(solver, q, centres, half, margin, finger).cost

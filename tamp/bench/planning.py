@@ -176,9 +176,7 @@ def run(
         cfg = replace(config, horizon=horizons[0])
         fast = run_once(suite, replace(cfg, batched=True), seeds[0], progress, subset)
         slow = run_once(suite, replace(cfg, batched=False), seeds[0], progress, subset)
-        times = sorted(r.time_s for r in slow.rows)
-        latency = {q: times[min(len(times) - 1, int(f * len(times)))] for q, f in
-                   (("p50", 0.5), ("p90", 0.9))} | {"max": times[-1]}  # fmt: skip
+        latency = percentiles([r.time_s for r in slow.rows])
         speed = Speed(len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s,
                       fast.valid(), slow.valid(), latency)  # fmt: skip
     n = len(suite.instances)
@@ -213,6 +211,14 @@ def with_lama(
         for run in bench.runs
     )  # fmt: skip
     return replace(bench, runs=runs)
+
+
+def percentiles(times: Sequence[float]) -> dict[str, float]:
+    """p50, p90 and max of per-problem planning times (s): a percentile is the sorted time at
+    index floor(f * count)."""
+    t = sorted(times)
+    cut = {q: t[min(len(t) - 1, int(f * len(t)))] for q, f in (("p50", 0.5), ("p90", 0.9))}
+    return cut | {"max": t[-1]}
 
 
 def total(n: int, seeds: int, horizons: int, sequential: int = 0) -> int:

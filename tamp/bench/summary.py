@@ -16,7 +16,7 @@ import statistics
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields
 
-from tamp.bench.planning import STATUSES, Bench, Row
+from tamp.bench.planning import STATUSES, Bench, Row, percentiles
 from task.errors import TampError
 
 
@@ -157,17 +157,14 @@ def size_rows(bench: Bench) -> list[Summary]:
 
 def latency_rows(bench: Bench) -> list[dict]:
     """Per (horizon, size): planning latency percentiles over every instance and seed, in s
-    (p50, p90, max; a percentile is the sorted time at index floor(f * count)). Meaningful
-    when each instance was planned alone (``batched=False``); [] for a batched run, whose
-    per-instance times are shares of a batch."""
+    (`planning.percentiles`). Meaningful when each instance was planned alone
+    (``batched=False``); [] for a batched run, whose per-instance times are shares of a batch."""
     if bench.config.batched:
         return []
     out = []
     for h in bench.horizons:
         rows = [r for run in bench.runs if run.horizon == h for r in run.rows]
         for b in sorted({r.size for r in rows}):
-            times = sorted(r.time_s for r in rows if r.size == b)
-            cut = {q: times[min(len(times) - 1, int(f * len(times)))] for q, f in
-                   (("p50", 0.5), ("p90", 0.9))}  # fmt: skip
-            out.append({"horizon": h, "size": b, "n": len(times), **cut, "max": times[-1]})
+            times = [r.time_s for r in rows if r.size == b]
+            out.append({"horizon": h, "size": b, "n": len(times), **percentiles(times)})
     return out

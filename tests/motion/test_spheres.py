@@ -15,7 +15,6 @@ from motion.spheres import (
     box_sdf,
     chomp_potential,
     collision_cost,
-    collision_cost_per_box,
     sphere_positions,
 )
 from robots.panda import PANDA, data_dir
@@ -119,7 +118,7 @@ def _three_boxes(solver):
 def test_the_per_box_costs_sum_to_phi_and_the_depth_is_the_deepest_sphere(solver):
     centres, half = _three_boxes(solver)
     q = torch.cat([HOME, _t([Q_SOME])])  # (2, J)
-    per_box = collision_cost_per_box(solver, q, centres, half)  # (2, 3)
+    per_box = box_contacts(solver, q, centres, half).cost  # (2, 3)
     assert per_box.shape == (2, 3) and per_box[0, 0] > 0 and per_box[0, 1] > 0
     assert (per_box[:, 2] == 0).all()
     torch.testing.assert_close(per_box.sum(1), collision_cost(solver, q, centres, half),
@@ -134,8 +133,8 @@ def test_boxes_of_each_configuration_match_shared_boxes_row_by_row(solver):
     centres, half = _three_boxes(solver)
     q = torch.cat([HOME, _t([Q_SOME])]).requires_grad_()  # (2, J)
     own = torch.stack([centres, centres + _t([[0.0, 0.0, 5.0]])])  # (2, 3, 3): row 1's far off
-    got = collision_cost_per_box(solver, q, own, half.expand(2, 3, 3))  # (2, 3)
-    torch.testing.assert_close(got[0], collision_cost_per_box(solver, q[:1], centres, half)[0])
+    got = box_contacts(solver, q, own, half.expand(2, 3, 3)).cost  # (2, 3)
+    torch.testing.assert_close(got[0], box_contacts(solver, q[:1], centres, half).cost[0])
     assert (got[1] == 0).all()
     (grad,) = torch.autograd.grad(got.sum(), q)
     assert grad[0].norm() > 0 and (grad[1] == 0).all()
@@ -157,7 +156,7 @@ def test_misuse_names_the_bad_input(solver, q, centres, half, message):
     with pytest.raises(MotionError, match=message):
         collision_cost(solver, q, centres, half)
     with pytest.raises(MotionError, match=message):
-        collision_cost_per_box(solver, q, centres, half)
+        box_contacts(solver, q, centres, half)
 
 
 def test_a_margin_of_zero_is_refused():
