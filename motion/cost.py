@@ -163,8 +163,10 @@ def move_costs_batch(
             cost = cost + config.collision_weight * _sweep(solver, q, n, centres, half, config)
     if config.block_weight != 0.0 and blocks is not None:
         if torch.as_tensor(blocks.centres).shape[1:2] != (n,):
-            raise MotionError(f"blocks have centres {tuple(blocks.centres.shape)}; expected "
-                              f"({p}, {n}, 3), one per pick")  # fmt: skip
+            raise MotionError(
+                f"blocks have centres {tuple(blocks.centres.shape)}; expected "
+                f"({p}, {n}, 3), one per pick"
+            )
         term = block_term(solver, q, blocks, config.collision_margin)
         cost = cost + config.block_weight * term.cost
     return cost
@@ -198,8 +200,9 @@ class BlockTerm(NamedTuple):
     depth: torch.Tensor  # (P, N, Y) m, detached: the deepest penetration into a counted block
 
 
-def block_term(solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float = 0.02
-               ) -> BlockTerm:  # fmt: skip
+def block_term(
+    solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float = 0.02
+) -> BlockTerm:
     """`BlockTerm` of the grasp configurations ``q[:, :N]`` and the release configurations
     ``q[:, N:]`` (q: (P, N + Y, J)) against ``blocks``, fingers open at both ends.
 
@@ -210,8 +213,10 @@ def block_term(solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float 
     under, (p, sites, j) = torch.as_tensor(blocks.under), q.shape
     n = c.shape[1] if c.ndim == 3 else -1
     if tuple(c.shape) != (p, n, 3) or tuple(h.shape) != (p, n, 3) or n > sites:
-        raise MotionError(f"blocks have centres {tuple(c.shape)}, half extents {tuple(h.shape)}"
-                          f"; expected (P, N, 3) each, P = {p}, N <= {sites}")  # fmt: skip
+        raise MotionError(
+            f"blocks have centres {tuple(c.shape)}, half extents {tuple(h.shape)}"
+            f"; expected (P, N, 3) each, P = {p}, N <= {sites}"
+        )
     if tuple(under.shape) != (p, n) or not ((under >= -1) & (under < n)).all():
         raise MotionError(f"blocks.under must be (P, N) = {(p, n)} indices in -1..{n - 1}")
     y = sites - n
@@ -219,8 +224,13 @@ def block_term(solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float 
         zero = torch.zeros((p, 0, y), dtype=torch.float64)
         return BlockTerm(zero, zero)
     expand = (p, sites, n, 3)
-    found = box_contacts(solver, q.reshape(-1, j), c[:, None].expand(expand).reshape(-1, n, 3),
-                         h[:, None].expand(expand).reshape(-1, n, 3), margin)  # fmt: skip
+    found = box_contacts(
+        solver,
+        q.reshape(-1, j),
+        c[:, None].expand(expand).reshape(-1, n, 3),
+        h[:, None].expand(expand).reshape(-1, n, 3),
+        margin,
+    )
     cost, depth = (t.reshape(p, sites, n) for t in found)  # (P, N + Y, N): site by block
     eye = torch.eye(n, dtype=torch.bool)  # (N, N): x == b
     b = torch.arange(n)
@@ -230,8 +240,9 @@ def block_term(solver: IKSolver, q: torch.Tensor, blocks: Blocks, margin: float 
     place_cost = torch.where(keep_place, cost[:, None, n:], 0.0).sum(-1)  # (P, N, Y)
     pick_depth = torch.where(keep_pick, depth[:, :n], 0.0).amax(-1)  # (P, N)
     place_depth = torch.where(keep_place, depth[:, None, n:], 0.0).amax(-1)  # (P, N, Y)
-    return BlockTerm(pick_cost[:, :, None] + place_cost,
-                     torch.maximum(pick_depth[:, :, None], place_depth))  # fmt: skip
+    return BlockTerm(
+        pick_cost[:, :, None] + place_cost, torch.maximum(pick_depth[:, :, None], place_depth)
+    )
 
 
 def block_depths(solver: IKSolver, solved, blocks: Blocks) -> torch.Tensor:

@@ -39,8 +39,9 @@ class CollisionModel(Protocol):
     def set_boxes(self, boxes: Sequence[Box]) -> None: ...
     def hold(self, size: float | None) -> None: ...
     def valid(self, q, fingers: float = ..., ignore=...) -> bool: ...
-    def check_path(self, path, fingers: float = ..., ignore=..., max_step: float = ...
-                   ) -> PathCheck: ...  # fmt: skip
+    def check_path(
+        self, path, fingers: float = ..., ignore=..., max_step: float = ...
+    ) -> PathCheck: ...
 
 
 @dataclass(frozen=True)
@@ -122,16 +123,18 @@ def _margin(model: CollisionModel, value: float):
         model.margin = before
 
 
-def _guard_phase(phase: Phase, model: CollisionModel, fingers: float, ignore, config: GuardConfig,
-                 seed: int):  # fmt: skip
+def _guard_phase(
+    phase: Phase, model: CollisionModel, fingers: float, ignore, config: GuardConfig, seed: int
+):
     """One arm phase against the model's current boxes and held block: (the phase to run, or a
     rerouted one, or None), the evidence of a collision, check and planning seconds."""
     start = time.perf_counter()
     free = phase.name in FREE_SPACE
     # the vertical phases move straight up or down beside blocks the move touches
     with _margin(model, model.margin if free else min(model.margin, config.vertical_margin)):
-        found = model.check_path(thin(phase.trajectory.positions, config.max_step), fingers,
-                                 ignore, config.max_step)  # fmt: skip
+        found = model.check_path(
+            thin(phase.trajectory.positions, config.max_step), fingers, ignore, config.max_step
+        )
     t_check = time.perf_counter() - start
     if found.ok:
         return phase, {}, t_check, 0.0
@@ -160,8 +163,9 @@ def _guard_phase(phase: Phase, model: CollisionModel, fingers: float, ignore, co
         evidence |= {"planner": found_path.failure, "checks": found_path.checks}
         return None, evidence, t_check, found_path.time_s
     trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
-    again = model.check_path(thin(trajectory.positions, config.max_step), fingers, ignore,
-                             config.max_step)  # fmt: skip
+    again = model.check_path(
+        thin(trajectory.positions, config.max_step), fingers, ignore, config.max_step
+    )
     if not again.ok:  # the planner checks at its own resolution; this is the final word
         evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
         return None, evidence, t_check, found_path.time_s

@@ -121,9 +121,12 @@ def load_many(paths: str | Sequence[str | Path]) -> SupportData:
         "parts": [{"file": str(p), **d.meta} for p, d in zip(paths, parts, strict=True)],
     }
     return SupportData(
-        images, np.concatenate([d.colours for d in parts]),
-        np.concatenate([d.supports for d in parts]), first.palette, meta,
-    )  # fmt: skip
+        images,
+        np.concatenate([d.colours for d in parts]),
+        np.concatenate([d.supports for d in parts]),
+        first.palette,
+        meta,
+    )
 
 
 def label_matrix(supports: np.ndarray, slots: int) -> np.ndarray:

@@ -123,8 +123,9 @@ def load_checkpoint(path: str | Path) -> tuple[SupportModel, dict]:
         raise PerceptionError(f"no perception checkpoint at {path}")
     try:
         blob = torch.load(path, map_location="cpu", weights_only=True)
-        config = ModelConfig(**{k: tuple(v) if isinstance(v, list) else v
-                                for k, v in blob["config"].items()})  # fmt: skip
+        config = ModelConfig(
+            **{k: tuple(v) if isinstance(v, list) else v for k, v in blob["config"].items()}
+        )
         model = SupportModel(config)
         model.load_state_dict(blob["state"])
     except (KeyError, TypeError, RuntimeError, EOFError, ValueError, UnpicklingError) as err:

@@ -33,13 +33,24 @@ HAND = ("panda_hand", "panda_leftfinger", "panda_rightfinger")
 # >= 99 % of 1000 configurations drawn uniformly within the datasheet limits (seed 0, fingers
 # uniform in [0, 0.04] m: exactly the adjacent pairs), and pairs penetrating at q_home with the
 # fingers open or closed (the two fingers, which touch when closed).
-DISABLED_PAIRS = frozenset(map(frozenset, (
-    ("panda_link0", "panda_link1"), ("panda_link1", "panda_link2"), ("panda_link2", "panda_link3"),
-    ("panda_link3", "panda_link4"), ("panda_link4", "panda_link5"), ("panda_link5", "panda_link6"),
-    ("panda_link6", "panda_link7"), ("panda_link7", "panda_hand"),
-    ("panda_hand", "panda_leftfinger"), ("panda_hand", "panda_rightfinger"),
-    ("panda_leftfinger", "panda_rightfinger"),
-)))  # fmt: skip
+DISABLED_PAIRS = frozenset(
+    map(
+        frozenset,
+        (
+            ("panda_link0", "panda_link1"),
+            ("panda_link1", "panda_link2"),
+            ("panda_link2", "panda_link3"),
+            ("panda_link3", "panda_link4"),
+            ("panda_link4", "panda_link5"),
+            ("panda_link5", "panda_link6"),
+            ("panda_link6", "panda_link7"),
+            ("panda_link7", "panda_hand"),
+            ("panda_hand", "panda_leftfinger"),
+            ("panda_hand", "panda_rightfinger"),
+            ("panda_leftfinger", "panda_rightfinger"),
+        ),
+    )
+)
 _TABLE_HALF = (3.0, 3.0, 0.5)  # m; its top face is z = 0
 Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip
 

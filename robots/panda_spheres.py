@@ -62,4 +62,4 @@ SPHERES: tuple[tuple[str, tuple[float, float, float], float], ...] = (
     ("panda_leftfinger", (0.0, 0.02, 0.015), 0.011),
     ("panda_rightfinger", (0.0, -0.01, 0.043), 0.011),
     ("panda_rightfinger", (0.0, -0.02, 0.015), 0.011),
-)  # fmt: skip
+)

@@ -59,9 +59,16 @@ def load_panda(
         p.changeDynamics(body, link, linearDamping=0, angularDamping=0, physicsClientId=client)
     # both fingers push on the object with equal force; the gear keeps them centred (bullet3#2101)
     gear = p.createConstraint(
-        body, fingers[0], body, fingers[1], p.JOINT_GEAR, [1, 0, 0], [0, 0, 0], [0, 0, 0],
+        body,
+        fingers[0],
+        body,
+        fingers[1],
+        p.JOINT_GEAR,
+        [1, 0, 0],
+        [0, 0, 0],
+        [0, 0, 0],
         physicsClientId=client,
-    )  # fmt: skip
+    )
     p.changeConstraint(gear, gearRatio=-1, erp=0.1, maxForce=50, physicsClientId=client)
     for j, q in zip(arm, spec.q_home, strict=True):
         p.resetJointState(body, j, q, physicsClientId=client)

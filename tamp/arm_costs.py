@@ -59,8 +59,11 @@ def predict_poses(
     s, out = scene.block_size, {}
     stacks = towers(entities, state)
     seen = read_state(entities, poses, scene).state
-    before = {} if seen is None else {x: tuple(t[:k]) for t in towers(entities, seen)
-                                      for k, x in enumerate(t)}  # fmt: skip
+    before = (
+        {}
+        if seen is None
+        else {x: tuple(t[:k]) for t in towers(entities, seen) for k, x in enumerate(t)}
+    )
     grounded = [t for t in stacks if abs(poses[t[0]].xyz[2] - s / 2) <= scene.tol_z]
     if bases is not None:
         grounded = stacks
@@ -113,8 +116,9 @@ class _Placed:
         shift = torch.stack([o.reach * torch.tanh(u) for u in self.offsets])  # (P, K, 2)
         table = self.places[:, n:] + torch.nn.functional.pad(shift, (0, 1))  # (P, K, 3)
         places = torch.cat([self.places[:, :n], table], dim=1)  # (P, Y, 3)
-        c = move_costs_batch(o.solver, o.q_now, self.picks, places, o.config,
-                             o.boxes, self.solved, self.blocks)  # fmt: skip
+        c = move_costs_batch(
+            o.solver, o.q_now, self.picks, places, o.config, o.boxes, self.solved, self.blocks
+        )
         return c + self.extra  # (P, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
@@ -171,10 +175,14 @@ class ArmCosts:
         solved = site_solutions(self.solver, self.q_now, picks, places)
         extra = extra + self._deep(solved, blocks)
         offsets = [
-            self._offsets.setdefault(i, torch.zeros(len(self.problems[i].fixed), 2,
-                                                    dtype=torch.float64, requires_grad=True))
+            self._offsets.setdefault(
+                i,
+                torch.zeros(
+                    len(self.problems[i].fixed), 2, dtype=torch.float64, requires_grad=True
+                ),
+            )
             for i in indices
-        ]  # fmt: skip
+        ]
         return _Placed(self, picks, places, extra, solved, offsets, blocks)
 
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
@@ -182,8 +190,9 @@ class ArmCosts:
         picks, places, extra, blocks = self._inputs(todo)
         solved = site_solutions(self.solver, self.q_now, picks, places)
         with torch.no_grad():
-            c = move_costs_batch(self.solver, self.q_now, picks, places, self.config,
-                                 self.boxes, solved, blocks)  # fmt: skip
+            c = move_costs_batch(
+                self.solver, self.q_now, picks, places, self.config, self.boxes, solved, blocks
+            )
         return list(c + extra + self._deep(solved, blocks))  # (P, N, Y) each
 
     def _deep(self, solved, blocks: Blocks) -> torch.Tensor:
@@ -201,9 +210,11 @@ class ArmCosts:
         for i, state in todo:
             problem, at = self.problems[i], None if self.places is None else self.places[i]
             plain = state if at is None else tuple(TABLE if x in at else x for x in state)
-            bases = None if at is None else {
-                x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at
-            }  # fmt: skip
+            bases = (
+                None
+                if at is None
+                else {x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at}
+            )
             now = predict_poses(problem.entities, plain, self.poses[i], self.scene, bases)
             xyz = np.array([now[x].xyz for x in problem.entities])  # (N, 3)
             up = xyz + np.array([0.0, 0.0, s])  # onto each block

@@ -71,8 +71,11 @@ CLUTTER = (
     Obstacle("wall", (0.48, -0.455, 0.15), (0.2, 0.01, 0.15)),  # beside the y = -0.32 column
 )
 SCENES: dict[str, tuple[Obstacle, ...]] = {
-    "tabletop": (), "shelf": SHELF, "clutter": CLUTTER, "cramped": (),
-}  # fmt: skip
+    "tabletop": (),
+    "shelf": SHELF,
+    "clutter": CLUTTER,
+    "cramped": (),
+}
 # scenes with their own slot grid (x values, y values): ``cramped`` has 6 slots in 3 rows, the
 # far one (x = 0.72 m) near the end of the arm's comfortable reach
 GRIDS = {"cramped": ((0.40, 0.56, 0.72), (-0.12, 0.12))}

@@ -179,8 +179,9 @@ def _fit(stacks: list[list[str]], order: np.ndarray, config: SceneConfig) -> lis
         room = [k for k in order if k not in chosen.values()]
         fits = [k for k in room if config.capacity(config.slots[k]) >= len(stacks[i])]
         if not fits:
-            raise SceneError(f"no slot of scene {config.name!r} has room for a tower of "
-                             f"{len(stacks[i])} blocks")  # fmt: skip
+            raise SceneError(
+                f"no slot of scene {config.name!r} has room for a tower of {len(stacks[i])} blocks"
+            )
         chosen[i] = int(fits[0])
     return [chosen[i] for i in range(len(stacks))]
 

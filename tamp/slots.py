@@ -77,8 +77,14 @@ def slotted(
     """``problem`` in the observed ``state`` on the scene's table places (see `places`):
     the slotted problem and the position of each place."""
     at, where = places(problem, state, poses, scene)
-    current = Problem(problem.name, problem.domain, problem.entities, tuple(state),
-                      problem.goal, data=problem.data)  # fmt: skip
+    current = Problem(
+        problem.name,
+        problem.domain,
+        problem.entities,
+        tuple(state),
+        problem.goal,
+        data=problem.data,
+    )
     return with_slots(current, tuple(at), where), at
 
 
@@ -106,11 +112,13 @@ def plan_on_places(
     continuous placements, each place's position optimised within ``reach`` m of its centre
     with the logits (the plan's moves carry the optimised positions)."""
     current, at = slotted(problem, problem.init, poses, scene)
-    costs = ArmCosts([current], [poses], scene, solver, q_now, places=[at], avoid=avoid,
-                     reach=reach)  # fmt: skip
+    costs = ArmCosts(
+        [current], [poses], scene, solver, q_now, places=[at], avoid=avoid, reach=reach
+    )
     result = plan(current, config, seed=seed, costs=costs)
-    moved = {k: (xy[0] + costs.offset(0, k)[0], xy[1] + costs.offset(0, k)[1])
-             for k, xy in at.items()}  # fmt: skip
+    moved = {
+        k: (xy[0] + costs.offset(0, k)[0], xy[1] + costs.offset(0, k)[1]) for k, xy in at.items()
+    }
     return replace(result, plan=Plan(tuple(plain_move(m, moved) for m in result.plan)))
 
 

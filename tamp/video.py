@@ -55,8 +55,9 @@ class VideoWriter:
 
         def text(line: str, x: float, y: float, size: float) -> None:
             at = (round(x * s), round(y * s))
-            cv2.putText(bgr, line, at, cv2.FONT_HERSHEY_SIMPLEX, size * s, (255, 255, 255), 1,
-                        cv2.LINE_AA)  # fmt: skip
+            cv2.putText(
+                bgr, line, at, cv2.FONT_HERSHEY_SIMPLEX, size * s, (255, 255, 255), 1, cv2.LINE_AA
+            )
 
         if caption:
             cv2.rectangle(bgr, (0, 0), (w, round(18 * s)), (0, 0, 0), -1)
@@ -89,9 +90,12 @@ class VideoWriter:
             images = [Image.fromarray(f) for f in self._gif]
             self.path.parent.mkdir(parents=True, exist_ok=True)
             images[0].save(
-                self.path, save_all=True, append_images=images[1:], duration=1000 / self.fps,
+                self.path,
+                save_all=True,
+                append_images=images[1:],
+                duration=1000 / self.fps,
                 loop=0,
-            )  # fmt: skip
+            )
             self._gif = []
         return self.path if self.frames else None
 
@@ -177,8 +181,9 @@ def _render(path: Path, fps: float, size: tuple[int, int], frames, result) -> No
         writer = VideoWriter(path, fps)
         world = _next(frames)
         if world is not None:
-            sim = make_simulator(world.sim, world.entities, world.poses, world.scene,
-                                 camera=world.camera, video=True)  # fmt: skip
+            sim = make_simulator(
+                world.sim, world.entities, world.poses, world.scene, camera=world.camera, video=True
+            )
             sim.set_view(world.camera, world.lighting)
             while (frame := _next(frames)) is not None:
                 snapshot, caption, notes = frame

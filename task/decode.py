@@ -62,8 +62,18 @@ class DecodedWindow:
             return (0, g, self.motion, 0, 0, self.loss)
         dead = math.isinf(self.remaining)
         rest = self.remaining if self.estimated is None else self.estimated
-        return (1, dead, self.revisit, g == 0, g + rest, self.buried, -g, self.motion,
-                not self.complete, self.loss)  # fmt: skip
+        return (
+            1,
+            dead,
+            self.revisit,
+            g == 0,
+            g + rest,
+            self.buried,
+            -g,
+            self.motion,
+            not self.complete,
+            self.loss,
+        )
 
 
 def decode_row(
@@ -122,9 +132,17 @@ def decode_row(
     remaining = 0 if reached else domain.lower_bound(problem, state)
     estimated = None if reached or estimate is None else estimate(problem, state)
     return DecodedWindow(
-        tuple(moves), state, reached, complete, loss, remaining, illegal, estimated,
-        state in seen, motion,
-    )  # fmt: skip
+        tuple(moves),
+        state,
+        reached,
+        complete,
+        loss,
+        remaining,
+        illegal,
+        estimated,
+        state in seen,
+        motion,
+    )
 
 
 def _best_prefix(
@@ -147,8 +165,19 @@ def _best_prefix(
         fixed = getattr(move, "target", None) in problem.fixed
         buried += bound >= before and not fixed
         parked += park and bound == before and fixed
-        window = DecodedWindow(tuple(moves[:k]), state, False, complete, loss, bound, None,
-                               bound - parked, state in seen, motion, buried)  # fmt: skip
+        window = DecodedWindow(
+            tuple(moves[:k]),
+            state,
+            False,
+            complete,
+            loss,
+            bound,
+            None,
+            bound - parked,
+            state in seen,
+            motion,
+            buried,
+        )
         if best is None or window.key() < best.key():
             best = window
         before = bound

@@ -127,8 +127,9 @@ def with_costs(batch: SoftBatch, costs: WindowCosts | None) -> Tensor | None:
     c = costs.compute()  # (P, N, Y)
     rows = batch.F0.shape[0]
     if c.shape[1:] != batch.F0.shape[1:] or rows % c.shape[0]:
-        raise TampError(f"move costs of shape {tuple(c.shape)} do not fit a batch of "
-                        f"{tuple(batch.F0.shape)}")  # fmt: skip
+        raise TampError(
+            f"move costs of shape {tuple(c.shape)} do not fit a batch of {tuple(batch.F0.shape)}"
+        )
     return c.to(batch.F0.dtype).repeat_interleave(rows // c.shape[0], dim=0)  # (B, N, Y)
 
 

@@ -48,9 +48,19 @@ def _window(
     steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
     _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs)
     return decode_best(
-        domain, problems, states, roll.gates, roll.loss, config.restarts, config.threshold,
-        config.crisp_check, visited, roll.costs, config.rank_prefixes, config.park_free,
-    )  # fmt: skip
+        domain,
+        problems,
+        states,
+        roll.gates,
+        roll.loss,
+        config.restarts,
+        config.threshold,
+        config.crisp_check,
+        visited,
+        roll.costs,
+        config.rank_prefixes,
+        config.park_free,
+    )
 
 
 def _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded):
@@ -61,9 +71,14 @@ def _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, v
     if fallback is None or not stuck:
         return
     again = _window(
-        domain, [problems[active[k]] for k in stuck], [crisp[k] for k in stuck], config,
-        generator, fallback(stuck), [visited[active[k]] for k in stuck],
-    )  # fmt: skip
+        domain,
+        [problems[active[k]] for k in stuck],
+        [crisp[k] for k in stuck],
+        config,
+        generator,
+        fallback(stuck),
+        [visited[active[k]] for k in stuck],
+    )
     for k, window in zip(stuck, again, strict=True):
         if window.moves or window.reached:
             decoded[k] = window
@@ -134,9 +149,15 @@ def _run(
         crisp, perceived = _crisp_states(beliefs, now)
         priced = None if costs is None else costs([indices[i] for i in active], crisp)
         decoded = _window(
-            domain, [problems[i] for i in active], crisp, config, generator, beliefs,
-            [visited[i] for i in active], priced,
-        )  # fmt: skip
+            domain,
+            [problems[i] for i in active],
+            crisp,
+            config,
+            generator,
+            beliefs,
+            [visited[i] for i in active],
+            priced,
+        )
         _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded)
         hoped = []  # perceived: windows that predict the goal, for a new image to confirm
         for i, seen, win in zip(active, crisp, decoded, strict=True):

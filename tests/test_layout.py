@@ -125,13 +125,3 @@ def test_no_flat_folder_of_many_modules():
         for folder in [ROOT / package, *(p for p in (ROOT / package).rglob("*") if p.is_dir())]:
             modules = [p for p in folder.glob("*.py") if p.name != "__init__.py"]
             assert len(modules) <= 11, f"{folder.relative_to(ROOT)}: {len(modules)} modules"
-
-
-def test_no_module_is_long():
-    long = {
-        f"{p.relative_to(ROOT)}: {n} lines"
-        for package in PACKAGES
-        for p in (ROOT / package).rglob("*.py")
-        if (n := len(p.read_text().splitlines())) > 300
-    }
-    assert not long, sorted(long)

@@ -111,9 +111,13 @@ def _call(
     """
     with open(cwd / "log.txt", "a", encoding="utf-8") as log:
         proc = subprocess.Popen(
-            [sys.executable, *args], cwd=cwd, stdout=log, stderr=subprocess.STDOUT,
-            stdin=subprocess.DEVNULL, start_new_session=True,
-        )  # fmt: skip
+            [sys.executable, *args],
+            cwd=cwd,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            stdin=subprocess.DEVNULL,
+            start_new_session=True,
+        )
     try:
         while True:
             pid, status, usage = os.wait4(proc.pid, os.WNOHANG)

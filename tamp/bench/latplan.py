@@ -63,8 +63,9 @@ def load(root: str | Path = DEFAULT, limit: int | None = None) -> LatPlanData:
     needed = [root / INSTANCES, root / "manifest.csv", root / "pddl" / "domain.pddl"]
     missing = [p for p in needed if not p.exists()]
     if missing:
-        raise DataError(f"LatPlan-40 data not found at {root.resolve()} (no {missing[0].name}): "
-                        f"{FIX}")  # fmt: skip
+        raise DataError(
+            f"LatPlan-40 data not found at {root.resolve()} (no {missing[0].name}): {FIX}"
+        )
     try:
         domain = pddl_io.load_domain(root / "pddl" / "domain.pddl")
         with (root / "manifest.csv").open(newline="", encoding="utf-8") as handle:
@@ -99,9 +100,19 @@ def load_perceiver(path: str | Path) -> Perceiver:
 
 
 def _row(inst: Instance, res: str, mode: str, seed: int) -> dict:
-    return {"instance": inst.name, "resolution": res, "mode": mode, "seed": seed,
-            "init_read": None, "goal_read": None, "status": None, "error": None,
-            "length": None, "optimal": inst.optimal, "time_s": None}  # fmt: skip
+    return {
+        "instance": inst.name,
+        "resolution": res,
+        "mode": mode,
+        "seed": seed,
+        "init_read": None,
+        "goal_read": None,
+        "status": None,
+        "error": None,
+        "length": None,
+        "optimal": inst.optimal,
+        "time_s": None,
+    }
 
 
 def _state_rows(data: LatPlanData, config: PlannerConfig, seed: int) -> list[dict]:
@@ -191,24 +202,35 @@ def summaries(rows: Sequence[dict]) -> list[dict]:
         seeds = sorted({r["seed"] for r in group})
         per = [[r for r in group if r["seed"] == s] for s in seeds]
         valid = [[r for r in g if r["status"] == "valid"] for g in per]
-        optimal = [sum(is_optimal(r["length"], r["optimal"], r["instance"]) for r in v)
-                   for v in valid]  # fmt: skip
+        optimal = [
+            sum(is_optimal(r["length"], r["optimal"], r["instance"]) for r in v) for v in valid
+        ]
         read = [sum(bool(r["init_read"] and r["goal_read"]) for r in g) for g in per]
-        out.append({
-            "resolution": res, "mode": mode, "n": len(per[0]), "seeds": seeds,
-            "valid": _spread([len(v) for v in valid]), "optimal": _spread(optimal),
-            "read_right": None if mode == "state" else _spread(read),
-            "statuses": dict(Counter(r["status"] for r in group)),
-            "time_s_per_instance": sum(r["time_s"] for r in group) / len(group),
-        })  # fmt: skip
+        out.append(
+            {
+                "resolution": res,
+                "mode": mode,
+                "n": len(per[0]),
+                "seeds": seeds,
+                "valid": _spread([len(v) for v in valid]),
+                "optimal": _spread(optimal),
+                "read_right": None if mode == "state" else _spread(read),
+                "statuses": dict(Counter(r["status"] for r in group)),
+                "time_s_per_instance": sum(r["time_s"] for r in group) / len(group),
+            }
+        )
     return out
 
 
 def report(data: LatPlanData, rows, summary, options: dict, machine: dict) -> dict:
     """The ``results.json`` body: options, machine, the cited rows and every summary."""
     return {
-        "benchmark": "latplan-40", "data": str(data.root), "n": len(data.instances),
-        "instances": [i.name for i in data.instances], **options, "machine": machine,
+        "benchmark": "latplan-40",
+        "data": str(data.root),
+        "n": len(data.instances),
+        "instances": [i.name for i in data.instances],
+        **options,
+        "machine": machine,
         "cited": [dict(zip(("row", "valid", "optimal"), c, strict=True)) for c in CITED],
         "summary": list(summary),
-    }  # fmt: skip
+    }

@@ -41,10 +41,23 @@ from task.symbolic.instances import Instance
 from task.symbolic.validate import validate
 
 EPISODE_COLUMNS = (
-    "sim", "problem", "status", "reached_goal", "moves", "moves_ok", "replans", "faults",
-    "disturbed", "touched", "sim_time_s", "wall_time_s", "plan_time_s", "first_plan_moves",
-    "arm_path_rad", "failures",
-)  # fmt: skip
+    "sim",
+    "problem",
+    "status",
+    "reached_goal",
+    "moves",
+    "moves_ok",
+    "replans",
+    "faults",
+    "disturbed",
+    "touched",
+    "sim_time_s",
+    "wall_time_s",
+    "plan_time_s",
+    "first_plan_moves",
+    "arm_path_rad",
+    "failures",
+)
 
 
 @dataclass(frozen=True)
@@ -60,9 +73,15 @@ class MotionBench:
 def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
     """Wall time of one batched IK call on ``n`` random top-down targets in the block area."""
     rng = np.random.default_rng(seed)
-    targets = np.stack([top_down_pose((rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3),
-                        rng.uniform(0.03, 0.3)), rng.uniform(-np.pi / 2, np.pi / 2))
-                        for _ in range(n)])  # fmt: skip
+    targets = np.stack(
+        [
+            top_down_pose(
+                (rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), rng.uniform(0.03, 0.3)),
+                rng.uniform(-np.pi / 2, np.pi / 2),
+            )
+            for _ in range(n)
+        ]
+    )
     q0 = np.asarray(solver.spec.q_home)
     solver.solve(targets[:2], q0)  # warm-up
     t0 = time.perf_counter()
@@ -108,19 +127,32 @@ def summarise(
     }
 
 
-def run(suite: Suite, base: LoopConfig, sims: Sequence[str], seed: int,
-        progress: Callable[[str, EpisodeReport], None] | None = None, workers: int = 1,
-        ray_address: str | None = None) -> MotionBench:  # fmt: skip
+def run(
+    suite: Suite,
+    base: LoopConfig,
+    sims: Sequence[str],
+    seed: int,
+    progress: Callable[[str, EpisodeReport], None] | None = None,
+    workers: int = 1,
+    ray_address: str | None = None,
+) -> MotionBench:
     """One closed-loop episode per instance in each simulator; ``progress(sim, report)`` as
     each ends. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
     reproducible from ``seed`` whatever ``workers``/``ray_address`` (`tamp.sweep.run_items`)."""
     ik = time_ik(process_solver())
-    items = [(inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name)
-             for name in sims for k, inst in enumerate(suite.instances)]  # fmt: skip
+    items = [
+        (inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name)
+        for name in sims
+        for k, inst in enumerate(suite.instances)
+    ]
     done = None if progress is None else lambda k, report: progress(report.sim, report)
     every, n = run_items(_episode, items, workers, ray_address, done), len(suite.instances)
-    summary = {s: summarise(every[j * n : (j + 1) * n], suite.instances, suite.domain,
-                            base.observe == "camera") for j, s in enumerate(sims)}  # fmt: skip
+    summary = {
+        s: summarise(
+            every[j * n : (j + 1) * n], suite.instances, suite.domain, base.observe == "camera"
+        )
+        for j, s in enumerate(sims)
+    }
     return MotionBench(tuple(sims), tuple(every), summary, ik)
 
 
@@ -133,17 +165,26 @@ def _episode(item: tuple) -> EpisodeReport:
 def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
     """One ``episodes.csv`` row per episode (columns `EPISODE_COLUMNS`)."""
     return [
-        {"sim": r.sim, "problem": r.problem, "status": r.status.value,
-         "reached_goal": r.reached_goal, "moves": len(r.moves),
-         "moves_ok": sum(m.ok for m in r.moves), "replans": r.replans,
-         "faults": " ".join(r.faults), "disturbed": r.disturbed,
-         "touched": " ".join(f"{k}:{v}" for k, v in sorted(r.touched.items())),
-         "sim_time_s": round(r.sim_time_s, 2), "wall_time_s": round(r.wall_time_s, 2),
-         "plan_time_s": round(r.plan_time_s, 3), "first_plan_moves": len(r.first_plan),
-         "arm_path_rad": round(sum(m.path_rad for m in r.moves), 3),
-         "failures": " ".join(m.failure.value for m in r.moves if m.failure is not None)}
+        {
+            "sim": r.sim,
+            "problem": r.problem,
+            "status": r.status.value,
+            "reached_goal": r.reached_goal,
+            "moves": len(r.moves),
+            "moves_ok": sum(m.ok for m in r.moves),
+            "replans": r.replans,
+            "faults": " ".join(r.faults),
+            "disturbed": r.disturbed,
+            "touched": " ".join(f"{k}:{v}" for k, v in sorted(r.touched.items())),
+            "sim_time_s": round(r.sim_time_s, 2),
+            "wall_time_s": round(r.wall_time_s, 2),
+            "plan_time_s": round(r.plan_time_s, 3),
+            "first_plan_moves": len(r.first_plan),
+            "arm_path_rad": round(sum(m.path_rad for m in r.moves), 3),
+            "failures": " ".join(m.failure.value for m in r.moves if m.failure is not None),
+        }
         for r in reports
-    ]  # fmt: skip
+    ]
 
 
 # --- executability of given plans (``tamp bench executability``) ---------------------------
@@ -211,7 +252,8 @@ def check_given(text: str | None, instance: Instance, domain, source: str):
         steps = parse_given(text.replace(";", "\n"), f"{source} {instance.name}", instance.problem)
         moves, rules = [s.move for s in steps], get_domain(instance.problem.domain)
         actions = [a for s in steps for a in s.actions] or rules.to_actions(
-            instance.problem, moves, strict=False)  # fmt: skip
+            instance.problem, moves, strict=False
+        )
         verdict = validate(domain, instance.pddl, actions)
     except TampError as exc:
         return None, "unparseable", str(exc)
@@ -231,16 +273,27 @@ def first_failure(steps: Sequence[StepReport], reached: bool) -> tuple[str, str]
     return ("", "") if reached else ("goal-not-reached", "end")
 
 
-def run_given(suite: Suite, sources: dict, base: LoopConfig, sims: Sequence[str], seed: int,
-              ours: PlannerConfig | None, progress: Callable | None = None, workers: int = 1,
-              ray_address: str | None = None) -> list:  # fmt: skip
+def run_given(
+    suite: Suite,
+    sources: dict,
+    base: LoopConfig,
+    sims: Sequence[str],
+    seed: int,
+    ours: PlannerConfig | None,
+    progress: Callable | None = None,
+    workers: int = 1,
+    ray_address: str | None = None,
+) -> list:
     """`PlanRow` of every source's plan of every instance in each simulator. Instance ``k`` uses
     episode seed ``seed * 100_003 + k`` (its layout) for every source; a plan met before on the
     same instance and simulator is run once (the rows share its outcome, time included): the
     distinct runs are the sweep's items. ``progress(sim, row)`` as each row's run ends."""
     plans = {**sources, **({OURS: our_plans(suite, ours, seed)} if ours is not None else {})}
-    checked = {(src, i.name): check_given(got.get(i.name, (None,))[0], i, suite.domain, src)
-               for src, got in plans.items() for i in suite.instances}  # fmt: skip
+    checked = {
+        (src, i.name): check_given(got.get(i.name, (None,))[0], i, suite.domain, src)
+        for src, got in plans.items()
+        for i in suite.instances
+    }
     specs, runs, waiting = [], {}, {}  # rows' given columns; key -> run's item; key -> rows
     for sim in sims:
         config = replace(base, sim=sim)
@@ -270,9 +323,13 @@ def run_given(suite: Suite, sources: dict, base: LoopConfig, sims: Sequence[str]
 def _given(item: tuple) -> tuple:
     """`run_given`'s run ``(problem, steps, config, seed)``: its row's outcome columns."""
     r = GivenPlanEpisode(*item, solver=process_solver()).run()
-    return (r.reached_goal, *first_failure(r.steps, r.reached_goal),
-            sum(bool(s.disturbed) for s in r.steps), sum(s.attempted for s in r.steps),
-            r.wall_time_s)  # fmt: skip
+    return (
+        r.reached_goal,
+        *first_failure(r.steps, r.reached_goal),
+        sum(bool(s.disturbed) for s in r.steps),
+        sum(s.attempted for s in r.steps),
+        r.wall_time_s,
+    )
 
 
 def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:
@@ -285,16 +342,23 @@ def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:
         pb = [r for r in first if r.planbench_valid is not None]
         by = {s: [r for r in mine if r.sim == s] for s in sims}
         ran = {s: [r for r in b if r.task != "unparseable"] for s, b in by.items()}
-        out.append({
-            "source": src, "plans": len(first), "task_valid": sum(r.task == "valid" for r in first),
-            "unparseable": sum(r.task == "unparseable" for r in first),
-            "planbench_valid": sum(r.planbench_valid for r in pb) if pb else None,
-            "agree": sum((r.task == "valid") == r.planbench_valid for r in pb) if pb else None,
-            "reached": {s: sum(r.reached_goal for r in b) for s, b in by.items()},
-            "failures": {s: dict(Counter(r.first_failure for r in b if r.first_failure)
-                                 .most_common(3)) for s, b in by.items()},
-            "disturbed": {s: sum(r.disturbed for r in b) for s, b in by.items()},
-            "s_per_plan": {s: sum(r.wall_time_s for r in b) / max(len(b), 1)
-                           for s, b in ran.items()},
-        })  # fmt: skip
+        out.append(
+            {
+                "source": src,
+                "plans": len(first),
+                "task_valid": sum(r.task == "valid" for r in first),
+                "unparseable": sum(r.task == "unparseable" for r in first),
+                "planbench_valid": sum(r.planbench_valid for r in pb) if pb else None,
+                "agree": sum((r.task == "valid") == r.planbench_valid for r in pb) if pb else None,
+                "reached": {s: sum(r.reached_goal for r in b) for s, b in by.items()},
+                "failures": {
+                    s: dict(Counter(r.first_failure for r in b if r.first_failure).most_common(3))
+                    for s, b in by.items()
+                },
+                "disturbed": {s: sum(r.disturbed for r in b) for s, b in by.items()},
+                "s_per_plan": {
+                    s: sum(r.wall_time_s for r in b) / max(len(b), 1) for s, b in ran.items()
+                },
+            }
+        )
     return out

@@ -215,20 +215,38 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
         r = results.get(i)
         status, length = ("perception_error", None) if r is None else check(suite.domain, inst, r)
         stats = {} if r is None else r.stats
-        rows.append({
-            "instance": inst.name, "blocks": inst.blocks, "optimal": inst.optimal,
-            "mode": mode.mode, "crisp": mode.crisp, "blur": mode.blur, "horizon": horizon,
-            "status": status, "length": length, "windows": stats.get("windows"),
-            "goal_misread": mode.mode != "state" and planned[i].goal != _full_goal(problems[i]),
-            "misread_windows": stats.get("misread_windows", 0),
-            "redrawn": camera.served[i] - served0[i], "illegal": stats.get("illegal"),
-        })  # fmt: skip
+        rows.append(
+            {
+                "instance": inst.name,
+                "blocks": inst.blocks,
+                "optimal": inst.optimal,
+                "mode": mode.mode,
+                "crisp": mode.crisp,
+                "blur": mode.blur,
+                "horizon": horizon,
+                "status": status,
+                "length": length,
+                "windows": stats.get("windows"),
+                "goal_misread": mode.mode != "state" and planned[i].goal != _full_goal(problems[i]),
+                "misread_windows": stats.get("misread_windows", 0),
+                "redrawn": camera.served[i] - served0[i],
+                "illegal": stats.get("illegal"),
+            }
+        )
     valid = [r for r in rows if r["status"] == "valid"]
-    optimal = [is_optimal(r["length"], r["optimal"], r["instance"]) for r in valid
-               if r["optimal"] is not None]  # fmt: skip
+    optimal = [
+        is_optimal(r["length"], r["optimal"], r["instance"])
+        for r in valid
+        if r["optimal"] is not None
+    ]
     summary = {
-        "mode": mode.mode, "crisp": mode.crisp, "blur": mode.blur, "horizon": horizon,
-        "n": len(rows), "valid": len(valid), "optimal": sum(optimal),
+        "mode": mode.mode,
+        "crisp": mode.crisp,
+        "blur": mode.blur,
+        "horizon": horizon,
+        "n": len(rows),
+        "valid": len(valid),
+        "optimal": sum(optimal),
         "optimal_pct": 100.0 * sum(optimal) / len(optimal) if optimal else None,
         **{s: sum(r["status"] == s for r in rows) for s in STATUSES if s != "valid"},
         "time_s_per_instance": wall / len(rows),
@@ -237,7 +255,7 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
         "perception_errors": sum(r["status"] == "perception_error" for r in rows),
         "misread_windows": sum(r["misread_windows"] for r in rows),
         "redrawn": sum(r["redrawn"] for r in rows),
-    }  # fmt: skip
+    }
     return rows, summary
 
 

@@ -177,8 +177,16 @@ def run(
         fast = run_once(suite, replace(cfg, batched=True), seeds[0], progress, subset)
         slow = run_once(suite, replace(cfg, batched=False), seeds[0], progress, subset)
         latency = percentiles([r.time_s for r in slow.rows])
-        speed = Speed(len(subset), horizons[0], seeds[0], fast.wall_s, slow.wall_s,
-                      fast.valid(), slow.valid(), latency)  # fmt: skip
+        speed = Speed(
+            len(subset),
+            horizons[0],
+            seeds[0],
+            fast.wall_s,
+            slow.wall_s,
+            fast.valid(),
+            slow.valid(),
+            latency,
+        )
     n = len(suite.instances)
     size_name = get_domain(domain_of(suite)).size_name
     return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed, size_name)
@@ -206,10 +214,15 @@ def with_lama(
         found[instance.name] = (result.length, time.perf_counter() - start)
         report(1)
     runs = tuple(
-        replace(run, rows=tuple(replace(r, lama_length=found[r.instance][0],
-                                        lama_s=found[r.instance][1]) for r in run.rows))
+        replace(
+            run,
+            rows=tuple(
+                replace(r, lama_length=found[r.instance][0], lama_s=found[r.instance][1])
+                for r in run.rows
+            ),
+        )
         for run in bench.runs
-    )  # fmt: skip
+    )
     return replace(bench, runs=runs)
 
 

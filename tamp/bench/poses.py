@@ -146,14 +146,42 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
     for x in names:
         fit, true = fits[x], truth[x]
         if isinstance(fit, str):
-            out.append(BlockRow(sim, scene, x, len(names), level[x], x in free, fit,
-                                None, None, None, None, None))  # fmt: skip
+            out.append(
+                BlockRow(
+                    sim,
+                    scene,
+                    x,
+                    len(names),
+                    level[x],
+                    x in free,
+                    fit,
+                    None,
+                    None,
+                    None,
+                    None,
+                    None,
+                )
+            )
             continue
         d = 1000.0 * (np.asarray(fit.pose.xyz) - np.asarray(true.xyz))  # (3,) mm
         error = float(np.linalg.norm(d))
         yaw = yaw_error(fit.pose.yaw, true.yaw)
-        out.append(BlockRow(sim, scene, x, len(names), level[x], x in free, "",
-                            error, float(d[0]), float(d[1]), float(d[2]), yaw))  # fmt: skip
+        out.append(
+            BlockRow(
+                sim,
+                scene,
+                x,
+                len(names),
+                level[x],
+                x in free,
+                "",
+                error,
+                float(d[0]),
+                float(d[1]),
+                float(d[2]),
+                yaw,
+            )
+        )
     return out
 
 

@@ -51,19 +51,33 @@ class Official:
 OFFICIAL = {
     "blocksworld": Official(
         "blocksworld",
-        tuple(f"{sub}/instance-{i}" for sub, n in (("generated_basic_3", 100),
-              ("generated_basic", 500)) for i in range(1, n + 1)),
-        "in_official_600", "n_blocks", "optimal_plan_length", None,
+        tuple(
+            f"{sub}/instance-{i}"
+            for sub, n in (("generated_basic_3", 100), ("generated_basic", 500))
+            for i in range(1, n + 1)
+        ),
+        "in_official_600",
+        "n_blocks",
+        "optimal_plan_length",
+        None,
     ),
     "logistics": Official(
-        "logistics", tuple(f"instance-{i}" for i in range(1, 201)),
-        "in_official_200", "n_packages", None, "planbench_ground_truth_plan_length",
+        "logistics",
+        tuple(f"instance-{i}" for i in range(1, 201)),
+        "in_official_200",
+        "n_packages",
+        None,
+        "planbench_ground_truth_plan_length",
     ),
     "sokoban": Official(
-        "sokoban", tuple(f"instance-{i}" for i in range(1, 56)),
-        "in_official_55", "n_boxes", "optimal_plan_length_astar", None,
+        "sokoban",
+        tuple(f"instance-{i}" for i in range(1, 56)),
+        "in_official_55",
+        "n_boxes",
+        "optimal_plan_length_astar",
+        None,
     ),
-}  # fmt: skip
+}
 
 
 @dataclass(frozen=True)
@@ -126,8 +140,11 @@ def _manifest(root: Path, spec: Official) -> list[tuple[str, int, int | None, in
     lengths = [c for c in (spec.optimal, spec.reference) if c]
     with path.open(newline="", encoding="utf-8") as handle:
         reader = csv.DictReader(handle)
-        missing = [c for c in ("file", spec.flag, spec.size, *lengths)
-                   if c not in (reader.fieldnames or ())]  # fmt: skip
+        missing = [
+            c
+            for c in ("file", spec.flag, spec.size, *lengths)
+            if c not in (reader.fieldnames or ())
+        ]
         if missing:
             raise DataError(f"{path}: missing column(s) {', '.join(missing)}")
         rows = []
@@ -136,8 +153,10 @@ def _manifest(root: Path, spec: Official) -> list[tuple[str, int, int | None, in
                 size = _int(row[spec.size], path, line, spec.size)
                 if size is None:
                     raise DataError(f"{path}: line {line}: {spec.size} is blank")
-                opt, ref = (_int(row[c], path, line, c) if c else None
-                            for c in (spec.optimal, spec.reference))  # fmt: skip
+                opt, ref = (
+                    _int(row[c], path, line, c) if c else None
+                    for c in (spec.optimal, spec.reference)
+                )
                 rows.append((row["file"], size, opt, ref))
     if not rows:
         raise DataError(f"{path}: no rows with {spec.flag} = 1")

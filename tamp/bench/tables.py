@@ -95,12 +95,14 @@ def planning_report(bench: Bench) -> str:
         "",
     ]
     refs = any(r.reference is not None for r in bench.rows())
-    main = [_ref(_row(s, "mean" if s.seed is None else str(s.seed)), s, refs)
-            for s in main_rows(bench)]  # fmt: skip
+    main = [
+        _ref(_row(s, "mean" if s.seed is None else str(s.seed)), s, refs) for s in main_rows(bench)
+    ]
     lines += [table(_ref(["T", "seed", *_HEAD], None, refs), main), ""]
     lines.append(f"by {_SIZE_LABEL.get(bench.size_name, bench.size_name)} (mean over seeds):")
-    by_size = [_ref([*_row(s, str(s.size))[:-2], f"{s.windows:.2f}"], s, refs)
-               for s in size_rows(bench)]  # fmt: skip
+    by_size = [
+        _ref([*_row(s, str(s.size))[:-2], f"{s.windows:.2f}"], s, refs) for s in size_rows(bench)
+    ]
     head = ["T", bench.size_name, *_HEAD[:-2], "win."]
     lines.append(table(_ref(head, None, refs), by_size))
     lines.append(
@@ -123,26 +125,48 @@ def planning_report(bench: Bench) -> str:
         ]
         if sp.latency_s:
             q = sp.latency_s
-            lines.append(f"one problem at a time, planning latency: p50 {q['p50']:.3f} s, "
-                         f"p90 {q['p90']:.3f} s, max {q['max']:.3f} s")  # fmt: skip
+            lines.append(
+                f"one problem at a time, planning latency: p50 {q['p50']:.3f} s, "
+                f"p90 {q['p90']:.3f} s, max {q['max']:.3f} s"
+            )
     return "\n".join(lines)
 
 
 def motion_table(rows: dict[str, dict], inject: str) -> str:
     """plans valid: the first task plan replayed by the validator ("-" with the camera, whose
     first plan is one window); exec. valid: the moves that executed ok, replayed."""
-    head = ["sim", "episodes", "plans valid", "exec. valid", "goal", "moves ok", "replans",
-            "disturbed", "wall/move", "sim/move", "x real"]  # fmt: skip
+    head = [
+        "sim",
+        "episodes",
+        "plans valid",
+        "exec. valid",
+        "goal",
+        "moves ok",
+        "replans",
+        "disturbed",
+        "wall/move",
+        "sim/move",
+        "x real",
+    ]
     body = []
     for sim, s in rows.items():
         e = s["episodes"]
         valid = "-" if s["plans_valid"] is None else f"{s['plans_valid']}/{e}"
-        body.append([
-            sim, e, valid, f"{s['executed_valid']}/{e}", f"{s['goal_reached']}/{e}",
-            f"{s['moves_ok']}/{s['moves']}", s["replans"], s["disturbed"],
-            f"{s['wall_per_move_s']:.2f}s", f"{s['sim_per_move_s']:.2f}s",
-            f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):.1f}",
-        ])  # fmt: skip
+        body.append(
+            [
+                sim,
+                e,
+                valid,
+                f"{s['executed_valid']}/{e}",
+                f"{s['goal_reached']}/{e}",
+                f"{s['moves_ok']}/{s['moves']}",
+                s["replans"],
+                s["disturbed"],
+                f"{s['wall_per_move_s']:.2f}s",
+                f"{s['sim_per_move_s']:.2f}s",
+                f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):.1f}",
+            ]
+        )
     lines = [table(head, body, indent="")]
     lines.append("")
     for sim, s in rows.items():
@@ -156,8 +180,10 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
                 f"motion planner on {s['rerouted']} moves, {s['path_per_move_s']:.3f} s/move"
             )
         if "arm_path_rad" in s:
-            lines.append(f"{sim}: arm path {s['arm_path_rad']:.2f} rad per episode; task "
-                         f"planning {s['plan_per_episode_s']:.2f} s per episode")  # fmt: skip
+            lines.append(
+                f"{sim}: arm path {s['arm_path_rad']:.2f} rad per episode; task "
+                f"planning {s['plan_per_episode_s']:.2f} s per episode"
+            )
         if inject != "none":
             lines.append(
                 f"{sim}: faults ({inject}) hit {s['with_faults']} episodes, "
@@ -170,8 +196,20 @@ def perception_table(summaries: list[dict]) -> str:
     """One row per (mode, crisp protocol, blur, horizon); a ``crisp`` column when rows differ in
     it. redrawn: images the row used that were re-rendered because a block was hidden."""
     crisp = len({s.get("crisp", "true") for s in summaries}) > 1
-    head = ["mode", *(["crisp"] if crisp else []), "blur", "T", "valid", "optimal", "inexec.",
-            "non-goal", "no plan", "redrawn", "s/inst", "notes"]  # fmt: skip
+    head = [
+        "mode",
+        *(["crisp"] if crisp else []),
+        "blur",
+        "T",
+        "valid",
+        "optimal",
+        "inexec.",
+        "non-goal",
+        "no plan",
+        "redrawn",
+        "s/inst",
+        "notes",
+    ]
     rows = []
     for s in summaries:
         pct = s.get("optimal_pct", 100.0 * s["optimal"] / max(s["valid"], 1))
@@ -182,20 +220,41 @@ def perception_table(summaries: list[dict]) -> str:
             notes.append(f"{s['perception_errors']} blocks not found")
         if s.get("misread_windows"):
             notes.append(f"{s['misread_windows']} windows decoded against a misread state")
-        rows.append([
-            s["mode"], *([s.get("crisp", "true")] if crisp else []), s["blur"], s["horizon"],
-            f"{s['valid']}/{s['n']}", "-" if pct is None else f"{pct:.1f}%",
-            s.get("inexecutable", 0), s.get("non_goal_reaching", 0), s.get("no_plan", 0),
-            s.get("redrawn", 0), f"{s['time_s_per_instance']:.3f}", "; ".join(notes),
-        ])  # fmt: skip
+        rows.append(
+            [
+                s["mode"],
+                *([s.get("crisp", "true")] if crisp else []),
+                s["blur"],
+                s["horizon"],
+                f"{s['valid']}/{s['n']}",
+                "-" if pct is None else f"{pct:.1f}%",
+                s.get("inexecutable", 0),
+                s.get("non_goal_reaching", 0),
+                s.get("no_plan", 0),
+                s.get("redrawn", 0),
+                f"{s['time_s_per_instance']:.3f}",
+                "; ".join(notes),
+            ]
+        )
     return table(head, rows, indent="")
 
 
 def poses_table(summary: dict[str, dict]) -> str:
     """The pose benchmark: per simulator and split (all, top face free, covered), the blocks
     estimated, position error (mm) and yaw error (degrees, modulo 90)."""
-    head = ["sim", "blocks", "estimated", "pos mean", "median", "p95", "max mm",
-            "yaw mean", "median", "p95", "max deg"]  # fmt: skip
+    head = [
+        "sim",
+        "blocks",
+        "estimated",
+        "pos mean",
+        "median",
+        "p95",
+        "max mm",
+        "yaw mean",
+        "median",
+        "p95",
+        "max deg",
+    ]
     rows = []
     for sim, by_split in summary.items():
         for split in ("all", "top", "covered"):
@@ -215,15 +274,35 @@ def poses_table(summary: dict[str, dict]) -> str:
 def executability_table(summary: Sequence[dict], sims: Sequence[str]) -> str:
     """One row per source: our and PlanBench's task-level verdicts, then per simulator the
     goals reached (ground truth), disturbed stacks, s/plan and the top 3 first failures."""
-    head = ["source", "plans", "task-valid", "PlanBench-valid", "agree",
-            *(f"{h} {s}" for s in sims for h in ("goal", "disturbed", "s/plan"))]  # fmt: skip
+    head = [
+        "source",
+        "plans",
+        "task-valid",
+        "PlanBench-valid",
+        "agree",
+        *(f"{h} {s}" for s in sims for h in ("goal", "disturbed", "s/plan")),
+    ]
     body, lines = [], ["", "", "first failures (top 3):"]
     for s in summary:
         n = s["plans"]
         flags = ("-" if v is None else f"{v}/{n}" for v in (s["planbench_valid"], s["agree"]))
-        body.append([s["source"], n, f"{s['task_valid']}/{n}", *flags, *(
-            v for sim in sims for v in (f"{s['reached'][sim]}/{n}", s["disturbed"][sim],
-                                        f"{s['s_per_plan'][sim]:.1f}"))])  # fmt: skip
+        body.append(
+            [
+                s["source"],
+                n,
+                f"{s['task_valid']}/{n}",
+                *flags,
+                *(
+                    v
+                    for sim in sims
+                    for v in (
+                        f"{s['reached'][sim]}/{n}",
+                        s["disturbed"][sim],
+                        f"{s['s_per_plan'][sim]:.1f}",
+                    )
+                ),
+            ]
+        )
         for sim in sims:
             kinds = ", ".join(f"{k} {v}" for k, v in s["failures"][sim].items())
             lines.append(f"  {s['source']} in {sim}: {kinds or 'none'}")
@@ -236,13 +315,25 @@ def latplan_table(summary: Sequence[dict]) -> str:
     head = ["row", "valid", "optimal", "read right", "s/inst", "failures (all seeds)"]
     body = [[name, valid, optimal, "-", "-", ""] for name, valid, optimal in LATPLAN_CITED]
     for s in summary:
-        what = ("ours, from the true states" if s["mode"] == "state"
-                else f"ours, {s['mode']} perception, {s['resolution']}")  # fmt: skip
+        what = (
+            "ours, from the true states"
+            if s["mode"] == "state"
+            else f"ours, {s['mode']} perception, {s['resolution']}"
+        )
         read = "-" if s["read_right"] is None else _count(s["read_right"], s["n"])
-        fails = ", ".join(f"{v} {k.replace('_', ' ')}" for k, v in sorted(s["statuses"].items())
-                          if k != "valid")  # fmt: skip
-        body.append([what, _count(s["valid"], s["n"]), _count(s["optimal"], s["n"]), read,
-                     f"{s['time_s_per_instance']:.2f}", fails])  # fmt: skip
+        fails = ", ".join(
+            f"{v} {k.replace('_', ' ')}" for k, v in sorted(s["statuses"].items()) if k != "valid"
+        )
+        body.append(
+            [
+                what,
+                _count(s["valid"], s["n"]),
+                _count(s["optimal"], s["n"]),
+                read,
+                f"{s['time_s_per_instance']:.2f}",
+                fails,
+            ]
+        )
     return table(head, body, indent="")
 
 
@@ -260,18 +351,32 @@ def lengths_table(bench: Bench) -> str:
     head += ["LAMA solved", "LAMA moves", "LAMA x opt", "LAMA s", "ours/LAMA"] if lama else []
     body = []
     for s in size_rows(bench):
-        row = [str(s.horizon), str(s.size), f"{count(s.valid)}/{s.n}", _num(s.length, 0.5),
-               _num(s.ratio), f"{s.time_s:.2f}"]  # fmt: skip
+        row = [
+            str(s.horizon),
+            str(s.size),
+            f"{count(s.valid)}/{s.n}",
+            _num(s.length, 0.5),
+            _num(s.ratio),
+            f"{s.time_s:.2f}",
+        ]
         if lama:
-            row += [f"{count(s.lama or 0)}/{s.n}", _num(s.lama_length, 0.5), _num(s.lama_ratio),
-                    _num(s.lama_s), _num(s.vs_lama)]  # fmt: skip
+            row += [
+                f"{count(s.lama or 0)}/{s.n}",
+                _num(s.lama_length, 0.5),
+                _num(s.lama_ratio),
+                _num(s.lama_s),
+                _num(s.vs_lama),
+            ]
         body.append(row)
     note = "moves: mean over plans found; x opt: mean length / optimum where the optimum is known"
     note += "; ours/LAMA: mean length ratio where both found a plan" if lama else ""
     latency = latency_rows(bench)
     if latency:
-        rows = [[str(r["horizon"]), str(r["size"]), str(r["n"])]
-                + [f"{r[q]:.3f}" for q in ("p50", "p90", "max")] for r in latency]  # fmt: skip
+        rows = [
+            [str(r["horizon"]), str(r["size"]), str(r["n"])]
+            + [f"{r[q]:.3f}" for q in ("p50", "p90", "max")]
+            for r in latency
+        ]
         note += f"\n\nplanning latency by {bench.size_name}, one problem at a time (s):\n"
         note += table(["T", bench.size_name, "plans", "p50", "p90", "max"], rows)
     return table(head, body) + "\n" + note

@@ -85,9 +85,14 @@ def generate(
                 names, colours, state = sample_scene(rng, min_blocks, max_blocks)
                 camera = jitter_camera(renderer.camera, jitter, rng)
                 image = renderer.render(
-                    names, state, int(rng.integers(2**31)), colours, camera,
-                    random_lighting(rng), scene,
-                )  # fmt: skip
+                    names,
+                    state,
+                    int(rng.integers(2**31)),
+                    colours,
+                    camera,
+                    random_lighting(rng),
+                    scene,
+                )
                 try:
                     find_boxes(image, palette[colours])
                     break
@@ -104,9 +109,14 @@ def generate(
             r.close()
     info = dict(meta or {})
     info.update(
-        seed=seed, sims=list(sims), n=n, blocks=[min_blocks, max_blocks], redrawn=redrawn,
-        camera=renderers[sims[0]].camera.__dict__, jitter=jitter.__dict__,
-    )  # fmt: skip
+        seed=seed,
+        sims=list(sims),
+        n=n,
+        blocks=[min_blocks, max_blocks],
+        redrawn=redrawn,
+        camera=renderers[sims[0]].camera.__dict__,
+        jitter=jitter.__dict__,
+    )
     return pdata.SupportData(
         np.stack(images), np.stack(colours_out), np.stack(supports_out), palette, info
     )

@@ -163,9 +163,10 @@ class ImageBeliefs:
     def _inputs(self, i: int, image: np.ndarray):
         p, colours = self.problems[i], self.colours[i]
         return self.perceiver.inputs(
-            [blur(image, self.mode.blur), self.goal_images[i]], [colours, colours],
+            [blur(image, self.mode.blur), self.goal_images[i]],
+            [colours, colours],
             [p.entities, p.entities],
-        )  # fmt: skip
+        )
 
     def __call__(self, indices: Sequence[int], states: Sequence[State]):
         t0 = time.perf_counter()

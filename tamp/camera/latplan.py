@@ -36,8 +36,12 @@ from tamp.scene import SceneConfig, towers
 from tamp.sim.base import SIMULATORS, Camera, Lighting
 from task.symbolic.generate import block_names, random_towers
 
-COLOURS = (("red", (1.0, 0.0, 0.0)), ("blue", (0.0, 0.0, 1.0)), ("green", (0.0, 1.0, 0.0)),
-           ("black", (0.0, 0.0, 0.0)))  # fmt: skip
+COLOURS = (
+    ("red", (1.0, 0.0, 0.0)),
+    ("blue", (0.0, 0.0, 1.0)),
+    ("green", (0.0, 1.0, 0.0)),
+    ("black", (0.0, 0.0, 0.0)),
+)
 SLOTS_CLEVR = (-3.5, -1.75, 0.0, 1.75, 3.5)  # table slots, CLEVR units
 SIZE_CLEVR = 1.4  # cylinder height and diameter, CLEVR units
 ROW_X = 0.5  # m, world x of the middle slot (in front of the robot)
@@ -68,10 +72,17 @@ def latplan_scene(block_size: float = 0.05) -> SceneConfig:
     """Cylinders of LatPlan's colours on one row of 5 slots, a floor and a backdrop wall."""
     k = unit(block_size)
     return SceneConfig(
-        block_size=block_size, slot_xs=tuple(ROW_X + k * x for x in SLOTS_CLEVR), slot_ys=(0.0,),
-        jitter_xy=0.0, jitter_yaw=math.pi, shape="cylinder", palette=COLOURS, floor_grey=0.45,
-        backdrop_y=30.0 * k, backdrop_grey=0.55,
-    )  # fmt: skip
+        block_size=block_size,
+        slot_xs=tuple(ROW_X + k * x for x in SLOTS_CLEVR),
+        slot_ys=(0.0,),
+        jitter_xy=0.0,
+        jitter_yaw=math.pi,
+        shape="cylinder",
+        palette=COLOURS,
+        floor_grey=0.45,
+        backdrop_y=30.0 * k,
+        backdrop_grey=0.55,
+    )
 
 
 def latplan_camera(block_size: float = 0.05, width: int = 150, height: int = 100) -> Camera:
@@ -83,8 +94,10 @@ def latplan_camera(block_size: float = 0.05, width: int = 150, height: int = 100
     return Camera(
         eye=(ROW_X + k * eye[0], k * eye[1], k * eye[2]),
         target=(ROW_X + k * target[0], k * target[1], k * target[2]),
-        fovy=math.degrees(2 * math.atan(half_h)), width=width, height=height,
-    )  # fmt: skip
+        fovy=math.degrees(2 * math.atan(half_h)),
+        width=width,
+        height=height,
+    )
 
 
 def scene_layout(path: str | Path) -> Layout:
@@ -204,9 +217,15 @@ def generate(
                     break
                 redrawn += 1
             poses = renderers[sims[i % len(sims)]].place(
-                names, state, int(rng.integers(2**31)), colours,
-                jitter_camera(camera, jitter, rng), random_light(rng, rand), scene, slots,
-            )  # fmt: skip
+                names,
+                state,
+                int(rng.integers(2**31)),
+                colours,
+                jitter_camera(camera, jitter, rng),
+                random_light(rng, rand),
+                scene,
+                slots,
+            )
             for part in ("floor", "backdrop"):
                 sim.set_colour(part, [rng.uniform(*rand.grey)] * 3)
             for name, rgb in COLOURS:
@@ -226,19 +245,29 @@ def generate(
             r.close()
     info = dict(meta or {})
     info.update(
-        scene="latplan", seed=seed, sims=list(sims), n=n, blocks=[min_blocks, max_blocks],
+        scene="latplan",
+        seed=seed,
+        sims=list(sims),
+        n=n,
+        blocks=[min_blocks, max_blocks],
         camera={**CAMERA_SOURCE, "world": camera.__dict__, "metres_per_clevr_unit": k},
-        randomisation=rand.__dict__, slots=slots_out,
-        evaluation_layouts_excluded=bool(excluded), excluded_layouts=len(excluded),
-        excluded_from=exclude_source if excluded else None, redrawn_as_excluded=redrawn,
-    )  # fmt: skip
+        randomisation=rand.__dict__,
+        slots=slots_out,
+        evaluation_layouts_excluded=bool(excluded),
+        excluded_layouts=len(excluded),
+        excluded_from=exclude_source if excluded else None,
+        redrawn_as_excluded=redrawn,
+    )
     palette = np.asarray([rgb for _, rgb in COLOURS], dtype=np.float32)
     full = np.stack(images)  # (M, 100, 150, 3)
     out = {}
     for size in SIZES:
         pics = full if full.shape[2:0:-1] == size else downscale(full, size)
         out[size] = pdata.SupportData(
-            pics, np.stack(colours_out), np.stack(supports_out), palette,
+            pics,
+            np.stack(colours_out),
+            np.stack(supports_out),
+            palette,
             {**info, "size": list(size)},
-        )  # fmt: skip
+        )
     return out

@@ -24,9 +24,15 @@ from tamp.cli.options import planner_config, sim_list
 from task.errors import TampError
 
 __all__ = [  # the handlers `tamp.cli.parser` dispatches to
-    "executability_command", "latplan_command", "motion_command", "pddl_command",
-    "perception_command", "planbench_command", "poses_command", "random_command",
-]  # fmt: skip
+    "executability_command",
+    "latplan_command",
+    "motion_command",
+    "pddl_command",
+    "perception_command",
+    "planbench_command",
+    "poses_command",
+    "random_command",
+]
 
 
 @contextmanager
@@ -73,8 +79,11 @@ def _lama(suite: suites.Suite, bench: planning.Bench, limit: float, progress: bo
     from tamp.bench import fast_downward
 
     if not fast_downward.available():
-        print(f"LAMA skipped: Fast Downward is not installed (pip install 'soft-tamp[bench]', "
-              f"the package {fast_downward.PACKAGE})", file=sys.stderr)  # fmt: skip
+        print(
+            f"LAMA skipped: Fast Downward is not installed (pip install 'soft-tamp[bench]', "
+            f"the package {fast_downward.PACKAGE})",
+            file=sys.stderr,
+        )
         return bench
     with _bar(len(suite.instances), "LAMA (lama-first)", progress, "instance") as update:
         return planning.with_lama(bench, suite, limit, update)
@@ -102,8 +111,14 @@ def _searching(enabled: bool):
 
     def update(k: int) -> None:
         if not bars:
-            bars.append(tqdm(desc="optimal lengths the data lack", unit="problem",
-                             file=sys.stderr, disable=not enabled))  # fmt: skip
+            bars.append(
+                tqdm(
+                    desc="optimal lengths the data lack",
+                    unit="problem",
+                    file=sys.stderr,
+                    disable=not enabled,
+                )
+            )
         bars[0].update(k)
 
     try:
@@ -141,28 +156,60 @@ def perception_command(args: argparse.Namespace) -> int:
     config = planner_config(args)
     horizons = args.horizons or (config.horizon,)
     modes = [  # ground truth (no images) once, as crisp "true"
-        PerceptionMode(m, kl_weight=args.kl_weight, blur=r, adapt=args.adapt,
-                       crisp="true" if m == "state" else c)
-        for r in args.blur for m in names for c in crisps
+        PerceptionMode(
+            m,
+            kl_weight=args.kl_weight,
+            blur=r,
+            adapt=args.adapt,
+            crisp="true" if m == "state" else c,
+        )
+        for r in args.blur
+        for m in names
+        for c in crisps
         if not (m == "state" and (r != args.blur[0] or c != crisps[0]))
-    ]  # fmt: skip
-    with tqdm(total=len(modes) * len(horizons), desc="perception bench", unit="row",
-              file=sys.stderr, disable=not args.progress) as bar:  # fmt: skip
+    ]
+    with tqdm(
+        total=len(modes) * len(horizons),
+        desc="perception bench",
+        unit="row",
+        file=sys.stderr,
+        disable=not args.progress,
+    ) as bar:
 
         def progress(mode, horizon) -> None:
             bar.set_postfix(mode=mode.mode, blur=mode.blur, T=horizon, refresh=False)
             bar.update(1)
 
-        result = bench.run(suite, modes, horizons, config, args.seed, perceiver, args.sim,
-                           example_blur=args.blur[-1], progress=progress,
-                           corruption=corruption)  # fmt: skip
+        result = bench.run(
+            suite,
+            modes,
+            horizons,
+            config,
+            args.seed,
+            perceiver,
+            args.sim,
+            example_blur=args.blur[-1],
+            progress=progress,
+            corruption=corruption,
+        )
     split = {str(b): sum(i.blocks == b for i in chosen) for b in bench.sizes(chosen)}
-    body = {"suite": suite.name, "source": suite.source, "n": len(chosen),
-            "instances": [i.name for i in chosen], "split": split, "sim": args.sim,
-            "checkpoint": str(args.checkpoint), "seed": args.seed, "threads": args.threads,
-            "cores": os.cpu_count(), "machine": results.machine(),
-            "date": time.strftime("%Y-%m-%d"), "redrawn_renders": result.redrawn,
-            "corruption": corruption.name, "rows": list(result.summaries)}  # fmt: skip
+    body = {
+        "suite": suite.name,
+        "source": suite.source,
+        "n": len(chosen),
+        "instances": [i.name for i in chosen],
+        "split": split,
+        "sim": args.sim,
+        "checkpoint": str(args.checkpoint),
+        "seed": args.seed,
+        "threads": args.threads,
+        "cores": os.cpu_count(),
+        "machine": results.machine(),
+        "date": time.strftime("%Y-%m-%d"),
+        "redrawn_renders": result.redrawn,
+        "corruption": corruption.name,
+        "rows": list(result.summaries),
+    }
     if args.out:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -171,8 +218,10 @@ def perception_command(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(body, indent=2))
     else:
-        print(f"{suite.name}: {len(chosen)} instances ({'/'.join(map(str, split.values()))} by "
-              f"block count), sim {args.sim}, images: {corruption.name}")  # fmt: skip
+        print(
+            f"{suite.name}: {len(chosen)} instances ({'/'.join(map(str, split.values()))} by "
+            f"block count), sim {args.sim}, images: {corruption.name}"
+        )
         print(tables.perception_table(list(result.summaries)))
         if result.redrawn:
             print(f"{result.redrawn} renders redrawn because a block was hidden")
@@ -200,9 +249,14 @@ def latplan_command(args: argparse.Namespace) -> int:
     with _bar(total, f"latplan ({len(data.instances)} instances)", args.progress) as update:
         rows = latplan.run(data, perceiver, res, modes, seeds, config, update)
     summary = latplan.summaries(rows)
-    options = {"checkpoint": str(args.checkpoint) if images else None, "resolutions": list(res),
-               "modes": list(modes), "seeds": list(seeds), "threads": args.threads,
-               "config": asdict(config)}  # fmt: skip
+    options = {
+        "checkpoint": str(args.checkpoint) if images else None,
+        "resolutions": list(res),
+        "modes": list(modes),
+        "seeds": list(seeds),
+        "threads": args.threads,
+        "config": asdict(config),
+    }
     body = latplan.report(data, rows, summary, options, results.machine())
     if args.out is not None:
         out = results.out_folder(args.out)
@@ -211,8 +265,10 @@ def latplan_command(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(body, indent=2))
         return 0
-    print(f"LatPlan-40: {len(data.instances)} instances from {data.root}, seeds 0..{seeds[-1]}; "
-          "valid and optimal judged against each instance's PDDL (full-state goals)")  # fmt: skip
+    print(
+        f"LatPlan-40: {len(data.instances)} instances from {data.root}, seeds 0..{seeds[-1]}; "
+        "valid and optimal judged against each instance's PDDL (full-state goals)"
+    )
     print(tables.latplan_table(summary))
     if args.out is not None:
         print(f"\nwrote results.json, instances.csv to {args.out}")
@@ -224,13 +280,33 @@ def poses_command(args: argparse.Namespace) -> int:
     from tamp.bench import poses
 
     sims = sim_list(args.sim)
-    with tqdm(total=args.n * len(sims), desc="poses", unit="scene", file=sys.stderr,
-              disable=not args.progress) as bar:  # fmt: skip
-        result = poses.run(sims, args.n, args.seed, args.min_blocks, args.max_blocks,
-                           args.jitter, lambda sim: bar.update(1))  # fmt: skip
-    body = {"config": {"sims": list(sims), "n": args.n, "seed": args.seed,
-                       "blocks": [args.min_blocks, args.max_blocks], "jitter": args.jitter},
-            "machine": results.machine(), "summary": result.summary}  # fmt: skip
+    with tqdm(
+        total=args.n * len(sims),
+        desc="poses",
+        unit="scene",
+        file=sys.stderr,
+        disable=not args.progress,
+    ) as bar:
+        result = poses.run(
+            sims,
+            args.n,
+            args.seed,
+            args.min_blocks,
+            args.max_blocks,
+            args.jitter,
+            lambda sim: bar.update(1),
+        )
+    body = {
+        "config": {
+            "sims": list(sims),
+            "n": args.n,
+            "seed": args.seed,
+            "blocks": [args.min_blocks, args.max_blocks],
+            "jitter": args.jitter,
+        },
+        "machine": results.machine(),
+        "summary": result.summary,
+    }
     if args.out:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -239,13 +315,18 @@ def poses_command(args: argparse.Namespace) -> int:
         print(json.dumps(body, indent=2))
         return 0
     view = "random camera and light" if args.jitter else "default camera and light"
-    print(f"pose benchmark: {args.n} scenes of {args.min_blocks}-{args.max_blocks} blocks per "
-          f"simulator, {view}, seed {args.seed}; errors against the true poses")  # fmt: skip
+    print(
+        f"pose benchmark: {args.n} scenes of {args.min_blocks}-{args.max_blocks} blocks per "
+        f"simulator, {view}, seed {args.seed}; errors against the true poses"
+    )
     print(tables.poses_table(result.summary))
-    times = ", ".join(f"{sim} {s['estimate_ms_per_image']:.0f} ms" for sim, s in
-                      result.summary.items())  # fmt: skip
-    print(f"estimation per image: {times}; yaw modulo 90 degrees; top free: nothing rests on "
-          f"the block; covered: its top face is under another block")  # fmt: skip
+    times = ", ".join(
+        f"{sim} {s['estimate_ms_per_image']:.0f} ms" for sim, s in result.summary.items()
+    )
+    print(
+        f"estimation per image: {times}; yaw modulo 90 degrees; top free: nothing rests on "
+        f"the block; covered: its top face is under another block"
+    )
     if args.out:
         print(f"wrote results.json, blocks.csv to {args.out}")
     return 0

@@ -93,22 +93,39 @@ def images_command(args: argparse.Namespace) -> int:
     ok = validation is not None and validation.valid
     goal = tuple(y for _, y in problem.goal)
     if args.json:
-        print(json.dumps({
-            "init_image": args.init, "goal_image": args.goal, "scene": args.scene,
-            "perception": args.perception, "checkpoint": str(checkpoint), "blocks": list(names),
-            "perceived_init": dict(zip(names, init, strict=True)),
-            "perceived_goal": dict(problem.goal),
-            "status": result.status.value, "valid": ok,
-            "moves": [[m.entity, m.target] for m in moves if isinstance(m, Move)],
-            "actions": [str(a).lower() for a in actions],
-            "validation": None if validation is None else report.validation_dict(validation),
-            "problem_pddl": text,
-            "timing": {"read_s": read_s, "perception_s": pair.perception_s,
-                       "planning_s": result.stats["time_s"],
-                       "total_s": time.perf_counter() - t0},
-            "stats": result.stats, "seed": args.seed, "threads": args.threads,
-            "config": asdict(config),
-        }, indent=2))  # fmt: skip
+        print(
+            json.dumps(
+                {
+                    "init_image": args.init,
+                    "goal_image": args.goal,
+                    "scene": args.scene,
+                    "perception": args.perception,
+                    "checkpoint": str(checkpoint),
+                    "blocks": list(names),
+                    "perceived_init": dict(zip(names, init, strict=True)),
+                    "perceived_goal": dict(problem.goal),
+                    "status": result.status.value,
+                    "valid": ok,
+                    "moves": [[m.entity, m.target] for m in moves if isinstance(m, Move)],
+                    "actions": [str(a).lower() for a in actions],
+                    "validation": None
+                    if validation is None
+                    else report.validation_dict(validation),
+                    "problem_pddl": text,
+                    "timing": {
+                        "read_s": read_s,
+                        "perception_s": pair.perception_s,
+                        "planning_s": result.stats["time_s"],
+                        "total_s": time.perf_counter() - t0,
+                    },
+                    "stats": result.stats,
+                    "seed": args.seed,
+                    "threads": args.threads,
+                    "config": asdict(config),
+                },
+                indent=2,
+            )
+        )
         return 0 if ok else 1
     if validation is not None:
         print(pddl_io.format_plan(actions), end="")

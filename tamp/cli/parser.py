@@ -54,19 +54,32 @@ def build_parser() -> argparse.ArgumentParser:
 def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     """``plan``, ``validate`` and ``demo``."""
     p = sub.add_parser(
-        "plan", parents=[plan_opts],
+        "plan",
+        parents=[plan_opts],
         help="plan a PDDL problem (blocksworld, logistics, sokoban or any STRIPS domain)",
-    )  # fmt: skip
+    )
     p.add_argument("domain", metavar="DOMAIN.pddl")
     p.add_argument("problem", metavar="PROBLEM.pddl")
-    p.add_argument("--seed", type=int, default=0, help="planner seed (0) and, with "
-                   "--motion-aware, the scene layout's")  # fmt: skip
-    p.add_argument("--motion-aware", dest="lambda_motion", action="store_const", const=0.05,
-                   help="blocksworld: the arm's cost of each move in the objective, for the "
-                   "problem laid out on --scene (off)")  # fmt: skip
-    p.add_argument("--scene", choices=("tabletop", "shelf", "clutter", "cramped"),
-                   default="tabletop",
-                   help="--motion-aware: the table scene (tabletop)")  # fmt: skip
+    p.add_argument(
+        "--seed",
+        type=int,
+        default=0,
+        help="planner seed (0) and, with --motion-aware, the scene layout's",
+    )
+    p.add_argument(
+        "--motion-aware",
+        dest="lambda_motion",
+        action="store_const",
+        const=0.05,
+        help="blocksworld: the arm's cost of each move in the objective, for the "
+        "problem laid out on --scene (off)",
+    )
+    p.add_argument(
+        "--scene",
+        choices=("tabletop", "shelf", "clutter", "cramped"),
+        default="tabletop",
+        help="--motion-aware: the table scene (tabletop)",
+    )
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
     p.set_defaults(func=_lazy("tamp.cli.plan", "plan_command"))
@@ -86,19 +99,31 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
 
 def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
     p = sub.add_parser(
-        "plan-images", parents=[plan_opts],
+        "plan-images",
+        parents=[plan_opts],
         help="plan a blocksworld problem from an initial and a goal image",
-    )  # fmt: skip
+    )
     p.add_argument("init", metavar="INIT.png", help="image of the initial scene (PNG or JPG)")
     p.add_argument("goal", metavar="GOAL.png", help="image of the goal scene, the same size")
-    p.add_argument("--scene", choices=("cubes", "latplan"), default="cubes",
-                   help="whose block colours to look for: the robot's cubes or LatPlan's red, "
-                   "blue, green and black cylinders (cubes)")  # fmt: skip
-    p.add_argument("--perception", choices=("frozen", "optimised"), default="frozen",
-                   help="frozen or planning-optimised perception (frozen)")  # fmt: skip
-    p.add_argument("--checkpoint", metavar="FILE.pt",
-                   help="perception weights (cubes: perception/support.pt; latplan: "
-                   "perception/support-latplan.pt)")  # fmt: skip
+    p.add_argument(
+        "--scene",
+        choices=("cubes", "latplan"),
+        default="cubes",
+        help="whose block colours to look for: the robot's cubes or LatPlan's red, "
+        "blue, green and black cylinders (cubes)",
+    )
+    p.add_argument(
+        "--perception",
+        choices=("frozen", "optimised"),
+        default="frozen",
+        help="frozen or planning-optimised perception (frozen)",
+    )
+    p.add_argument(
+        "--checkpoint",
+        metavar="FILE.pt",
+        help="perception weights (cubes: perception/support.pt; latplan: "
+        "perception/support-latplan.pt)",
+    )
     p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
     output_options(p, "write the plan file (VAL format) here")
@@ -130,14 +155,20 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         p.add_argument(
             "--seeds", type=positive, default=1, metavar="S", help="planner seeds 0..S-1 (1)"
         )
-        p.add_argument("--sequential", type=nonnegative, default=0, metavar="N",
-                       help="also time batched vs sequential planning on the first N "
-                       "instances")  # fmt: skip
         p.add_argument(
-            "--no-crisp-check", dest="crisp_check", action="store_false",
+            "--sequential",
+            type=nonnegative,
+            default=0,
+            metavar="N",
+            help="also time batched vs sequential planning on the first N instances",
+        )
+        p.add_argument(
+            "--no-crisp-check",
+            dest="crisp_check",
+            action="store_false",
             help="keep a window's strongest move even when it is illegal (the plan is then "
             "inexecutable); measures the soft planner without the decoder's legality filter",
-        )  # fmt: skip
+        )
         p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
@@ -151,24 +182,42 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
     rules_option(folder)
     for p in (planbench, folder):
         p.add_argument(
-            "--limit", type=positive, metavar="N",
+            "--limit",
+            type=positive,
+            metavar="N",
             help="a spread of N instances over the sizes (all)",
-        )  # fmt: skip
+        )
     planbench.set_defaults(func=_lazy("tamp.cli.bench", "planbench_command"))
     folder.set_defaults(func=_lazy("tamp.cli.bench", "pddl_command"))
-    random_.add_argument("--blocks", type=positive_list, default=(6, 8, 10, 15, 20),
-                         metavar="B[,B...]", help="block counts (6,8,10,15,20)")  # fmt: skip
+    random_.add_argument(
+        "--blocks",
+        type=positive_list,
+        default=(6, 8, 10, 15, 20),
+        metavar="B[,B...]",
+        help="block counts (6,8,10,15,20)",
+    )
     random_.add_argument("--n", type=positive, default=50, help="instances per block count (50)")
     random_.add_argument("--seed", type=int, default=0, help="instance generator seed (0)")
-    random_.add_argument("--max-nodes", type=positive, default=20_000, metavar="N",
-                         help="A* expansion budget for the optimal lengths (20000)")  # fmt: skip
-    random_.add_argument("--one-at-a-time", action="store_true",
-                         help="plan one instance at a time, each within its own --time-limit "
-                         "(default: batched, a batch shares the limit)")  # fmt: skip
-    random_.add_argument("--lama", action="store_true",
-                         help="also run Fast Downward's LAMA (first plan, --time-limit or "
-                         "60 s) on every instance: its length and time beside ours (needs the "
-                         "bench extra)")  # fmt: skip
+    random_.add_argument(
+        "--max-nodes",
+        type=positive,
+        default=20_000,
+        metavar="N",
+        help="A* expansion budget for the optimal lengths (20000)",
+    )
+    random_.add_argument(
+        "--one-at-a-time",
+        action="store_true",
+        help="plan one instance at a time, each within its own --time-limit "
+        "(default: batched, a batch shares the limit)",
+    )
+    random_.add_argument(
+        "--lama",
+        action="store_true",
+        help="also run Fast Downward's LAMA (first plan, --time-limit or "
+        "60 s) on every instance: its length and time beside ours (needs the "
+        "bench extra)",
+    )
     random_.set_defaults(func=_lazy("tamp.cli.bench", "random_command"))
 
 
@@ -186,9 +235,11 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
 
 
 def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
-    p = bench.add_parser("executability", parents=[plan_opts],
-                         help="execute plans of any source (CSV) open-loop in the "
-                         "simulators")  # fmt: skip
+    p = bench.add_parser(
+        "executability",
+        parents=[plan_opts],
+        help="execute plans of any source (CSV) open-loop in the simulators",
+    )
     executability_options(p)
     sweep_options(p)
     p.set_defaults(func=_lazy("tamp.cli.bench", "executability_command"))
@@ -212,14 +263,30 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
 
 def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     p = bench.add_parser("latplan", parents=[plan_opts], help="LatPlan-40: plan from its images")
-    p.add_argument("--data", default=str(DEFAULT_DATA / "latplan"), metavar="DIR",
-                   help="LatPlan-40 folder (%(default)s)")  # fmt: skip
-    p.add_argument("--checkpoint", default=str(CHECKPOINT.with_name("support-latplan.pt")),
-                   metavar="FILE.pt", help="perception weights (%(default)s)")  # fmt: skip
-    p.add_argument("--res", default="150x100,45x30", metavar="WxH[,WxH]",
-                   help="image_tr/ renders and/or LatPlan's own input (%(default)s)")  # fmt: skip
-    p.add_argument("--modes", default="state,frozen,optimised", metavar="M[,M...]",
-                   help="state (the PDDL problem, no images), frozen, optimised (all)")  # fmt: skip
+    p.add_argument(
+        "--data",
+        default=str(DEFAULT_DATA / "latplan"),
+        metavar="DIR",
+        help="LatPlan-40 folder (%(default)s)",
+    )
+    p.add_argument(
+        "--checkpoint",
+        default=str(CHECKPOINT.with_name("support-latplan.pt")),
+        metavar="FILE.pt",
+        help="perception weights (%(default)s)",
+    )
+    p.add_argument(
+        "--res",
+        default="150x100,45x30",
+        metavar="WxH[,WxH]",
+        help="image_tr/ renders and/or LatPlan's own input (%(default)s)",
+    )
+    p.add_argument(
+        "--modes",
+        default="state,frozen,optimised",
+        metavar="M[,M...]",
+        help="state (the PDDL problem, no images), frozen, optimised (all)",
+    )
     p.add_argument("--seeds", type=positive, default=3, metavar="S", help="planner seeds (3)")
     p.add_argument("--limit", type=positive, metavar="N", help="a spread of N instances (40)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
@@ -230,8 +297,12 @@ def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
 
 def _poses_benchmark(bench) -> None:
     p = bench.add_parser("poses", help="block poses from RGB-D images against the true poses")
-    p.add_argument("--sim", default=",".join(SIMULATORS), metavar="SIM[,SIM]",
-                   help=f"simulators, comma-separated ({','.join(SIMULATORS)})")  # fmt: skip
+    p.add_argument(
+        "--sim",
+        default=",".join(SIMULATORS),
+        metavar="SIM[,SIM]",
+        help=f"simulators, comma-separated ({','.join(SIMULATORS)})",
+    )
     p.add_argument("--n", type=positive, default=200, help="random scenes per simulator (200)")
     p.add_argument("--seed", type=int, default=0, help="scene seed (0)")
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
@@ -252,13 +323,21 @@ def _perception_commands(sub) -> None:
     p = cmds.add_parser("dataset", help="render a labelled support dataset")
     p.add_argument("--n", type=positive, default=4000, help="images (4000)")
     p.add_argument("--seed", type=int, default=0, help="scene and view seed (0)")
-    p.add_argument("--sim", default="pybullet,mujoco", metavar="SIM[,SIM]",
-                   help="simulators, samples alternate (pybullet,mujoco)")  # fmt: skip
+    p.add_argument(
+        "--sim",
+        default="pybullet,mujoco",
+        metavar="SIM[,SIM]",
+        help="simulators, samples alternate (pybullet,mujoco)",
+    )
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
     p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
-    p.add_argument("--scene", choices=("cubes", "latplan"), default="cubes",
-                   help="cubes (the robot's scene) or latplan: LatPlan's 4 cylinders on 5 slots, "
-                   "written at 150x100 to --out and at 45x30 beside it (cubes)")  # fmt: skip
+    p.add_argument(
+        "--scene",
+        choices=("cubes", "latplan"),
+        default="cubes",
+        help="cubes (the robot's scene) or latplan: LatPlan's 4 cylinders on 5 slots, "
+        "written at 150x100 to --out and at 45x30 beside it (cubes)",
+    )
     p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
@@ -270,8 +349,12 @@ def _perception_commands(sub) -> None:
     p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
     p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
     p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
-    p.add_argument("--out", required=True, metavar="FILE.pt",
-                   help="checkpoint to write (never the shipped one)")  # fmt: skip
+    p.add_argument(
+        "--out",
+        required=True,
+        metavar="FILE.pt",
+        help="checkpoint to write (never the shipped one)",
+    )
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
     p.set_defaults(func=_lazy("tamp.cli.perception", "train_command"))

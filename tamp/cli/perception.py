@@ -26,12 +26,18 @@ def dataset_command(args: argparse.Namespace) -> int:
     sims = tuple(s for s in args.sim.split(",") if s)
     if args.scene == "latplan":
         return _latplan_dataset(args, sims)
-    with tqdm(total=args.n, desc="render", unit="image", file=sys.stderr,
-              disable=not args.progress) as bar:  # fmt: skip
+    with tqdm(
+        total=args.n, desc="render", unit="image", file=sys.stderr, disable=not args.progress
+    ) as bar:
         data = generate(
-            args.n, args.seed, sims, args.min_blocks, args.max_blocks,
-            progress=bar.update, meta={"command": _command_line()},
-        )  # fmt: skip
+            args.n,
+            args.seed,
+            sims,
+            args.min_blocks,
+            args.max_blocks,
+            progress=bar.update,
+            meta={"command": _command_line()},
+        )
     path = pdata.save(args.out, data)
     if args.json:
         print(json.dumps({"images": len(data), "redrawn": data.meta["redrawn"], "out": str(path)}))
@@ -46,19 +52,34 @@ def _latplan_dataset(args: argparse.Namespace, sims: tuple[str, ...]) -> int:
     from tamp.camera import latplan
 
     exclude = latplan.evaluation_layouts()
-    with tqdm(total=args.n, desc="render", unit="image", file=sys.stderr,
-              disable=not args.progress) as bar:  # fmt: skip
+    with tqdm(
+        total=args.n, desc="render", unit="image", file=sys.stderr, disable=not args.progress
+    ) as bar:
         out = latplan.generate(
-            args.n, args.seed, sims, exclude=exclude, exclude_source=str(latplan.EVALUATION),
-            progress=bar.update, meta={"command": _command_line()},
-        )  # fmt: skip
+            args.n,
+            args.seed,
+            sims,
+            exclude=exclude,
+            exclude_source=str(latplan.EVALUATION),
+            progress=bar.update,
+            meta={"command": _command_line()},
+        )
     big = Path(args.out)
-    paths = [pdata.save(big, out[(150, 100)]),
-             pdata.save(big.with_name(f"{big.stem}_45x30{big.suffix}"), out[(45, 30)])]  # fmt: skip
+    paths = [
+        pdata.save(big, out[(150, 100)]),
+        pdata.save(big.with_name(f"{big.stem}_45x30{big.suffix}"), out[(45, 30)]),
+    ]
     meta = out[(150, 100)].meta
     if args.json:
-        print(json.dumps({"images": args.n, "out": [str(p) for p in paths],
-                          "excluded_layouts": meta["excluded_layouts"]}))  # fmt: skip
+        print(
+            json.dumps(
+                {
+                    "images": args.n,
+                    "out": [str(p) for p in paths],
+                    "excluded_layouts": meta["excluded_layouts"],
+                }
+            )
+        )
         return 0
     excluded = (
         f"{meta['excluded_layouts']} evaluation layouts excluded"
@@ -71,8 +92,15 @@ def _latplan_dataset(args: argparse.Namespace, sims: tuple[str, ...]) -> int:
 
 # what a checkpoint's meta keeps of its training set's own meta (scene, camera provenance,
 # whether evaluation layouts were excluded)
-DATASET_KEYS = ("scene", "sims", "camera", "evaluation_layouts_excluded", "excluded_layouts",
-                "excluded_from", "randomisation")  # fmt: skip
+DATASET_KEYS = (
+    "scene",
+    "sims",
+    "camera",
+    "evaluation_layouts_excluded",
+    "excluded_layouts",
+    "excluded_from",
+    "randomisation",
+)
 
 
 def train_command(args: argparse.Namespace) -> int:
@@ -94,8 +122,9 @@ def train_command(args: argparse.Namespace) -> int:
     train_data, test_data = pdata.tensors(train_raw), pdata.tensors(test_raw)
     hw = list(train_raw.images.shape[1:3])
     config = TrainConfig(epochs=args.epochs, seed=args.seed)
-    with tqdm(total=config.epochs, desc="train", unit="epoch", file=sys.stderr,
-              disable=not args.progress) as bar:  # fmt: skip
+    with tqdm(
+        total=config.epochs, desc="train", unit="epoch", file=sys.stderr, disable=not args.progress
+    ) as bar:
 
         def on_epoch(k: int, loss: float) -> None:
             bar.set_postfix(nll=f"{loss:.4f}")
@@ -107,9 +136,12 @@ def train_command(args: argparse.Namespace) -> int:
     for path in args.test.split(",")[1:]:
         extra = pdata.load_many([path])
         resized = pdata.SupportData(
-            np.stack([pdata.resize_image(im, hw) for im in extra.images]), extra.colours,
-            extra.supports, extra.palette, extra.meta,
-        )  # fmt: skip
+            np.stack([pdata.resize_image(im, hw) for im in extra.images]),
+            extra.colours,
+            extra.supports,
+            extra.palette,
+            extra.meta,
+        )
         more[path] = evaluate(model, pdata.tensors(resized))
     meta = {
         "command": _command_line(),
@@ -145,8 +177,10 @@ def train_command(args: argparse.Namespace) -> int:
         f"{scores['unreadable']} unreadable, left out) -> {args.out}"
     )
     for path, more_scores in more.items():
-        print(f"  {path}: relation accuracy {more_scores['relation_accuracy']:.4%}, "
-              f"scene accuracy {more_scores['scene_accuracy']:.2%}")  # fmt: skip
+        print(
+            f"  {path}: relation accuracy {more_scores['relation_accuracy']:.4%}, "
+            f"scene accuracy {more_scores['scene_accuracy']:.2%}"
+        )
     return 0
 
 

@@ -57,8 +57,10 @@ def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> 
     (seeded by ``--seed``), the arm at home, on the scene's table slots (`tamp.slots`): a
     move onto the table carries the place it goes to."""
     if problem.domain != "blocksworld":
-        raise TampError(f"--motion-aware prices arm moves of blocksworld problems on a table; "
-                        f"this is a {problem.domain} problem")  # fmt: skip
+        raise TampError(
+            f"--motion-aware prices arm moves of blocksworld problems on a table; "
+            f"this is a {problem.domain} problem"
+        )
     from motion.ik import IKSolver
     from robots.panda import PANDA
     from tamp.obstacles import with_scene

@@ -72,8 +72,9 @@ def loop_config(args: argparse.Namespace) -> LoopConfig:
 def given_config(args: argparse.Namespace) -> LoopConfig:
     """The loop settings of ``bench executability``: grasp, scene and collision mode."""
     execution = replace(ExecConfig(), collision=args.collision)
-    return LoopConfig(grasp=args.grasp, scene=with_scene(SceneConfig(), args.scene),
-                      execution=execution)  # fmt: skip
+    return LoopConfig(
+        grasp=args.grasp, scene=with_scene(SceneConfig(), args.scene), execution=execution
+    )
 
 
 def summary_lines(report: EpisodeReport) -> list[str]:
@@ -134,8 +135,10 @@ def run_command(args: argparse.Namespace) -> int:
         if seen == "camera":
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
         given = f", given plan {args.plan} ({len(steps)} steps)" if steps else ""
-        print(f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
-              file=sys.stderr)  # fmt: skip
+        print(
+            f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
+            file=sys.stderr,
+        )
     report = episode.run()
     written = []
     if video is not None:
@@ -146,13 +149,21 @@ def run_command(args: argparse.Namespace) -> int:
             print(f"warning: {exc}", file=sys.stderr)
     body = report.to_json()
     body["config"] = {
-        "sim": config.sim, "grasp": config.grasp, "inject": str(config.inject),
-        "seed": args.seed, "max_replans": config.max_replans, "observe": config.observe,
-        "perception": config.perception.mode, "blur": config.perception.blur,
-        "plan": args.plan, "replan": args.replan, "stop_at_invalid": args.stop_at_invalid,
-        "scene": config.scene.name, "collision": config.execution.collision,
+        "sim": config.sim,
+        "grasp": config.grasp,
+        "inject": str(config.inject),
+        "seed": args.seed,
+        "max_replans": config.max_replans,
+        "observe": config.observe,
+        "perception": config.perception.mode,
+        "blur": config.perception.blur,
+        "plan": args.plan,
+        "replan": args.replan,
+        "stop_at_invalid": args.stop_at_invalid,
+        "scene": config.scene.name,
+        "collision": config.execution.collision,
         "lambda_motion": config.planner.lambda_motion,
-    }  # fmt: skip
+    }
     if out is not None:
         (out / "report.json").write_text(json.dumps(body, indent=2))
         written.append("report.json")

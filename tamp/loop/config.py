@@ -47,7 +47,9 @@ class LoopConfig:
         if self.crisp not in CRISP:
             raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
         if not 0.0 <= self.placements <= 0.03:
-            raise TampError(f"placements must lie in [0, 0.03] m (a block stays on its slot), "
-                            f"got {self.placements}")  # fmt: skip
+            raise TampError(
+                f"placements must lie in [0, 0.03] m (a block stays on its slot), "
+                f"got {self.placements}"
+            )
         if self.observe == "camera" and self.perception.mode == "state":
             raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

@@ -43,8 +43,15 @@ from task.planner import plan
 from task.problem import Move, Problem
 
 # what the arm could not do (not a fault of the world): motion-aware planning prices the move out
-ARM_FAILURES = frozenset({Failure.IK_INFEASIBLE, Failure.NO_FREE_SLOT, Failure.NO_CLEARANCE,
-                          Failure.COLLISION, Failure.TRACKING})  # fmt: skip
+ARM_FAILURES = frozenset(
+    {
+        Failure.IK_INFEASIBLE,
+        Failure.NO_FREE_SLOT,
+        Failure.NO_CLEARANCE,
+        Failure.COLLISION,
+        Failure.TRACKING,
+    }
+)
 
 
 class Episode:
@@ -191,8 +198,17 @@ class Episode:
         if self.config.planner.lambda_motion > 0:
             poses, scene, q = self._poses(), self.config.scene, self.sim.arm_q()
             if self.config.observe == "state":
-                return plan_on_places(current, poses, scene, self.solver, q, self.config.planner,
-                                      seed, self._avoid, self.config.placements)  # fmt: skip
+                return plan_on_places(
+                    current,
+                    poses,
+                    scene,
+                    self.solver,
+                    q,
+                    self.config.planner,
+                    seed,
+                    self._avoid,
+                    self.config.placements,
+                )
             costs = ArmCosts([current], [poses], scene, self.solver, q, avoid=self._avoid)
         if self.config.observe == "state":
             return plan(current, self.config.planner, seed=seed, costs=costs)
@@ -263,9 +279,17 @@ class Episode:
         cfg = self.config
         self._acts += 1
         return execute_move(
-            self.sim, self.solver, move, self._poses, cfg.execution, cfg.scene, drop_at,
-            self.on_frame, self.collision, self.seed * 1000 + self._acts,
-        )  # fmt: skip
+            self.sim,
+            self.solver,
+            move,
+            self._poses,
+            cfg.execution,
+            cfg.scene,
+            drop_at,
+            self.on_frame,
+            self.collision,
+            self.seed * 1000 + self._acts,
+        )
 
     def _settle(self) -> None:
         self.eyes.settle(self.on_frame)

@@ -124,16 +124,22 @@ def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig)
     fixed = obstacle_boxes(scene)
     pick = poses[move.entity]
     below = [
-        k for k, p in poses.items()
-        if k != move.entity and np.linalg.norm(p.xy - pick.xy) <= scene.tol_xy
+        k
+        for k, p in poses.items()
+        if k != move.entity
+        and np.linalg.norm(p.xy - pick.xy) <= scene.tol_xy
         and abs(pick.xyz[2] - p.xyz[2] - scene.block_size) <= 2 * scene.tol_z
-    ]  # fmt: skip
+    ]
     onto = "table" if move.target == TABLE else move.target
     placed = Box(move.entity, target.xyz, half, target.yaw)
     return PickPlaceWorld(
-        blocks + fixed, move.entity, below[0] if below else "table", onto, placed,
+        blocks + fixed,
+        move.entity,
+        below[0] if below else "table",
+        onto,
+        placed,
         scene.block_size,
-    )  # fmt: skip
+    )
 
 
 def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
@@ -165,9 +171,15 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
         if target is None:
             return last or (Failure.NO_FREE_SLOT, ik, {"slots": len(scene.slots)})
         request = PickPlaceRequest(
-            pick.xyz, pick.yaw, target.xyz, target.yaw, clear_z,
-            ceiling(pick.xyz, scene.obstacles), ceiling(target.xyz, scene.obstacles), turn,
-        )  # fmt: skip
+            pick.xyz,
+            pick.yaw,
+            target.xyz,
+            target.yaw,
+            clear_z,
+            ceiling(pick.xyz, scene.obstacles),
+            ceiling(target.xyz, scene.obstacles),
+            turn,
+        )
         planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
         ik += planned.ik_time_s
         if not planned.ok:
@@ -210,9 +222,15 @@ def execute_move(
 
     def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
         return ExecutionResult(
-            move, failure is None, failure, evidence, sim.time - sim0,
-            time.perf_counter() - wall0, ik_time, *times,
-        )  # fmt: skip
+            move,
+            failure is None,
+            failure,
+            evidence,
+            sim.time - sim0,
+            time.perf_counter() - wall0,
+            ik_time,
+            *times,
+        )
 
     sim.moving = move.entity  # scoring: the arm touching this block is no collision
     try:
@@ -258,7 +276,10 @@ def execute_move(
     dz = abs(seen.xyz[2] - target.xyz[2])
     if dxy > config.place_tol_xy or dz > config.place_tol_z:
         return result(
-            Failure.MISPLACED, ik, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4),
+            Failure.MISPLACED,
+            ik,
+            off_xy_m=round(dxy, 4),
+            off_z_m=round(dz, 4),
             target=[round(v, 4) for v in target.xyz],
-        )  # fmt: skip
+        )
     return result(None, ik, tracking_rad=round(worst, 4))

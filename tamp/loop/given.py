@@ -206,9 +206,16 @@ class GivenPlanEpisode(Episode):
     """An episode that executes ``steps`` open-loop (see the module docstring); ``run()``
     returns the EpisodeReport with ``steps`` filled in."""
 
-    def __init__(self, problem: Problem, steps: tuple[GivenStep, ...], config: LoopConfig,
-                 seed: int = 0, replan: bool = False, stop_at_invalid: bool = False,
-                 **kw) -> None:  # fmt: skip
+    def __init__(
+        self,
+        problem: Problem,
+        steps: tuple[GivenStep, ...],
+        config: LoopConfig,
+        seed: int = 0,
+        replan: bool = False,
+        stop_at_invalid: bool = False,
+        **kw,
+    ) -> None:
         super().__init__(problem, config, seed, **kw)
         self.steps, self.replan, self.stop_at_invalid = steps, replan, stop_at_invalid
         self.pddl = _pddl(problem)
@@ -239,8 +246,11 @@ class GivenPlanEpisode(Episode):
             truth = read_state(self.problem.entities, before, self.config.scene).state
             valid, failed, reason = verdict(step, self.problem, truth, self.pddl)
             if step.move is None or (valid is False and self.stop_at_invalid):
-                self._record(StepReport(step.number, step.label, valid, failed, reason, False,
-                                        "not attempted"))  # fmt: skip
+                self._record(
+                    StepReport(
+                        step.number, step.label, valid, failed, reason, False, "not attempted"
+                    )
+                )
                 if not self.replan:
                     p.stop(EpisodeStatus.INVALID_PLAN, f"{step.label}: {reason}")
                     return False
@@ -250,11 +260,26 @@ class GivenPlanEpisode(Episode):
             x, scene = step.move.entity, self.config.scene
             read0, read1 = (read_state(self.problem.entities, q, scene) for q in (before, after))
             moved = _disturbed(x, (before, after), (read0, read1), self.problem, scene)
-            carried = "loose" if x in read1.loose or read1.state is None else read1.state[
-                self.problem.entities.index(x)]  # fmt: skip
+            carried = (
+                "loose"
+                if x in read1.loose or read1.state is None
+                else read1.state[self.problem.entities.index(x)]
+            )
             outcome = "executed" if done.ok else done.failure.value
-            self._record(StepReport(step.number, step.label, valid, failed, reason, True, outcome,
-                                    dict(done.evidence), moved, carried))  # fmt: skip
+            self._record(
+                StepReport(
+                    step.number,
+                    step.label,
+                    valid,
+                    failed,
+                    reason,
+                    True,
+                    outcome,
+                    dict(done.evidence),
+                    moved,
+                    carried,
+                )
+            )
             if self.replan:  # the robot's own check: observe, and replan on a surprise
                 replans = p.replans
                 self._check(p, step.move, done, self._expect(p.state, step.move))

@@ -98,8 +98,19 @@ class Progress:
     ) -> EpisodeReport:
         """The EpisodeReport; ``wall0`` is the episode's start on ``time.perf_counter``."""
         return EpisodeReport(
-            problem, sim, self.status, reached, tuple(self.moves), tuple(self.plans),
-            self.replans, tuple(self.faults), self.disturbed, sim_time,
-            time.perf_counter() - wall0, self.plan_time, self.first_solved, self.reason,
+            problem,
+            sim,
+            self.status,
+            reached,
+            tuple(self.moves),
+            tuple(self.plans),
+            self.replans,
+            tuple(self.faults),
+            self.disturbed,
+            sim_time,
+            time.perf_counter() - wall0,
+            self.plan_time,
+            self.first_solved,
+            self.reason,
             self.first_plan,
-        )  # fmt: skip
+        )

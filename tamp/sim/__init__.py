@@ -17,6 +17,11 @@ from tamp.sim.factory import make_simulator
 from tamp.sim.truth import GroundTruth, GroundTruthLeak
 
 __all__ = [
-    "SIMULATORS", "Camera", "GripperReading", "GroundTruth", "GroundTruthLeak", "Simulator",
+    "SIMULATORS",
+    "Camera",
+    "GripperReading",
+    "GroundTruth",
+    "GroundTruthLeak",
+    "Simulator",
     "make_simulator",
-]  # fmt: skip
+]

@@ -56,41 +56,73 @@ class MuJoCoSim(Simulator):
         if self.video:  # llvmpipe spends most of a frame on the 4096^2 default shadow map
             s.visual.quality.shadowsize = VIDEO_SHADOW_MAP
         world, scene = s.worldbody, self.scene
-        world.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[3.0, 3.0, 0.01],
-                       rgba=[*[scene.floor_grey] * 3, 1])  # fmt: skip
+        world.add_geom(
+            name="floor",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=[3.0, 3.0, 0.01],
+            rgba=[*[scene.floor_grey] * 3, 1],
+        )
         if scene.backdrop_y is not None:  # collides with nothing (the other geoms have bit 1
             # only); conaffinity 0 too would let the URDF import's discardvisual drop it
-            world.add_geom(name="backdrop", type=mujoco.mjtGeom.mjGEOM_BOX,
-                           size=[3.0, 0.005, 1.5], pos=[0.0, scene.backdrop_y, 1.5],
-                           rgba=[*[scene.backdrop_grey] * 3, 1], contype=0,
-                           conaffinity=2)  # fmt: skip
+            world.add_geom(
+                name="backdrop",
+                type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=[3.0, 0.005, 1.5],
+                pos=[0.0, scene.backdrop_y, 1.5],
+                rgba=[*[scene.backdrop_grey] * 3, 1],
+                contype=0,
+                conaffinity=2,
+            )
         for o in scene.obstacles:  # fixed boxes (tamp.obstacles)
-            world.add_geom(name=f"obstacle_{o.name}", type=mujoco.mjtGeom.mjGEOM_BOX,
-                           size=list(o.half), pos=list(o.centre), quat=_quat(o.yaw),
-                           rgba=[*o.rgb, 1])  # fmt: skip
+            world.add_geom(
+                name=f"obstacle_{o.name}",
+                type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=list(o.half),
+                pos=list(o.centre),
+                quat=_quat(o.yaw),
+                rgba=[*o.rgb, 1],
+            )
         shape, size = mujoco.mjtGeom.mjGEOM_BOX, [scene.block_size / 2] * 3
         if scene.shape == "cylinder":  # radius, half height; matte like LatPlan's rubber
             shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [scene.block_size / 2] * 2
             s.add_material(name="block", specular=0.1, shininess=0.1)
-        world.add_light(name="sun", type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-                        pos=[0.5, 0.3, 2.0], dir=[-0.2, -0.1, -1.0],
-                        diffuse=[0.8, 0.8, 0.8])  # fmt: skip
-        world.add_camera(name="scene", pos=list(cam.eye), quat=_look_at(cam.eye, cam.target,
-                         cam.up), fovy=cam.fovy)  # fmt: skip
+        world.add_light(
+            name="sun",
+            type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+            pos=[0.5, 0.3, 2.0],
+            dir=[-0.2, -0.1, -1.0],
+            diffuse=[0.8, 0.8, 0.8],
+        )
+        world.add_camera(
+            name="scene",
+            pos=list(cam.eye),
+            quat=_look_at(cam.eye, cam.target, cam.up),
+            fovy=cam.fovy,
+        )
         for i, name in enumerate(self.entities):
             pose = poses[name]
             body = world.add_body(name=f"block_{name}", pos=list(pose.xyz), quat=_quat(pose.yaw))
             body.add_freejoint(name=f"block_{name}")
             geom = body.add_geom(
-                name=f"block_{name}", type=shape, size=size, mass=scene.block_mass,
-                rgba=[*colour(i, scene.palette), 1], friction=[1.0, 0.03, 0.0001], condim=4,
+                name=f"block_{name}",
+                type=shape,
+                size=size,
+                mass=scene.block_mass,
+                rgba=[*colour(i, scene.palette), 1],
+                friction=[1.0, 0.03, 0.0001],
+                condim=4,
                 solref=[0.004, 1.0],
-            )  # fmt: skip
+            )
             if scene.shape == "cylinder":
                 geom.material = "block"
-            s.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name=f"weld_{name}", name1=HAND_BODY,
-                           name2=f"block_{name}", objtype=mujoco.mjtObj.mjOBJ_BODY,
-                           active=False)  # fmt: skip
+            s.add_equality(
+                type=mujoco.mjtEq.mjEQ_WELD,
+                name=f"weld_{name}",
+                name1=HAND_BODY,
+                name2=f"block_{name}",
+                objtype=mujoco.mjtObj.mjOBJ_BODY,
+                active=False,
+            )
         self.model = m = s.compile()
         self.data = d = mujoco.MjData(m)
         self._arm_q = np.array([m.joint(j).qposadr[0] for j in PANDA.arm_joints])

@@ -69,17 +69,22 @@ class PyBulletSim(Simulator):
         grey = [self.scene.floor_grey] * 3
         half = 0.05 if self._gl else 0.001  # top at z = 0.001; OpenGL's shadows need depth
         look = p.createVisualShape(
-            p.GEOM_BOX, halfExtents=[3.0, 3.0, half], rgbaColor=[*grey, 1],
-            visualFramePosition=[0, 0, 0.001 - half], physicsClientId=c,
-        )  # fmt: skip
+            p.GEOM_BOX,
+            halfExtents=[3.0, 3.0, half],
+            rgbaColor=[*grey, 1],
+            visualFramePosition=[0, 0, 0.001 - half],
+            physicsClientId=c,
+        )
         self.table = p.createMultiBody(0, plane, look, [0, 0, 0], physicsClientId=c)
         p.changeDynamics(self.table, -1, lateralFriction=1.0, physicsClientId=c)
         self.backdrop = None
         if self.scene.backdrop_y is not None:  # visual only: nothing collides with it
             wall = p.createVisualShape(
-                p.GEOM_BOX, halfExtents=[3.0, 0.005, 1.5],
-                rgbaColor=[*[self.scene.backdrop_grey] * 3, 1], physicsClientId=c,
-            )  # fmt: skip
+                p.GEOM_BOX,
+                halfExtents=[3.0, 0.005, 1.5],
+                rgbaColor=[*[self.scene.backdrop_grey] * 3, 1],
+                physicsClientId=c,
+            )
             at = [0.0, self.scene.backdrop_y, 1.5]
             self.backdrop = p.createMultiBody(0, -1, wall, at, physicsClientId=c)
         self.obstacles = [self._obstacle(o) for o in self.scene.obstacles]
@@ -97,8 +102,11 @@ class PyBulletSim(Simulator):
             self.blocks[name] = body
         self._weld: int | None = None
         obstacles = zip(self.obstacles, self.scene.obstacles, strict=True)
-        self._names = {self.table: "table", **{b: o.name for b, o in obstacles},
-                       **{b: n for n, b in self.blocks.items()}}  # fmt: skip
+        self._names = {
+            self.table: "table",
+            **{b: o.name for b, o in obstacles},
+            **{b: n for n, b in self.blocks.items()},
+        }
         self._finger_command = ""
         self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
@@ -133,18 +141,28 @@ class PyBulletSim(Simulator):
     def _command(self, q, qd, gripper) -> None:
         r, c = self.robot, self.client
         p.setJointMotorControlArray(
-            r.body, r.arm, p.POSITION_CONTROL, targetPositions=list(q),
-            targetVelocities=list(qd), forces=list(PANDA.effort),
-            positionGains=[ARM_KP] * 7, velocityGains=[ARM_KD] * 7, physicsClientId=c,
-        )  # fmt: skip
+            r.body,
+            r.arm,
+            p.POSITION_CONTROL,
+            targetPositions=list(q),
+            targetVelocities=list(qd),
+            forces=list(PANDA.effort),
+            positionGains=[ARM_KP] * 7,
+            velocityGains=[ARM_KD] * 7,
+            physicsClientId=c,
+        )
         if gripper == self._finger_command:
             return
         self._finger_command = gripper
         width = PANDA.finger_open if gripper == "open" else 0.0
         p.setJointMotorControlArray(
-            r.body, r.fingers, p.POSITION_CONTROL, targetPositions=[width, width],
-            forces=[FINGER_FORCE] * 2, physicsClientId=c,
-        )  # fmt: skip
+            r.body,
+            r.fingers,
+            p.POSITION_CONTROL,
+            targetPositions=[width, width],
+            forces=[FINGER_FORCE] * 2,
+            physicsClientId=c,
+        )
 
     def _step(self) -> None:
         p.stepSimulation(physicsClientId=self.client)
@@ -194,10 +212,17 @@ class PyBulletSim(Simulator):
         rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, b_pos, b_orn)
         # the TCP link is massless, so its inertial frame is its link frame
         self._weld = p.createConstraint(
-            r.body, r.tcp, self.blocks[block], -1, p.JOINT_FIXED, [0, 0, 0],
-            parentFramePosition=rel_pos, childFramePosition=[0, 0, 0],
-            parentFrameOrientation=rel_orn, physicsClientId=c,
-        )  # fmt: skip
+            r.body,
+            r.tcp,
+            self.blocks[block],
+            -1,
+            p.JOINT_FIXED,
+            [0, 0, 0],
+            parentFramePosition=rel_pos,
+            childFramePosition=[0, 0, 0],
+            parentFrameOrientation=rel_orn,
+            physicsClientId=c,
+        )
 
     def detach(self) -> None:
         if self._weld is not None:
@@ -228,12 +253,20 @@ class PyBulletSim(Simulator):
         # OpenGL takes the light's position from the target (its shadow map's eye): far away
         # along the light; TinyRenderer normalises it. OpenGL ignores the coefficients.
         _, _, rgb, _, _ = p.getCameraImage(
-            w, h, self._view, proj, flags=p.ER_NO_SEGMENTATION_MASK,
+            w,
+            h,
+            self._view,
+            proj,
+            flags=p.ER_NO_SEGMENTATION_MASK,
             renderer=p.ER_BULLET_HARDWARE_OPENGL if self._gl else p.ER_TINY_RENDERER,
             lightDirection=[-LIGHT_DISTANCE * v for v in light.direction],
-            lightColor=[1.0, 1.0, 1.0], lightAmbientCoeff=light.ambient,
-            lightDiffuseCoeff=light.diffuse, lightSpecularCoeff=0.05, shadow=0, physicsClientId=c,
-        )  # fmt: skip
+            lightColor=[1.0, 1.0, 1.0],
+            lightAmbientCoeff=light.ambient,
+            lightDiffuseCoeff=light.diffuse,
+            lightSpecularCoeff=0.05,
+            shadow=0,
+            physicsClientId=c,
+        )
         return np.asarray(rgb, dtype=np.uint8).reshape(h, w, 4)[..., :3].copy()
 
     def snapshot(self) -> Snapshot:
@@ -266,11 +299,19 @@ class PyBulletSim(Simulator):
             raise TampError("a world made for videos (video=True) renders no camera images")
         cam, light = self.camera, self.lighting
         _, _, rgb, buffer, _ = p.getCameraImage(
-            cam.width, cam.height, self._view, self._proj, renderer=p.ER_TINY_RENDERER,
-            lightDirection=[-v for v in light.direction], lightColor=[1.0, 1.0, 1.0],
-            lightAmbientCoeff=light.ambient, lightDiffuseCoeff=light.diffuse,
-            lightSpecularCoeff=0.05, shadow=0, physicsClientId=self.client,
-        )  # fmt: skip
+            cam.width,
+            cam.height,
+            self._view,
+            self._proj,
+            renderer=p.ER_TINY_RENDERER,
+            lightDirection=[-v for v in light.direction],
+            lightColor=[1.0, 1.0, 1.0],
+            lightAmbientCoeff=light.ambient,
+            lightDiffuseCoeff=light.diffuse,
+            lightSpecularCoeff=0.05,
+            shadow=0,
+            physicsClientId=self.client,
+        )
         rgb = np.asarray(rgb, dtype=np.uint8).reshape(cam.height, cam.width, 4)[..., :3].copy()
         return rgb, np.asarray(buffer, dtype=np.float32).reshape(cam.height, cam.width)
 

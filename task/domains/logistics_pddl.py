@@ -119,8 +119,15 @@ def make_problem(name, kinds, city, airports, support, goal, order) -> Problem:
     entities, locations = of["package"] + of["truck"] + of["airplane"], of["location"]
     port = tuple(x for x in locations if x in airports)
     truck_city = tuple(city[support[t]] for t in of["truck"])
-    data = LogisticsData(of["package"], of["truck"], of["airplane"], of["city"],
-                         tuple(city[x] for x in locations), port, truck_city)  # fmt: skip
+    data = LogisticsData(
+        of["package"],
+        of["truck"],
+        of["airplane"],
+        of["city"],
+        tuple(city[x] for x in locations),
+        port,
+        truck_city,
+    )
     init = tuple(support[x] for x in entities)
     return Problem(name, NAME, entities, init, tuple(goal), locations, data)
 

@@ -101,8 +101,11 @@ def estimate(problem: Problem, state: State) -> float:
         at, goal, robot = [g.index[c] for c in state[1:]], rules.goals(problem), g.index[state[0]]
         before, todo = first(problem, state), [k for k, c in goal.items() if at[k] != c]
         orders = list(itertools.permutations(todo))
-        fine = [o for o in orders if all(o.index(a) < o.index(b) for b in o for a in before[b]
-                                         if a in o)] or orders  # fmt: skip
+        fine = [
+            o
+            for o in orders
+            if all(o.index(a) < o.index(b) for b in o for a in before[b] if a in o)
+        ] or orders
         heads = {o[0] for o in fine}
         walled = {k: _placed_cost(g, goal[k], at[k], robot, set(at) - {at[k]}) for k in heads}
         alone = {k: g.lone_cost(goal[k])[at[k]][robot] for k in heads}
@@ -188,8 +191,15 @@ def encode(
         pot[i, 1 : p.n, :c] = torch.where(on, pt, wt).to(dtype)
         walk[i, : p.n - 1, :c, :c] = torch.where(on[:, :, None], wk, bonus[i]).to(dtype)
     ok2 = ok * ok.gather(2, nxt)  # (B, 4, Y) two cells ahead exist
-    static = {"nxt": nxt, "nxt2": nxt.gather(2, nxt), "ok": ok, "ok2": ok2, "pot": pot,
-              "walk": walk, "cell": cell}  # fmt: skip
+    static = {
+        "nxt": nxt,
+        "nxt2": nxt.gather(2, nxt),
+        "ok": ok,
+        "ok2": ok2,
+        "pot": pot,
+        "walk": walk,
+        "cell": cell,
+    }
     return SoftBatch(F0, entity, mask, goal, static)
 
 
@@ -197,8 +207,10 @@ def _others(v: Tensor) -> Tensor:
     """out[:, x] = prod_{x' != x} v[:, x'] over the few rows (plain products, exact at 0 and
     cheap to differentiate): (B, N, Y) -> (B, N, Y)."""
     rows = v.unbind(1)
-    out = [math.prod((r for j, r in enumerate(rows) if j != x), start=torch.ones_like(rows[x]))
-           for x in range(len(rows))]  # fmt: skip
+    out = [
+        math.prod((r for j, r in enumerate(rows) if j != x), start=torch.ones_like(rows[x]))
+        for x in range(len(rows))
+    ]
     return torch.stack(out, 1) if out else v
 
 

@@ -100,8 +100,9 @@ def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None 
             raise PDDLError(f"goal places a {what} twice: {goal}")
     data = Grid(tuple(kinds["loc"]), tuple(dirs), tuple(kinds["box"]), adjacent, cells)
     init_cells = (robots[0], *(place[b] for b in kinds["box"]))
-    return Problem(str(problem.name), NAME, (ROBOT, *kinds["box"]), init_cells, tuple(goal),
-                   cells, data)  # fmt: skip
+    return Problem(
+        str(problem.name), NAME, (ROBOT, *kinds["box"]), init_cells, tuple(goal), cells, data
+    )
 
 
 def problem_from_text(domain: Domain, text: str, source: str = "<problem>") -> Problem:

@@ -80,15 +80,21 @@ class StripsTask:
         )
         goal = tuple(a for a in goal if a in col)
         return cls(
-            tuple(a for a, _ in ground), effects, tuple(fluent), frozenset(static),
-            frozenset(init & set(fluent)), goal,
+            tuple(a for a, _ in ground),
+            effects,
+            tuple(fluent),
+            frozenset(static),
+            frozenset(init & set(fluent)),
+            goal,
             _padded([[col[a] for a in sorted(e.pre_pos)] for e in effects], n),
             _padded([[col[a] for a in sorted(e.add)] for e in effects], n + 1),
             _padded([[col[a] for a in sorted(e.delete - e.add)] for e in effects], n + 1),
             _padded([[a in e.delete - e.add for a in sorted(e.pre_pos)] for e in effects], 0) > 0,
             max((len(e.add & set(goal)) for e in effects), default=1),
-            domain, problem, tuple(order),
-        )  # fmt: skip
+            domain,
+            problem,
+            tuple(order),
+        )
 
     @functools.cached_property
     def column(self) -> dict[Atom, int]:

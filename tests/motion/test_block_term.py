@@ -45,8 +45,9 @@ def _term(solver, near: int):
 
 def _freeze_ik(monkeypatch, solver) -> None:
     real, cache = solver.solve, []
-    monkeypatch.setattr(solver, "solve", lambda t, q: cache[0] if cache else
-                        cache.append(real(t, q)) or cache[0])  # fmt: skip
+    monkeypatch.setattr(
+        solver, "solve", lambda t, q: cache[0] if cache else cache.append(real(t, q)) or cache[0]
+    )
 
 
 def test_a_release_behind_a_tall_near_tower_costs_and_penetrates_a_low_one_does_not(solver):
@@ -80,8 +81,9 @@ def test_the_term_is_the_sum_over_the_counted_blocks_at_both_ends(solver):
 def test_the_held_block_the_target_and_the_block_under_the_pick_are_not_counted(solver):
     # 1 stands on 0; 0 and 2 are wide slabs, so the open fingers come within the margin of 0
     # when picking 1 and of 2 when releasing onto it; the held block is between the fingers
-    c = torch.tensor([[(0.5, 0.0, S / 2), (0.5, 0.0, 1.5 * S), (0.5, 0.2, S / 2)]],
-                     dtype=torch.float64)  # fmt: skip
+    c = torch.tensor(
+        [[(0.5, 0.0, S / 2), (0.5, 0.0, 1.5 * S), (0.5, 0.2, S / 2)]], dtype=torch.float64
+    )
     half = torch.tensor([[(0.06, 0.06, S / 2), (S / 2,) * 3, (0.06, 0.06, S / 2)]])
     blocks = Blocks(c, half.double(), torch.tensor([[-1, 0, -1]]))
     on = c + torch.tensor([0.0, 0.0, S], dtype=torch.float64)  # (1, 3, 3)
@@ -104,8 +106,9 @@ def test_a_block_weight_of_zero_or_no_blocks_leave_the_costs_bit_identical(solve
     picks, places, blocks = _scene(near=6)
     old = move_costs_batch(solver, PANDA.q_home, picks, places)
     for config, given in ((MoveCostConfig(), blocks), (ON, None)):
-        assert torch.equal(move_costs_batch(solver, PANDA.q_home, picks, places, config,
-                                            blocks=given), old)  # fmt: skip
+        assert torch.equal(
+            move_costs_batch(solver, PANDA.q_home, picks, places, config, blocks=given), old
+        )
     on = move_costs_batch(solver, PANDA.q_home, picks, places, ON, blocks=blocks)
     assert on[0, 1, 0] > old[0, 1, 0] + 0.1
 

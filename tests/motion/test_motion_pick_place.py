@@ -112,8 +112,11 @@ def test_a_ceiling_keeps_the_hand_under_it_or_leaves_no_clearance(solver):
     req = dataclasses.replace(base, pick_ceiling=0.12, place_ceiling=0.16)
     result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
     assert result.ok, result.evidence
-    tops = {n: solver.fk(p.trajectory.positions)[:, 2, 3].max() for n, p in  # (S,) TCP heights
-            ((p.name, p) for p in result.phases) if n in ("descend", "lift", "lower")}  # fmt: skip
+    tops = {
+        n: solver.fk(p.trajectory.positions)[:, 2, 3].max()
+        for n, p in ((p.name, p) for p in result.phases)  # (S,) TCP heights
+        if n in ("descend", "lift", "lower")
+    }
     assert tops["descend"] <= 0.12 + 1e-3 and tops["lift"] <= 0.12 + 1e-3
     assert tops["lower"] <= 0.16 + 1e-3
     low = dataclasses.replace(base, pick_ceiling=HALF + 0.01)  # no room to come down

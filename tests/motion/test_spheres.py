@@ -121,8 +121,9 @@ def test_the_per_box_costs_sum_to_phi_and_the_depth_is_the_deepest_sphere(solver
     per_box = box_contacts(solver, q, centres, half).cost  # (2, 3)
     assert per_box.shape == (2, 3) and per_box[0, 0] > 0 and per_box[0, 1] > 0
     assert (per_box[:, 2] == 0).all()
-    torch.testing.assert_close(per_box.sum(1), collision_cost(solver, q, centres, half),
-                               atol=1e-14, rtol=0)  # fmt: skip
+    torch.testing.assert_close(
+        per_box.sum(1), collision_cost(solver, q, centres, half), atol=1e-14, rtol=0
+    )
     depth = box_contacts(solver, q, centres, half).depth  # (2, 3)
     gap = box_sdf(sphere_positions(solver, q), centres, half) - RADII[:, None]  # (2, G, 3)
     torch.testing.assert_close(depth, (-gap).amax(1).clamp(min=0.0), atol=0, rtol=0)

@@ -189,8 +189,11 @@ def test_datasets_of_two_resolutions_load_as_one_at_the_first_size(tmp_path):
     big = _dataset(4)
     small = pdata.SupportData(
         np.stack([cv2.resize(im, (48, 36), interpolation=cv2.INTER_AREA) for im in big.images]),
-        big.colours, big.supports, big.palette, {"y": 2},
-    )  # fmt: skip
+        big.colours,
+        big.supports,
+        big.palette,
+        {"y": 2},
+    )
     a, b = pdata.save(tmp_path / "a.npz", big), pdata.save(tmp_path / "b.npz", small)
     both = pdata.load_many(f"{a},{b}")
     assert both.images.shape == (8, 120, 160, 3) and len(both.meta["parts"]) == 2

@@ -30,8 +30,9 @@ def _pybullet_fk(qs: np.ndarray) -> np.ndarray:
         for q in qs:
             for j, v in zip(robot.arm, q, strict=True):
                 p.resetJointState(robot.body, j, v, physicsClientId=c)
-            state = p.getLinkState(robot.body, robot.tcp, computeForwardKinematics=True,
-                                   physicsClientId=c)  # fmt: skip
+            state = p.getLinkState(
+                robot.body, robot.tcp, computeForwardKinematics=True, physicsClientId=c
+            )
             rot = np.asarray(p.getMatrixFromQuaternion(state[5])).reshape(3, 3)
             out.append((np.asarray(state[4]), rot))
         return out

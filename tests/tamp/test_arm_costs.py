@@ -20,8 +20,9 @@ from task.config import PlannerConfig
 from task.problem import TABLE, Problem
 
 SCENE = SceneConfig()
-FOUR = Problem("four", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
-               (("b", "c"),))  # fmt: skip
+FOUR = Problem(
+    "four", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE), (("b", "c"),)
+)
 
 
 @pytest.fixture(scope="module")
@@ -53,8 +54,9 @@ def test_costs_are_one_matrix_per_problem_and_a_far_place_costs_more(solver):
 
 def test_a_tower_at_its_slots_clearance_blocks_one_more_block(solver):
     shelf = with_scene(SCENE, "shelf")
-    five = Problem("five", "blocksworld", tuple("abcdef"), (TABLE, "a", "b", "c", "d", TABLE),
-                   (("f", "e"),))  # fmt: skip
+    five = Problem(
+        "five", "blocksworld", tuple("abcdef"), (TABLE, "a", "b", "c", "d", TABLE), (("f", "e"),)
+    )
     poses = layout(five.entities, five.init, SCENE, seed=0, slots=[8, 0])  # the tower under it
     c = ArmCosts([five], [poses], shelf, solver, PANDA.q_home)([0], [five.init]).compute()
     assert shelf.capacity(poses["a"].xy) == 5
@@ -78,16 +80,19 @@ def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places
 
     solver, bw = IKSolver(), get_domain("blocksworld")
     real, cache = solver.solve, []
-    monkeypatch.setattr(solver, "solve", lambda t, q: cache[0] if cache else
-                        cache.append(real(t, q)) or cache[0])  # fmt: skip
+    monkeypatch.setattr(
+        solver, "solve", lambda t, q: cache[0] if cache else cache.append(real(t, q)) or cache[0]
+    )
     batch = bw.encode([FOUR], [bw.initial_state(FOUR)], torch.float64)
     steps = torch.ones(1, 2, dtype=torch.bool)
-    logits = torch.randn((1, 2, 4, 6), generator=torch.Generator().manual_seed(0),
-                         dtype=torch.float64).requires_grad_(True)  # fmt: skip
+    logits = torch.randn(
+        (1, 2, 4, 6), generator=torch.Generator().manual_seed(0), dtype=torch.float64
+    ).requires_grad_(True)
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0)
     picks = torch.tensor([poses[x].xyz for x in FOUR.entities], dtype=torch.float64)
-    places = torch.cat([picks + torch.tensor([0.0, 0.0, 0.05]),
-                        torch.tensor([[0.45, 0.3, 0.025]])]).requires_grad_(True)  # fmt: skip
+    places = torch.cat(
+        [picks + torch.tensor([0.0, 0.0, 0.05]), torch.tensor([[0.45, 0.3, 0.025]])]
+    ).requires_grad_(True)
     config = PlannerConfig(horizon=2, lambda_motion=0.5)
 
     def loss(lg, pl):
@@ -120,8 +125,13 @@ def test_a_place_the_hand_cannot_reach_at_hover_height_is_ruled_out(solver):
 
     cramped = with_scene(SCENE, "cramped")
     low = Problem("low", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
-    tall = Problem("tall", "blocksworld", tuple("abcdefg"), (TABLE, "a", "b", "c", "d", "e", "f"),
-                   (("a", "g"),))  # fmt: skip
+    tall = Problem(
+        "tall",
+        "blocksworld",
+        tuple("abcdefg"),
+        (TABLE, "a", "b", "c", "d", "e", "f"),
+        (("a", "g"),),
+    )
     for problem, blocked in ((low, False), (tall, True)):
         slots = [0] if problem is tall else [0, 1]
         poses = layout(problem.entities, problem.init, cramped, seed=0, slots=slots)
@@ -155,8 +165,15 @@ def test_a_release_behind_a_tall_near_tower_is_ruled_out(solver, near, blocked):
     cramped, current, at, poses, mover, far = _behind(near)
     costs = {}
     for weight in (ARM.block_weight, 0.0):
-        source = ArmCosts([current], [poses], cramped, solver, PANDA.q_home,
-                          config=replace(ARM, block_weight=weight), places=[at])  # fmt: skip
+        source = ArmCosts(
+            [current],
+            [poses],
+            cramped,
+            solver,
+            PANDA.q_home,
+            config=replace(ARM, block_weight=weight),
+            places=[at],
+        )
         costs[weight] = source([0], [current.init]).compute()[0]
     assert bool(costs[ARM.block_weight][mover, far] >= BLOCKED) == blocked
     assert costs[0.0][mover, far] < BLOCKED  # without the blocks in the proxy: never

@@ -72,9 +72,12 @@ def test_bad_scene_inputs_are_clear_errors():
 
 @pytest.mark.parametrize(
     ("text", "expected"),
-    [(None, Injection()), ("drop:0.2", Injection(drop=0.2)),
-     ("drop:0.2,nudge:0.1,noise:0.5", Injection(drop=0.2, nudge=0.1, noise=0.5))],
-)  # fmt: skip
+    [
+        (None, Injection()),
+        ("drop:0.2", Injection(drop=0.2)),
+        ("drop:0.2,nudge:0.1,noise:0.5", Injection(drop=0.2, nudge=0.1, noise=0.5)),
+    ],
+)
 def test_fault_specs_parse(text, expected):
     assert Injection.parse(text) == expected
 

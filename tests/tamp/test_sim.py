@@ -145,7 +145,10 @@ def test_frames_keep_one_clock_across_runs():
     with make_simulator("pybullet", ("a",), {"a": Pose((0.5, 0.0, 0.025))}) as sim:
         sim.frame_period = 0.1
         for _ in range(3):  # three short runs of 0.15 s
-            sim.run(JointTrajectory.hold(PANDA.q_home, 0.15, sim.dt), "open",
-                    on_frame=lambda s: times.append(s.time))  # fmt: skip
+            sim.run(
+                JointTrajectory.hold(PANDA.q_home, 0.15, sim.dt),
+                "open",
+                on_frame=lambda s: times.append(s.time),
+            )
     np.testing.assert_allclose(np.diff(times), 0.1, atol=1.5 * sim.dt)
     assert len(times) == 5  # 0.45 s: frames at 0.0, 0.1, 0.2, 0.3, 0.4 (plus a step)

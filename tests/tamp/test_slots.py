@@ -95,14 +95,23 @@ def test_a_move_the_arm_failed_is_priced_out_in_that_state_only(solver):
 
 def test_planning_on_places_names_them_and_never_needs_more_than_the_table_has(solver):
     # five single blocks on a 6-slot table; the goal is one tower: no place is needed beyond
-    five = Problem("five", "blocksworld", tuple("abcde"), (TABLE,) * 5,
-                   (("a", "b"), ("b", "c"), ("c", "d"), ("d", "e")))  # fmt: skip
+    five = Problem(
+        "five",
+        "blocksworld",
+        tuple("abcde"),
+        (TABLE,) * 5,
+        (("a", "b"), ("b", "c"), ("c", "d"), ("d", "e")),
+    )
     scene = with_scene(SCENE, "cramped")
     poses = layout(five.entities, five.init, scene, seed=1)
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
     result = plan_on_places(five, poses, scene, solver, PANDA.q_home, config, seed=0)
     assert result.solved and [str(m) for m in result.plan] == [
-        "move(d -> e)", "move(c -> d)", "move(b -> c)", "move(a -> b)"]  # fmt: skip
+        "move(d -> e)",
+        "move(c -> d)",
+        "move(b -> c)",
+        "move(a -> b)",
+    ]
 
 
 @pytest.mark.sim
@@ -187,8 +196,13 @@ def test_continuous_placements_are_differentiable_offsets_the_planner_optimises(
 
 
 def test_planned_moves_carry_the_optimised_placements(solver):
-    five = Problem("five", "blocksworld", tuple("abcde"), ("b", "c", TABLE, "e", TABLE),
-                   (("c", "a"), ("e", "b")))  # fmt: skip
+    five = Problem(
+        "five",
+        "blocksworld",
+        tuple("abcde"),
+        ("b", "c", TABLE, "e", TABLE),
+        (("c", "a"), ("e", "b")),
+    )
     poses = layout(five.entities, five.init, SCENE, seed=1)
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
     result = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, config, reach=0.02)

@@ -75,8 +75,10 @@ def _suite(tmp_path):
 
 def _rows(bench: motion.MotionBench) -> list:
     """Episode rows without wall times, and every move with its outcome."""
-    rows = [{k: v for k, v in r.items() if k != "wall_time_s"}
-            for r in motion.episode_rows(bench.reports)]  # fmt: skip
+    rows = [
+        {k: v for k, v in r.items() if k != "wall_time_s"}
+        for r in motion.episode_rows(bench.reports)
+    ]
     moves = [[(str(m.move), m.ok, m.failure) for m in r.moves] for r in bench.reports]
     return [rows, moves, bench.summary["pybullet"]["statuses"]]
 
@@ -108,10 +110,14 @@ def test_executability_rows_and_shared_runs_do_not_depend_on_the_number_of_worke
     suite = _suite(tmp_path)
     one, two = (i.name for i in suite.instances)
     tower = "(unstack b a);(put-down b);(pick-up a);(stack a c);(pick-up b);(stack b a)"
-    sources = {"x": {one: (tower, True), two: ("(pick-up a);(stack a b)", True)},
-               "y": {one: (tower, None), two: ("(unstack a)", False)}}  # fmt: skip
-    runs = [motion.run_given(suite, sources, LoopConfig(), ("pybullet",), 0, None, workers=n)
-            for n in (1, 2)]  # fmt: skip
+    sources = {
+        "x": {one: (tower, True), two: ("(pick-up a);(stack a b)", True)},
+        "y": {one: (tower, None), two: ("(unstack a)", False)},
+    }
+    runs = [
+        motion.run_given(suite, sources, LoopConfig(), ("pybullet",), 0, None, workers=n)
+        for n in (1, 2)
+    ]
     alone, pooled = ([{**vars(r), "wall_time_s": None} for r in rows] for rows in runs)
     assert pooled == alone
     x1, y1, x2, y2 = runs[1]  # sim, then instance, then source

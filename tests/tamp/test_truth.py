@@ -80,8 +80,11 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
     # in the loop: the scorer, the nudge (experimenter), the state-mode mocap oracle and the
     # per-step verdicts of a given plan (scoring: what the report says, never what the robot does)
     assert _uses("truth", "tamp/loop") <= {
-        "tamp/loop/episode.py", "tamp/loop/score.py", "tamp/loop/recover.py",
-        "tamp/loop/sensors.py", "tamp/loop/given.py",
-    }  # fmt: skip
+        "tamp/loop/episode.py",
+        "tamp/loop/score.py",
+        "tamp/loop/recover.py",
+        "tamp/loop/sensors.py",
+        "tamp/loop/given.py",
+    }
     for room in ("tamp/camera", "tamp/bench", "tamp/cli", "motion", "perception"):
         assert not _uses("truth", room) | _uses("block_poses", room), room

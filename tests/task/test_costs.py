@@ -17,8 +17,9 @@ from task.rollout import rollout
 
 BW = get_domain("blocksworld")
 # a sits on b; the goal puts b on c, so a must go first: onto the table or onto d, 2 moves both
-UNSTACK = Problem("unstack", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE),
-                  (("b", "c"),))  # fmt: skip
+UNSTACK = Problem(
+    "unstack", "blocksworld", ("a", "b", "c", "d"), ("b", TABLE, TABLE, TABLE), (("b", "c"),)
+)
 A, D, TABLE_COL = 0, 3, 4  # rows / columns of the cost matrix (targets: a, b, c, d, table)
 
 

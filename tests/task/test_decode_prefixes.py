@@ -12,8 +12,13 @@ from task.problem import Move, Problem
 BW = get_domain("blocksworld")
 # a on b; c and d on the table; goal: the tower b-c-a. Lower bound 2 (a and c must move), optimum
 # 3 (a parks on the table, c onto b, a onto c).
-TOWER = Problem("p", "blocksworld", ("a", "b", "c", "d"), ("b", "table", "table", "table"),
-                (("a", "c"), ("c", "b")))  # fmt: skip
+TOWER = Problem(
+    "p",
+    "blocksworld",
+    ("a", "b", "c", "d"),
+    ("b", "table", "table", "table"),
+    (("a", "c"), ("c", "b")),
+)
 
 
 def _gates(*moves: Move) -> torch.Tensor:

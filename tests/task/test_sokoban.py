@@ -219,8 +219,9 @@ def test_dead_ends_have_an_infinite_lower_bound():
     corridor = level("@.....\n.2....\n...1..\n....0.\n...##a\n...#.b\n...#.c")
     assert ready(corridor, corridor.init) == [False, False, True]
     assert SOK.lower_bound(corridor, corridor.init) < math.inf
-    placed = dataclasses.replace(corridor, init=(*cells(corridor, (3, 5)), *cells(
-        corridor, (4, 5), (2, 3), (1, 1))))  # fmt: skip
+    placed = dataclasses.replace(
+        corridor, init=(*cells(corridor, (3, 5)), *cells(corridor, (4, 5), (2, 3), (1, 1)))
+    )
     assert SOK.lower_bound(placed, placed.init) == math.inf  # 0 on its goal blocks the others
 
 

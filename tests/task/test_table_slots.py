@@ -16,8 +16,9 @@ SLOTS = ("s0", "s1", "s2")
 
 def _problem() -> Problem:
     # a on b (b on the table), c on the table; goal: b on c, a on the table
-    plain = Problem("p", "blocksworld", ("a", "b", "c"), ("b", TABLE, TABLE),
-                    (("b", "c"), ("a", TABLE)))  # fmt: skip
+    plain = Problem(
+        "p", "blocksworld", ("a", "b", "c"), ("b", TABLE, TABLE), (("b", "c"), ("a", TABLE))
+    )
     return bw.with_slots(plain, SLOTS)
 
 
@@ -25,17 +26,24 @@ def test_with_slots_puts_each_tower_on_its_own_slot():
     p = _problem()
     assert p.init == ("b", "s0", "s1") and p.fixed == SLOTS and bw.slotted(p)
     assert not bw.slotted(random_problem(3, 0))
-    bases = bw.with_slots(p.__class__(**{**p.__dict__, "fixed": (TABLE,), "init": ("b", TABLE,
-                          TABLE)}), SLOTS, {"b": "s2", "c": "s0"})  # fmt: skip
+    bases = bw.with_slots(
+        p.__class__(**{**p.__dict__, "fixed": (TABLE,), "init": ("b", TABLE, TABLE)}),
+        SLOTS,
+        {"b": "s2", "c": "s0"},
+    )
     assert bases.init == ("b", "s2", "s0")
 
 
 @pytest.mark.parametrize(
     "slots, bases, words",
-    [(("s0",), None, "2 towers need"), (("s0", "a"), None, "must be distinct, new"),
-     (("s0", "s0"), None, "must be distinct"), (SLOTS, {"b": "s0", "c": "s0"}, "own slots"),
-     (SLOTS, {"b": "s9", "c": "s0"}, "own slots")],
-)  # fmt: skip
+    [
+        (("s0",), None, "2 towers need"),
+        (("s0", "a"), None, "must be distinct, new"),
+        (("s0", "s0"), None, "must be distinct"),
+        (SLOTS, {"b": "s0", "c": "s0"}, "own slots"),
+        (SLOTS, {"b": "s9", "c": "s0"}, "own slots"),
+    ],
+)
 def test_with_slots_rejects_too_few_or_bad_slots(slots, bases, words):
     plain = Problem("p", "blocksworld", ("a", "b", "c"), ("b", TABLE, TABLE), ())
     with pytest.raises(ProblemError, match=words):
@@ -62,11 +70,15 @@ def test_slot_moves_are_4op_put_downs_and_pick_ups():
     p = _problem()
     moves = (Move("a", "s2"), Move("b", "c"), Move("a", "b"), Move("a", "s0"))
     assert bw.moves_to_actions(p, moves) == (
-        Action("unstack", ("a", "b")), Action("put-down", ("a",)),
-        Action("pick-up", ("b",)), Action("stack", ("b", "c")),
-        Action("pick-up", ("a",)), Action("stack", ("a", "b")),
-        Action("unstack", ("a", "b")), Action("put-down", ("a",)),
-    )  # fmt: skip
+        Action("unstack", ("a", "b")),
+        Action("put-down", ("a",)),
+        Action("pick-up", ("b",)),
+        Action("stack", ("b", "c")),
+        Action("pick-up", ("a",)),
+        Action("stack", ("a", "b")),
+        Action("unstack", ("a", "b")),
+        Action("put-down", ("a",)),
+    )
     assert "(ontable b)" in bw.to_pddl(p) and "s0" not in bw.to_pddl(p)
     assert ("ontable", "c") in bw.to_atoms(p, bw.initial_state(p))
     with pytest.raises(ProblemError, match="give moves, not actions"):

@@ -142,8 +142,15 @@ def test_one_at_a_time_runs_report_latency_percentiles_per_size():
         return Row("i", size, None, None, 3, 0, 4, "valid", seconds, 1)
 
     rows = (*(row(5, 0.1 * k) for k in range(1, 11)), row(10, 2.0))
-    alone = bench.Bench("t", "synthetic", 11, PlannerConfig(batched=False), (0,), (3,),
-                        (bench.Run(3, 0, 1.0, rows),))  # fmt: skip
+    alone = bench.Bench(
+        "t",
+        "synthetic",
+        11,
+        PlannerConfig(batched=False),
+        (0,),
+        (3,),
+        (bench.Run(3, 0, 1.0, rows),),
+    )
     five, ten = latency_rows(alone)
     assert (five["size"], five["n"], five["max"]) == (5, 10, pytest.approx(1.0))
     assert (five["p50"], five["p90"]) == (pytest.approx(0.6), pytest.approx(1.0))

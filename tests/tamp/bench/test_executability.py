@@ -40,8 +40,9 @@ def _data(tmp_path):
         writer = csv.writer(handle)
         writer.writerow(["file", "llm_correct", "plan", "source", "plan_converted"])
         for k, (plan, flag) in PLANS.items():
-            writer.writerow([f"instances/generated_basic_3/instance-{k}.pddl", flag, plan,
-                             "upstream", plan])  # fmt: skip
+            writer.writerow(
+                [f"instances/generated_basic_3/instance-{k}.pddl", flag, plan, "upstream", plan]
+            )
     return root, plans
 
 
@@ -74,8 +75,21 @@ def test_a_missing_plans_path_is_a_one_line_error(tmp_path, capsys, where):
 def test_valid_invalid_and_unparseable_plans_and_our_reference_row(tmp_path, capsys):
     root, plans = _data(tmp_path)
     out = tmp_path / "out"
-    argv = ["bench", "executability", "--plans", str(plans), "--data", str(root), "--n", "3",
-            "--threads", "1", "--no-progress", "--out", str(out)]  # fmt: skip
+    argv = [
+        "bench",
+        "executability",
+        "--plans",
+        str(plans),
+        "--data",
+        str(root),
+        "--n",
+        "3",
+        "--threads",
+        "1",
+        "--no-progress",
+        "--out",
+        str(out),
+    ]
     assert main(argv) == 0
     printed = capsys.readouterr().out
     assert "model-x" in printed and "ours" in printed and "first failures" in printed

@@ -55,8 +55,7 @@ def folder(tmp_path_factory):
             atoms = tuple(zip(NAMES, goal, strict=True))
             text = to_pddl(Problem(f"latplan-{name}", "blocksworld", NAMES, init, atoms))
             (root / "pddl" / f"{name}.pddl").write_text(text)
-            rows.append({"problem": name, "opt_len_4op": optimal,
-                         "pddl_file": f"pddl/{name}.pddl"})  # fmt: skip
+            rows.append({"problem": name, "opt_len_4op": optimal, "pddl_file": f"pddl/{name}.pddl"})
     with (root / "manifest.csv").open("w", newline="") as handle:
         writer = csv.DictWriter(handle, ["problem", "opt_len_4op", "pddl_file"])
         writer.writeheader()
@@ -99,7 +98,10 @@ def test_state_and_frozen_rows_table_and_files(folder, tmp_path, capsys):
     body = json.loads((out / "results.json").read_text())
     assert body["instances"] == list(INSTANCES) and body["modes"] == ["state", "frozen"]
     assert [(s["resolution"], s["mode"]) for s in body["summary"]] == [
-        ("-", "state"), ("150x100", "frozen"), ("45x30", "frozen")]  # fmt: skip
+        ("-", "state"),
+        ("150x100", "frozen"),
+        ("45x30", "frozen"),
+    ]
     assert body["summary"][0]["valid"]["mean"] == 2  # from the true states: solved
 
 
@@ -109,8 +111,19 @@ def test_the_shipped_latplan_model_reads_our_own_renders(folder, tmp_path, capsy
     here: every state read right and every plan valid, at both resolutions."""
     torch.set_num_threads(1)
     out = tmp_path / "shipped"
-    args = ["bench", "latplan", "--data", str(folder), "--modes", "frozen", "--seeds", "1",
-            "--no-progress", "--out", str(out)]  # fmt: skip
+    args = [
+        "bench",
+        "latplan",
+        "--data",
+        str(folder),
+        "--modes",
+        "frozen",
+        "--seeds",
+        "1",
+        "--no-progress",
+        "--out",
+        str(out),
+    ]
     assert main(args) == 0
     with (out / "instances.csv").open() as handle:
         rows = list(csv.DictReader(handle))

@@ -50,9 +50,22 @@ def test_an_inexecutable_plan_is_replayed_not_called_no_plan():
 
 def _report(first_plan, executed, solved=True) -> EpisodeReport:
     return EpisodeReport(
-        EXAMPLE.name, "pybullet", EpisodeStatus.GOAL_REACHED, True, tuple(executed), (), 0, (),
-        0, 1.0, 1.0, 0.1, solved, "", tuple(first_plan),
-    )  # fmt: skip
+        EXAMPLE.name,
+        "pybullet",
+        EpisodeStatus.GOAL_REACHED,
+        True,
+        tuple(executed),
+        (),
+        0,
+        (),
+        0,
+        1.0,
+        1.0,
+        0.1,
+        solved,
+        "",
+        tuple(first_plan),
+    )
 
 
 def test_motion_plans_valid_comes_from_the_validator_not_the_planner_flag():
@@ -98,10 +111,24 @@ def test_renders_count_the_images_of_each_problem_that_were_redrawn(monkeypatch)
 
 
 def _summary(crisp: str, **kw) -> dict:
-    row = {"mode": "frozen", "crisp": crisp, "blur": 0, "horizon": 3, "n": 10, "valid": 8,
-           "optimal": 6, "optimal_pct": 75.0, "inexecutable": 1, "non_goal_reaching": 1,
-           "no_plan": 0, "time_s_per_instance": 0.1, "goal_misread": 0, "perception_errors": 0,
-           "misread_windows": 2, "redrawn": 3}  # fmt: skip
+    row = {
+        "mode": "frozen",
+        "crisp": crisp,
+        "blur": 0,
+        "horizon": 3,
+        "n": 10,
+        "valid": 8,
+        "optimal": 6,
+        "optimal_pct": 75.0,
+        "inexecutable": 1,
+        "non_goal_reaching": 1,
+        "no_plan": 0,
+        "time_s_per_instance": 0.1,
+        "goal_misread": 0,
+        "perception_errors": 0,
+        "misread_windows": 2,
+        "redrawn": 3,
+    }
     return row | kw
 
 

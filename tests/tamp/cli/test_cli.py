@@ -76,8 +76,10 @@ def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(capsys, file
         " :effect (and (held ?b) (not (at ?b)) (not (free)))))"
     )
     problem = tmp_path / "g1.pddl"
-    problem.write_text("(define (problem g1) (:domain g) (:objects b1) (:init (at b1) (free))"
-                       " (:goal (and (held b1))))")  # fmt: skip
+    problem.write_text(
+        "(define (problem g1) (:domain g) (:objects b1) (:init (at b1) (free))"
+        " (:goal (and (held b1))))"
+    )
     assert main(["plan", str(gripper), str(problem), "--motion-aware"]) == 2
     assert "blocksworld problems on a table" in one_line_error(capsys)
 

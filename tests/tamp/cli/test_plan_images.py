@@ -71,8 +71,20 @@ def test_plan_from_images_validates_against_the_true_states(scenes, capsys):
 
 @pytest.mark.sim
 def test_json_record_of_optimised_perception_over_several_windows(scenes, capsys):
-    args = ["plan-images", scenes["init"], scenes["goal"], "--perception", "optimised",
-            "--horizon", "1", "--lookahead-share", "0", "--threads", "1", "--json"]  # fmt: skip
+    args = [
+        "plan-images",
+        scenes["init"],
+        scenes["goal"],
+        "--perception",
+        "optimised",
+        "--horizon",
+        "1",
+        "--lookahead-share",
+        "0",
+        "--threads",
+        "1",
+        "--json",
+    ]
     assert main(args) == 0
     record = json.loads(capsys.readouterr().out)
     assert record["blocks"] == ["red", "green", "purple"]  # palette order

@@ -54,8 +54,9 @@ def test_without_the_planner_the_blocked_move_fails_before_it_moves(solver):
 
 
 def test_an_episode_in_the_clutter_scene_reaches_the_goal_untouched(solver):
-    three = Problem("three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE),
-                    (("a", "c"), ("b", "a")))  # fmt: skip
+    three = Problem(
+        "three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("a", "c"), ("b", "a"))
+    )
     config = LoopConfig(scene=with_scene(SceneConfig(), "clutter"))
     report = run_episode(three, config, seed=1, solver=solver)
     assert report.reached_goal and not report.collided, (report.reason, report.touched)
@@ -74,8 +75,9 @@ def test_the_planner_finds_a_way_under_the_shelf_and_runs_it_untouched(sim_name,
         refused = execute_move(sim, solver, Move("a", "e"), observe, check, shelf, collision=model)
         assert refused.failure is Failure.COLLISION
         assert (refused.evidence["phase"], refused.evidence["other"]) == ("approach", "shelf_board")
-        result = execute_move(sim, solver, Move("a", "e"), observe, ExecConfig(), shelf,
-                              collision=model)  # fmt: skip
+        result = execute_move(
+            sim, solver, Move("a", "e"), observe, ExecConfig(), shelf, collision=model
+        )
         assert result.ok and result.path_time_s > 0, result.evidence
         assert read_state(entities, observe(), shelf).state == ("e", *state[1:])
         assert sim.touched == {}

@@ -65,15 +65,32 @@ def test_describe_says_why_a_move_failed():
 def test_an_episode_report_turns_into_plain_json():
     moves = (ExecutionResult(A_B, True, sim_time_s=1.23456), _failed(A_TABLE))
     report = EpisodeReport(
-        "p", "pybullet", EpisodeStatus.OUT_OF_REACH, False, moves, (("move(a -> b)",),), 1,
-        ("drop@0",), 0, 2.0, 3.0, 0.5, True, "why",
-    )  # fmt: skip
+        "p",
+        "pybullet",
+        EpisodeStatus.OUT_OF_REACH,
+        False,
+        moves,
+        (("move(a -> b)",),),
+        1,
+        ("drop@0",),
+        0,
+        2.0,
+        3.0,
+        0.5,
+        True,
+        "why",
+    )
     out = json.loads(json.dumps(report.to_json()))  # plain JSON
     assert out["status"] == "out_of_reach" and out["reason"] == "why"
     assert out["moves"][0] == {
-        "move": "move(a -> b)", "ok": True, "failure": None, "evidence": {},
-        "sim_time_s": 1.235, "wall_time_s": 0.0, "ik_time_s": 0.0,
-    }  # fmt: skip
+        "move": "move(a -> b)",
+        "ok": True,
+        "failure": None,
+        "evidence": {},
+        "sim_time_s": 1.235,
+        "wall_time_s": 0.0,
+        "ik_time_s": 0.0,
+    }
     assert out["moves"][1]["failure"] == "ik_infeasible"
     assert out["plans"] == [["move(a -> b)"]] and out["faults"] == ["drop@0"]
 

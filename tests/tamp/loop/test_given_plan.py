@@ -16,14 +16,17 @@ from task.errors import TampError
 from task.problem import TABLE, Move, Problem
 
 # b on a, c on the table; goal: the tower c-a-b
-THREE = Problem("three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE),
-                (("a", "c"), ("b", "a")))  # fmt: skip
+THREE = Problem(
+    "three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("a", "c"), ("b", "a"))
+)
 PROBLEM = """(define (problem three) (:domain blocksworld-4ops) (:objects a b c)
 (:init (handempty) (ontable a) (on b a) (ontable c) (clear b) (clear c))
 (:goal (and (on a c) (on b a))))
 """
-VALID = "; a valid plan\n(unstack b a)\n(put-down b)\n0: (pick-up a)\n1: (stack a c)\n" \
-        "(pick-up b)\n(stack b a)\n; cost = 6 (unit cost)\n"  # fmt: skip
+VALID = (
+    "; a valid plan\n(unstack b a)\n(put-down b)\n0: (pick-up a)\n1: (stack a c)\n"
+    "(pick-up b)\n(stack b a)\n; cost = 6 (unit cost)\n"
+)
 ONTO_NOT_CLEAR = "(pick-up c)\n(stack c a)\n"  # b is on a
 
 
