@@ -2,9 +2,11 @@
 
 Every benchmark writes through here: `out_folder` creates ``--out`` (one-line error when it
 cannot), `write_json` a ``results.json`` that carries the configuration and `machine` (cores,
-platform, torch version, date), `write_csv` one row per instance or episode. The planning
-benchmarks also get ``steps.png`` (`plot_steps`: our plan lengths against the optimal ones).
-matplotlib is imported only when a plot is drawn (Agg backend, no display needed).
+platform, torch version, date, and what produced it: the command line, the git commit and
+whether the checkout had uncommitted changes), `write_csv` one row per instance or episode.
+The planning benchmarks also get ``steps.png`` (`plot_steps`: our plan lengths against the
+optimal ones). matplotlib is imported only when a plot is drawn (Agg backend, no display
+needed).
 """
 
 from __future__ import annotations
@@ -14,6 +16,8 @@ import datetime
 import json
 import os
 import platform
+import shlex
+import subprocess
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, fields
@@ -24,10 +28,37 @@ from tamp.bench.summary import latency_rows, main_rows, size_rows
 from task.errors import TampError
 
 
-def machine() -> dict:
-    """Where the benchmark ran."""
+def git_state(root: Path | None = None) -> tuple[str | None, bool | None]:
+    """``(commit, dirty)`` of the checkout holding this code (``root``: this repository);
+    ``(None, None)`` outside a git checkout of it (an installed copy, no git). ``dirty``: the
+    checkout has changes not committed, untracked files included (ignored ones not)."""
+    root = Path(__file__).resolve().parents[2] if root is None else root
+
+    def git(*args: str) -> str | None:
+        try:
+            done = subprocess.run(
+                ["git", "-C", str(root), *args], capture_output=True, text=True, timeout=30
+            )
+        except (OSError, subprocess.SubprocessError):
+            return None
+        return done.stdout if done.returncode == 0 else None
+
+    top = git("rev-parse", "--show-toplevel")
+    if top is None or Path(top.strip()).resolve() != root.resolve():
+        return None, None  # not a checkout, or this code sits inside some other repository
+    commit, status = git("rev-parse", "HEAD"), git("status", "--porcelain")
+    if commit is None or status is None:
+        return None, None
+    return commit.strip(), bool(status.strip())
+
+
+def machine(argv: Sequence[str] | None = None) -> dict:
+    """Where and from what the benchmark ran: the machine, its load average as the run ended,
+    the date, the command line ``tamp`` + ``argv`` (None when no command line ran it) and
+    `git_state`."""
     import torch
 
+    commit, dirty = git_state()
     return {
         "cores": os.cpu_count(),
         "platform": platform.platform(),
@@ -37,11 +68,16 @@ def machine() -> dict:
         "torch_threads": torch.get_num_threads(),
         "device": "cpu",
         "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "load_1min": round(os.getloadavg()[0], 2),  # other work on the machine as it finished
+        "command": None if argv is None else f"tamp {shlex.join(argv)}".strip(),
+        "commit": commit,
+        "dirty": dirty,
     }
 
 
-def results(bench: Bench) -> dict:
-    """The JSON-ready report of a benchmark (no per-instance rows; see ``instances.csv``)."""
+def results(bench: Bench, argv: Sequence[str] | None = None) -> dict:
+    """The JSON-ready report of a benchmark (no per-instance rows; see ``instances.csv``);
+    ``argv``: the command line's arguments after ``tamp``, recorded in ``machine``."""
     speed = None
     if bench.speed is not None:
         speed = {**asdict(bench.speed), "speedup": bench.speed.speedup}
@@ -52,7 +88,7 @@ def results(bench: Bench) -> dict:
         "seeds": list(bench.seeds),
         "horizons": list(bench.horizons),
         "config": asdict(bench.config),
-        "machine": machine(),
+        "machine": machine(argv),
         "summary": [s.asdict() for s in main_rows(bench)],
         "size_name": bench.size_name,
         "by_size": [s.asdict() for s in size_rows(bench)],

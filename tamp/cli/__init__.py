@@ -33,6 +33,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # argparse: --help exits 0, usage errors 2
         return exc.code if isinstance(exc.code, int) else 2
+    args.argv = list(sys.argv[1:] if argv is None else argv)  # recorded in results.json
     try:
         return args.func(args)
     except TampError as exc:

@@ -58,7 +58,7 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
         result = planning.run(suite, config, seeds, horizons, args.sequential, update)
     if getattr(args, "lama", False):
         result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
-    body = results.results(result)
+    body = results.results(result, args.argv)
     if args.out is not None:
         paths = results.write(result, args.out, body)
     if args.json:
@@ -204,7 +204,7 @@ def perception_command(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "threads": args.threads,
         "cores": os.cpu_count(),
-        "machine": results.machine(),
+        "machine": results.machine(args.argv),
         "date": time.strftime("%Y-%m-%d"),
         "redrawn_renders": result.redrawn,
         "corruption": corruption.name,
@@ -257,7 +257,7 @@ def latplan_command(args: argparse.Namespace) -> int:
         "threads": args.threads,
         "config": asdict(config),
     }
-    body = latplan.report(data, rows, summary, options, results.machine())
+    body = latplan.report(data, rows, summary, options, results.machine(args.argv))
     if args.out is not None:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -304,7 +304,7 @@ def poses_command(args: argparse.Namespace) -> int:
             "blocks": [args.min_blocks, args.max_blocks],
             "jitter": args.jitter,
         },
-        "machine": results.machine(),
+        "machine": results.machine(args.argv),
         "summary": result.summary,
     }
     if args.out:

@@ -105,7 +105,7 @@ def motion_command(args: argparse.Namespace) -> int:
             "blocks": args.blocks,
             "source": suite.source,
         },
-        "machine": results.machine(),
+        "machine": results.machine(args.argv),
         "ik_batch": result.ik,
         "summary": result.summary,
     }
@@ -180,7 +180,7 @@ def executability_command(args: argparse.Namespace) -> int:
             "workers": args.workers,
             "ray": args.ray,
         },
-        "machine": results.machine(),
+        "machine": results.machine(args.argv),
         "wall_s": wall,
         "summary": summary,
     }
