@@ -2,8 +2,9 @@
 
 A given plan is 4-op PDDL actions in the VAL / Fast Downward format (``(unstack a b)`` per line,
 ``;`` comments, optional step numbers ``0: (pick-up a)``) or relational moves (``move(a -> b)``,
-the form `task.problem.Move` prints, or ``move(a, b)`` or ``a -> b``). Actions pair up into
-pick-and-place moves (`read_given`). Per step, `GivenPlanEpisode` reports:
+the form `task.problem.Move` prints, or ``move(a, b)`` or ``a -> b``), read by the project's one
+plan reader (`task.symbolic.pddl_io.parse_plan_lines`, which ``tamp validate`` uses too).
+Actions pair up into pick-and-place moves (`read_given`). Per step, `GivenPlanEpisode` reports:
 
 - the task-level verdict: do the step's preconditions hold in the TRUE symbolic state (read from
   the simulator for scoring only, `tamp.loop.score`), and which fails (`task.symbolic.strips`);
@@ -18,7 +19,6 @@ failed or the observed state is not the one the step should give (robot-side sig
 
 from __future__ import annotations
 
-import re
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -36,10 +36,6 @@ from task.problem import TABLE, Action, Move, Problem
 from task.symbolic import pddl_io, strips
 
 PICKS, PUTS = ("pick-up", "unstack"), ("put-down", "stack")
-_NUMBER = re.compile(r"^\d+\s*[:.]\s*")  # "0: (pick-up a)" (LPG, LLM plans)
-_ACTION = re.compile(r"^\(\s*([^\s()]+)((?:\s+[^\s()]+)*)\s*\)(?:\s*\[[^\]]*\])?$")
-_MOVE = re.compile(r"^move\s*\(\s*([^\s(),]+?)\s*(?:->|,)\s*([^\s(),]+)\s*\)$", re.IGNORECASE)
-_ARROW = re.compile(r"^([^\s(),]+?)\s*->\s*([^\s(),]+)$")
 MOVED_M = 0.01  # a block other than the carried one that moved this far was disturbed
 
 
@@ -70,6 +66,7 @@ class StepReport:
     evidence: dict = field(default_factory=dict)
     disturbed: tuple[str, ...] = ()  # other blocks that moved, e.g. "c fell", "d pushed 2.1 cm"
     carried_to: str = ""  # where the carried block came to rest: a block, "table" or "loose"
+    # ("" when it never left its place: the move was refused or failed before the lift)
 
     def line(self) -> str:
         """One line, e.g. ``3-4 (unstack a d) (stack a b): INVALID at task level: ...``."""
@@ -95,28 +92,11 @@ def read_given(path: str | Path, problem: Problem) -> tuple[GivenStep, ...]:
 
 def parse_given(text: str, source: str, problem: Problem) -> tuple[GivenStep, ...]:
     """`read_given` of plan text; ``source`` names it in errors."""
-    entries = []  # (lineno, Action | Move)
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = _NUMBER.sub("", raw.split(";", 1)[0].strip()).lower()
-        if not line:
-            continue
-        if m := _ACTION.match(line):
-            entries.append((lineno, Action(m.group(1), tuple(m.group(2).split()))))
-        elif m := _MOVE.match(line) or _ARROW.match(line):
-            entries.append((lineno, Move(m.group(1), m.group(2))))
-        else:
-            raise PDDLError(
-                f"{source}: line {lineno}: malformed plan line {raw.strip()!r} (expected "
-                "'(action-name arg ...)' or a move 'move(a -> b)')"
-            )
+    entries = [(e.lineno, e.step) for e in pddl_io.parse_plan_lines(text, source)]
     if not entries:
         raise PDDLError(f"{source}: the plan is empty (no action or move lines)")
-    kinds = [isinstance(e, Move) for _, e in entries]
-    if len(set(kinds)) > 1:
-        lineno = entries[kinds.index(not kinds[0])][0]
-        raise PDDLError(f"{source}: line {lineno}: the plan mixes 4-op actions and moves")
     _check_names(entries, source, problem)
-    if kinds[0]:
+    if isinstance(entries[0][1], Move):
         return tuple(GivenStep(k, f"{k} {e}", (), e) for k, (_, e) in enumerate(entries, start=1))
     return _pair([e for _, e in entries])
 
@@ -260,8 +240,11 @@ class GivenPlanEpisode(Episode):
             x, scene = step.move.entity, self.config.scene
             read0, read1 = (read_state(self.problem.entities, q, scene) for q in (before, after))
             moved = _disturbed(x, (before, after), (read0, read1), self.problem, scene)
+            lifted = np.linalg.norm(np.subtract(after[x].xyz, before[x].xyz)) >= MOVED_M
             carried = (
-                "loose"
+                ""  # refused or failed before the block left its place: nothing was carried
+                if not lifted
+                else "loose"
                 if x in read1.loose or read1.state is None
                 else read1.state[self.problem.entities.index(x)]
             )

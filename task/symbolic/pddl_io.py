@@ -2,8 +2,12 @@
 
 Every failure is one `PDDLError` line that names the file (or the ``source`` given for text):
 a missing file, a parse error (condensed to line and column), a problem whose ``:domain`` does
-not match the domain. Plans are read and written in the PlanBench / VAL / Fast Downward format:
-one ``(name arg1 arg2)`` per line, ``;`` comments, a ``; cost = N (unit cost)`` trailer.
+not match the domain. Plans are written in the PlanBench / VAL / Fast Downward format: one
+``(name arg1 arg2)`` per line, then a ``; cost = N (unit cost)`` trailer. `parse_plan_lines` is
+the one plan reader of the project (``tamp validate`` and ``tamp run --plan`` both use it): that
+format with ``;`` comments, optional step numbers (``0: (pick-up a)``, LPG and LLM plans) and
+``[duration]`` suffixes, or relational moves (``move(a -> b)``, the form `task.problem.Move`
+prints, or ``move(a, b)`` or ``a -> b``), one kind per plan.
 
 The `pddl` library compiles its grammar on every ``pddl.parse_*`` call (about 60 ms); here the
 compiled grammar is built once per start symbol and a fresh transformer is used per file, so
@@ -15,6 +19,7 @@ from __future__ import annotations
 import functools
 import re
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,9 +32,12 @@ from pddl.parser.domain import DomainTransformer
 from pddl.parser.problem import ProblemTransformer
 
 from task.errors import PDDLError
-from task.problem import Action
+from task.problem import Action, Move
 
-_PLAN_LINE = re.compile(r"^\(\s*([^\s()]+)((?:\s+[^\s()]+)*)\s*\)$")
+_NUMBER = re.compile(r"^\d+\s*[:.]\s*")  # "0: (pick-up a)" (LPG, LLM plans)
+_ACTION = re.compile(r"^\(\s*([^\s()]+)((?:\s+[^\s()]+)*)\s*\)(?:\s*\[[^\]]*\])?$")
+_MOVE = re.compile(r"^move\s*\(\s*([^\s(),]+?)\s*(?:->|,)\s*([^\s(),]+)\s*\)$", re.IGNORECASE)
+_ARROW = re.compile(r"^([^\s(),]+?)\s*->\s*([^\s(),]+)$")
 _MAX_EXPECTED = 8
 
 
@@ -45,11 +53,16 @@ def _grammar(start: str) -> lark.Lark:
 
 
 def read_text(path: str | Path) -> str:
-    """The text of ``path``; PDDLError naming the file if it is missing or unreadable."""
+    """The text of ``path``; PDDLError naming the file if it is missing, unreadable or not
+    UTF-8 text (a binary file given by mistake: an image, a checkpoint, an archive)."""
     try:
         return Path(path).read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise PDDLError(f"{path}: no such file") from None
+    except UnicodeDecodeError as exc:
+        raise PDDLError(
+            f"{path}: not a text file (byte {exc.start} is not UTF-8); expected PDDL or plan text"
+        ) from None
     except OSError as exc:
         raise PDDLError(f"{path}: cannot read ({exc.strerror or exc})") from None
 
@@ -158,21 +171,55 @@ def load_object_order(path: str | Path) -> tuple[str, ...]:
     return object_order(read_text(path))
 
 
-def parse_plan(text: str, source: str = "<plan>") -> tuple[Action, ...]:
-    """Parse plan text: one ``(name args...)`` per line; ``;`` comments and blank lines skipped."""
-    actions = []
+@dataclass(frozen=True)
+class PlanLine:
+    """One entry of a plan file: its 1-based line number and the action or move on it."""
+
+    lineno: int
+    step: Action | Move
+
+
+def parse_plan_lines(text: str, source: str = "<plan>") -> tuple[PlanLine, ...]:
+    """Every action or move of plan text with its line number (the format is in the module
+    docstring); names are lowercased. PDDLError naming ``source`` and the line for a malformed
+    line or a plan that mixes actions and moves. An empty plan is an empty tuple."""
+    entries = []
     for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split(";", 1)[0].strip()
+        line = _NUMBER.sub("", raw.split(";", 1)[0].strip()).lower()
         if not line:
             continue
-        match = _PLAN_LINE.match(line)
-        if match is None:
+        if m := _ACTION.match(line):
+            entries.append(PlanLine(lineno, Action(m.group(1), tuple(m.group(2).split()))))
+        elif m := _MOVE.match(line) or _ARROW.match(line):
+            entries.append(PlanLine(lineno, Move(m.group(1), m.group(2))))
+        else:
             raise PDDLError(
-                f"{source}: line {lineno}: malformed plan line {raw.strip()!r} "
-                "(expected '(action-name arg ...)')"
+                f"{source}: line {lineno}: malformed plan line {raw.strip()!r} (expected "
+                "'(action-name arg ...)' or a move 'move(a -> b)')"
             )
-        actions.append(Action(match.group(1).lower(), tuple(match.group(2).lower().split())))
+    kinds = [isinstance(e.step, Move) for e in entries]
+    if len(set(kinds)) > 1:
+        lineno = entries[kinds.index(not kinds[0])].lineno
+        raise PDDLError(f"{source}: line {lineno}: the plan mixes 4-op actions and moves")
+    return tuple(entries)
+
+
+def parse_plan(text: str, source: str = "<plan>") -> tuple[Action, ...]:
+    """The actions of plan text (`parse_plan_lines`); PDDLError naming the line of a move (a
+    move stands for actions that depend on the state: `task.symbolic.validate` expands it)."""
+    actions = []
+    for entry in parse_plan_lines(text, source):
+        if isinstance(entry.step, Move):
+            raise PDDLError(
+                f"{source}: line {entry.lineno}: {entry.step} is a move, not a PDDL action"
+            )
+        actions.append(entry.step)
     return tuple(actions)
+
+
+def read_plan_lines(path: str | Path) -> tuple[PlanLine, ...]:
+    """Read a plan file (see `parse_plan_lines`)."""
+    return parse_plan_lines(read_text(path), str(path))
 
 
 def read_plan(path: str | Path) -> tuple[Action, ...]:

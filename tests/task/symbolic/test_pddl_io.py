@@ -138,3 +138,12 @@ def test_types_without_the_typing_requirement_are_read_as_typed():
     assert str(domain.name) == "lift" and "floor" in {str(t) for t in domain.types}
     bare = "(define (domain d) (:types t) (:predicates (p ?x - t)))"
     assert "t" in {str(t) for t in pddl_io.parse_domain(bare).types}
+
+
+@pytest.mark.parametrize("loader", ["load_domain", "load_problem", "read_plan", "read_plan_lines"])
+def test_a_binary_file_is_one_line_naming_it(tmp_path, loader):
+    path = tmp_path / "picture.png"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe\x9d")
+    with pytest.raises(PDDLError) as excinfo:
+        getattr(pddl_io, loader)(path)
+    _error(excinfo, str(path), "not a text file")
