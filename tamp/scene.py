@@ -145,10 +145,15 @@ def layout(
     slots: Sequence[int] | None = None,
 ) -> dict[str, Pose]:
     """Poses for a crisp state: towers on random slots (or tower i, in `towers` order, on slot
-    ``slots[i]`` of ``config.slots``), stacked exactly, jittered in xy and yaw."""
+    ``slots[i]`` of ``config.slots``), stacked exactly, jittered in xy and yaw. One slot always
+    stays free (a move to the table needs one), so at most ``len(config.slots) - 1`` towers."""
     stacks = towers(entities, state)
     if len(stacks) > len(config.slots) - 1:
-        raise SceneError(f"{len(stacks)} towers need more than the {len(config.slots)} slots")
+        k = len(config.slots)
+        raise SceneError(
+            f"{len(stacks)} towers leave no free table slot: the scene has {k} slots and keeps "
+            f"one free for moves to the table (at most {k - 1} towers)"
+        )
     if max(len(t) for t in stacks) > config.max_height:
         raise SceneError(f"a tower is taller than {config.max_height} blocks")
     rng = np.random.default_rng(seed)

@@ -64,10 +64,20 @@ def test_full_table_has_no_free_slot():
 def test_bad_scene_inputs_are_clear_errors():
     with pytest.raises(ProblemError, match="unknown target"):
         place_pose(Move("a", "zz"), layout(("a",), (TABLE,)))
-    with pytest.raises(SceneError, match="towers need more than"):
+    with pytest.raises(SceneError, match="11 towers leave no free table slot"):
         layout(tuple("abcdefghijk"), (TABLE,) * 11)
     with pytest.raises(ProblemError, match="cycle"):
         towers(("a", "b"), ("b", "a"))
+
+
+def test_as_many_towers_as_slots_is_refused_with_a_true_message():
+    config = SceneConfig(slot_xs=(0.45, 0.6), slot_ys=(0.0,))  # 2 slots
+    assert set(layout(("a", "b"), (TABLE, "a"), config)) == {"a", "b"}  # 1 tower: one slot free
+    with pytest.raises(SceneError) as excinfo:
+        layout(("a", "b"), (TABLE, TABLE), config)  # 2 towers on 2 slots: none left free
+    message = str(excinfo.value)
+    assert message.startswith("2 towers leave no free table slot: the scene has 2 slots")
+    assert "(at most 1 towers)" in message and "more than" not in message
 
 
 @pytest.mark.parametrize(
