@@ -30,6 +30,7 @@ from task.soft import (
     log_chain,
     row_normalise,
 )
+from task.symbolic.generate import random_problem
 from task.symbolic.search import moves_lower_bound
 
 State = tuple[str, ...]
@@ -245,8 +246,6 @@ def with_slots(problem: Problem, slots: Sequence[str], bases: dict | None = None
 
 def samples(seed: int):
     """Random problems of 3 to 6 blocks, and one of 5 blocks on 4 slots when its towers fit."""
-    from task.symbolic.generate import random_problem
-
     for n_blocks in (3, 4, 5, 6):
         yield random_problem(n_blocks, seed)
     small = random_problem(5, seed + 100)

@@ -3,11 +3,13 @@
 `from_pddl` reads a parsed problem into a relational `Problem` (each block's support), checking
 that the init is a hand-empty blocksworld state and that the goal is a set of support atoms that
 can hold at once (`support_error` names why not); `to_pddl` writes a problem back as
-PlanBench-style text. The moves <-> actions mapping lives with the domain (`blocksworld`).
+PlanBench-style text; `write_instances` writes seeded random problems as instance files. The
+moves <-> actions mapping lives with the domain (`blocksworld`).
 """
 
 from __future__ import annotations
 
+import random
 import re
 from collections.abc import Iterable, Sequence
 from pathlib import Path
@@ -18,6 +20,7 @@ from pddl.core import Problem as PDDLProblem
 from task.errors import PDDLError, ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
 from task.symbolic import pddl_io, strips
+from task.symbolic.generate import random_problem
 from task.symbolic.signature import signature
 
 NAME = "blocksworld"
@@ -146,6 +149,24 @@ def to_pddl(problem: Problem) -> str:
     lines += ["(and", *goal[:-1], goal[-1] + ")"] if goal else ["(and)"]
     lines += [")", ")"]
     return "\n".join(lines) + "\n"
+
+
+def write_instances(out_dir: str | Path, n_blocks: int, n: int, seed: int) -> tuple[Path, ...]:
+    """Write ``instance-1.pddl .. instance-n.pddl`` (PlanBench format) of seeded random problems
+    (`task.symbolic.generate.random_problem`) and return their paths.
+
+    Instance ``i`` uses the ``i``-th seed drawn from ``random.Random(seed)``.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    seeds = random.Random(seed)
+    paths = []
+    for i in range(1, n + 1):
+        problem = random_problem(n_blocks, seeds.randrange(2**31))
+        path = out / f"instance-{i}.pddl"
+        path.write_text(to_pddl(problem), encoding="utf-8")
+        paths.append(path)
+    return tuple(paths)
 
 
 def pddl_domain_text() -> str:

@@ -1,4 +1,7 @@
-"""The logistics domain: crisp moves, soft gates, a shaped goal potential, moves <-> actions.
+"""The logistics domain: crisp moves, soft gates, a shaped goal potential, moves <-> actions,
+and seeded random problems (`samples`, named as PlanBench names them: a0, c0, t0, l0-0, p0;
+l<c>-0 is city c's airport). The static map and routes are `task.domains.logistics_map`;
+problem PDDL in and out `task.domains.logistics_pddl`.
 
 Rows are packages, trucks and airplanes; targets are those entities and the locations (fixed
 targets). ``move(p -> v)`` loads a package into a vehicle at its location, ``move(p -> l)``
@@ -23,11 +26,13 @@ from __future__ import annotations
 
 import functools
 import math
+import random
 from collections.abc import Sequence
 
 import torch
 from torch import Tensor
 
+from task.domains import logistics_map as lm
 from task.domains import logistics_pddl as lp
 from task.domains.base import INF, SoftBatch, encode_supports, relational_decode, zero_cycle_loss
 from task.errors import ProblemError, one_of
@@ -47,7 +52,7 @@ def initial_state(problem: Problem) -> State:
 def check_move(problem: Problem, state: State, move: Move) -> str | None:
     """None if ``move`` is legal in ``state``, else a one-line reason (ProblemError: unknown)."""
     d, fixed, x, y = problem.data, problem.fixed, move.entity, move.target
-    s, kind = state[lp.entity(problem, x)], d.kind(x)
+    s, kind = state[lm.entity(problem, x)], d.kind(x)
     if y not in problem.targets:
         raise ProblemError(f"unknown vehicle or location {one_of(y, problem.targets)}")
     if x == y or d.kind(y) == "package":
@@ -55,18 +60,18 @@ def check_move(problem: Problem, state: State, move: Move) -> str | None:
     if kind == "package" and y in fixed:
         if s in fixed:
             return f"{x} is not in a vehicle (it is at {s})"
-        at = lp.where(problem, state, s)
+        at = lm.where(problem, state, s)
         return None if at == y else f"{x} is in {s}, which is at {at}, not {y}"
     if kind == "package":
         if s not in fixed:
             return f"{x} is in {s}; unload it first"
-        at = lp.where(problem, state, y)
+        at = lm.where(problem, state, y)
         return None if at == s else f"{x} is at {s} but {y} is at {at}"
     if y not in fixed:
         return f"{kind} {x} can only go to a location, not {y}"
     if s == y:
         return f"{x} is already at {y}"
-    if kind == "truck" and fixed.index(y) not in lp.reach(problem, x):
+    if kind == "truck" and fixed.index(y) not in lm.reach(problem, x):
         return f"{y} is in {d.city[fixed.index(y)]}; truck {x} stays in its city"
     if kind == "airplane" and y not in d.airports:
         return f"{y} is not an airport {one_of(y, d.airports)}"
@@ -78,7 +83,7 @@ def apply_move(problem: Problem, state: State, move: Move) -> State:
     reason = check_move(problem, state, move)
     if reason is not None:
         raise ProblemError(f"illegal {move}: {reason}")
-    i = lp.entity(problem, move.entity)
+    i = lm.entity(problem, move.entity)
     return (*state[:i], move.target, *state[i + 1 :])
 
 
@@ -89,7 +94,7 @@ def legal_moves(problem: Problem, state: State) -> list[Move]:
 
 
 def is_goal(problem: Problem, state: State) -> bool:
-    return all(state[lp.entity(problem, x)] == loc for x, loc in problem.goal)
+    return all(state[lm.entity(problem, x)] == loc for x, loc in problem.goal)
 
 
 def lower_bound(problem: Problem, state: State) -> float:
@@ -99,14 +104,14 @@ def lower_bound(problem: Problem, state: State) -> float:
     package changing city an airplane at its city's only airport (unless one is there) and the
     goal city's, a truck at its city's airport (unless the package is there); one move per unmet
     vehicle goal. `INF` when a package's goal is unreachable."""
-    d: lp.LogisticsData = problem.data
-    dist, idx = lp.routes(d, problem.fixed)[0], {x: j for j, x in enumerate(problem.fixed)}
-    at = {x: lp.where(problem, state, x) for x in problem.entities}
+    d: lm.LogisticsData = problem.data
+    dist, idx = lm.routes(d, problem.fixed)[0], {x: j for j, x in enumerate(problem.fixed)}
+    at = {x: lm.where(problem, state, x) for x in problem.entities}
     present = {(d.kind(v), at[v]) for v in (*d.trucks, *d.airplanes)}
     ports = {c: [a for a in d.airports if d.city[idx[a]] == c] for c in d.cities}
     need, goals, actions = {"truck": set(), "airplane": set()}, {"truck": [], "airplane": []}, 0.0
     for x, g in problem.goal:
-        s, gj = state[lp.entity(problem, x)], idx[g]
+        s, gj = state[lm.entity(problem, x)], idx[g]
         goals[d.kind(x)] = goals.get(d.kind(x), []) + ([] if s == g else [g])
         if d.kind(x) != "package" or s == g:
             continue
@@ -115,7 +120,7 @@ def lower_bound(problem: Problem, state: State) -> float:
             if s not in d.airports and ("truck", s) not in present:
                 need["truck"].add(s)
         else:
-            actions += 1 + 2 * min(dist[u][gj] for u in lp.reach(problem, s))
+            actions += 1 + 2 * min(dist[u][gj] for u in lm.reach(problem, s))
         if g not in d.airports and not (d.kind(s) == "truck" and at[s] == g):
             need["truck"].add(g)
         here, there = d.city[idx[at[x]]], d.city[gj]
@@ -133,18 +138,18 @@ def to_actions(problem: Problem, moves: Sequence[Move], strict: bool = True) -> 
     ``strict=False`` translates an illegal move as it stands, for a validator to name (a vehicle
     sent where it is becomes a no-op drive or flight, which PDDL allows), and replays on. Unknown
     names and moves no action expresses (a truck into a package) raise either way."""
-    d: lp.LogisticsData = problem.data
+    d: lm.LogisticsData = problem.data
     state, out = initial_state(problem), []
     for move in moves:
-        i, (x, y) = lp.entity(problem, move.entity), (move.entity, move.target)
+        i, (x, y) = lm.entity(problem, move.entity), (move.entity, move.target)
         if check_move(problem, state, move) and strict:  # unknown names raise either way
             apply_move(problem, state, move)  # ProblemError: illegal
         kind, ky, s = d.kind(x), d.kind(y), state[i]
         if kind == "package" and ky in ("truck", "airplane"):
-            loc = s if s in problem.fixed else lp.where(problem, state, y)
+            loc = s if s in problem.fixed else lm.where(problem, state, y)
             out.append(Action(f"load-{ky}", (x, y, loc)))
         elif kind == "package" and y in problem.fixed:
-            there = [v for v in (*d.trucks, *d.airplanes) if lp.where(problem, state, v) == y]
+            there = [v for v in (*d.trucks, *d.airplanes) if lm.where(problem, state, v) == y]
             v = s if s not in problem.fixed else [*there, *d.trucks, *d.airplanes][0]
             out.append(Action(f"unload-{d.kind(v)}", (x, v, y)))
         elif kind == "truck" and y in problem.fixed:
@@ -158,12 +163,12 @@ def to_actions(problem: Problem, moves: Sequence[Move], strict: bool = True) -> 
 
 
 @functools.lru_cache(maxsize=4096)
-def _tables(problem: Problem, data: lp.LogisticsData) -> dict[str, Tensor]:
+def _tables(problem: Problem, data: lm.LogisticsData) -> dict[str, Tensor]:
     """One problem's unpadded static tensors: ``kind`` (n, 3) package / truck / airplane,
     ``allow`` (n, Y) static action columns, and the potential's ``base`` (n, Y), ``req``
     (n, Y, 2, K) (legs needing a truck / an airplane at l), ``unload`` (n, n, K)."""
     n, k, ents = problem.n, len(problem.fixed), problem.entities
-    (dist, legs), y = lp.routes(data, problem.fixed), n + k
+    (dist, legs), y = lm.routes(data, problem.fixed), n + k
     z = functools.partial(torch.zeros, dtype=torch.float64)
     kind, allow, base, req, unload = z(n, 3), z(n, y), z(n, y), z(n, y, 2, k), z(n, n, k)
     for i, x in enumerate(ents):
@@ -171,7 +176,7 @@ def _tables(problem: Problem, data: lp.LogisticsData) -> dict[str, Tensor]:
         if data.kind(x) == "package":
             allow[i] = torch.tensor([float(data.kind(v) != "package") for v in ents] + [1.0] * k)
         else:
-            allow[i, [n + j for j in lp.reach(problem, x)]] = 1.0
+            allow[i, [n + j for j in lm.reach(problem, x)]] = 1.0
 
     def route(i: int, col: int, start: int, goal: int) -> None:
         base[i, col] += UNREACHABLE if math.isinf(dist[start][goal]) else 0.0
@@ -184,7 +189,7 @@ def _tables(problem: Problem, data: lp.LogisticsData) -> dict[str, Tensor]:
         for j in range(k):
             route(i, n + j, j, gj)
         for v, vehicle in ((v, e) for v, e in enumerate(ents) if data.kind(e) != "package"):
-            u = min(lp.reach(problem, vehicle), key=lambda u: (dist[u][gj], u != gj))
+            u = min(lm.reach(problem, vehicle), key=lambda u: (dist[u][gj], u != gj))
             base[i, v], unload[i, v, u] = 1.0, 1.0
             route(i, v, u, gj)
     return {"kind": kind, "allow": allow, "base": base, "req": req, "unload": unload}
@@ -263,6 +268,40 @@ def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
 
 
+# ------------------------------------------------------------------------------- samples
+
+
+def random_problem(cities: int, locations: int, packages: int, planes: int, seed: int) -> Problem:
+    """A random problem: one truck per city, ``locations`` per city (the first an airport),
+    airplanes at random airports, packages and their goals at random locations (at least one
+    package away from its goal)."""
+    rng = random.Random(seed)
+    cs = [f"c{i}" for i in range(cities)]
+    city = {f"l{i}-{j}": c for i, c in enumerate(cs) for j in range(locations)}
+    locs, ports = list(city), [f"l{i}-0" for i in range(cities)]
+    support = {f"t{i}": f"l{i}-{rng.randrange(locations)}" for i in range(cities)}
+    support |= {f"a{i}": rng.choice(ports) for i in range(planes)}
+    support |= {f"p{i}": rng.choice(locs) for i in range(packages)}
+    goal = [(f"p{i}", rng.choice(locs)) for i in range(packages)]
+    if all(support[p] == g for p, g in goal):
+        goal[0] = ("p0", rng.choice([x for x in locs if x != support["p0"]]))
+    kinds = {c: "city" for c in cs} | {x: "location" for x in locs}
+    kinds |= {x: {"t": "truck", "a": "airplane", "p": "package"}[x[0]] for x in support}
+    order = [*(f"a{i}" for i in range(planes)), *cs, *(f"t{i}" for i in range(cities)), *locs]
+    order += [f"p{i}" for i in range(packages)]
+    name = f"logistics-c{cities}-s{locations}-p{packages}-a{planes}-{seed}"
+    return lp.make_problem(name, kinds, city, ports, support, goal, order)
+
+
+SIZES = ((2, 1, 1, 1), (2, 2, 2, 1), (3, 1, 2, 2), (3, 2, 3, 2))  # cities, locations, ...
+
+
+def samples(seed: int):
+    """Random problems of 2-3 cities, 1-2 locations per city, 1-3 packages, 1-2 airplanes."""
+    for cities, locations, packages, planes in SIZES:
+        yield random_problem(cities, locations, packages, planes, seed)
+
+
 class Logistics:
     """The logistics domain object the shared planner drives (see task.domains.base.Domain)."""
 
@@ -286,7 +325,7 @@ class Logistics:
     from_pddl = staticmethod(lp.from_pddl)
     matches = staticmethod(lp.matches)
     pddl_domain_text = staticmethod(lp.pddl_domain_text)
-    samples = staticmethod(lp.samples)
+    samples = staticmethod(samples)
 
     @staticmethod
     def shape_key(problem: Problem) -> tuple[int, int]:

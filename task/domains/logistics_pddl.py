@@ -3,28 +3,24 @@
 Relational reading: the entities are the packages, trucks and airplanes (in that order, each in
 file order) and the fixed targets are the locations. A crisp state is the support of every
 entity: a package's location or the vehicle it is in, a vehicle's location. The static facts
-(the city of each location, the airports, each truck's city) are a `LogisticsData` in
-``Problem.data``; `routes` gives the shortest static package routes between locations.
-`from_pddl` reads the untyped problem by its type predicates (OBJ, TRUCK, AIRPLANE, LOCATION,
-CITY, AIRPORT) and names whatever does not fit; `to_pddl` writes PlanBench-style text;
-`to_atoms` gives every atom of a state; `random_problem` draws small problems named as
-PlanBench names them (a0, c0, t0, l0-0, p0; l<c>-0 is city c's airport).
+(the city of each location, the airports, each truck's city) are a
+`task.domains.logistics_map.LogisticsData` in ``Problem.data``; `make_problem` builds a
+problem from checked parts. `from_pddl` reads the untyped problem by its type predicates (OBJ,
+TRUCK, AIRPLANE, LOCATION, CITY, AIRPORT) and names whatever does not fit; `to_pddl` writes
+PlanBench-style text; `to_atoms` gives every atom of a state.
 """
 
 from __future__ import annotations
 
 import functools
-import itertools
-import math
-import random
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
-from task.errors import PDDLError, ProblemError, one_of
+from task.domains.logistics_map import LogisticsData
+from task.errors import PDDLError, one_of
 from task.problem import Problem
 from task.symbolic import strips
 
@@ -35,81 +31,6 @@ OPERATORS = ("load-truck", "load-airplane", "unload-truck", "unload-airplane", "
 OPERATORS += ("fly-airplane",)
 KINDS = {"obj": "package", "truck": "truck", "airplane": "airplane", "location": "location"}
 KINDS |= {"city": "city"}  # type predicate -> kind (AIRPORT marks some locations)
-
-
-@dataclass(frozen=True)
-class LogisticsData:
-    """The static facts of a logistics problem (hashable; ``Problem.data``)."""
-
-    packages: tuple[str, ...]
-    trucks: tuple[str, ...]
-    airplanes: tuple[str, ...]
-    cities: tuple[str, ...]
-    city: tuple[str, ...]  # the city of each location, in ``Problem.fixed`` order
-    airports: tuple[str, ...]
-    truck_city: tuple[str, ...]  # the city of each truck (where it starts; it never leaves)
-
-    def kind(self, name: str) -> str:
-        """'package', 'truck', 'airplane' or 'other' (a location or a city)."""
-        for kind, names in (("package", self.packages), ("truck", self.trucks)):
-            if name in names:
-                return kind
-        return "airplane" if name in self.airplanes else "other"
-
-
-def entity(problem: Problem, x: str) -> int:
-    """The row of package or vehicle ``x``; ProblemError listing them if unknown."""
-    if x not in problem.entities:
-        raise ProblemError(f"unknown package or vehicle {one_of(x, problem.entities)}")
-    return problem.entities.index(x)
-
-
-def where(problem: Problem, state: Sequence[str], x: str) -> str:
-    """The location of entity ``x`` (a package in a vehicle is where the vehicle is)."""
-    s = state[entity(problem, x)]
-    return s if s in problem.fixed else state[problem.entities.index(s)]
-
-
-def reach(problem: Problem, v: str) -> list[int]:
-    """The locations (indices) vehicle ``v`` may go to: its city's, or the airports."""
-    d: LogisticsData = problem.data
-    if d.kind(v) == "truck":
-        return [j for j, c in enumerate(d.city) if c == d.truck_city[d.trucks.index(v)]]
-    return [j for j, x in enumerate(problem.fixed) if x in d.airports]
-
-
-Legs = tuple[tuple[str, int], ...]  # a route: (vehicle kind, start location) per leg
-
-
-@functools.lru_cache(maxsize=4096)
-def routes(data: LogisticsData, locations: tuple[str, ...]):
-    """Shortest static package routes: ``(dist, legs)`` with ``dist[i][j]`` the legs from
-    location i to j (inf: unreachable) and ``legs[i][j]`` one such route. A leg is a load, a
-    vehicle move and an unload: by a truck within its city, or by an airplane between airports."""
-    k, towns = len(locations), set(data.truck_city)
-    port = [x in data.airports for x in locations]
-    edge: list[list[str | None]] = [[None] * k for _ in range(k)]
-    for i, j in itertools.permutations(range(k), 2):
-        if data.city[i] == data.city[j] and data.city[i] in towns:
-            edge[i][j] = "truck"
-        elif port[i] and port[j] and data.airplanes:
-            edge[i][j] = "airplane"
-    dist = [
-        [0.0 if i == j else 1.0 if edge[i][j] else math.inf for j in range(k)] for i in range(k)
-    ]
-    nxt = [[j if edge[i][j] else None for j in range(k)] for i in range(k)]
-    for m, i, j in itertools.product(range(k), repeat=3):  # Floyd-Warshall
-        if dist[i][m] + dist[m][j] < dist[i][j]:
-            dist[i][j], nxt[i][j] = dist[i][m] + dist[m][j], nxt[i][m]
-
-    def legs(i: int, j: int) -> Legs:
-        out = []
-        while i != j and nxt[i][j] is not None:
-            out.append((edge[i][nxt[i][j]], i))
-            i = nxt[i][j]
-        return tuple(out)
-
-    return tuple(map(tuple, dist)), tuple(tuple(legs(i, j) for j in range(k)) for i in range(k))
 
 
 def make_problem(name, kinds, city, airports, support, goal, order) -> Problem:
@@ -270,34 +191,3 @@ def to_pddl(problem: Problem) -> str:
     lines += [f"(:objects {objects}", ")", "(:init", *(f"    {a}" for a in init), ")"]
     lines += ["(:goal", "    (and", *(f"        (at {x} {g})" for x, g in problem.goal)]
     return "\n".join([*lines, "    )", ")", ")"]) + "\n"
-
-
-def random_problem(cities: int, locations: int, packages: int, planes: int, seed: int) -> Problem:
-    """A random problem: one truck per city, ``locations`` per city (the first an airport),
-    airplanes at random airports, packages and their goals at random locations (at least one
-    package away from its goal)."""
-    rng = random.Random(seed)
-    cs = [f"c{i}" for i in range(cities)]
-    city = {f"l{i}-{j}": c for i, c in enumerate(cs) for j in range(locations)}
-    locs, ports = list(city), [f"l{i}-0" for i in range(cities)]
-    support = {f"t{i}": f"l{i}-{rng.randrange(locations)}" for i in range(cities)}
-    support |= {f"a{i}": rng.choice(ports) for i in range(planes)}
-    support |= {f"p{i}": rng.choice(locs) for i in range(packages)}
-    goal = [(f"p{i}", rng.choice(locs)) for i in range(packages)]
-    if all(support[p] == g for p, g in goal):
-        goal[0] = ("p0", rng.choice([x for x in locs if x != support["p0"]]))
-    kinds = {c: "city" for c in cs} | {x: "location" for x in locs}
-    kinds |= {x: {"t": "truck", "a": "airplane", "p": "package"}[x[0]] for x in support}
-    order = [*(f"a{i}" for i in range(planes)), *cs, *(f"t{i}" for i in range(cities)), *locs]
-    order += [f"p{i}" for i in range(packages)]
-    name = f"logistics-c{cities}-s{locations}-p{packages}-a{planes}-{seed}"
-    return make_problem(name, kinds, city, ports, support, goal, order)
-
-
-SIZES = ((2, 1, 1, 1), (2, 2, 2, 1), (3, 1, 2, 2), (3, 2, 3, 2))  # cities, locations, ...
-
-
-def samples(seed: int):
-    """Random problems of 2-3 cities, 1-2 locations per city, 1-3 packages, 1-2 airplanes."""
-    for cities, locations, packages, planes in SIZES:
-        yield random_problem(cities, locations, packages, planes, seed)

@@ -8,7 +8,8 @@ rest are the P *fluent* atoms, the columns of a single state row (``entities = (
 ``fixed`` = the fluent atoms as strings, ``goal`` = ``("state", atom)`` for each fluent goal
 atom). A crisp state is the frozenset of fluent atoms that hold (static atoms may be included:
 they are ignored); a move is the ground `task.problem.Action` itself, so ``to_actions`` is the
-identity. The grounding, tensors, goal terms and relaxations are `task.domains.strips_soft`.
+identity. The grounded arrays are `task.symbolic.strips_task`; the tensors and goal terms
+`task.domains.strips_soft`; the relaxations `task.symbolic.relaxed`.
 ``lower_bound`` is LM-cut (admissible; it marks dead ends) and ``estimate`` h_FF: the decoder
 ranks restarts by moves + estimate. With h_max or the goal count most windows tie, so the
 fewest moves win (Logistics dev instances 201-286: 2 of 11 solved with h_max, 11 of 11 with
@@ -30,11 +31,11 @@ from pddl.core import Problem as PDDLProblem
 
 from task.domains import strips_soft
 from task.domains.base import zero_cycle_loss
-from task.domains.strips_soft import StripsTask
 from task.errors import PDDLError, ProblemError
 from task.problem import Action, Problem
 from task.symbolic import relaxed, strips
 from task.symbolic.strips import Atom, GroundAction
+from task.symbolic.strips_task import StripsTask
 
 NAME = "strips"
 State = frozenset[Atom]

@@ -1,11 +1,12 @@
-"""The grounded task of the generic STRIPS lift, its tensors and its crisp relaxations.
+"""The tensors of the generic STRIPS lift: the soft step and goal terms over a grounded task.
 
 A problem is one row of P independent fluent-atom probabilities, ``F: (B, 1, P)``, and one
 commitment per step over ``A = G + 1`` columns (the G reachable ground actions, then STAY).
 Columns P and P + 1 of the extended row ``[F, 1, 0]`` are a constant-true and a constant-false
 atom: precondition lists are padded with P, padded actions' with P + 1 (they never apply), and
 effect lists with P + 1 (a dump column, dropped). Each per-action list is an index tensor
-``(B, G, k)``: a step costs O(B G k) (a gather and two scatter-adds), never O(B G P).
+``(B, G, k)``: a step costs O(B G k) (a gather and two scatter-adds), never O(B G P). The
+grounded task these are batched from is the crisp `task.symbolic.strips_task.StripsTask`.
 
 Goal terms: "atoms" is the paper's CE, which a 3-5 step window cannot feel for goal atoms more
 than a window away. The default "hadd" adds the expected h_add of the goal (`relaxed_cost`),
@@ -17,9 +18,7 @@ tiny gripper (3-6 balls) and Logistics instances 201-286 only.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
 import numpy as np
 import torch
@@ -27,9 +26,10 @@ from torch import Tensor
 
 from task.domains.base import SoftBatch
 from task.errors import ProblemError, one_of
-from task.problem import Action, Problem
+from task.problem import Problem
 from task.symbolic import relaxed
-from task.symbolic.strips import Atom, GroundAction, atom_str, initial_state
+from task.symbolic.strips import atom_str
+from task.symbolic.strips_task import StripsTask
 
 CAP = 30.0  # the relaxed cost of an atom nothing reaches (and the ceiling of every cost)
 SOFTMIN_TAU = 0.1  # temperature of the softmin over an atom's achievers
@@ -37,87 +37,6 @@ ATOMS_WEIGHT = 1.0  # weight of the paper's goal cross-entropy inside "hadd"
 SWEEP_MARGIN = 2  # Bellman sweeps beyond the relaxed depth of the window's start
 MAX_SWEEPS = 40
 GOAL_LOSSES = ("hadd", "atoms")  # the first is the default
-
-
-def _padded(rows: Sequence[Sequence[int]], pad: int) -> np.ndarray:
-    """Ragged index lists -> (len(rows), k) int64, padded with ``pad`` (k >= 1)."""
-    out = np.full((len(rows), max(map(len, rows), default=1) or 1), pad, dtype=np.int64)
-    for j, r in enumerate(rows):
-        out[j, : len(r)] = r
-    return out
-
-
-@dataclass(frozen=True, eq=False)
-class StripsTask:
-    """The grounding of one problem (``Problem.data`` of the lift). Column j of the action
-    axis is ``actions[j]``; column i of the state row is ``atoms[i]``."""
-
-    actions: tuple[Action, ...]  # the G reachable ground actions, sorted by (name, args)
-    effects: tuple[GroundAction, ...]  # per action: fluent preconditions, adds, deletes
-    atoms: tuple[Atom, ...]  # the P fluent atoms (added or deleted by some action), sorted
-    static: frozenset[Atom]  # the other atoms of init: they hold in every reachable state
-    init: frozenset[Atom]  # the fluent atoms of the initial state
-    goal: tuple[Atom, ...]  # fluent goal atoms in file order (static goal atoms hold already)
-    pre: np.ndarray = field(repr=False)  # (G, kp) fluent precondition columns, padded with P
-    add: np.ndarray = field(repr=False)  # (G, ka) added columns, padded with P + 1
-    delete: np.ndarray = field(repr=False)  # (G, kd) deleted and not added, padded with P + 1
-    consumed: np.ndarray = field(repr=False)  # (G, kp) bool: the precondition is deleted
-    goal_adds: int = 1  # the most fluent goal atoms one action adds (the goal-count bound)
-    pddl_domain: object = field(default=None, repr=False)  # the parsed PDDL it was built from
-    pddl_problem: object = field(default=None, repr=False)
-    order: tuple[str, ...] = ()  # the problem's objects in file order
-
-    @classmethod
-    def build(cls, ground, goal: Sequence[Atom], domain, problem, order=()) -> StripsTask:
-        """The task of reachable ``ground`` ``(Action, GroundAction)`` pairs; static
-        preconditions (true at init, never changed) are dropped."""
-        fluent = sorted({a for _, g in ground for a in g.add | g.delete})
-        col, n = {a: i for i, a in enumerate(fluent)}, len(fluent)
-        init = initial_state(problem)
-        static = init.difference(fluent)
-        effects = tuple(
-            GroundAction(g.pre_pos - static, frozenset(), g.add, g.delete) for _, g in ground
-        )
-        goal = tuple(a for a in goal if a in col)
-        return cls(
-            tuple(a for a, _ in ground),
-            effects,
-            tuple(fluent),
-            frozenset(static),
-            frozenset(init & set(fluent)),
-            goal,
-            _padded([[col[a] for a in sorted(e.pre_pos)] for e in effects], n),
-            _padded([[col[a] for a in sorted(e.add)] for e in effects], n + 1),
-            _padded([[col[a] for a in sorted(e.delete - e.add)] for e in effects], n + 1),
-            _padded([[a in e.delete - e.add for a in sorted(e.pre_pos)] for e in effects], 0) > 0,
-            max((len(e.add & set(goal)) for e in effects), default=1),
-            domain,
-            problem,
-            tuple(order),
-        )
-
-    @functools.cached_property
-    def column(self) -> dict[Atom, int]:
-        return {a: i for i, a in enumerate(self.atoms)}
-
-    @functools.cached_property
-    def index(self) -> dict[Action, int]:
-        return {a: j for j, a in enumerate(self.actions)}
-
-    @functools.cached_property
-    def pairs(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(added atom, action) pairs sorted by atom: their actions (E,), the atoms some
-        action adds (U,) and where each one's pairs start (U,), for ``np.minimum.reduceat``."""
-        j, k = np.nonzero(self.add < len(self.atoms))
-        order = np.argsort(self.add[j, k], kind="stable")
-        targets, starts = np.unique(self.add[j, k][order], return_index=True)
-        return j[order], targets, starts
-
-    @functools.cached_property
-    def bounds(self) -> dict:
-        """Memo of the domain's lower bound and estimate by state (restarts often reach the
-        same one)."""
-        return {}
 
 
 def encode(

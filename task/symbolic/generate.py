@@ -3,7 +3,8 @@
 The initial state is a random set of towers; the goal is the ``on`` atoms of another random
 configuration (a partial goal, as in PlanBench: blocks that end on the table are left free),
 optionally subsampled, and never already satisfied at init. Randomness comes only from
-``random.Random(seed)``; nothing is seeded globally.
+``random.Random(seed)``; nothing is seeded globally. The problems are relational (each block's
+support); `task.domains.blocksworld_pddl.write_instances` writes them as PDDL files.
 """
 
 from __future__ import annotations
@@ -11,13 +12,12 @@ from __future__ import annotations
 import itertools
 import random
 import string
-from pathlib import Path
 
-from task.domains import blocksworld
 from task.errors import ProblemError
 from task.problem import TABLE, Problem
 
 _MAX_TRIES = 10_000
+DOMAIN = "blocksworld"  # the domain of the problems made here (`task.domains.blocksworld`)
 
 
 def block_names(n_blocks: int) -> tuple[str, ...]:
@@ -78,22 +78,5 @@ def random_problem(n_blocks: int, seed: int, n_goal_atoms: int | None = None) ->
         support = dict(zip(names, init, strict=True))
         if atoms and any(support[x] != y for x, y in atoms):
             name = f"BW-gen-{n_blocks}-{seed}"
-            return Problem(name, blocksworld.NAME, names, init, tuple(atoms))
+            return Problem(name, DOMAIN, names, init, tuple(atoms))
     raise ProblemError(f"no goal found for {n_blocks} blocks after {_MAX_TRIES} tries")
-
-
-def write_instances(out_dir: str | Path, n_blocks: int, n: int, seed: int) -> tuple[Path, ...]:
-    """Write ``instance-1.pddl .. instance-n.pddl`` (PlanBench format) and return their paths.
-
-    Instance ``i`` uses the ``i``-th seed drawn from ``random.Random(seed)``.
-    """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    seeds = random.Random(seed)
-    paths = []
-    for i in range(1, n + 1):
-        problem = random_problem(n_blocks, seeds.randrange(2**31))
-        path = out / f"instance-{i}.pddl"
-        path.write_text(blocksworld.to_pddl(problem), encoding="utf-8")
-        paths.append(path)
-    return tuple(paths)

@@ -1,7 +1,7 @@
 """Crisp delete relaxations of a grounded STRIPS task: h_max, LM-cut (admissible) and h_FF
 (an inadmissible estimate that ranks restarts), vectorised over the task's padded arrays.
 
-``task`` is any object with the arrays of `task.domains.strips_soft.StripsTask`: ``pre``
+``task`` is a `task.symbolic.strips_task.StripsTask` (or any object with its arrays): ``pre``
 (G, kp) precondition columns padded with P (column P is constant-true, P + 1 constant-false),
 ``add`` (G, ka) padded with P + 1, ``pairs`` (achievers sorted by atom), ``column``, ``goal``
 and ``actions``. Unit action costs throughout.

@@ -7,6 +7,7 @@ import random
 import pytest
 
 from task.domains import blocksworld as bw
+from task.domains.blocksworld_pddl import write_instances
 from task.errors import ProblemError
 from task.problem import TABLE
 from task.symbolic import generate, pddl_io, search
@@ -17,6 +18,10 @@ def test_seeded_determinism(n_blocks):
     assert generate.random_problem(n_blocks, seed=3) == generate.random_problem(n_blocks, seed=3)
     problems = {generate.random_problem(n_blocks, seed=s) for s in range(10)}
     assert len(problems) > 1 or n_blocks == 2
+
+
+def test_problems_belong_to_the_blocksworld_domain():
+    assert generate.random_problem(4, seed=0).domain == generate.DOMAIN == bw.NAME
 
 
 def test_block_names():
@@ -61,9 +66,9 @@ def test_random_towers_are_forests():
 
 
 def test_write_instances(tmp_path, bw_domain_path):
-    paths = generate.write_instances(tmp_path / "gen", n_blocks=4, n=5, seed=11)
+    paths = write_instances(tmp_path / "gen", n_blocks=4, n=5, seed=11)
     assert [p.name for p in paths] == [f"instance-{i}.pddl" for i in range(1, 6)]
-    again = generate.write_instances(tmp_path / "again", n_blocks=4, n=5, seed=11)
+    again = write_instances(tmp_path / "again", n_blocks=4, n=5, seed=11)
     assert [p.read_text() for p in paths] == [p.read_text() for p in again]
     domain = pddl_io.load_domain(bw_domain_path)
     for path in paths:
