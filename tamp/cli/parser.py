@@ -47,6 +47,7 @@ def build_parser() -> argparse.ArgumentParser:
     _perception_benchmark(bench, bench_opts)
     _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
+    _record_command(bench)
     _perception_commands(sub)
     return parser
 
@@ -313,6 +314,34 @@ def _poses_benchmark(bench) -> None:
     progress_option(p)
     output_options(p, "write results.json and blocks.csv into this folder")
     p.set_defaults(func=_lazy("tamp.cli.bench", "poses_command"))
+
+
+def _record_command(bench) -> None:
+    p = bench.add_parser(
+        "record",
+        help="record benchmark results folders and regenerate BENCHMARKS.md's current table",
+    )
+    p.add_argument(
+        "--results",
+        nargs="*",
+        default=(),
+        metavar="DIR",
+        help="benchmark --out folders, or a folder of them (none: only regenerate the table)",
+    )
+    p.add_argument(
+        "--into",
+        default="results/current",
+        metavar="DIR",
+        help="the committed records, one per results folder name (%(default)s)",
+    )
+    p.add_argument(
+        "--markdown",
+        default="BENCHMARKS.md",
+        metavar="FILE.md",
+        help="the file whose current-results table is regenerated (%(default)s)",
+    )
+    p.add_argument("--json", action="store_true", help="the records written, as JSON")
+    p.set_defaults(func=_lazy("tamp.cli.record", "record_command"))
 
 
 def _perception_commands(sub) -> None:

@@ -5,9 +5,14 @@ from __future__ import annotations
 import json
 import shlex
 import subprocess
+from pathlib import Path
 
-from tamp.bench import results
+import pytest
+
+from tamp.bench import record, results
+from tamp.bench.summary import Summary
 from tamp.cli import main
+from task.errors import DataError
 
 
 def _git(root, *args: str) -> str:
@@ -53,3 +58,188 @@ def test_a_benchmark_run_records_its_command_commit_and_machine(tmp_path):
 def test_machine_without_a_command_line_records_none():
     assert results.machine()["command"] is None
     assert results.machine(["bench", "x"])["command"] == "tamp bench x"
+
+
+REPO = Path(__file__).resolve().parents[3]
+COMMIT = "0123456789abcdef0123456789abcdef01234567"
+
+
+def _summary(seed: int | None, **figures) -> dict:
+    base = dict(horizon=3, seed=seed, size=None, n=4, known=4, valid=3, optimal=2)
+    base |= dict(optimal_pct=200 / 3, inexecutable=0, non_goal_reaching=0, no_plan=1)
+    base |= dict(time_s=0.5, wall_s=2.0, windows=1.0)
+    return Summary(**(base | figures)).asdict()
+
+
+def _results(folder: Path, *, seeds=(0,), commit=COMMIT, dirty=False, command="tamp bench x"):
+    """A planning benchmark's results.json as `tamp.bench.results.results` lays it out."""
+    folder.mkdir(parents=True)
+    rows = [_summary(s) for s in seeds]
+    if len(seeds) > 1:
+        rows.append(_summary(None, valid=3.5, no_plan=0.5, optimal_pct=50.0))
+    rows.append(_summary(None, size=3, valid=1))  # a block-count row: never the headline
+    body = {
+        "benchmark": "planbench",
+        "source": "tiny",
+        "instances": 4,
+        "seeds": list(seeds),
+        "horizons": [3],
+        "summary": rows,
+        "machine": {
+            "cores": 2,
+            "processor": "x86_64",
+            "python": "3.11",
+            "torch": "2.x",
+            "torch_threads": 1,
+            "device": "cpu",
+            "load_1min": 3.5,
+            "date": "2026-12-01T10:00:00+00:00",
+            "command": command,
+            "commit": commit,
+            "dirty": dirty,
+        },
+    }
+    (folder / "results.json").write_text(json.dumps(body))
+    return folder
+
+
+def test_a_record_keeps_the_headline_figures_and_what_produced_them(tmp_path):
+    r = record.extract(_results(tmp_path / "blocks"))
+    assert (r.name, r.benchmark, r.instances, r.seeds) == ("blocks", "planbench", 4, (0,))
+    assert (r.command, r.commit, r.dirty, r.date[:10]) == (
+        "tamp bench x",
+        COMMIT,
+        False,
+        "2026-12-01",
+    )
+    assert [f["valid"] for f in r.figures] == [3] and r.machine["load_1min"] == 3.5
+    assert record.ours(r) == "3/4 valid (1 no plan), 66.7% optimal, 0.5 s/instance, 2 s in all"
+    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+    several = record.extract(_results(tmp_path / "seeds", seeds=(0, 1, 2)))
+    assert [f["valid"] for f in several.figures] == [3.5]  # the mean over seeds
+    assert record.ours(several).endswith("(mean of 3 seeds)") and "3.5/4 valid" in record.ours(
+        several
+    )
+
+
+def test_a_dirty_run_is_marked_in_its_row_and_a_clean_one_is_not(tmp_path):
+    clean = record.extract(_results(tmp_path / "clean"))
+    dirty = record.extract(_results(tmp_path / "dirty", dirty=True))
+    table = record.render([clean, dirty])
+    lines = [line for line in table.splitlines() if line.startswith("| PlanBench")]
+    assert ["uncommitted changes" in line for line in lines] == [False, True]
+    assert "commit alone does not reproduce it" in table
+    assert "uncommitted" not in record.render([clean])
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"commit": None}, "records no git commit"),
+        ({"command": None}, "records no command line"),
+    ],
+)
+def test_a_results_folder_that_names_no_commit_or_command_is_refused(tmp_path, change, message):
+    folder = _results(tmp_path / "old", **change)
+    with pytest.raises(DataError, match=message):
+        record.extract(folder)
+
+
+def test_other_folders_are_refused_in_one_line(tmp_path):
+    with pytest.raises(DataError, match=r"no results\.json"):
+        record.extract(tmp_path)
+    (tmp_path / "motion").mkdir()
+    (tmp_path / "motion" / "results.json").write_text(json.dumps({"summary": {}, "machine": {}}))
+    with pytest.raises(DataError, match="records no command"):
+        record.extract(tmp_path / "motion")
+    body = {"summary": {}, "machine": {"command": "tamp bench motion", "commit": COMMIT}}
+    (tmp_path / "motion" / "results.json").write_text(json.dumps(body))
+    with pytest.raises(DataError, match=r"not a planning .* or latplan"):
+        record.extract(tmp_path / "motion")
+    (tmp_path / "motion" / "results.json").write_bytes(b"\x89PNG\x00")
+    with pytest.raises(DataError, match="not JSON"):
+        record.extract(tmp_path / "motion")
+
+
+def test_a_latplan_record_reads_true_states_and_images_apart(tmp_path):
+    folder = _results(tmp_path / "latplan")
+    body = json.loads((folder / "results.json").read_text())
+    spread = lambda m: {"mean": m, "min": m, "max": m}  # noqa: E731
+    body |= {
+        "benchmark": "latplan-40",
+        "n": 40,
+        "seeds": [0],
+        "summary": [
+            {
+                "resolution": "150x100",
+                "mode": "state",
+                "n": 40,
+                "valid": spread(40),
+                "optimal": spread(40),
+            },
+            {
+                "resolution": "150x100",
+                "mode": "frozen",
+                "n": 40,
+                "valid": spread(40),
+                "optimal": spread(39),
+            },
+            {
+                "resolution": "45x30",
+                "mode": "frozen",
+                "n": 40,
+                "valid": spread(38),
+                "optimal": spread(38),
+            },
+        ],
+    }
+    (folder / "results.json").write_text(json.dumps(body))
+    r = record.extract(folder)
+    assert record.label(r) == "LatPlan-40"
+    assert record.ours(r) == (
+        "true states: 40/40 valid, 40/40 optimal; images (frozen 150x100, frozen 45x30): "
+        "38-40/40 valid, 38-39/40 optimal"
+    )
+    assert "31/40 optimal" in record.render([r])  # the paper's figure beside ours
+
+
+def test_bench_record_writes_records_and_regenerates_only_the_block(tmp_path, capsys):
+    _results(tmp_path / "runs" / "blocks")
+    _results(tmp_path / "runs" / "more", seeds=(0, 1))
+    md = tmp_path / "B.md"
+    md.write_text(f"# Title\n\nbefore\n{record.START}\nstale\n{record.END}\nafter\n")
+    into = tmp_path / "current"
+    argv = ["bench", "record", "--results", str(tmp_path / "runs"), "--into", str(into)]
+    assert main([*argv, "--markdown", str(md)]) == 0  # a parent folder: each subfolder
+    assert sorted(p.name for p in into.iterdir()) == ["blocks.json", "more.json"]
+    text = md.read_text()
+    assert text.startswith("# Title\n\nbefore\n") and text.endswith("\nafter\n")
+    assert "stale" not in text and record.block_of(text) == record.render(record.load_all(into))
+    assert "wrote 2 record(s)" in capsys.readouterr().out
+    assert main(["bench", "record", "--into", str(into), "--markdown", str(md)]) == 0
+    assert md.read_text() == text  # regenerating from the same records changes nothing
+
+
+def test_bench_record_checks_everything_before_writing(tmp_path, capsys):
+    _results(tmp_path / "blocks")
+    md = tmp_path / "B.md"
+    md.write_text("# no markers\n")
+    into = tmp_path / "current"
+    argv = ["bench", "record", "--results", str(tmp_path / "blocks"), "--into", str(into)]
+    assert main([*argv, "--markdown", str(md)]) == 2
+    assert "no current-results markers" in capsys.readouterr().err
+    assert not into.exists() and md.read_text() == "# no markers\n"
+    assert main([*argv, "--markdown", str(tmp_path / "missing.md")]) == 2
+    assert main(["bench", "record", "--results", str(tmp_path / "nothing")]) == 2
+    assert "no results.json" in capsys.readouterr().err
+
+
+def test_the_current_table_in_benchmarks_md_is_the_one_the_records_give():
+    """BENCHMARKS.md's current table cannot drift from ``results/current``: regenerate it with
+    ``tamp bench record`` (from the repository root) after changing a record."""
+    records = record.load_all(REPO / "results" / "current")
+    assert records, "results/current holds no records"
+    for r in records:
+        assert r.command.startswith("tamp bench ") and len(r.commit) == 40, r.name
+    text = (REPO / "BENCHMARKS.md").read_text(encoding="utf-8")
+    assert record.block_of(text) == record.render(records)
