@@ -19,7 +19,9 @@ Rooms:
 - ``task.domains``: one file per planning domain (Blocksworld, Logistics, Sokoban), picked up
   by a registry, and ``strips``, the generic soft lift of any grounded STRIPS domain;
 - ``task.symbolic``: the crisp side: PDDL in and out, STRIPS, validation, search, instance
-  generation and loading;
+  generation; it never imports torch or a domain;
+- ``instances``: a PDDL problem read into the domain that plans it (through the registry),
+  with its parsed PDDL and known lengths;
 - ``task.data``: the embedded PDDL domains (4-operator blocksworld, logistics-strips,
   typed-sokoban) and a 5-block example.
 

@@ -13,9 +13,9 @@ from collections.abc import Sequence
 from tamp.bench.planning import replay
 from task import data
 from task.domains import blocksworld
+from task.instances import from_text
 from task.problem import Move, Problem
 from task.symbolic import validate
-from task.symbolic.instances import from_text
 
 
 def validate_moves(problem: Problem, moves: Sequence[Move]) -> validate.Validation:

@@ -30,14 +30,15 @@ SHARED = {"task.errors"}
 
 # rooms inside a package -> modules (dotted prefixes) they must never import. The direction
 # inside tamp: cli -> bench -> loop -> camera -> sim; inside task: the crisp side and the domains
-# never reach into the optimiser.
+# never reach into the optimiser, and the domains (soft, torch) build on the crisp side, never
+# the other way round.
 OPTIMISER = ("task.planner", "task.optimize", "task.rollout", "task.decode", "task.beliefs")
 ROOM_FORBIDDEN = {
     "tamp/sim": ("tamp.loop", "tamp.camera", "tamp.bench", "tamp.cli"),
     "tamp/camera": ("tamp.loop", "tamp.bench", "tamp.cli"),
     "tamp/loop": ("tamp.bench", "tamp.cli"),
     "tamp/bench": ("tamp.cli",),
-    "task/symbolic": OPTIMISER,
+    "task/symbolic": (*OPTIMISER, "task.domains", "torch"),
     "task/domains": OPTIMISER,
 }
 ROOMS = {
@@ -86,6 +87,30 @@ def test_import_task_stays_light():
     code = "import sys, task; print(sorted(m for m in ('torch', 'pddl') if m in sys.modules))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+CRISP = sorted(
+    f"task.symbolic.{p.stem}"
+    for p in (ROOT / "task" / "symbolic").glob("*.py")
+    if p.name != "__init__.py"
+)
+LOADED = """
+import importlib
+import sys
+
+importlib.import_module(sys.argv[1])
+print(sorted(m for m in sys.modules if m == "torch" or m.startswith("task.domains.")))
+"""
+
+
+@pytest.mark.parametrize("module", CRISP)
+def test_the_crisp_side_loads_neither_torch_nor_a_domain(module):
+    """Importing any task.symbolic module, through whatever it imports in turn, loads no torch
+    and no domain module: no circle through the domains drags the soft machinery in."""
+    out = subprocess.run(
+        [sys.executable, "-c", LOADED, module], capture_output=True, text=True, check=True, cwd=ROOT
+    )
+    assert out.stdout.strip() == "[]", f"import {module} loads {out.stdout.strip()}"
 
 
 @pytest.mark.parametrize("room", sorted(ROOM_FORBIDDEN))

@@ -33,10 +33,10 @@ from tamp.bench.tables import LATPLAN_CITED as CITED
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
 from task.config import PlannerConfig
 from task.errors import DataError, PDDLError, ProblemError, TampError
+from task.instances import Instance, from_text
 from task.planner import plan_batch
 from task.problem import PlanStatus
 from task.symbolic import pddl_io
-from task.symbolic.instances import Instance, from_text
 from task.symbolic.validate import validate
 
 DEFAULT = DEFAULT_DATA / "latplan"

@@ -36,8 +36,8 @@ from tamp.sweep import process_solver, run_items
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.errors import DataError, TampError
+from task.instances import Instance
 from task.planner import plan_batch
-from task.symbolic.instances import Instance
 from task.symbolic.validate import validate
 
 EPISODE_COLUMNS = (

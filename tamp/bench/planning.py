@@ -19,9 +19,9 @@ from pddl.core import Domain
 from tamp.bench.suites import Suite, domain_of
 from task.config import PlannerConfig
 from task.domains import get_domain
+from task.instances import Instance
 from task.planner import plan_batch
 from task.problem import Move, PlanResult, PlanStatus
-from task.symbolic.instances import Instance
 from task.symbolic.validate import Validation, validate
 
 STATUSES = ("valid", "inexecutable", "non_goal_reaching", "no_plan")

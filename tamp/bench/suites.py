@@ -22,9 +22,9 @@ from tamp.bench.optimal import digest, optimal_lengths
 from task import data
 from task.domains import blocksworld
 from task.errors import DataError, PDDLError, ProblemError, one_of
+from task.instances import Instance, from_text, rules_for
 from task.symbolic import pddl_io
 from task.symbolic.generate import random_problem
-from task.symbolic.instances import Instance, from_text, rules_for
 from task.symbolic.search import optimal_moves
 
 PLANBENCH_SOURCE = "github.com/karthikv792/LLMs-Planning, folder llm_planning_analysis/instances"

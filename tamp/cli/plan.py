@@ -19,10 +19,10 @@ from task import data
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
+from task.instances import Instance, example, from_files
 from task.planner import plan
 from task.problem import Move, PlanResult
 from task.symbolic import pddl_io, strips
-from task.symbolic.instances import Instance, example, from_files
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
 

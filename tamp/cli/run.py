@@ -25,9 +25,9 @@ from tamp.scene import SceneConfig
 from tamp.video import EpisodeVideo
 from task import data
 from task.errors import TampError
+from task.instances import example, from_files, from_text
 from task.problem import Problem
 from task.symbolic import pddl_io
-from task.symbolic.instances import example, from_files, from_text
 
 VIDEO_FPS = 10.0  # frames per second of playback, each rendered at VIDEO_SIZE (640x480)
 SPEEDUP = 4.0  # playback is 4x real time

@@ -4,10 +4,11 @@ Adding a domain is one file in this folder exposing a ``DOMAIN`` object that sat
 `task.domains.base.Domain`, plus its name in ``_NAMES`` below; modules are imported on first
 use. ``base`` holds the protocol and the soft batch every domain fills. A domain too large for
 one file keeps helpers beside it under its own prefix: ``blocksworld_pddl``, ``logistics_pddl``,
-``sokoban_pddl`` (problem PDDL in and out), ``sokoban_grid`` (the grid's static tables),
-``strips_soft`` (the lift's tensors). ``strips`` is the generic soft lift of any grounded STRIPS
-domain: the planner of a PDDL domain no file is written for, and the oracle the hand-written
-domains are tested on.
+``sokoban_pddl`` (problem PDDL in and out), ``logistics_map`` (the static map and routes),
+``sokoban_grid`` (the grid's static tables), ``strips_soft`` (the lift's tensors). ``strips``
+is the generic soft lift of any grounded STRIPS domain: the planner of a PDDL domain no file is
+written for, and the oracle the hand-written domains are tested on. The domains build on the
+crisp side (`task.symbolic`), which never imports them.
 """
 
 from __future__ import annotations

@@ -2,10 +2,15 @@
 
 - ``pddl_io``: PDDL text in and out (parse domains, problems and plans; one-line errors);
 - ``strips``: grounded STRIPS semantics (applicable / apply) of a parsed PDDL domain;
+- ``ground``: grounding by relaxed reachability (the ground actions the relaxation reaches);
+- ``strips_task``: one grounded problem as padded index arrays;
+- ``relaxed``: delete relaxations over those arrays (h_max, LM-cut, h_FF);
 - ``validate``: a plan checked step by step against the PDDL (the official check);
 - ``search``: optimal plans by breadth-first search and A* (for optimal lengths);
 - ``generate``: seeded random blocksworld problems;
-- ``instances``: a problem with its parsed PDDL and optimum, from files or the embedded example.
+- ``signature``: what recognises a parsed PDDL domain.
 
-Nothing here imports torch.
+Nothing here imports torch or a domain (`task.domains` builds on this side, never the other
+way round; tests/test_layout.py keeps it so). Reading a PDDL problem into a domain's
+`Problem` needs the domain registry, so it lives above both: `task.instances`.
 """

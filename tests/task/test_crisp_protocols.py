@@ -15,10 +15,10 @@ from task.decode import decode_best, decode_row
 from task.domains.blocksworld import DOMAIN as BW
 from task.domains.blocksworld_pddl import to_pddl
 from task.errors import TampError
+from task.instances import from_text
 from task.planner import plan, plan_batch
 from task.problem import TABLE, Move, PlanStatus, Problem
 from task.symbolic.generate import random_problem
-from task.symbolic.instances import from_text
 from task.symbolic.validate import ValidationStatus, validate
 
 # truth: b sits on a; goal: a on c. Read as "every block on the table", move(a -> c) looks legal

@@ -12,11 +12,10 @@ from tamp.bench import results as bench_io
 from tamp.bench import suites, tables
 from tamp.bench.planning import Row
 from tamp.bench.summary import latency_rows, main_rows, size_rows, summarise
-from task import data
+from task import data, instances
 from task.config import PlannerConfig
 from task.errors import DataError
 from task.problem import Move, Plan, PlanResult, PlanStatus
-from task.symbolic import instances
 from task.symbolic.search import optimal_moves
 
 

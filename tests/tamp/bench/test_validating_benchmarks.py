@@ -16,9 +16,9 @@ from tamp.cli import build_parser
 from tamp.cli.options import planner_config
 from tamp.loop import EpisodeReport, EpisodeStatus
 from tamp.loop.execute import ExecutionResult, Failure
+from task import instances
 from task.errors import TampError
 from task.problem import Move, Plan, PlanResult, PlanStatus
-from task.symbolic import instances
 from task.symbolic.search import optimal_moves
 
 DOMAIN, EXAMPLE = instances.example()
