@@ -27,7 +27,7 @@ $(PY):
 
 $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install -q torch==2.13.0
-	$(PY) -m pip install -q -e '.[dev]'
+	$(PY) -m pip install -q -e '.[dev,ray]'  # ray: the sweep tests (-m slow); no CUDA packages
 	touch $(STAMP)
 
 # the embedded 5-block example from camera images: perception, planning and the simulated Panda
