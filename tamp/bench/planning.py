@@ -155,8 +155,10 @@ def run(
     horizons: Sequence[int] | None = None,
     sequential: int = 0,
     progress: Callable[[int], None] | None = None,
+    on_run: Callable[[Run], None] | None = None,
 ) -> Bench:
-    """Plan the suite for every horizon and seed (horizons default to ``config.horizon``).
+    """Plan the suite for every horizon and seed (horizons default to ``config.horizon``);
+    ``on_run(run)`` as each (horizon, seed) run is complete (what Ctrl-C keeps).
 
     With ``sequential > 0`` the first ``sequential`` instances are also planned once batched and
     once with ``PlannerConfig(batched=False)`` (first horizon, first seed) to time batching.
@@ -167,9 +169,13 @@ def run(
     if suite.instances:  # untimed warm-up: torch's one-time start-up cost
         warm = replace(config, iters=1, max_windows=1)
         plan_batch([suite.instances[0].problem], warm, seeds[0])
-    runs = tuple(
-        run_once(suite, replace(config, horizon=h), s, progress) for h in horizons for s in seeds
-    )
+    runs = []
+    for h in horizons:
+        for s in seeds:
+            runs.append(run_once(suite, replace(config, horizon=h), s, progress))
+            if on_run is not None:
+                on_run(runs[-1])
+    runs = tuple(runs)
     speed = None
     if sequential > 0:
         subset = suite.instances[:sequential]

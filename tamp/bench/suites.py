@@ -210,8 +210,11 @@ def planbench(
     domain: str = "blocksworld",
     progress: Callable[[int], None] | None = None,
     rules: str | None = None,
+    names: Sequence[str] | None = None,
 ) -> Suite:
-    """The official PlanBench set of ``domain`` (or a ``limit``-instance `spread` of it).
+    """The official PlanBench set of ``domain`` (or a ``limit``-instance `spread` of it;
+    ``names``: of these instances only, e.g. ``generated_basic_3/instance-1``; DataError naming
+    those not in the set). ``limit`` beyond the instances there are: `DataError`.
 
     With a ``manifest.csv`` in ``data_dir``, its official rows and lengths are used (sizes are
     checked against the files); without one the official files are known by name (others are
@@ -229,28 +232,57 @@ def planbench(
     pddl_domain, domain_path = _domain(root, domain)
     folder = root / "instances" if (root / "instances").is_dir() else root
     if (root / "manifest.csv").is_file():
-        rows = spread(_manifest(root, spec), limit, key=lambda row: row[1])
+        rows = _only(_manifest(root, spec), names, lambda row: _name(row[0]), root)
+        rows = spread(_at_most(rows, limit, root), limit, key=lambda row: row[1])
         found = []
         for file, size, opt, ref in rows:
-            name = file.removeprefix("instances/").removesuffix(".pddl")
-            instance, text, _ = _load(pddl_domain, root / file, name, rules or domain)
+            instance, text, _ = _load(pddl_domain, root / file, _name(file), rules or domain)
             if rules in (None, domain) and instance.size != size:
                 raise DataError(f"{root / file}: size {instance.size}, manifest.csv says {size}")
             found.append((replace(instance, optimal=opt, reference=ref), text, root / file))
     else:
-        paths = [(n, folder / f"{n}.pddl") for n in spec.names]
-        found = [_load(pddl_domain, p, n, rules or domain) for n, p in paths if p.is_file()]
+        there = [n for n in spec.names if (folder / f"{n}.pddl").is_file()]
+        there = _only(there, names, lambda n: n, root)
+        found = [_load(pddl_domain, folder / f"{n}.pddl", n, rules or domain) for n in there]
         if not found:
             first, last = spec.names[0], spec.names[-1]
             raise DataError(
                 f"{root}: no official PlanBench {domain} instances (expected "
                 f"instances/{first}.pddl ... {last}.pddl)"
             )
-        found = spread(found, limit, key=lambda item: item[0].size)
+        found = spread(_at_most(found, limit, root), limit, key=lambda item: item[0].size)
     instances = _fill_optima(found, domain_path, cache_dir, progress)
     name = "planbench" if domain == "blocksworld" else f"planbench-{domain}"
     name += f" ({rules} rules)" if rules not in (None, domain) else ""
     return Suite(name, pddl_domain, tuple(instances), str(root.resolve()))
+
+
+def _name(file: str) -> str:
+    """``instances/generated_basic_3/instance-1.pddl`` -> ``generated_basic_3/instance-1``."""
+    return file.removeprefix("instances/").removesuffix(".pddl")
+
+
+def _only(items: list, names: Sequence[str] | None, name: Callable, root: Path) -> list:
+    """``items`` whose ``name(item)`` is one of ``names`` (all when None), in data order."""
+    if names is None:
+        return items
+    have = {name(item) for item in items}
+    unknown = [n for n in dict.fromkeys(names) if n not in have]
+    if unknown:
+        more = f" and {len(unknown) - 3} more" if len(unknown) > 3 else ""
+        raise DataError(
+            f"{root}: no instance {', '.join(unknown[:3])}{more} in this PlanBench set "
+            "(names like generated_basic_3/instance-1)"
+        )
+    wanted = set(names)
+    return [item for item in items if name(item) in wanted]
+
+
+def _at_most(items: list, limit: int | None, root: Path) -> list:
+    """``items``, or `DataError` when ``limit`` asks for more than there are."""
+    if limit is not None and limit > len(items):
+        raise DataError(f"asked for {limit} instances, but {root} has {len(items)}")
+    return items
 
 
 def _natural(path: Path) -> tuple:
@@ -275,7 +307,7 @@ def pddl_folder(
     if not paths:
         raise DataError(f"{root}: no problem files (*.pddl besides {domain_path.name})")
     found = [_load(pddl_domain, p, p.stem, chosen) for p in paths]
-    found = spread(found, limit, key=lambda item: item[0].size)
+    found = spread(_at_most(found, limit, root), limit, key=lambda item: item[0].size)
     instances = _fill_optima(found, domain_path, cache_dir, progress)
     return Suite(root.name, pddl_domain, tuple(instances), str(root.resolve()))
 
@@ -291,7 +323,8 @@ def generated(
     """``n`` random problems per block count (only those ``keep`` accepts, if given: a scene
     they must fit); optimal lengths from A* within ``max_nodes``. Instance ``i`` of ``b``
     blocks uses the ``i``-th kept seed drawn from ``Random(f"{seed}:{b}")``, so adding a block
-    count leaves the others unchanged. Each problem goes through its PDDL text."""
+    count leaves the others unchanged. Each problem goes through its PDDL text. DataError when
+    no problem of a block count is kept (a benchmark of zero episodes)."""
     report = progress or (lambda k: None)
     domain = data.domain()
     instances = []
@@ -310,6 +343,11 @@ def generated(
             report(1)
             if kept == n:
                 break
+        if kept == 0:
+            raise DataError(
+                f"--blocks {b}: none of {100 * n} random {b}-block problems fits the scene "
+                "(a slot per tower, one to spare, none too tall): fewer blocks, or another scene"
+            )
     source = f"task.symbolic.generate.random_problem, seed {seed}, A* budget {max_nodes} nodes"
     return Suite("random", domain, tuple(instances), source)
 

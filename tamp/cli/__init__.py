@@ -2,8 +2,9 @@
 
     tamp plan DOMAIN.pddl PROBLEM.pddl [--horizon 3 --restarts K --seed S --json --out plan.txt]
     tamp validate DOMAIN.pddl PROBLEM.pddl PLAN [--json]
-    tamp demo [--json --out DIR]
-    tamp plan-images INIT.png GOAL.png [--scene cubes|latplan --perception frozen|optimised]
+    tamp example [--json --out DIR]
+    tamp demo [--sim pybullet|mujoco --out out/demo]   (run --observe camera: make demo)
+    tamp plan-images INIT.png GOAL.png [--image-scene cubes|latplan --perception frozen|optimised]
     tamp bench planbench [--data DIR --limit N --seeds 3 --horizon 1,3,5 --sequential N --out DIR]
     tamp bench random [--blocks 6,8,10 --n 50 --seed 0 --max-nodes 20000 --out DIR]
     tamp run [PROBLEM.pddl] [--sim pybullet|mujoco --inject drop:0.2 --seed S --out DIR]
@@ -11,8 +12,9 @@
     tamp bench motion [--sim pybullet,mujoco --data DIR --n 100 --inject drop:0.2 --out DIR]
     tamp bench executability --plans FILE.csv|DIR [--sim pybullet,mujoco --n 20 --out DIR]
 
-Exit codes: 0 success, 1 no plan or an invalid plan, 2 usage error or bad input (one line on
-stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``).
+Exit codes: 0 success, 1 no plan or an invalid plan (an empty plan file that does not reach the
+goal, in ``validate`` and ``run --plan`` alike), 2 usage error or bad input (one line on
+stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``), 130 on Ctrl-C.
 """
 
 from __future__ import annotations
@@ -21,14 +23,30 @@ import os
 import sys
 from collections.abc import Sequence
 
-from tamp.cli.parser import build_parser
 from task.errors import TampError
 
 __all__ = ["build_parser", "main"]
 
 
+def build_parser():
+    """The ``tamp`` argument parser (`tamp.cli.parser`), imported when first asked for, so a
+    Ctrl-C while it loads is caught by `main` like any other."""
+    from tamp.cli.parser import build_parser as build
+
+    return build()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the ``tamp`` command line; returns the exit code."""
+    """Run the ``tamp`` command line; returns the exit code (Ctrl-C at any moment: one line,
+    130; a benchmark first writes what it has done, marked partial)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
     try:
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # argparse: --help exits 0, usage errors 2
@@ -39,9 +57,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     except TampError as exc:
         print(f"tamp: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("tamp: interrupted", file=sys.stderr)
-        return 130
     except BrokenPipeError:  # stdout closed early (e.g. piped into head): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1

@@ -19,8 +19,16 @@ from dataclasses import replace
 from tqdm import tqdm
 
 from tamp.bench import planning, results, suites, tables
-from tamp.cli.bench_motion import executability_command, motion_command
+from tamp.cli.bench_motion import executability_command, interrupted, motion_command
 from tamp.cli.options import planner_config, sim_list
+from tamp.cli.recorded import (
+    checkpoint,
+    latplan_config,
+    perception_bench_config,
+    planning_config,
+    poses_config,
+)
+from tamp.cli.recorded import out_folder as output_folder
 from task.errors import TampError
 
 __all__ = [  # the handlers `tamp.cli.parser` dispatches to
@@ -49,16 +57,40 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
 
     torch.set_num_threads(args.threads)
     rules = {i.problem.domain for i in suite.instances}
-    config = planner_config(args, rules.pop() if len(rules) == 1 else None)
+    domain = rules.pop() if len(rules) == 1 else None
+    recorded = planning_config(args, domain)
+    config = planner_config(args, domain)
     if getattr(args, "one_at_a_time", False):
         config = replace(config, batched=False)
     horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
+    runs: list[planning.Run] = []
     with _bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
-        result = planning.run(suite, config, seeds, horizons, args.sequential, update)
+        try:
+            result = planning.run(
+                suite, config, seeds, horizons, args.sequential, update, runs.append
+            )
+        except KeyboardInterrupt:
+            done = [row for run in runs for row in run.rows]
+            if args.out is not None:
+                out = results.out_folder(args.out)
+                partial = {
+                    "done": len(done),
+                    "of": len(suite.instances) * len(seeds) * len(horizons),
+                    "complete_runs": len(runs),  # a batched run keeps nothing until complete
+                }
+                body = {
+                    "config": recorded,
+                    "partial": partial,
+                    "machine": results.machine(args.argv),
+                }
+                results.write_json(out / "results.json", body)
+                results.write_csv(out / "instances.csv", done)
+            return interrupted(args.out, len(done), total, "plans (complete horizon-seed runs)")
     if getattr(args, "lama", False):
         result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
     body = results.results(result, args.argv)
+    body["config"] = {**body["config"], **recorded}
     if args.out is not None:
         paths = results.write(result, args.out, body)
     if args.json:
@@ -91,6 +123,8 @@ def _lama(suite: suites.Suite, bench: planning.Bench, limit: float, progress: bo
 
 def planbench_command(args: argparse.Namespace) -> int:
     """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
+    planning_config(args)  # refused combinations: before any work
+    output_folder(args.out)
     data = args.data if args.data is not None else suites.default_data(args.domain)
     with _searching(args.progress) as update:
         suite = suites.planbench(data, args.limit, args.out, args.domain, update, args.domain_rules)
@@ -99,6 +133,8 @@ def planbench_command(args: argparse.Namespace) -> int:
 
 def pddl_command(args: argparse.Namespace) -> int:
     """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
+    planning_config(args)
+    output_folder(args.out)
     with _searching(args.progress) as update:
         suite = suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules, update)
     return _run(suite, args)
@@ -132,6 +168,8 @@ def random_command(args: argparse.Namespace) -> int:
     """``--n`` generated instances per ``--blocks`` count, optima from A* within a budget."""
     if min(args.blocks) < 2:
         raise TampError(f"--blocks: random problems need at least 2 blocks, got {min(args.blocks)}")
+    planning_config(args)
+    output_folder(args.out)
     total = len(args.blocks) * args.n
     with _bar(total, "instances, A* optima", args.progress, "instance") as update:
         suite = suites.generated(args.blocks, args.n, args.seed, args.max_nodes, update)
@@ -147,12 +185,15 @@ def perception_command(args: argparse.Namespace) -> int:
     from tamp.bench import perception as bench
     from tamp.camera.from_images import PerceptionMode
 
+    recorded = perception_bench_config(args)
+    output_folder(args.out)
     names, crisps = bench.parse_modes(args.modes), bench.parse_crisp(args.crisp)
     corruption = bench.parse_corruption(args.corrupt)
+    checkpoint(args.checkpoint)
     torch.set_num_threads(args.threads)
     suite = suites.planbench(args.data, args.n)
     chosen = list(suite.instances)
-    perceiver = Perceiver.load(args.checkpoint)
+    perceiver = Perceiver.load(args.checkpoint, scene="cubes")  # PlanBench renders
     config = planner_config(args)
     horizons = args.horizons or (config.horizon,)
     modes = [  # ground truth (no images) once, as crisp "true"
@@ -209,6 +250,7 @@ def perception_command(args: argparse.Namespace) -> int:
         "redrawn_renders": result.redrawn,
         "corruption": corruption.name,
         "rows": list(result.summaries),
+        "config": recorded,
     }
     if args.out:
         out = results.out_folder(args.out)
@@ -237,8 +279,12 @@ def latplan_command(args: argparse.Namespace) -> int:
     from tamp.bench import latplan
     from tamp.bench.perception import choices
 
+    recorded = latplan_config(args)
+    output_folder(args.out)
     res = choices(args.res, tuple(latplan.FILES), "--res", "resolution")
     modes = choices(args.modes, latplan.MODES, "--modes", "mode")
+    if any(m != "state" for m in modes):
+        checkpoint(args.checkpoint)
     data = latplan.load(args.data, args.limit)
     images = any(m != "state" for m in modes)
     perceiver = latplan.load_perceiver(args.checkpoint) if images else None
@@ -256,6 +302,7 @@ def latplan_command(args: argparse.Namespace) -> int:
         "seeds": list(seeds),
         "threads": args.threads,
         "config": asdict(config),
+        "recorded": recorded,
     }
     body = latplan.report(data, rows, summary, options, results.machine(args.argv))
     if args.out is not None:
@@ -279,6 +326,8 @@ def poses_command(args: argparse.Namespace) -> int:
     """Block poses from RGB-D images of ``--n`` random scenes in each ``--sim``, against truth."""
     from tamp.bench import poses
 
+    recorded = poses_config(args)
+    output_folder(args.out)
     sims = sim_list(args.sim)
     with tqdm(
         total=args.n * len(sims),
@@ -297,13 +346,7 @@ def poses_command(args: argparse.Namespace) -> int:
             lambda sim: bar.update(1),
         )
     body = {
-        "config": {
-            "sims": list(sims),
-            "n": args.n,
-            "seed": args.seed,
-            "blocks": [args.min_blocks, args.max_blocks],
-            "jitter": args.jitter,
-        },
+        "config": recorded,
         "machine": results.machine(args.argv),
         "summary": result.summary,
     }

@@ -1,4 +1,5 @@
-"""``tamp bench motion|executability``: options in, `tamp.bench.motion` runs, tables out.
+"""``tamp bench motion|executability``: options in, `tamp.bench.motion` and
+`tamp.bench.executability` run, tables out. Ctrl-C keeps the episodes done (marked partial).
 
 Both sweep many independent episodes: ``--workers N`` runs them in N processes of this machine,
 ``--ray ADDRESS`` as Ray tasks on a cluster (`tamp.sweep.run_items`); each episode has its own
@@ -15,14 +16,25 @@ from functools import partial
 from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
-from tamp.cli.options import data_option, planner_config, positive, positive_list, sim_list
+from tamp.cli.options import block_counts, data_option, positive, sim_list, threads
+from tamp.cli.recorded import (
+    checkpoint,
+    executability_config,
+    given_config,
+    loop_config,
+    motion_config,
+)
+from tamp.cli.recorded import out_folder as output_folder
+from task.errors import TampError
+
+DEFAULT_N = 20  # bench executability: instances when --n is not given (fewer if fewer named)
 
 
 def sweep_options(p: argparse.ArgumentParser) -> None:
     """``--workers`` and ``--ray``: where the episodes run."""
     p.add_argument(
         "--workers",
-        type=positive,
+        type=threads,
         default=1,
         metavar="N",
         help="run the episodes in N processes at once, one torch thread each (1: in "
@@ -48,20 +60,32 @@ def suite_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--blocks",
-        type=positive_list,
+        type=block_counts,
         metavar="B[,B...]",
         help="random problems of these block counts instead of PlanBench, seeded by --seed, "
         "those whose towers fit --scene (episodes.csv lists them)",
     )
 
 
+def interrupted(out, done: int, total: int, what: str) -> int:
+    """After Ctrl-C in a benchmark: say what was kept (exit 130)."""
+    kept = (
+        f"wrote the {done} done to {out}, marked partial" if out else "nothing written (no --out)"
+    )
+    print(f"tamp: interrupted after {done} of {total} {what}; {kept}", file=sys.stderr)
+    return 130
+
+
 def motion_command(args: argparse.Namespace) -> int:
     """Closed-loop episodes on a ``--n`` spread of PlanBench (or random ``--blocks``
     problems) in each ``--sim``."""
     from tamp.bench import motion
-    from tamp.cli.run import loop_config
     from tamp.slots import fits
 
+    recorded = motion_config(args)  # refused combinations: before any work
+    output_folder(args.out)
+    if args.observe == "camera":
+        checkpoint(args.checkpoint)
     sims, base = sim_list(args.sim), loop_config(args)
     if args.blocks:
         suite = suites.generated(
@@ -69,42 +93,28 @@ def motion_command(args: argparse.Namespace) -> int:
         )
     else:
         suite = suites.planbench(args.data, args.n)
-    goals = dict.fromkeys(sims, 0)
+    recorded |= {"n": len(suite.instances), "source": suite.source}
+    goals, done = dict.fromkeys(sims, 0), []
+    total = len(sims) * len(suite.instances)
     with tqdm(
-        total=len(sims) * len(suite.instances),
-        desc="motion",
-        unit="episode",
-        file=sys.stderr,
-        disable=not args.progress,
+        total=total, desc="motion", unit="episode", file=sys.stderr, disable=not args.progress
     ) as bar:
 
         def progress(sim: str, report) -> None:
+            done.append(report)
             goals[sim] += report.reached_goal
             bar.set_postfix(sim=sim, goal=goals[sim], refresh=False)
             bar.update(1)
 
-        result = motion.run(suite, base, sims, args.seed, progress, args.workers, args.ray)
+        try:
+            result = motion.run(suite, base, sims, args.seed, progress, args.workers, args.ray)
+        except KeyboardInterrupt:
+            if args.out:
+                _motion_partial(args.out, recorded, suite, done, sims, base, total)
+            return interrupted(args.out, len(done), total, "episodes")
     inject = str(base.inject)
     body = {
-        "config": {
-            "sims": sims,
-            "n": len(suite.instances),
-            "inject": inject,
-            "grasp": base.grasp,
-            "seed": args.seed,
-            "data": str(args.data),
-            "observe": base.observe,
-            "perception": base.perception.mode,
-            "blur": base.perception.blur,
-            "crisp": base.crisp,
-            "scene": base.scene.name,
-            "collision": base.execution.collision,
-            "lambda_motion": base.planner.lambda_motion,
-            "workers": args.workers,
-            "ray": args.ray,
-            "blocks": args.blocks,
-            "source": suite.source,
-        },
+        "config": recorded,
         "machine": results.machine(args.argv),
         "ik_batch": result.ik,
         "summary": result.summary,
@@ -136,66 +146,97 @@ def motion_command(args: argparse.Namespace) -> int:
     return 0
 
 
+def _motion_partial(out, recorded: dict, suite, done: list, sims, base, total: int) -> None:
+    """The episodes done before Ctrl-C: episodes.csv and a results.json marked partial."""
+    from tamp.bench import motion
+
+    named = {i.name: i for i in suite.instances}
+    summary = {}
+    for sim in sims:
+        mine = [r for r in done if r.sim == sim]
+        if mine:
+            instances = [named[r.problem] for r in mine]
+            camera = base.observe == "camera"
+            summary[sim] = motion.summarise(mine, instances, suite.domain, camera)
+    folder = results.out_folder(out)
+    body = {
+        "config": recorded,
+        "partial": {"done": len(done), "of": total},
+        "machine": results.machine(),
+        "summary": summary,
+    }
+    results.write_json(folder / "results.json", body)
+    results.write_csv(folder / "episodes.csv", motion.episode_rows(done), motion.EPISODE_COLUMNS)
+
+
 def executability_command(args: argparse.Namespace) -> int:
-    """Each ``--plans`` source's plans and ours, executed open-loop in each ``--sim``."""
+    """Each ``--plans`` source's plans and ours, executed open-loop in each ``--sim``, on the
+    instances the plan files name (``--n``: a spread of at most N of them)."""
     import torch
 
-    from tamp.bench import motion
-    from tamp.cli.run import given_config
+    from tamp.bench import executability as bench
 
-    sims, sources = sim_list(args.sim), motion.read_sources(args.plans)
-    suite, out = suites.planbench(args.data, args.n), args.out and results.out_folder(args.out)
-    torch.set_num_threads(args.threads)
-    ours, wall0 = planner_config(args, "blocksworld") if args.ours else None, time.perf_counter()
-    with tqdm(
-        total=len(sims) * len(suite.instances) * (len(sources) + bool(ours)),
-        desc="executability",
-        unit="plan",
-        file=sys.stderr,
-        disable=not args.progress,
-    ) as bar:
-        rows = motion.run_given(
-            suite,
-            sources,
-            given_config(args),
-            sims,
-            args.seed,
-            ours,
-            lambda sim, row: bar.update(1),
-            args.workers,
-            args.ray,
+    recorded = executability_config(args)  # refused combinations: before any work
+    output_folder(args.out)
+    sims, sources = sim_list(args.sim), bench.read_sources(args.plans)
+    names = bench.named(sources)
+    if args.n is not None and args.n > len(names):
+        raise TampError(
+            f"--n {args.n}: the plan files name {len(names)} instance"
+            f"{'' if len(names) == 1 else 's'}; give at most that many (or leave --n out)"
         )
-    summary, wall = motion.given_summary(rows, sims), time.perf_counter() - wall0
+    limit = args.n if args.n is not None else min(DEFAULT_N, len(names))
+    suite = suites.planbench(args.data, limit, names=names)
+    torch.set_num_threads(args.threads)
+    base = given_config(args)
+    ours, wall0 = base.planner if args.ours else None, time.perf_counter()
+    recorded["instances"] = [i.name for i in suite.instances]
+    total = len(sims) * len(suite.instances) * (len(sources) + bool(ours))
+    done = []
+    with tqdm(
+        total=total, desc="executability", unit="plan", file=sys.stderr, disable=not args.progress
+    ) as bar:
+
+        def progress(sim: str, row) -> None:
+            done.append(row)
+            bar.update(1)
+
+        try:
+            rows = bench.run_given(
+                suite, sources, base, sims, args.seed, ours, progress, args.workers, args.ray
+            )
+        except KeyboardInterrupt:
+            if args.out:
+                folder = results.out_folder(args.out)
+                body = {
+                    "config": recorded,
+                    "partial": {"done": len(done), "of": total},
+                    "machine": results.machine(args.argv),
+                    "summary": bench.given_summary(done, sims) if done else [],
+                }
+                results.write_json(folder / "results.json", body)
+                results.write_csv(folder / "plans.csv", done, digits=2)
+            return interrupted(args.out, len(done), total, "plans")
+    summary, wall = bench.given_summary(rows, sims), time.perf_counter() - wall0
     body = {
-        "config": {
-            "plans": str(args.plans),
-            "sims": sims,
-            "instances": [i.name for i in suite.instances],
-            "seed": args.seed,
-            "grasp": args.grasp,
-            "ours": args.ours,
-            "data": str(args.data),
-            "scene": args.scene,
-            "collision": args.collision,
-            "workers": args.workers,
-            "ray": args.ray,
-        },
+        "config": recorded,
         "machine": results.machine(args.argv),
         "wall_s": wall,
         "summary": summary,
     }
-    if out:
+    if args.out:
+        out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
         results.write_csv(out / "plans.csv", rows, digits=2)
     if args.json:
         print(json.dumps(body, indent=2))
         return 0
     print(
-        f"executability: {len(suite.instances)} PlanBench instances, open-loop, grasp "
-        f"{args.grasp}, seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
+        f"executability: {len(suite.instances)} PlanBench instances named by --plans, "
+        f"open-loop, grasp {args.grasp}, seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
         tables.executability_table(summary, sims),
         sep="\n",
     )
-    if out:
-        print(f"wrote results.json, plans.csv to {out}")
+    if args.out:
+        print(f"wrote results.json, plans.csv to {args.out}")
     return 0

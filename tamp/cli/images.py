@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import json
 import time
-from dataclasses import asdict
 from pathlib import Path
 
 import torch
@@ -22,6 +21,8 @@ from perception.train import load_checkpoint
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
 from tamp.cli import report
 from tamp.cli.options import planner_config
+from tamp.cli.recorded import checkpoint as check_checkpoint
+from tamp.cli.recorded import images_config, out_file
 from task import data
 from task.domains import blocksworld, blocksworld_pddl
 from task.errors import TampError
@@ -38,7 +39,7 @@ def _checkpoint(args: argparse.Namespace) -> Path:
         if not path.is_file():
             raise TampError(f"no perception checkpoint at {path} (--checkpoint)")
         return path
-    if args.scene == "latplan":
+    if args.image_scene == "latplan":
         if not LATPLAN_CHECKPOINT.is_file():
             raise TampError(
                 f"no LatPlan perception checkpoint at {LATPLAN_CHECKPOINT} (is the package "
@@ -57,12 +58,15 @@ def _towers(entities, supports) -> str:
 def images_command(args: argparse.Namespace) -> int:
     """``tamp plan-images INIT GOAL``: the PDDL plan and its validation line."""
     t0 = time.perf_counter()
+    recorded = images_config(args)
+    out_file(args.out)
     paths = (args.init, args.goal)
     images = [read_image(p) for p in paths]
     checkpoint = _checkpoint(args)
-    model, meta = load_checkpoint(checkpoint)
+    check_checkpoint(checkpoint)
+    model, meta = load_checkpoint(checkpoint, args.image_scene)  # refuses another scene
     check_sizes(images, paths, model)
-    names, rgbs = blocks_in(images, paths, args.scene)
+    names, rgbs = blocks_in(images, paths, args.image_scene)
     # a checkpoint trained at one input size for several resolutions resizes every image
     options = {"input_hw": meta["input_hw"]} if meta.get("input_hw") else {}
     perceiver = Perceiver(model, **options)
@@ -98,7 +102,7 @@ def images_command(args: argparse.Namespace) -> int:
                 {
                     "init_image": args.init,
                     "goal_image": args.goal,
-                    "scene": args.scene,
+                    "image_scene": args.image_scene,
                     "perception": args.perception,
                     "checkpoint": str(checkpoint),
                     "blocks": list(names),
@@ -121,7 +125,7 @@ def images_command(args: argparse.Namespace) -> int:
                     "stats": result.stats,
                     "seed": args.seed,
                     "threads": args.threads,
-                    "config": asdict(config),
+                    "config": recorded,
                 },
                 indent=2,
             )

@@ -7,12 +7,17 @@ stays fast.
 from __future__ import annotations
 
 import argparse
+import os
 
 from tamp.bench.suites import OFFICIAL, default_data
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains import names
 from task.errors import TampError
+
+SCENES = ("tabletop", "shelf", "clutter", "cramped")  # `tamp.obstacles` (no simulator import)
+IMAGE_SCENES = ("cubes", "latplan")  # whose blocks an image shows (`tamp.camera.image_pair`)
+MAX_PLACEMENT_M = 0.03  # `tamp.loop.LoopConfig.placements`: a block stays on its slot
 
 # every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
 # Blocksworld's "towers", Logistics' and Sokoban's "potential", the STRIPS lift's "hadd"
@@ -57,6 +62,40 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
+# what the machine can do: a bound per option, each a one-line usage error beyond it
+MAX_SEED = 2**32 - 1  # numpy's and torch's seeds; an episode seed is seed * 100_003 + k
+MAX_WINDOW = 64  # moves per window (--horizon, --lookahead): beyond it no problem gets a plan
+# sooner, and the (B, T, N, A) tensors outgrow the memory (1_000_000 hung before planning)
+MAX_RESTARTS = 4096
+MAX_ITERS = 100_000
+MAX_BLOCKS = 200  # blocks of a random problem (--blocks)
+MAX_BLUR = 64  # pixels; a radius beyond the image's size blurs nothing more (100000 hung)
+MAX_COUNT = 1_000_000  # instances, images, nodes: more than any data set or a day of running
+CORES = os.cpu_count() or 1
+MAX_THREADS = 4 * CORES  # torch threads and worker processes (100000 threads crashed torch)
+
+
+def bounded(low: int, high: int, what: str = "an integer"):
+    """An argparse type: an integer in [``low``, ``high``], else one line naming the range."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"expected {what} in [{low}, {high}], got {text!r}")
+        return value
+
+    parse.__name__ = f"int_{low}_{high}"
+    return parse
+
+
+seed = bounded(0, MAX_SEED, "a seed")
+threads = bounded(1, MAX_THREADS, f"a count of threads (4 x this machine's {CORES} cores)")
+window = bounded(1, MAX_WINDOW, "a window length")
+
+
 def positive(text: str) -> int:
     try:
         value = int(text)
@@ -64,6 +103,8 @@ def positive(text: str) -> int:
         value = 0
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    if value > MAX_COUNT:
+        raise argparse.ArgumentTypeError(f"expected at most {MAX_COUNT}, got {text!r}")
     return value
 
 
@@ -81,16 +122,24 @@ def nonnegative(text: str) -> int:
     return 0 if text.strip() == "0" else positive(text)
 
 
-def positive_list(text: str) -> tuple[int, ...]:
+def positive_list(text: str, high: int = MAX_COUNT) -> tuple[int, ...]:
     try:
         values = tuple(int(t) for t in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"expected comma-separated positive integers such as 1,3,5, got {text!r}"
         ) from None
-    if not values or min(values) < 1:
-        raise argparse.ArgumentTypeError(f"expected positive integers, got {text!r}")
+    if not values or min(values) < 1 or max(values) > high:
+        raise argparse.ArgumentTypeError(f"expected integers in [1, {high}], got {text!r}")
     return tuple(dict.fromkeys(values))
+
+
+def window_list(text: str) -> tuple[int, ...]:
+    return positive_list(text, MAX_WINDOW)
+
+
+def block_counts(text: str) -> tuple[int, ...]:
+    return positive_list(text, MAX_BLOCKS)
 
 
 def radius_list(text: str) -> tuple[int, ...]:
@@ -98,9 +147,14 @@ def radius_list(text: str) -> tuple[int, ...]:
         values = tuple(int(t) for t in text.split(","))
     except ValueError:
         values = (-1,)
-    if not values or min(values) < 0:
-        raise argparse.ArgumentTypeError(f"expected radii >= 0 such as 0,6, got {text!r}")
+    if not values or min(values) < 0 or max(values) > MAX_BLUR:
+        raise argparse.ArgumentTypeError(
+            f"expected radii in [0, {MAX_BLUR}] pixels such as 0,6, got {text!r}"
+        )
     return tuple(dict.fromkeys(values))
+
+
+radius = bounded(0, MAX_BLUR, "a blur radius in pixels")
 
 
 def positive_float(text: str) -> float:
@@ -110,6 +164,18 @@ def positive_float(text: str) -> float:
         value = -1.0
     if not value > 0.0:
         raise argparse.ArgumentTypeError(f"expected a number > 0, got {text!r}")
+    return value
+
+
+def placement(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0.0 <= value <= MAX_PLACEMENT_M:
+        raise argparse.ArgumentTypeError(
+            f"expected metres in [0, {MAX_PLACEMENT_M}] (a block stays on its slot), got {text!r}"
+        )
     return value
 
 
@@ -132,14 +198,24 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         g.add_argument(
             "--horizon",
             dest="horizons",
-            type=positive_list,
+            type=window_list,
             metavar="T[,T...]",
             help=f"window lengths; several run the window ablation ({d.horizon})",
         )
     else:
-        g.add_argument("--horizon", type=positive, metavar="T", help=f"window length ({d.horizon})")
-    g.add_argument("--restarts", type=positive, metavar="K", help=f"random restarts ({d.restarts})")
-    g.add_argument("--iters", type=positive, metavar="N", help=f"Adam steps per window ({d.iters})")
+        g.add_argument("--horizon", type=window, metavar="T", help=f"window length ({d.horizon})")
+    g.add_argument(
+        "--restarts",
+        type=bounded(1, MAX_RESTARTS),
+        metavar="K",
+        help=f"random restarts ({d.restarts})",
+    )
+    g.add_argument(
+        "--iters",
+        type=bounded(1, MAX_ITERS),
+        metavar="N",
+        help=f"Adam steps per window ({d.iters})",
+    )
     g.add_argument("--goal-loss", choices=GOAL_LOSSES, help=f"goal objective ({d.goal_loss})")
     g.add_argument(
         "--lookahead-share",
@@ -150,7 +226,7 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
     )
     g.add_argument(
         "--lookahead",
-        type=positive,
+        type=window,
         metavar="T",
         help=f"length of the long-lookahead windows ({d.lookahead})",
     )
@@ -236,9 +312,9 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
         )
     else:
         p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="(pybullet)")
-    p.add_argument(
-        "--domain", metavar="DOMAIN.pddl", help="domain file (the embedded 4-op blocksworld)"
-    )
+        p.add_argument(
+            "--domain", metavar="DOMAIN.pddl", help="domain file (the embedded 4-op blocksworld)"
+        )
     p.add_argument(
         "--grasp",
         choices=("friction", "weld"),
@@ -265,7 +341,7 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
     )
     p.add_argument(
         "--blur",
-        type=int,
+        type=radius,
         default=0,
         metavar="R",
         help="camera: Gaussian blur radius in pixels (0)",
@@ -284,13 +360,9 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
 
 
 def scene_options(p: argparse.ArgumentParser) -> None:
-    """The scene's obstacles, and what happens to a trajectory that would hit one."""
-    p.add_argument(
-        "--scene",
-        choices=("tabletop", "shelf", "clutter", "cramped"),
-        default="tabletop",
-        help="obstacles on the table (tabletop: none)",
-    )
+    """The scene's obstacles, what happens to a trajectory that would hit one, and
+    motion-aware planning on it (`workcell_options`)."""
+    workcell_options(p)
     p.add_argument(
         "--collision",
         choices=("plan", "check", "off"),
@@ -298,21 +370,58 @@ def scene_options(p: argparse.ArgumentParser) -> None:
         help="check every trajectory and route blocked ones with the motion planner "
         "(plan), fail them (check), or run unchecked (off) (plan)",
     )
+
+
+def workcell_options(p: argparse.ArgumentParser) -> None:
+    """The robot's table (``--scene``) and motion-aware planning on it (``--motion-aware``,
+    ``--placements``): the one place these options are defined."""
+    p.add_argument(
+        "--scene",
+        choices=SCENES,
+        default="tabletop",
+        help="the workcell: obstacles on the robot's table (tabletop: none)",
+    )
     p.add_argument(
         "--motion-aware",
         dest="lambda_motion",
         action="store_const",
         const=0.05,
         help="put the arm's cost of each move into the planner's objective, weight "
-        "0.05, and plan on the table's slots (off: task-only planning)",
+        "0.05, and plan on the table's slots, the problem laid out on --scene (off: "
+        "task-only planning)",
     )
     p.add_argument(
         "--placements",
-        type=float,
+        type=placement,
         default=0.0,
         metavar="M",
-        help="--motion-aware: blocks up to M m (<= 0.03) off a slot's centre, where planned (0)",
+        help="--motion-aware, state observation: blocks up to M m (<= 0.03) off a slot's "
+        "centre, where planned (0)",
     )
+
+
+def check_workcell(args: argparse.Namespace, executes: bool) -> None:
+    """``--scene``, ``--placements`` and ``--perception/--blur/--checkpoint`` only where they
+    take effect: a one-line usage error (TampError) in any other combination. ``executes``:
+    the command runs the arm (its scene's obstacles matter without ``--motion-aware``)."""
+    aware = bool(getattr(args, "lambda_motion", None))
+    camera = getattr(args, "observe", "state") == "camera"
+    if getattr(args, "placements", 0.0) and not aware:
+        raise TampError("--placements needs --motion-aware (it places the planned moves)")
+    if getattr(args, "placements", 0.0) and camera:
+        raise TampError(
+            "--placements needs --observe state: a camera window's moves go to a free slot"
+        )
+    if not executes and args.scene != "tabletop" and not aware:
+        raise TampError(f"--scene {args.scene} needs --motion-aware (the arm's table to plan on)")
+    if not camera and hasattr(args, "observe"):
+        given = [
+            f"--{name}"
+            for name, default in (("perception", "frozen"), ("blur", 0), ("checkpoint", None))
+            if getattr(args, name, default) != default
+        ]
+        if given:
+            raise TampError(f"{', '.join(given)} need --observe camera (they read the image)")
 
 
 def run_options(p: argparse.ArgumentParser) -> None:
@@ -333,7 +442,9 @@ def run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--stop-at-invalid",
         action="store_true",
-        help="--plan: stop at the first step invalid at task level instead of attempting it",
+        help="--plan: an experimenter grant: the experimenter (not the robot) reads the TRUE "
+        "state before each step and stops at the first step invalid there instead of "
+        "attempting it (report.json counts these reads under truth_reads.experimenter)",
     )
 
 
@@ -403,9 +514,8 @@ def executability_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--n",
         type=positive,
-        default=20,
-        help="a spread of N Blocksworld-600 instances over sizes, the same for every "
-        "source (20; 600 is all)",
+        help="at most N of the instances the plan files name, spread over sizes, the same "
+        "for every source (all of them, up to 20)",
     )
     p.add_argument(
         "--sim",
@@ -425,8 +535,8 @@ def executability_options(p: argparse.ArgumentParser) -> None:
         default="friction",
         help="physical friction grasp or a weld attach (friction)",
     )
-    p.add_argument("--seed", type=int, default=0, help="scene layout and planner seed (0)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--seed", type=seed, default=0, help="scene layout and planner seed (0)")
+    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     scene_options(p)
     progress_option(p)
     output_options(p, "write results.json and plans.csv into this folder")

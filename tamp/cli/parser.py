@@ -12,6 +12,7 @@ from perception import CHECKPOINT
 from tamp.bench.suites import DEFAULT_DATA
 from tamp.cli.bench_motion import suite_options, sweep_options
 from tamp.cli.options import (
+    IMAGE_SCENES,
     Parser,
     data_option,
     episode_options,
@@ -23,8 +24,12 @@ from tamp.cli.options import (
     positive,
     positive_list,
     progress_option,
+    radius,
     rules_option,
     run_options,
+    seed,
+    threads,
+    workcell_options,
 )
 from tamp.sim.base import SIMULATORS
 
@@ -63,39 +68,39 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("problem", metavar="PROBLEM.pddl")
     p.add_argument(
         "--seed",
-        type=int,
+        type=seed,
         default=0,
         help="planner seed (0) and, with --motion-aware, the scene layout's",
     )
-    p.add_argument(
-        "--motion-aware",
-        dest="lambda_motion",
-        action="store_const",
-        const=0.05,
-        help="blocksworld: the arm's cost of each move in the objective, for the "
-        "problem laid out on --scene (off)",
-    )
-    p.add_argument(
-        "--scene",
-        choices=("tabletop", "shelf", "clutter", "cramped"),
-        default="tabletop",
-        help="--motion-aware: the table scene (tabletop)",
-    )
+    workcell_options(p)
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
-    p.set_defaults(func=_lazy("tamp.cli.plan", "plan_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.plan", "plan_command"),
+        recorded=_lazy("tamp.cli.recorded", "plan_config"),
+    )
 
     p = sub.add_parser("validate", help="validate a plan file against a domain and a problem")
     p.add_argument("domain", metavar="DOMAIN.pddl")
     p.add_argument("problem", metavar="PROBLEM.pddl")
     p.add_argument("plan", metavar="PLAN")
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
-    p.set_defaults(func=_lazy("tamp.cli.plan", "validate_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.plan", "validate_command"),
+        recorded=_lazy("tamp.cli.recorded", "validate_config"),
+    )
 
-    p = sub.add_parser("demo", parents=[plan_opts], help="plan the embedded 5-block example")
-    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
+    p = sub.add_parser(
+        "example",
+        parents=[plan_opts],
+        help="plan the embedded 5-block example and show every stage (no robot)",
+    )
+    p.add_argument("--seed", type=seed, default=0, help="planner seed (0)")
     output_options(p, "write the example's domain, problem and plan files into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.plan", "demo_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.plan", "example_command"),
+        recorded=_lazy("tamp.cli.recorded", "plan_config"),
+    )
 
 
 def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
@@ -107,8 +112,8 @@ def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("init", metavar="INIT.png", help="image of the initial scene (PNG or JPG)")
     p.add_argument("goal", metavar="GOAL.png", help="image of the goal scene, the same size")
     p.add_argument(
-        "--scene",
-        choices=("cubes", "latplan"),
+        "--image-scene",
+        choices=IMAGE_SCENES,
         default="cubes",
         help="whose block colours to look for: the robot's cubes or LatPlan's red, "
         "blue, green and black cylinders (cubes)",
@@ -125,24 +130,34 @@ def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
         help="perception weights (cubes: perception/support.pt; latplan: "
         "perception/support-latplan.pt)",
     )
-    p.add_argument("--seed", type=int, default=0, help="planner seed (0)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--seed", type=seed, default=0, help="planner seed (0)")
+    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     output_options(p, "write the plan file (VAL format) here")
-    p.set_defaults(func=_lazy("tamp.cli.images", "images_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.images", "images_command"),
+        recorded=_lazy("tamp.cli.recorded", "images_config"),
+    )
 
 
 def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
-    p = sub.add_parser(
-        "run", parents=[plan_opts], help="plan and execute a problem with the simulated Panda"
-    )
-    p.add_argument(
-        "problem", nargs="?", metavar="PROBLEM.pddl", help="blocksworld problem (the example)"
-    )
-    episode_options(p)
-    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
-    run_options(p)
-    output_options(p, "write the episode video and report.json into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.run", "run_command"))
+    """``run``, and ``demo``: the same episode observed by the camera, written to out/demo."""
+    for name, what in (
+        ("run", "plan and execute a problem with the simulated Panda"),
+        ("demo", "the camera-to-arm episode of 'make demo': run --observe camera --out out/demo"),
+    ):
+        p = sub.add_parser(name, parents=[plan_opts], help=what)
+        p.add_argument(
+            "problem", nargs="?", metavar="PROBLEM.pddl", help="blocksworld problem (the example)"
+        )
+        episode_options(p)
+        p.add_argument("--seed", type=seed, default=0, help="scene, planner and fault seed (0)")
+        run_options(p)
+        output_options(p, "write the episode video and report.json into this folder")
+        p.set_defaults(
+            func=_lazy("tamp.cli.run", "run_command"),
+            recorded=_lazy("tamp.cli.recorded", "run_config"),
+        )
+    sub.choices["demo"].set_defaults(observe="camera", out="out/demo")
 
 
 def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
@@ -170,7 +185,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             help="keep a window's strongest move even when it is illegal (the plan is then "
             "inexecutable); measures the soft planner without the decoder's legality filter",
         )
-        p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+        p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
@@ -188,8 +203,14 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             metavar="N",
             help="a spread of N instances over the sizes (all)",
         )
-    planbench.set_defaults(func=_lazy("tamp.cli.bench", "planbench_command"))
-    folder.set_defaults(func=_lazy("tamp.cli.bench", "pddl_command"))
+    planbench.set_defaults(
+        func=_lazy("tamp.cli.bench", "planbench_command"),
+        recorded=_lazy("tamp.cli.recorded", "planning_config"),
+    )
+    folder.set_defaults(
+        func=_lazy("tamp.cli.bench", "pddl_command"),
+        recorded=_lazy("tamp.cli.recorded", "planning_config"),
+    )
     random_.add_argument(
         "--blocks",
         type=positive_list,
@@ -198,7 +219,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         help="block counts (6,8,10,15,20)",
     )
     random_.add_argument("--n", type=positive, default=50, help="instances per block count (50)")
-    random_.add_argument("--seed", type=int, default=0, help="instance generator seed (0)")
+    random_.add_argument("--seed", type=seed, default=0, help="instance generator seed (0)")
     random_.add_argument(
         "--max-nodes",
         type=positive,
@@ -219,7 +240,10 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         "60 s) on every instance: its length and time beside ours (needs the "
         "bench extra)",
     )
-    random_.set_defaults(func=_lazy("tamp.cli.bench", "random_command"))
+    random_.set_defaults(
+        func=_lazy("tamp.cli.bench", "random_command"),
+        recorded=_lazy("tamp.cli.recorded", "planning_config"),
+    )
 
 
 def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
@@ -228,11 +252,14 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     )
     episode_options(p, multi_sim=True)
     suite_options(p)
-    p.add_argument("--seed", type=int, default=0, help="scene, planner and fault seed (0)")
+    p.add_argument("--seed", type=seed, default=0, help="scene, planner and fault seed (0)")
     sweep_options(p)
     progress_option(p)
     output_options(p, "write results.json and episodes.csv into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.bench", "motion_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "motion_command"),
+        recorded=_lazy("tamp.cli.recorded", "motion_config"),
+    )
 
 
 def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
@@ -243,7 +270,10 @@ def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     )
     executability_options(p)
     sweep_options(p)
-    p.set_defaults(func=_lazy("tamp.cli.bench", "executability_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "executability_command"),
+        recorded=_lazy("tamp.cli.recorded", "executability_config"),
+    )
 
 
 def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
@@ -255,11 +285,14 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
         "--n", type=positive, default=100, help="instances over block counts (100: 17/74/9)"
     )
     perception_bench_options(p, str(CHECKPOINT))
-    p.add_argument("--seed", type=int, default=0, help="planner and layout seed (0)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--seed", type=seed, default=0, help="planner and layout seed (0)")
+    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     progress_option(p)
     output_options(p, "write results.json, instances.csv and example.png into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.bench", "perception_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "perception_command"),
+        recorded=_lazy("tamp.cli.recorded", "perception_bench_config"),
+    )
 
 
 def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
@@ -290,10 +323,13 @@ def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seeds", type=positive, default=3, metavar="S", help="planner seeds (3)")
     p.add_argument("--limit", type=positive, metavar="N", help="a spread of N instances (40)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     progress_option(p)
     output_options(p, "write results.json and instances.csv into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.bench", "latplan_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "latplan_command"),
+        recorded=_lazy("tamp.cli.recorded", "latplan_config"),
+    )
 
 
 def _poses_benchmark(bench) -> None:
@@ -305,7 +341,7 @@ def _poses_benchmark(bench) -> None:
         help=f"simulators, comma-separated ({','.join(SIMULATORS)})",
     )
     p.add_argument("--n", type=positive, default=200, help="random scenes per simulator (200)")
-    p.add_argument("--seed", type=int, default=0, help="scene seed (0)")
+    p.add_argument("--seed", type=seed, default=0, help="scene seed (0)")
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
     p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
     p.add_argument(
@@ -313,7 +349,10 @@ def _poses_benchmark(bench) -> None:
     )
     progress_option(p)
     output_options(p, "write results.json and blocks.csv into this folder")
-    p.set_defaults(func=_lazy("tamp.cli.bench", "poses_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "poses_command"),
+        recorded=_lazy("tamp.cli.recorded", "poses_config"),
+    )
 
 
 def _record_command(bench) -> None:
@@ -351,7 +390,7 @@ def _perception_commands(sub) -> None:
 
     p = cmds.add_parser("dataset", help="render a labelled support dataset")
     p.add_argument("--n", type=positive, default=4000, help="images (4000)")
-    p.add_argument("--seed", type=int, default=0, help="scene and view seed (0)")
+    p.add_argument("--seed", type=seed, default=0, help="scene and view seed (0)")
     p.add_argument(
         "--sim",
         default="pybullet,mujoco",
@@ -361,8 +400,8 @@ def _perception_commands(sub) -> None:
     p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
     p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
     p.add_argument(
-        "--scene",
-        choices=("cubes", "latplan"),
+        "--image-scene",
+        choices=IMAGE_SCENES,
         default="cubes",
         help="cubes (the robot's scene) or latplan: LatPlan's 4 cylinders on 5 slots, "
         "written at 150x100 to --out and at 45x30 beside it (cubes)",
@@ -370,14 +409,17 @@ def _perception_commands(sub) -> None:
     p.add_argument("--out", required=True, metavar="FILE.npz", help="where to write it")
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
-    p.set_defaults(func=_lazy("tamp.cli.perception", "dataset_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.perception", "dataset_command"),
+        recorded=_lazy("tamp.cli.recorded", "dataset_config"),
+    )
 
     p = cmds.add_parser("train", help="train the support model and write a checkpoint")
     p.add_argument("--train", required=True, metavar="FILE.npz", help="training dataset")
     p.add_argument("--test", required=True, metavar="FILE.npz", help="held-out test dataset")
     p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
-    p.add_argument("--seed", type=int, default=0, help="initialisation and batch order (0)")
-    p.add_argument("--threads", type=positive, default=2, help="torch threads (2)")
+    p.add_argument("--seed", type=seed, default=0, help="initialisation and batch order (0)")
+    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     p.add_argument(
         "--out",
         required=True,
@@ -386,14 +428,22 @@ def _perception_commands(sub) -> None:
     )
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.add_argument("--no-progress", dest="progress", action="store_false")
-    p.set_defaults(func=_lazy("tamp.cli.perception", "train_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.perception", "train_command"),
+        recorded=_lazy("tamp.cli.recorded", "train_config"),
+    )
 
     p = cmds.add_parser("eval", help="relation accuracy of a checkpoint on a dataset")
     p.add_argument("data", metavar="FILE.npz")
     p.add_argument("--checkpoint", default=str(CHECKPOINT), metavar="FILE.pt")
-    p.add_argument("--blur", type=positive, metavar="R", help="Gaussian blur radius, pixels")
+    p.add_argument(
+        "--blur", type=radius, default=0, metavar="R", help="Gaussian blur radius, pixels (0)"
+    )
     p.add_argument("--json", action="store_true")
-    p.set_defaults(func=_lazy("tamp.cli.perception", "eval_command"))
+    p.set_defaults(
+        func=_lazy("tamp.cli.perception", "eval_command"),
+        recorded=_lazy("tamp.cli.recorded", "eval_config"),
+    )
 
 
 def _lazy(module: str, name: str):

@@ -12,6 +12,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from perception import CHECKPOINT
+from tamp.cli.recorded import checkpoint, dataset_config, eval_config, out_file, train_config
 from task.errors import TampError
 
 
@@ -23,8 +24,10 @@ def dataset_command(args: argparse.Namespace) -> int:
     from perception import data as pdata
     from tamp.camera.dataset import generate
 
-    sims = tuple(s for s in args.sim.split(",") if s)
-    if args.scene == "latplan":
+    recorded = dataset_config(args)  # refused combinations: before any work
+    out_file(args.out)
+    sims = tuple(recorded["sims"])
+    if args.image_scene == "latplan":
         return _latplan_dataset(args, sims)
     with tqdm(
         total=args.n, desc="render", unit="image", file=sys.stderr, disable=not args.progress
@@ -115,6 +118,8 @@ def train_command(args: argparse.Namespace) -> int:
             f"--out {args.out} is the shipped checkpoint; write elsewhere and copy it over "
             "deliberately"
         )
+    train_config(args)
+    out_file(args.out)
     torch.set_num_threads(args.threads)
     t0 = time.perf_counter()
     train_raw = pdata.load_many(args.train)  # several files: resized to the first's size
@@ -188,6 +193,8 @@ def eval_command(args: argparse.Namespace) -> int:
     from perception import data as pdata
     from perception.train import evaluate, load_checkpoint
 
+    recorded = eval_config(args)
+    checkpoint(args.checkpoint)
     model, _ = load_checkpoint(args.checkpoint)
     data = pdata.load(args.data)
     if args.blur:
@@ -198,7 +205,7 @@ def eval_command(args: argparse.Namespace) -> int:
         )
     scores = evaluate(model, pdata.tensors(data))
     if args.json:
-        print(json.dumps(scores))
+        print(json.dumps({**scores, "config": recorded}))
     else:
         print(
             f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "

@@ -1,6 +1,7 @@
-"""What the ``tamp`` subcommands do: plan, validate, demo. Each returns the exit code.
+"""What the ``tamp`` subcommands do: plan, validate, example. Each returns the exit code.
 
-0: success (a valid plan); 1: no plan or an invalid plan. Bad input raises `TampError`, which
+0: success (a valid plan); 1: no plan or an invalid plan (an empty plan file that does not reach
+the goal included, as in ``tamp run --plan``). Bad input raises `TampError`, which
 `tamp.cli.main` turns into one ``tamp: error:`` line and exit code 2.
 """
 
@@ -8,13 +9,14 @@ from __future__ import annotations
 
 import argparse
 import json
-from dataclasses import asdict, replace
+from dataclasses import replace
 from pathlib import Path
 
 from pddl.core import Domain
 
 from tamp.cli import report
-from tamp.cli.options import planner_config
+from tamp.cli.options import check_workcell, planner_config
+from tamp.cli.recorded import out_file, out_folder, plan_config
 from task import data
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
@@ -36,7 +38,9 @@ def _write(path: Path, text: str) -> None:
 
 
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
-    """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan)."""
+    """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan);
+    ``(recorded config, config, result, actions, validation)``."""
+    recorded = plan_config(args, instance.problem.domain)
     config = planner_config(args, instance.problem.domain)
     if getattr(args, "lambda_motion", None):
         result = _plan_on_table(instance.problem, config, args)
@@ -49,7 +53,7 @@ def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
             instance.problem, result.plan.moves
         )
         validation = validate(domain, instance.pddl, actions)
-    return config, result, actions, validation
+    return recorded, config, result, actions, validation
 
 
 def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> PlanResult:
@@ -69,12 +73,14 @@ def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> 
 
     scene = with_scene(SceneConfig(), args.scene)
     poses = layout(problem.entities, problem.init, scene, args.seed)
-    found = plan_on_places(problem, poses, scene, IKSolver(), PANDA.q_home, config, args.seed)
+    found = plan_on_places(
+        problem, poses, scene, IKSolver(), PANDA.q_home, config, args.seed, reach=args.placements
+    )
     return replace(found, problem=problem)
 
 
 def _plan_json(
-    config: PlannerConfig,
+    config: dict,
     result: PlanResult,
     actions: tuple,
     validation: Validation | None,
@@ -91,7 +97,7 @@ def _plan_json(
             "validation": None if validation is None else report.validation_dict(validation),
             "stats": result.stats,
             "seed": seed,
-            "config": asdict(config),
+            "config": config,
         },
         indent=2,
     )
@@ -143,12 +149,14 @@ def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
 
 def plan_command(args: argparse.Namespace) -> int:
     """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line."""
+    check_workcell(args, executes=False)
+    out_file(args.out)
     domain, instance = from_files(args.domain, args.problem, args.domain_rules)
-    config, result, actions, validation = _solve(domain, instance, args)
+    recorded, _, result, actions, validation = _solve(domain, instance, args)
     if args.out is not None and validation is not None:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:
-        print(_plan_json(config, result, actions, validation, args.seed))
+        print(_plan_json(recorded, result, actions, validation, args.seed))
     else:
         if actions:
             print(pddl_io.format_plan(actions), end="")
@@ -167,10 +175,12 @@ def validate_command(args: argparse.Namespace) -> int:
     return 0 if validation.valid else 1
 
 
-def demo_command(args: argparse.Namespace) -> int:
-    """``tamp demo``: plan the embedded 5-block example and show every stage."""
+def example_command(args: argparse.Namespace) -> int:
+    """``tamp example``: plan the embedded 5-block example and show every stage (no robot;
+    ``tamp demo`` runs it with the arm)."""
+    out_folder(args.out)
     domain, instance = example()
-    config, result, actions, validation = _solve(domain, instance, args)
+    recorded, config, result, actions, validation = _solve(domain, instance, args)
     written = []
     if args.out is not None:
         out = Path(args.out)
@@ -181,12 +191,12 @@ def demo_command(args: argparse.Namespace) -> int:
             _write(out / "example-5.plan", pddl_io.format_plan(actions))
             written.append("example-5.plan")
     if args.json:
-        print(_plan_json(config, result, actions, validation, args.seed))
+        print(_plan_json(recorded, result, actions, validation, args.seed))
         return 0 if validation is not None and validation.valid else 1
     problem = instance.problem
     best = optimal_moves(problem)
     lines = [
-        f"soft-tamp demo: {data.source(data.EXAMPLE_FILE)}, {problem.n} blocks, "
+        f"soft-tamp example: {data.source(data.EXAMPLE_FILE)}, {problem.n} blocks, "
         f"optimal plan {'?' if best is None else len(best)} moves (A*)",
         "",
         *report.problem_picture(problem),

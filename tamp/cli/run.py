@@ -2,7 +2,9 @@
 With ``--plan PLAN`` it executes a given plan open-loop instead (`tamp.loop.given`), one line
 per step.
 
-Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise.
+Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise
+(an empty ``--plan`` file included, as ``tamp validate``). ``tamp demo`` is this command with
+``--observe camera --out out/demo``: the camera-to-arm episode ``make demo`` runs.
 """
 
 from __future__ import annotations
@@ -11,17 +13,11 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
-from tamp.camera.from_images import PerceptionMode
-from tamp.cli.options import planner_config
-from tamp.loop import Episode, EpisodeReport, LoopConfig
-from tamp.loop.execute import ExecConfig
-from tamp.loop.faults import Injection
+from tamp.cli.recorded import checkpoint, loop_config, out_folder, run_config
+from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
-from tamp.obstacles import with_scene
-from tamp.scene import SceneConfig
 from tamp.video import EpisodeVideo
 from task import data
 from task.errors import TampError
@@ -50,33 +46,6 @@ def load_problem(problem: str | None, domain: str | None) -> Problem:
     return loaded
 
 
-def loop_config(args: argparse.Namespace) -> LoopConfig:
-    config = LoopConfig(
-        sim=args.sim,
-        grasp=args.grasp,
-        planner=planner_config(args),
-        inject=Injection.parse(args.inject),
-        observe=args.observe,
-        perception=PerceptionMode(args.perception, blur=args.blur),
-        checkpoint=args.checkpoint,
-        crisp=args.crisp,
-        scene=with_scene(SceneConfig(), args.scene),
-        execution=replace(ExecConfig(), collision=args.collision),
-        placements=args.placements,
-    )
-    if args.max_replans is not None:
-        config = replace(config, max_replans=args.max_replans)
-    return config
-
-
-def given_config(args: argparse.Namespace) -> LoopConfig:
-    """The loop settings of ``bench executability``: grasp, scene and collision mode."""
-    execution = replace(ExecConfig(), collision=args.collision)
-    return LoopConfig(
-        grasp=args.grasp, scene=with_scene(SceneConfig(), args.scene), execution=execution
-    )
-
-
 def summary_lines(report: EpisodeReport) -> list[str]:
     moves = report.moves
     ok = sum(r.ok for r in moves)
@@ -94,12 +63,25 @@ def summary_lines(report: EpisodeReport) -> list[str]:
     ]
 
 
+def _given_steps(path: str | None, problem: Problem):
+    """The steps of ``--plan`` (None: plan instead); an empty plan file is a plan of no steps
+    (it reaches the goal only if the goal already holds: exit 1 otherwise, as `validate`)."""
+    if path is None:
+        return None
+    text = pddl_io.read_text(path)
+    if not any(line.split(";", 1)[0].strip() for line in text.splitlines()):
+        return ()
+    return read_given(path, problem)
+
+
 def run_command(args: argparse.Namespace) -> int:
+    recorded = run_config(args)  # refused combinations: before any work
+    out_folder(args.out)
     problem = load_problem(args.problem, args.domain)
     config = loop_config(args)
-    steps = None if args.plan is None else read_given(args.plan, problem)
-    if steps is None and (args.replan or args.stop_at_invalid):
-        raise TampError("--replan and --stop-at-invalid apply to a given plan (--plan PLAN)")
+    if config.observe == "camera":
+        checkpoint(config.checkpoint)
+    steps = _given_steps(args.plan, problem)
     out = Path(args.out) if args.out else None
     if out is not None:
         try:
@@ -134,7 +116,7 @@ def run_command(args: argparse.Namespace) -> int:
         seen = config.observe
         if seen == "camera":
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
-        given = f", given plan {args.plan} ({len(steps)} steps)" if steps else ""
+        given = f", given plan {args.plan} ({len(steps)} steps)" if steps is not None else ""
         print(
             f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
             file=sys.stderr,
@@ -148,22 +130,7 @@ def run_command(args: argparse.Namespace) -> int:
         except TampError as exc:  # the episode's outcome and report stand without the video
             print(f"warning: {exc}", file=sys.stderr)
     body = report.to_json()
-    body["config"] = {
-        "sim": config.sim,
-        "grasp": config.grasp,
-        "inject": str(config.inject),
-        "seed": args.seed,
-        "max_replans": config.max_replans,
-        "observe": config.observe,
-        "perception": config.perception.mode,
-        "blur": config.perception.blur,
-        "plan": args.plan,
-        "replan": args.replan,
-        "stop_at_invalid": args.stop_at_invalid,
-        "scene": config.scene.name,
-        "collision": config.execution.collision,
-        "lambda_motion": config.planner.lambda_motion,
-    }
+    body["config"] = recorded
     if out is not None:
         (out / "report.json").write_text(json.dumps(body, indent=2))
         written.append("report.json")

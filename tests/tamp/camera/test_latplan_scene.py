@@ -133,7 +133,7 @@ def test_cli_writes_both_sizes(tmp_path, capsys):
     from tamp.cli import main
 
     out = tmp_path / "lp.npz"
-    argv = ["perception", "dataset", "--scene", "latplan", "--n", "2", "--sim", "pybullet"]
+    argv = ["perception", "dataset", "--image-scene", "latplan", "--n", "2", "--sim", "pybullet"]
     assert main([*argv, "--out", str(out), "--no-progress", "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["images"] == 2 and len(report["out"]) == 2

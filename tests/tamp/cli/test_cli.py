@@ -29,8 +29,8 @@ def files(tmp_path):
     return domain, problem
 
 
-def test_demo_plans_validates_and_writes_files(capsys, tmp_path):
-    assert main(["demo", *FAST, "--out", str(tmp_path)]) == 0
+def test_example_plans_validates_and_writes_files(capsys, tmp_path):
+    assert main(["example", *FAST, "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     for text in ("initial", "goal", "move(", "PDDL plan", "; cost = ", "VALID: valid plan of"):
         assert text in out
@@ -113,7 +113,7 @@ def test_validate_names_the_first_failing_step(capsys, files, tmp_path):
         (["frobnicate"], "invalid choice: 'frobnicate'"),
         ([], "required: COMMAND"),
         (["plan", "{domain}", "{problem}", "--horizon", "x"], "--horizon"),
-        (["plan", "{domain}", "{problem}", "--horizon", "0"], "positive integer"),
+        (["plan", "{domain}", "{problem}", "--horizon", "0"], "window length in [1, 64]"),
         (["plan", "{domain}", "{problem}", "--goal-loss", "l2"], "invalid choice: 'l2'"),
         (["bench", "planbench", "--horizon", "1,x"], "comma-separated"),
         (["bench", "planbench", "--data", "{missing}"], "PlanBench blocksworld data not found"),

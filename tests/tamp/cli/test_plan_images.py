@@ -145,6 +145,6 @@ def test_missing_checkpoints(tmp_path, capsys, monkeypatch):
     assert main(["plan-images", grey, grey, "--checkpoint", missing]) == 2
     assert missing in one_line_error(capsys, "tamp: error:")
     monkeypatch.setattr(images, "LATPLAN_CHECKPOINT", tmp_path / "support-latplan.pt")
-    assert main(["plan-images", grey, grey, "--scene", "latplan"]) == 2
+    assert main(["plan-images", grey, grey, "--image-scene", "latplan"]) == 2
     err = one_line_error(capsys, "tamp: error:")
     assert "support-latplan.pt" in err and "--checkpoint" in err

@@ -1,0 +1,383 @@
+"""What each ``tamp`` command records as its configuration, and the checks run before any work.
+
+Every command's handler builds the settings it runs with through the function named here for it
+(the parser binds it as ``args.recorded``), and writes that dict as the ``config`` of its
+``results.json`` / ``report.json`` / ``--json`` output. So an option either changes the recorded
+config (and the run, which is built from the same objects) or is refused here in one line
+(`TampError`, exit 2) in the combination where it would do nothing; ``tests/tamp/cli/
+test_every_option.py`` walks every option of every command to keep it so.
+
+Also here: the output checks (`out_file`, `out_folder`), done before the work so a long run is
+never lost to a path that cannot be written, and the checkpoint check (`checkpoint`).
+Parsing-level only: nothing here plans, simulates or imports a simulator.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import asdict, replace
+from pathlib import Path
+
+from perception import CHECKPOINT
+from tamp.bench.suites import default_data
+from tamp.cli.options import check_workcell, planner_config, sim_list
+from task.errors import TampError
+
+# options that change where or how the output is shown, never what is computed: checked by
+# their own tests (tests/tamp/cli/test_every_option.py names them)
+PRESENTATION = frozenset({"json", "out", "progress", "help"})
+
+
+def _planner(args: argparse.Namespace, domain: str | None = None) -> dict:
+    return asdict(planner_config(args, domain))
+
+
+def plan_config(args: argparse.Namespace, domain: str | None = None) -> dict:
+    """``plan`` and ``example``: the planner config, seed, rules, and the table planned on."""
+    if hasattr(args, "scene"):
+        check_workcell(args, executes=False)
+    body = {**_planner(args, domain), "seed": args.seed}
+    if hasattr(args, "scene"):
+        body |= {"scene": args.scene, "placements": args.placements}
+        body["domain_rules"] = args.domain_rules
+    return body
+
+
+def images_config(args: argparse.Namespace) -> dict:
+    """``plan-images``."""
+    return {
+        **_planner(args, "blocksworld"),
+        "seed": args.seed,
+        "image_scene": args.image_scene,
+        "perception": args.perception,
+        "checkpoint": args.checkpoint,
+        "threads": args.threads,
+    }
+
+
+def loop_config(args: argparse.Namespace):
+    """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first)."""
+    from tamp.camera.from_images import PerceptionMode
+    from tamp.loop import LoopConfig
+    from tamp.loop.execute import ExecConfig
+    from tamp.loop.faults import Injection
+    from tamp.obstacles import with_scene
+    from tamp.scene import SceneConfig
+
+    check_workcell(args, executes=True)
+    config = LoopConfig(
+        sim=args.sim,
+        grasp=args.grasp,
+        planner=planner_config(args),
+        inject=Injection.parse(args.inject),
+        observe=args.observe,
+        perception=PerceptionMode(args.perception, blur=args.blur),
+        checkpoint=args.checkpoint,
+        crisp=args.crisp,
+        scene=with_scene(SceneConfig(), args.scene),
+        execution=replace(ExecConfig(), collision=args.collision),
+        placements=args.placements,
+    )
+    if args.max_replans is not None:
+        config = replace(config, max_replans=args.max_replans)
+    return config
+
+
+def _loop_dict(config) -> dict:
+    """A `LoopConfig` as recorded (flat names kept from earlier reports)."""
+    return {
+        "sim": config.sim,
+        "grasp": config.grasp,
+        "inject": str(config.inject),
+        "max_replans": config.max_replans,
+        "observe": config.observe,
+        "perception": config.perception.mode,
+        "blur": config.perception.blur,
+        "checkpoint": config.checkpoint,
+        "crisp": config.crisp,
+        "scene": config.scene.name,
+        "collision": config.execution.collision,
+        "lambda_motion": config.planner.lambda_motion,
+        "placements": config.placements,
+        "planner": asdict(config.planner),
+    }
+
+
+def run_config(args: argparse.Namespace) -> dict:
+    """``run`` and ``demo``."""
+    if args.domain is not None and args.problem is None:
+        raise TampError("--domain needs PROBLEM.pddl (the embedded example has its own domain)")
+    if args.plan is None and (args.replan or args.stop_at_invalid):
+        raise TampError("--replan and --stop-at-invalid apply to a given plan (--plan PLAN)")
+    if args.no_video and args.video_format != "mp4":
+        raise TampError("--video-format with --no-video: there is no video to format")
+    if args.out is None and (args.no_video or args.video_format != "mp4"):
+        raise TampError("--no-video and --video-format apply with --out DIR (the video's folder)")
+    config = loop_config(args)
+    return {
+        **_loop_dict(config),
+        "problem": args.problem,
+        "domain": args.domain,
+        "seed": args.seed,
+        "plan": args.plan,
+        "replan": args.replan,
+        "stop_at_invalid": args.stop_at_invalid,
+        "video": None if args.no_video or args.out is None else args.video_format,
+    }
+
+
+def given_config(args: argparse.Namespace):
+    """The loop settings of ``bench executability``: grasp, scene, collision mode, and the
+    planner and placements of our reference row (refused without it)."""
+    from tamp.loop import LoopConfig
+    from tamp.loop.execute import ExecConfig
+    from tamp.obstacles import with_scene
+    from tamp.scene import SceneConfig
+
+    check_workcell(args, executes=True)
+    if not args.ours:
+        given = [name for name in _PLANNER_FLAGS if getattr(args, name, None) is not None]
+        if given:
+            flags = ", ".join("--" + n.replace("_", "-") for n in given)
+            raise TampError(
+                f"{flags} set(s) our planner, whose row --no-ours leaves out; drop one of them"
+            )
+    return LoopConfig(
+        grasp=args.grasp,
+        scene=with_scene(SceneConfig(), args.scene),
+        execution=replace(ExecConfig(), collision=args.collision),
+        planner=planner_config(args, "blocksworld"),
+        placements=args.placements,
+    )
+
+
+_PLANNER_FLAGS = (
+    "horizon",
+    "restarts",
+    "iters",
+    "goal_loss",
+    "lookahead_share",
+    "lookahead",
+    "max_windows",
+    "park_free",
+    "time_limit_s",
+    "tau_end",
+    "lambda_motion",
+)
+
+
+def executability_config(args: argparse.Namespace) -> dict:
+    """``bench executability``."""
+    config = given_config(args)
+    return {
+        "plans": str(args.plans),
+        "sims": list(sim_list(args.sim)),
+        "n": args.n,
+        "seed": args.seed,
+        "grasp": config.grasp,
+        "ours": args.ours,
+        "data": str(args.data),
+        "scene": config.scene.name,
+        "collision": config.execution.collision,
+        "lambda_motion": config.planner.lambda_motion if args.ours else None,
+        "placements": config.placements,
+        "planner": asdict(config.planner) if args.ours else None,
+        "threads": args.threads,
+        "workers": args.workers,
+        "ray": args.ray,
+    }
+
+
+def motion_config(args: argparse.Namespace) -> dict:
+    """``bench motion``."""
+    if args.blocks and args.data != str(default_data("blocksworld")):
+        raise TampError("--data with --blocks: random problems read no data; drop one")
+    config = loop_config(args)
+    body = _loop_dict(config)
+    del body["sim"]
+    return {
+        **body,
+        "sims": list(sim_list(args.sim)),
+        "n": args.n,
+        "seed": args.seed,
+        "data": None if args.blocks else str(args.data),
+        "blocks": list(args.blocks) if args.blocks else None,
+        "workers": args.workers,
+        "ray": args.ray,
+    }
+
+
+def planning_config(args: argparse.Namespace, domain: str | None = None) -> dict:
+    """``bench planbench``, ``bench pddl`` and ``bench random``: the planner config the suite
+    runs with (``domain``: its rules' defaults) and the suite's own options."""
+    config = planner_config(args, domain)
+    if getattr(args, "one_at_a_time", False):
+        config = replace(config, batched=False)
+    body = {
+        **asdict(config),
+        "horizons": list(args.horizons or (config.horizon,)),
+        "seeds": args.seeds,
+        "sequential": args.sequential,
+        "threads": args.threads,
+    }
+    for name in ("data", "limit", "domain", "domain_rules", "blocks", "n", "seed", "max_nodes"):
+        if hasattr(args, name):
+            value = getattr(args, name)
+            body[f"suite_{name}"] = list(value) if isinstance(value, tuple) else value
+    if hasattr(args, "lama"):
+        body["lama"] = args.lama
+    return body
+
+
+def perception_bench_config(args: argparse.Namespace) -> dict:
+    """``bench perception``."""
+    return {
+        **_planner(args),
+        "horizons": list(args.horizons or (planner_config(args).horizon,)),
+        "data": str(args.data),
+        "n": args.n,
+        "modes": args.modes,
+        "blur": list(args.blur),
+        "crisp": args.crisp,
+        "corrupt": args.corrupt,
+        "sim": args.sim,
+        "checkpoint": str(args.checkpoint),
+        "kl_weight": args.kl_weight,
+        "adapt": args.adapt,
+        "seed": args.seed,
+        "threads": args.threads,
+    }
+
+
+def latplan_config(args: argparse.Namespace) -> dict:
+    """``bench latplan``."""
+    images = any(m.strip() != "state" for m in args.modes.split(","))
+    if not images and Path(args.checkpoint) != CHECKPOINT.with_name("support-latplan.pt"):
+        raise TampError("--checkpoint with --modes state: no image is read; drop one")
+    return {
+        "config": _planner(args, "blocksworld"),
+        "data": str(args.data),
+        "checkpoint": str(args.checkpoint) if images else None,
+        "resolutions": args.res,
+        "modes": args.modes,
+        "seeds": args.seeds,
+        "limit": args.limit,
+        "threads": args.threads,
+    }
+
+
+def poses_config(args: argparse.Namespace) -> dict:
+    """``bench poses``."""
+    if args.min_blocks > args.max_blocks:
+        raise TampError(
+            f"--min-blocks {args.min_blocks} is more than --max-blocks {args.max_blocks}"
+        )
+    return {
+        "sims": list(sim_list(args.sim)),
+        "n": args.n,
+        "seed": args.seed,
+        "blocks": [args.min_blocks, args.max_blocks],
+        "jitter": args.jitter,
+    }
+
+
+def dataset_config(args: argparse.Namespace) -> dict:
+    """``perception dataset``."""
+    if args.image_scene == "latplan" and (args.min_blocks, args.max_blocks) != (3, 6):
+        raise TampError("--min-blocks/--max-blocks with --image-scene latplan: it has 4 blocks")
+    if args.min_blocks > args.max_blocks:
+        raise TampError(
+            f"--min-blocks {args.min_blocks} is more than --max-blocks {args.max_blocks}"
+        )
+    return {
+        "n": args.n,
+        "seed": args.seed,
+        "sims": list(sim_list(args.sim)),
+        "image_scene": args.image_scene,
+        "blocks": None if args.image_scene == "latplan" else [args.min_blocks, args.max_blocks],
+    }
+
+
+def train_config(args: argparse.Namespace) -> dict:
+    """``perception train``."""
+    return {
+        "train": args.train,
+        "test": args.test,
+        "epochs": args.epochs,
+        "seed": args.seed,
+        "threads": args.threads,
+    }
+
+
+def eval_config(args: argparse.Namespace) -> dict:
+    """``perception eval``."""
+    return {"data": args.data, "checkpoint": str(args.checkpoint), "blur": args.blur}
+
+
+def validate_config(args: argparse.Namespace) -> dict:
+    """``validate``: its inputs only."""
+    return {"domain": args.domain, "problem": args.problem, "plan": args.plan}
+
+
+# --- checks before the work ------------------------------------------------------------------
+def out_file(path: str | None, option: str = "--out") -> None:
+    """``path`` can be written as a file: not a folder, its folder creatable (TampError)."""
+    if path is None:
+        return
+    target = Path(path)
+    if target.is_dir():
+        raise TampError(f"{option} {target}: is a folder; give a file name")
+    parent = target.parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise TampError(f"{option} {target}: {parent} is a file, not a folder")
+    if not _writable(parent):
+        raise TampError(f"{option} {target}: cannot write in {parent}")
+
+
+def out_folder(path: str | None, option: str = "--out") -> None:
+    """``path`` is or can become a folder (TampError before any work)."""
+    if path is None:
+        return
+    target = Path(path)
+    if target.exists() and not target.is_dir():
+        raise TampError(f"{option} {target}: is a file; give a folder")
+    out_file(str(target / "results.json"), option)
+
+
+def _writable(folder: Path) -> bool:
+    import os
+
+    return os.access(folder, os.W_OK | os.X_OK)
+
+
+def checkpoint(path: str | Path | None) -> None:
+    """A perception checkpoint that loads, or one `TampError` line naming it: torch's errors
+    for a file that is not a checkpoint (several lines) become one."""
+    if path is None:
+        return
+    import pickle
+    import zipfile
+
+    from perception.train import load_checkpoint
+
+    if not Path(path).is_file():
+        raise TampError(f"--checkpoint {path}: no perception checkpoint there (no such file)")
+    try:
+        load_checkpoint(path)
+    except TampError:
+        raise
+    except (
+        pickle.UnpicklingError,
+        zipfile.BadZipFile,
+        EOFError,
+        RuntimeError,
+        ValueError,
+        KeyError,
+        TypeError,
+        AttributeError,
+        OSError,
+    ) as exc:
+        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise TampError(f"--checkpoint {path}: not a perception checkpoint ({first})") from None
