@@ -4,12 +4,13 @@ episode rows whatever the number of workers, and on a local Ray instance (slow, 
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 
 import pytest
 
-from tamp.bench import motion
+from tamp.bench import executability, motion
 from tamp.bench.suites import planbench
 from tamp.loop import LoopConfig
 from tamp.sweep import RAY_MISSING, run_items
@@ -73,14 +74,32 @@ def _suite(tmp_path):
     return planbench(root, len(PROBLEMS))
 
 
+# wall-clock timings differ from run to run; every other field of an episode (its report, its
+# moves, its episodes.csv row) and of a summary must not depend on what runs the episodes
+TIMINGS = {"wall_time_s", "plan_time_s"}
+MOVE_TIMINGS = {"wall_time_s", "ik_time_s", "check_time_s", "path_time_s"}
+SUMMARY_TIMINGS = {f"{k}_per_move_s" for k in ("wall", "ik", "check", "path")}
+SUMMARY_TIMINGS |= {"wall_s", "plan_per_episode_s"}
+
+
+def _without(record: dict, timings: set[str]) -> dict:
+    assert timings <= set(record), f"timing fields renamed: {sorted(timings - set(record))}"
+    return {k: v for k, v in record.items() if k not in timings}
+
+
+def _report(report) -> dict:
+    out = _without(dataclasses.asdict(report), TIMINGS)
+    out["moves"] = [_without(m, MOVE_TIMINGS) for m in out["moves"]]
+    return out
+
+
 def _rows(bench: motion.MotionBench) -> list:
-    """Episode rows without wall times, and every move with its outcome."""
-    rows = [
-        {k: v for k, v in r.items() if k != "wall_time_s"}
-        for r in motion.episode_rows(bench.reports)
-    ]
-    moves = [[(str(m.move), m.ok, m.failure) for m in r.moves] for r in bench.reports]
-    return [rows, moves, bench.summary["pybullet"]["statuses"]]
+    """Every episode report (its moves' outcomes and evidence included), every episodes.csv
+    row and each simulator's summary, less the wall-clock timings."""
+    reports = [_report(r) for r in bench.reports]
+    rows = [_without(r, TIMINGS) for r in motion.episode_rows(bench.reports)]
+    summary = {sim: _without(s, SUMMARY_TIMINGS) for sim, s in bench.summary.items()}
+    return [reports, rows, summary]
 
 
 def _sweep(suite, **where) -> motion.MotionBench:
@@ -115,7 +134,7 @@ def test_executability_rows_and_shared_runs_do_not_depend_on_the_number_of_worke
         "y": {one: (tower, None), two: ("(unstack a)", False)},
     }
     runs = [
-        motion.run_given(suite, sources, LoopConfig(), ("pybullet",), 0, None, workers=n)
+        executability.run_given(suite, sources, LoopConfig(), ("pybullet",), 0, None, workers=n)
         for n in (1, 2)
     ]
     alone, pooled = ([{**vars(r), "wall_time_s": None} for r in rows] for rows in runs)
