@@ -56,10 +56,11 @@ class Perceiver:
             p.requires_grad_(False)
 
     @classmethod
-    def load(cls, path: str | Path) -> Perceiver:
+    def load(cls, path: str | Path, scene: str | None = None) -> Perceiver:
         """The checkpoint at ``path``; one trained at one input size for several resolutions
-        (its meta's ``input_hw``) resizes every image to that size first."""
-        model, meta = load_checkpoint(path)
+        (its meta's ``input_hw``) resizes every image to that size first. With ``scene`` (the
+        image scene it is to read), one trained on another scene is refused (`load_checkpoint`)."""
+        model, meta = load_checkpoint(path, scene)
         return cls(model, input_hw=meta.get("input_hw"))
 
     def inputs(

@@ -9,10 +9,11 @@ relation right.
 from __future__ import annotations
 
 import dataclasses
+import re
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from pickle import UnpicklingError
 
 import torch
 from torch import Tensor
@@ -116,19 +117,134 @@ def save_checkpoint(path: str | Path, model: SupportModel, meta: dict) -> Path:
     return path
 
 
-def load_checkpoint(path: str | Path) -> tuple[SupportModel, dict]:
-    """The model stored at ``path`` (eval mode) and its meta; one-line error if unusable."""
+CHECKPOINT_KEYS = ("config", "state", "meta")  # what `save_checkpoint` writes
+DEFAULT_SCENE = "cubes"  # the scene ``tamp perception dataset`` renders without ``--scene``
+_SCENE_FLAG = re.compile(r"--(?:image-)?scene[ =](\S+)")
+
+
+def checkpoint_scene(meta: dict) -> str | None:
+    """The image scene a checkpoint was trained on, from its ``meta``: the training set's own
+    record (``meta["dataset"]["scene"]``), else the dataset command that made the training set
+    (``--scene X``, or `DEFAULT_SCENE` without it: the shipped ``support.pt`` predates the
+    record); None when the meta says neither."""
+    dataset = meta.get("dataset")
+    if isinstance(dataset, dict) and dataset.get("scene"):
+        return str(dataset["scene"])
+    train = meta.get("train")
+    made_by = train.get("made_by") if isinstance(train, dict) else None
+    if not isinstance(made_by, str) or "perception dataset" not in made_by:
+        return None
+    match = _SCENE_FLAG.search(made_by)
+    return match.group(1) if match else DEFAULT_SCENE
+
+
+def _torch_detail(err: BaseException) -> str:
+    """The one informative line of a weights-only `torch.load` failure, e.g. ``" (torch:
+    Unsupported operand 44)"``; "" for other failures, whose messages (a pickle key, a zip
+    assertion) say nothing to a user. Torch's full message spans several lines and suggests
+    ``weights_only=False``, which this loader never uses."""
+    text = str(err)
+    if "WeightsUnpickler error:" not in text:
+        return ""
+    rest = [ln.strip() for ln in text.split("WeightsUnpickler error:", 1)[1].splitlines()]
+    detail = next((ln for ln in rest if ln), "")
+    return f" (torch: {detail[:80]})" if detail else ""
+
+
+def _read(path: Path) -> dict:
+    """The dict a checkpoint file holds; PerceptionError when torch cannot read it as one."""
+    if path.stat().st_size == 0:
+        raise PerceptionError(f"{path}: not a perception checkpoint (the file is empty)")
+    try:
+        with warnings.catch_warnings():  # torch warns about pickle protocols on stderr
+            warnings.simplefilter("ignore")
+            blob = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as err:  # torch raises many kinds, most with several lines
+        raise PerceptionError(
+            f"{path}: not a perception checkpoint: not a file torch.save wrote with tensors "
+            f"and plain data only{_torch_detail(err)}"
+        ) from None
+    if not isinstance(blob, dict):
+        raise PerceptionError(
+            f"{path}: not a perception checkpoint: it holds a {type(blob).__name__}, not a dict "
+            f"with keys {', '.join(CHECKPOINT_KEYS)} (what tamp perception train writes)"
+        )
+    missing = [k for k in CHECKPOINT_KEYS[:2] if k not in blob]
+    if missing:
+        keys = ", ".join(sorted(map(str, blob))) or "none"
+        raise PerceptionError(
+            f"{path}: not a perception checkpoint: no {' or '.join(missing)} key (its keys: "
+            f"{keys}; expected {', '.join(CHECKPOINT_KEYS)})"
+        )
+    for key, kind in (("config", dict), ("state", dict), ("meta", dict)):
+        if key in blob and not isinstance(blob[key], kind):
+            raise PerceptionError(
+                f"{path}: its {key!r} is a {type(blob[key]).__name__}, not a dict"
+            )
+    return blob
+
+
+def _config(path: Path, raw: dict) -> ModelConfig:
+    fields = [f.name for f in dataclasses.fields(ModelConfig)]
+    unknown = sorted(str(k) for k in raw if k not in fields)
+    if unknown:
+        raise PerceptionError(
+            f"{path}: model config has fields this code does not know: {', '.join(unknown)} "
+            f"(valid: {', '.join(fields)})"
+        )
+    try:
+        return ModelConfig(**{k: tuple(v) if isinstance(v, list) else v for k, v in raw.items()})
+    except (TypeError, ValueError) as err:
+        raise PerceptionError(f"{path}: bad model config: {str(err).splitlines()[0]}") from None
+
+
+def _weights(path: Path, model: SupportModel, state: dict) -> None:
+    """Load ``state`` into ``model``; PerceptionError naming the missing, unexpected or
+    misshapen weights (torch's own message spans several lines)."""
+    expected = model.state_dict()
+    missing = [k for k in expected if k not in state]
+    unexpected = [str(k) for k in state if k not in expected]
+    shapes = [
+        f"{k} {tuple(state[k].shape)} (model: {tuple(v.shape)})"
+        if isinstance(state[k], Tensor)
+        else f"{k} (not a tensor)"
+        for k, v in expected.items()
+        if k in state and not (isinstance(state[k], Tensor) and state[k].shape == v.shape)
+    ]
+    problems = [
+        f"{label}: {', '.join(names[:3])}{', ...' if len(names) > 3 else ''}"
+        for label, names in (
+            ("missing weights", missing),
+            ("unexpected weights", unexpected),
+            ("wrong shapes", shapes),
+        )
+        if names
+    ]
+    if problems:
+        raise PerceptionError(
+            f"{path}: weights do not fit the model its config describes ({'; '.join(problems)})"
+        )
+    model.load_state_dict(state)
+
+
+def load_checkpoint(path: str | Path, scene: str | None = None) -> tuple[SupportModel, dict]:
+    """The model stored at ``path`` (eval mode) and its meta. One PerceptionError line naming
+    the file and what is wrong when it is not a checkpoint (missing, empty, not a torch file,
+    wrong keys, a config or weights that do not fit this code). With ``scene`` (the image scene
+    to be read, e.g. ``"latplan"``), a checkpoint whose meta says it was trained on another
+    scene is refused too (`checkpoint_scene`): its readings would be confidently wrong."""
     path = Path(path)
     if not path.is_file():
         raise PerceptionError(f"no perception checkpoint at {path}")
-    try:
-        blob = torch.load(path, map_location="cpu", weights_only=True)
-        config = ModelConfig(
-            **{k: tuple(v) if isinstance(v, list) else v for k, v in blob["config"].items()}
-        )
-        model = SupportModel(config)
-        model.load_state_dict(blob["state"])
-    except (KeyError, TypeError, RuntimeError, EOFError, ValueError, UnpicklingError) as err:
-        raise PerceptionError(f"{path} is not a support-model checkpoint: {err}") from None
+    blob = _read(path)
+    model = SupportModel(_config(path, blob["config"]))
+    _weights(path, model, blob["state"])
     model.eval()
-    return model, dict(blob.get("meta", {}))
+    meta = dict(blob.get("meta", {}))
+    trained = checkpoint_scene(meta)
+    if scene is not None and trained is not None and trained != scene:
+        raise PerceptionError(
+            f"{path} was trained on the {trained} scene, not {scene}: its readings of {scene} "
+            f"images would be wrong; pass a checkpoint trained on {scene} images"
+        )
+    return model, meta

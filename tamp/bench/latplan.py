@@ -17,6 +17,7 @@ are evaluation data only: nothing here trains or tunes on them.
 from __future__ import annotations
 
 import csv
+import sys
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -26,6 +27,7 @@ from pathlib import Path
 from pddl.core import Domain
 
 from perception.perceive import Perceiver
+from perception.train import checkpoint_scene, load_checkpoint
 from tamp.bench.planning import check
 from tamp.bench.suites import DEFAULT_DATA, spread
 from tamp.bench.summary import is_optimal
@@ -44,6 +46,7 @@ INSTANCES = "prob-cylinders-4"
 OPTIMAL = "opt_len_4op"  # manifest column: optimal 4-op plan length (2 x optimal moves)
 FILES = {"150x100": ("image_tr/init.png", "image_tr/goal.png"), "45x30": ("init.png", "goal.png")}
 MODES = ("state", "frozen", "optimised")
+SCENE = "latplan"  # the image scene of these images (`tamp.camera.image_pair.blocks_in`)
 FIX = "get it as ../shared/data/latplan/README.md describes and pass --data DIR"
 
 
@@ -89,14 +92,31 @@ def load(root: str | Path = DEFAULT, limit: int | None = None) -> LatPlanData:
 
 
 def load_perceiver(path: str | Path) -> Perceiver:
-    """The perception checkpoint at ``path``; one-line DataError naming the fix if absent."""
+    """The perception checkpoint at ``path``; one-line DataError naming the fix if absent.
+
+    A checkpoint trained on another scene (the cube one, the documented negative control) is
+    not refused, but warned about on stderr, and `report` records its scene
+    (``checkpoint_scene``) so that its rows cannot pass for a LatPlan result."""
     if not Path(path).is_file():
         raise DataError(
             f"no LatPlan perception checkpoint at {path}: train one on rendered LatPlan-like "
             "scenes (tamp perception dataset --scene latplan, then tamp perception train) and "
             "pass it with --checkpoint FILE.pt, or run --modes state"
         )
-    return Perceiver.load(path)
+    model, meta = load_checkpoint(path)
+    trained = checkpoint_scene(meta)
+    if trained != SCENE:
+        print(f"warning: {scene_warning(path, trained)}", file=sys.stderr, flush=True)
+    return Perceiver(model, input_hw=meta.get("input_hw"))
+
+
+def scene_warning(path: str | Path, trained: str | None) -> str:
+    """Why the image rows of a checkpoint not trained on LatPlan's scene are no result."""
+    what = "an unknown scene" if trained is None else f"the {trained} scene"
+    return (
+        f"{path} was trained on {what}, not {SCENE}: its image rows measure a mismatched "
+        "model (a negative control), not LatPlan perception"
+    )
 
 
 def _row(inst: Instance, res: str, mode: str, seed: int) -> dict:
@@ -137,7 +157,7 @@ def image_row(data, k: int, res: str, mode: str, seed: int, perceiver, config) -
     try:
         images = [read_image(p) for p in paths]
         check_sizes(images, paths, perceiver.model)
-        names, rgbs = blocks_in(images, paths, "latplan")
+        names, rgbs = blocks_in(images, paths, SCENE)
         pair = plan_from_images(*images, rgbs, names, perceiver, mode, config, seed)
     except TampError as exc:
         row.update(status="unreadable", error=str(exc), time_s=time.perf_counter() - t0)
@@ -223,13 +243,22 @@ def summaries(rows: Sequence[dict]) -> list[dict]:
 
 
 def report(data: LatPlanData, rows, summary, options: dict, machine: dict) -> dict:
-    """The ``results.json`` body: options, machine, the cited rows and every summary."""
+    """The ``results.json`` body: options, machine, the cited rows and every summary. With a
+    checkpoint, the scene it was trained on (``checkpoint_scene``, from its meta) and, when
+    that is not LatPlan's, the warning `load_perceiver` printed (``warnings``)."""
+    scenes = {}
+    if options.get("checkpoint"):
+        trained = checkpoint_scene(load_checkpoint(options["checkpoint"])[1])
+        scenes["checkpoint_scene"] = trained
+        if trained != SCENE:
+            scenes["warnings"] = [scene_warning(options["checkpoint"], trained)]
     return {
         "benchmark": "latplan-40",
         "data": str(data.root),
         "n": len(data.instances),
         "instances": [i.name for i in data.instances],
         **options,
+        **scenes,
         "machine": machine,
         "cited": [dict(zip(("row", "valid", "optimal"), c, strict=True)) for c in CITED],
         "summary": list(summary),

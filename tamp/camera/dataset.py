@@ -109,6 +109,7 @@ def generate(
             r.close()
     info = dict(meta or {})
     info.update(
+        scene="cubes",  # the image scene (training copies it into the checkpoint's meta)
         seed=seed,
         sims=list(sims),
         n=n,

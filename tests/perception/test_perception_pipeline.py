@@ -97,7 +97,7 @@ def test_a_missing_dataset_or_checkpoint_is_a_one_line_error(tmp_path):
     with pytest.raises(PerceptionError, match="no perception checkpoint"):
         load_checkpoint(tmp_path / "none.pt")
     (tmp_path / "junk.pt").write_bytes(b"not a checkpoint")
-    with pytest.raises(PerceptionError, match="is not a support-model checkpoint"):
+    with pytest.raises(PerceptionError, match=r"junk\.pt: not a perception checkpoint"):
         load_checkpoint(tmp_path / "junk.pt")
 
 
