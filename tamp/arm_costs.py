@@ -9,9 +9,13 @@ gradients to the targets), plus the reach residual, an infeasibility penalty and
 model's clearance to the scene's obstacles along the move and to the other blocks (boxes at
 their predicted places) at its grasp and release. A place onto a tower that its slot's
 clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a move to a full
-table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top. The
-matrix is computed once per state (no placements are optimised here: the table placement is
-the scene's free slot).
+table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so
+does a move the arm failed in that state before (``avoid``, `failed_key`). The matrix is
+computed once per state: the table placement is the scene's free slot, or with table places
+(`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
+placements): every window optimises fresh offsets, one set per restart row, with the logits,
+and the source records, for each committed move, the position the chosen row decided it with
+(`ArmCosts.decided`).
 """
 
 from __future__ import annotations
@@ -85,44 +89,76 @@ def predict_poses(
     return out
 
 
+XY = tuple[float, float]
+
+
 class _Fixed:
-    """The costs of one window: a fixed (P, N, Y) matrix and no parameters."""
+    """The costs of one window: a fixed (P, N, Y) matrix, the same for every restart row, and
+    no parameters (a move onto a table place goes to the place's centre)."""
 
     lr = 0.0
 
-    def __init__(self, matrix: torch.Tensor) -> None:
-        self.matrix = matrix
+    def __init__(self, owner: ArmCosts, indices: Sequence[int], matrix: torch.Tensor) -> None:
+        self.owner, self.indices, self.matrix = owner, list(indices), matrix
 
     def compute(self) -> torch.Tensor:
-        return self.matrix
+        return self.matrix  # (P, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
         return []
 
+    def commit(self, rows: Sequence[int | None], moves: Sequence[tuple]) -> None:
+        for i, done in zip(self.indices, moves, strict=True):
+            self.owner._record(i, done, None)
+
 
 class _Placed:
-    """The costs of one window whose K table places move: place k of problem p sits at its
-    centre + ``reach * tanh(u[p][k])`` in x and y; the IK solutions at the centres are reused
-    (`motion.cost.site_solutions`), refined differentiably at every step."""
+    """The costs of one window whose K table places move, per restart row: in row b (problem
+    p = b // R, restart b % R) place k sits at its centre + ``reach * tanh(u[b, k])`` in x and
+    y, u starting at 0 in every window. The IK solutions at the centres are reused
+    (`motion.cost.site_solutions`), refined differentiably at every step. Row b's costs depend
+    on u[b] only, so each restart row optimises its own placements."""
 
     lr = 0.05  # Adam learning rate of the unbounded offsets u
 
-    def __init__(self, owner: ArmCosts, picks, places, extra, solved, offsets, blocks) -> None:
-        self.owner, self.picks, self.places, self.extra = owner, picks, places, extra
-        self.solved, self.offsets, self.blocks = solved, offsets, blocks
+    def __init__(
+        self, owner: ArmCosts, indices: Sequence[int], restarts: int, inputs, solved, extra
+    ) -> None:
+        picks, places, _, blocks = inputs
+        q, ok = solved  # (P * (N + Y), J), (P * (N + Y),)
+        p, r, n = picks.shape[0], restarts, picks.shape[1]
+        self.owner, self.indices, self.restarts, self.n = owner, list(indices), r, n
+        self.picks = picks.repeat_interleave(r, dim=0)  # (B, N, 3), B = P * R
+        self.places = places.repeat_interleave(r, dim=0)  # (B, Y, 3)
+        self.extra = extra.repeat_interleave(r, dim=0)  # (B, N, Y)
+        self.solved = (
+            q.reshape(p, -1, q.shape[-1]).repeat_interleave(r, dim=0).reshape(-1, q.shape[-1]),
+            ok.reshape(p, -1).repeat_interleave(r, dim=0).reshape(-1),
+        )  # (B * (N + Y), J), (B * (N + Y),)
+        self.blocks = Blocks(*(t.repeat_interleave(r, dim=0) for t in blocks))
+        k = places.shape[1] - n
+        self.u = torch.zeros(p * r, k, 2, dtype=torch.float64, requires_grad=True)  # (B, K, 2)
+
+    def shift(self) -> torch.Tensor:
+        """(B, K, 2) m: every row's offset of every place from its centre."""
+        return self.owner.reach * torch.tanh(self.u)
 
     def compute(self) -> torch.Tensor:
-        o, n = self.owner, self.picks.shape[1]
-        shift = torch.stack([o.reach * torch.tanh(u) for u in self.offsets])  # (P, K, 2)
-        table = self.places[:, n:] + torch.nn.functional.pad(shift, (0, 1))  # (P, K, 3)
-        places = torch.cat([self.places[:, :n], table], dim=1)  # (P, Y, 3)
+        o, n = self.owner, self.n
+        table = self.places[:, n:] + torch.nn.functional.pad(self.shift(), (0, 1))  # (B, K, 3)
+        places = torch.cat([self.places[:, :n], table], dim=1)  # (B, Y, 3)
         c = move_costs_batch(
             o.solver, o.q_now, self.picks, places, o.config, o.boxes, self.solved, self.blocks
         )
-        return c + self.extra  # (P, N, Y)
+        return c + self.extra  # (B, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
-        return list({id(u): u for u in self.offsets}.values())
+        return [self.u]
+
+    def commit(self, rows: Sequence[int | None], moves: Sequence[tuple]) -> None:
+        shift = self.shift().detach()  # (B, K, 2)
+        for p, (i, row, done) in enumerate(zip(self.indices, rows, moves, strict=True)):
+            self.owner._record(i, done, None if row is None else shift[p * self.restarts + row])
 
 
 class ArmCosts:
@@ -137,7 +173,7 @@ class ArmCosts:
         solver: IKSolver,
         q_now,
         config: MoveCostConfig = ARM,
-        places: Sequence[Mapping[str, tuple[float, float]]] | None = None,
+        places: Sequence[Mapping[str, XY]] | None = None,
         avoid: Mapping[State, set] | None = None,
         reach: float = 0.0,
     ) -> None:
@@ -147,43 +183,52 @@ class ArmCosts:
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
         self.reach = reach  # m: how far a block may go from its place's centre (0: fixed)
         self.boxes = obstacle_tensors(scene)  # the collision proxy's obstacles, made once
-        self._offsets: dict[int, torch.Tensor] = {}  # problem -> (K, 2) unbounded parameters
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
+        self._decided: dict[int, list[tuple[object, XY | None]]] = {}
 
-    def offset(self, index: int, place: str) -> tuple[float, float]:
-        """The optimised (dx, dy) of ``place`` in problem ``index`` (m; 0 before planning)."""
-        u = self._offsets.get(index)
-        if u is None:
-            return 0.0, 0.0
-        dx, dy = (self.reach * torch.tanh(u[self.problems[index].fixed.index(place)])).tolist()
-        return dx, dy
+    def decided(self, index: int) -> list[tuple[object, XY | None]]:
+        """Every move the planner committed for problem ``index`` since this source was made,
+        in order, with the (x, y) of the table place it goes to as its window decided it: the
+        place's centre plus the offset of the restart row the move came from (None: a move
+        onto a block or, without places, onto the table)."""
+        return list(self._decided.get(index, ()))
 
-    def __call__(self, indices: Sequence[int], states: Sequence[State]):
+    def _record(self, index: int, moves: Sequence, shift: torch.Tensor | None) -> None:
+        """Note the committed ``moves`` of problem ``index`` with their places' positions
+        (``shift``: (K, 2) offsets from the centres, None: at the centres)."""
+        problem = self.problems[index]
+        at = None if self.places is None else self.places[index]
+        out = self._decided.setdefault(index, [])
+        for move in moves:
+            xy = None
+            if at is not None and move.target in at:
+                xy = at[move.target]
+                if shift is not None:
+                    dx, dy = shift[problem.fixed.index(move.target)].tolist()
+                    xy = (xy[0] + dx, xy[1] + dy)
+            out.append((move, xy))
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State], restarts: int = 1):
+        """The costs of a window (`task.costs.CostSource`): a fixed (P, N, Y) matrix, or with
+        places and ``reach`` > 0 per-row placements (P * ``restarts``, N, Y)."""
         if self.reach > 0 and self.places is not None:
-            return self._placed(indices, states)
+            return self._placed(indices, states, restarts)
         todo = [(i, s) for i, s in zip(indices, states, strict=True) if (i, s) not in self._cache]
         if todo:
             for key, matrix in zip(todo, self._price(todo), strict=True):
                 self._cache[key] = matrix
         keys = zip(indices, states, strict=True)
-        return _Fixed(torch.stack([self._cache[key] for key in keys]))  # (P, N, Y)
+        return _Fixed(self, indices, torch.stack([self._cache[key] for key in keys]))
 
-    def _placed(self, indices: Sequence[int], states: Sequence[State]) -> _Placed:
+    def _placed(self, indices: Sequence[int], states: Sequence[State], restarts: int) -> _Placed:
         """A window whose table places move within ``reach`` of their centres: continuous
-        placements, optimised with the logits (each problem's offsets carry over windows)."""
-        picks, places, extra, blocks = self._inputs(list(zip(indices, states, strict=True)))
+        placements, fresh for the window and one set per restart row, optimised with the
+        logits."""
+        inputs = self._inputs(list(zip(indices, states, strict=True)))
+        picks, places, extra, blocks = inputs
         solved = site_solutions(self.solver, self.q_now, picks, places)
         extra = extra + self._deep(solved, blocks)
-        offsets = [
-            self._offsets.setdefault(
-                i,
-                torch.zeros(
-                    len(self.problems[i].fixed), 2, dtype=torch.float64, requires_grad=True
-                ),
-            )
-            for i in indices
-        ]
-        return _Placed(self, picks, places, extra, solved, offsets, blocks)
+        return _Placed(self, indices, restarts, inputs, solved, extra)
 
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
         """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
@@ -231,7 +276,7 @@ class ArmCosts:
             extra.append(self._blocked(problem, plain, now, at is None and slot is None))
             self._hover(extra[-1], xyz, places[-1], now)
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
-                j = _column(problem, key, at)
+                j = _column(problem, key, at, self.reach)
                 if j is not None:
                     extra[-1][problem.entities.index(x), j] += BLOCKED
         picks, places, extra = (torch.tensor(np.stack(a)) for a in (picks, places, extra))
@@ -271,24 +316,34 @@ class ArmCosts:
 
 def failed_key(move) -> tuple[str, object]:
     """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
-    ("at", x, y) for a move onto a planned table place (`tamp.slots.PlacedMove`)."""
+    ("at", place, x, y) for a move onto a planned table place (`tamp.slots.PlacedMove`: the
+    place's name and the position the block was to go to, to the mm)."""
     at = getattr(move, "at", None)
     if at is not None:
-        return move.entity, ("at", round(at[0], 3), round(at[1], 3))
+        place = getattr(move, "place", None)
+        return move.entity, ("at", place, round(at[0], 3), round(at[1], 3))
     return move.entity, move.target
 
 
-def _column(problem: Problem, key, at) -> int | None:
-    """The action column of a `failed_key` target in ``problem`` (a place: by position; None
-    when the problem has no such target)."""
+def _column(problem: Problem, key, at, reach: float) -> int | None:
+    """The action column of a `failed_key` target in ``problem`` (None when the problem has no
+    such target). A place matches by name (any place when the key names none) and by
+    position: the failed position lies within the place's ``reach`` (each offset is at most
+    ``reach`` in x and y) of its centre, to the key's mm; the nearest such place."""
     if isinstance(key, str) and key != TABLE:
         return problem.entities.index(key)
     if at is None:  # the one table column
         return problem.n
     if isinstance(key, str):
         return None  # "somewhere on the table": no one place to blame
-    near = [j for j, k in enumerate(problem.fixed) if math.dist(at[k], key[1:]) < 1e-3]
-    return problem.n + near[0] if near else None
+    _, place, x, y = key
+    tol = reach * math.sqrt(2) + 1e-3
+    near = [
+        (math.dist(at[k], (x, y)), j)
+        for j, k in enumerate(problem.fixed)
+        if place in (None, k) and math.dist(at[k], (x, y)) <= tol
+    ]
+    return problem.n + min(near)[1] if near else None
 
 
 def obstacle_tensors(scene: SceneConfig) -> tuple[torch.Tensor, torch.Tensor]:

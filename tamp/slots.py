@@ -9,8 +9,9 @@ named ``spot_<base>``, which other towers may use once it is empty. The observed
 each tower base's place from its observed pose, nothing else.
 
 The loop stays on the plain problem: `plain_move` turns a planned move onto a place into a
-move onto the table that carries the place's position (`PlacedMove.at`), where the executor
-puts the block (`tamp.scene.place_pose`).
+move onto the table that carries the place's name and position (`PlacedMove.at`: with
+continuous placements, the position its window decided), where the executor puts the block
+(`tamp.scene.place_pose`).
 """
 
 from __future__ import annotations
@@ -32,9 +33,11 @@ XY = tuple[float, float]
 
 @dataclass(frozen=True)
 class PlacedMove(Move):
-    """A move onto the table with the table position ``at`` (x, y) the plan chose for it."""
+    """A move onto the table with the table position ``at`` (x, y) the plan chose for it, at
+    the planner's table place named ``place`` (None: not planned on places)."""
 
     at: XY | None = field(default=None, compare=False)
+    place: str | None = field(default=None, compare=False)
 
 
 def places(
@@ -88,10 +91,12 @@ def slotted(
     return with_slots(current, tuple(at), where), at
 
 
-def plain_move(move: Move, at: Mapping[str, XY]) -> Move:
-    """A planned move onto a place as a move onto the table at that place (`PlacedMove`)."""
+def plain_move(move: Move, at: Mapping[str, XY], where: XY | None = None) -> Move:
+    """A planned move onto a place as a move onto the table at that place (`PlacedMove`):
+    at ``where`` when given (the position its window decided), else at the place's centre."""
     if move.target in at:
-        return PlacedMove(move.entity, TABLE, at[move.target])
+        xy = at[move.target] if where is None else where
+        return PlacedMove(move.entity, TABLE, xy, move.target)
     return move
 
 
@@ -110,16 +115,18 @@ def plan_on_places(
     table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
     the arm failed, priced out); the plan's moves are plain (`plain_move`). ``reach`` > 0:
     continuous placements, each place's position optimised within ``reach`` m of its centre
-    with the logits (the plan's moves carry the optimised positions)."""
+    with the logits, per window and restart row: every move onto a place carries the position
+    that the restart row it was decoded from decided in its window (`ArmCosts.decided`)."""
     current, at = slotted(problem, problem.init, poses, scene)
     costs = ArmCosts(
         [current], [poses], scene, solver, q_now, places=[at], avoid=avoid, reach=reach
     )
     result = plan(current, config, seed=seed, costs=costs)
-    moved = {
-        k: (xy[0] + costs.offset(0, k)[0], xy[1] + costs.offset(0, k)[1]) for k, xy in at.items()
-    }
-    return replace(result, plan=Plan(tuple(plain_move(m, moved) for m in result.plan)))
+    decided = costs.decided(0)
+    if [m for m, _ in decided] != list(result.plan.moves):  # the planner commits every move
+        raise RuntimeError("the planner's moves differ from those committed to the cost source")
+    moves = tuple(plain_move(m, at, xy) for m, xy in decided)
+    return replace(result, plan=Plan(moves))
 
 
 def fits(problem: Problem, scene: SceneConfig) -> bool:

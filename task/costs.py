@@ -10,10 +10,17 @@ The planner adds the expected cost of the committed move mass to its loss,
 (`task.config.PlannerConfig.lambda_motion`), and ranks restarts that are equally good at task
 level (validity, then length) by the crisp cost of their decoded moves. The costs may depend
 on continuous parameters of the source (placements), which the window's Adam then optimises
-with the action logits at the source's own learning rate. The soft machinery never leaves
-`task`; the costs come in as a tensor. The costs are those of the window's start state for
-every step of the window (later steps see the same matrix): an approximation the next window
-corrects, as it starts from the state the executed moves reached.
+with the action logits at the source's own learning rate. Such parameters belong to one
+restart row of one window: each row optimises its own copy from the source's start values (so
+a row is optimised as it would be alone, `task.optimize`), and after decoding the planner tells
+the window which row each problem's committed moves came from (`WindowCosts.commit`), so the
+source can execute every move with the values it was decided with. The soft machinery never
+leaves `task`; the costs come in as a tensor. The costs are those of the window's start state
+for every step of the window (later steps see the same matrix): an approximation the next
+window corrects, as it starts from the state the executed moves reached.
+
+Shapes: P problems in the window (all of one size N, `Y` targets each), R restart rows per
+problem, adjacent in the batch (row ``p * R + r`` is restart r of problem p).
 """
 
 from __future__ import annotations
@@ -31,22 +38,36 @@ IMPOSSIBLE = 10.0
 
 
 class WindowCosts(Protocol):
-    """The move costs of one planning window for P problems (all of one size N)."""
+    """The move costs of one planning window for P problems (all of one size N), R restart
+    rows each."""
 
     lr: float  # Adam learning rate of ``parameters()``
 
     def compute(self) -> Tensor:
-        """(P, N, Y) cost of moving entity x onto target y; called at every Adam step, so it
-        may depend on ``parameters()`` differentiably."""
+        """The cost of moving entity x onto target y: (P, N, Y), every restart row of a
+        problem priced alike, or (P * R, N, Y), one matrix per row (restarts adjacent), when
+        it depends on per-row ``parameters()``. Called at every Adam step, so it may depend on
+        ``parameters()`` differentiably; a row's costs must depend on that row's values only."""
         ...
 
     def parameters(self) -> list[Tensor]:
-        """Continuous variables to optimise with the logits (placements); may be empty."""
+        """Continuous variables to optimise with the logits (placements), fresh for this
+        window, their leading axis one entry per restart row (P * R); may be empty."""
+        ...
+
+    def commit(self, rows: Sequence[int | None], moves: Sequence[tuple]) -> None:
+        """The planner executes ``moves[p]`` (in order) for window problem p, decoded from its
+        restart row ``rows[p]`` (0 <= row < R; None: from a retry planned without these costs).
+        A source with parameters records that row's values as the ones the moves are executed
+        with; one without has nothing to record."""
         ...
 
 
 class CostSource(Protocol):
     """Makes the costs of a window for the problems ``indices`` (positions in the list given to
-    `task.planner.plan_batch`) in their current crisp ``states``."""
+    `task.planner.plan_batch`) in their current crisp ``states``, planned with ``restarts`` (R)
+    restart rows each."""
 
-    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowCosts: ...
+    def __call__(
+        self, indices: Sequence[int], states: Sequence[State], restarts: int
+    ) -> WindowCosts: ...

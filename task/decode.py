@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from torch import Tensor
 
@@ -49,6 +49,7 @@ class DecodedWindow:
     revisit: bool = False  # ``state`` was already visited earlier in the plan (a loop)
     motion: float = 0.0  # the move costs of ``moves`` (`task.costs`; 0 without a cost source)
     buried: int = 0  # moves that left the bound unchanged, putting an entity on an entity
+    row: int = 0  # the restart row of its problem it was decoded from (0 <= row < R)
 
     def key(self) -> tuple:
         """Sort key: the goal reached in fewest moves; else not a dead end (an infinite lower
@@ -202,20 +203,21 @@ def decode_best(
 
     ``visited``: per problem, the states its plan has passed through (a window that ends in
     one ranks below every window that does not). ``check=False``: illegal moves are kept and
-    the lowest soft objective wins. ``costs``: (P * R, N, A - 1) move costs (`task.costs`)."""
+    the lowest soft objective wins. ``costs``: (P * R, N, A - 1) move costs (`task.costs`).
+    Each window names the restart row it came from (``row``)."""
     gates, losses = gates.cpu(), losses.cpu().tolist()
     costs = None if costs is None else costs.detach().cpu()
     out = []
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
         rows = range(i * restarts, (i + 1) * restarts)
         seen = () if visited is None else visited[i]
-        row_costs = [None if costs is None else costs[r] for r in rows]
-        windows = [
-            decode_row(
+        windows = []
+        for k, r in enumerate(rows):
+            c = None if costs is None else costs[r]
+            window = decode_row(
                 domain, problem, state, gates[r], threshold, losses[r], check, seen, c, prefix, park
             )
-            for r, c in zip(rows, row_costs, strict=True)
-        ]
+            windows.append(replace(window, row=k))
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
     return out
 

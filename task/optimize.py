@@ -17,7 +17,7 @@ from task.config import PlannerConfig
 from task.costs import WindowCosts
 from task.domains.base import Domain, SoftBatch
 from task.errors import TampError
-from task.rollout import Rollout, rollout
+from task.rollout import Rollout, check_deadline, rollout
 
 
 def initial_logits(
@@ -38,6 +38,7 @@ def optimise_window(
     generator: torch.Generator,
     beliefs: WindowBeliefs | None = None,
     costs: WindowCosts | None = None,
+    deadline: float | None = None,
 ) -> tuple[Tensor, Rollout]:
     """Optimise the window's logits; returns them and the final rollout (no grad; at
     ``config.decode_tau`` when set, the temperature the decoder reads the moves at).
@@ -46,6 +47,8 @@ def optimise_window(
     ``beliefs`` (see `task.beliefs`) replaces the batch's F0 and goal by soft ones, recomputed
     at every step; their parameters, if any, are optimised too, at their own learning rate.
     ``costs`` (see `task.costs`) adds the expected move cost to the loss, likewise.
+    ``deadline`` (a `time.perf_counter` value): raise `task.rollout.OutOfTime` once it has
+    passed, checked at every Adam step and every rollout step.
     """
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
     groups = [{"params": [logits], "lr": config.lr}]
@@ -57,18 +60,20 @@ def optimise_window(
         groups.append({"params": placed, "lr": costs.lr})
     opt = Adam(groups)
     for k in range(config.iters):
+        check_deadline(deadline)
         opt.zero_grad()
         tau = temperature(config, k)
         live, penalty = with_beliefs(batch, beliefs)
         c = with_costs(batch, costs)
-        (rollout(domain, logits, live, steps, config, tau, c).loss.sum() + penalty).backward()
+        roll = rollout(domain, logits, live, steps, config, tau, c, deadline)
+        (roll.loss.sum() + penalty).backward()
         opt.step()
     with torch.no_grad():
         tau = config.decode_tau
         tau = temperature(config, config.iters - 1) if tau is None else tau
         live, _ = with_beliefs(batch, beliefs)
         c = with_costs(batch, costs)
-        return logits.detach(), rollout(domain, logits, live, steps, config, tau, c)
+        return logits.detach(), rollout(domain, logits, live, steps, config, tau, c, deadline)
 
 
 class Adam:
@@ -121,10 +126,11 @@ def with_beliefs(batch: SoftBatch, beliefs: WindowBeliefs | None) -> tuple[SoftB
 
 
 def with_costs(batch: SoftBatch, costs: WindowCosts | None) -> Tensor | None:
-    """The window's move costs (P, N, Y), each problem's repeated for its restart rows."""
+    """The window's move costs, one matrix per restart row (B, N, Y): a source's (P, N, Y)
+    repeated for each problem's restart rows, or its own (B, N, Y) per-row matrices."""
     if costs is None:
         return None
-    c = costs.compute()  # (P, N, Y)
+    c = costs.compute()  # (P, N, Y), or (B, N, Y) per row
     rows = batch.F0.shape[0]
     if c.shape[1:] != batch.F0.shape[1:] or rows % c.shape[0]:
         raise TampError(

@@ -31,6 +31,7 @@ from task.domains.base import Domain, State, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
+from task.rollout import OutOfTime, check_deadline
 
 
 def _window(
@@ -42,11 +43,12 @@ def _window(
     beliefs: WindowBeliefs | None = None,
     visited: Sequence[set] | None = None,
     costs: WindowCosts | None = None,
+    deadline: float | None = None,
 ):
     batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
     horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
     steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
-    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs)
+    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs, deadline)
     return decode_best(
         domain,
         problems,
@@ -63,13 +65,16 @@ def _window(
     )
 
 
-def _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded):
+def _retry_frozen(
+    domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
+) -> set[int]:
     """Windows that decoded no move under adapted beliefs are planned again with the beliefs'
-    frozen ``fallback`` (`task.beliefs`); a retry that moves replaces the window in place."""
+    frozen ``fallback`` (`task.beliefs`, without move costs); a retry that moves replaces the
+    window in place. Returns the positions of the replaced windows."""
     fallback = getattr(beliefs, "fallback", None)
     stuck = [k for k, w in enumerate(decoded) if not w.moves and not w.reached]
     if fallback is None or not stuck:
-        return
+        return set()
     again = _window(
         domain,
         [problems[active[k]] for k in stuck],
@@ -78,10 +83,14 @@ def _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, v
         generator,
         fallback(stuck),
         [visited[active[k]] for k in stuck],
+        deadline=deadline,
     )
+    replaced = set()
     for k, window in zip(stuck, again, strict=True):
         if window.moves or window.reached:
             decoded[k] = window
+            replaced.add(k)
+    return replaced
 
 
 def _crisp_states(
@@ -115,6 +124,48 @@ def _execute(
     return tuple(done), state, None
 
 
+def _next_window(
+    domain: Domain,
+    problems: Sequence[Problem],
+    active: Sequence[int],
+    states: Sequence[State],
+    indices: Sequence[int],
+    visited: Sequence[set],
+    config: PlannerConfig,
+    generator: torch.Generator,
+    source: BeliefSource | None,
+    costs: CostSource | None,
+    deadline: float | None,
+):
+    """One window of the ``active`` problems from their world ``states``: the decoded windows,
+    the window's costs (None without a source), the positions of the windows a frozen-belief
+    retry replaced, the crisp states decoded against and whether they are perceived. Raises
+    `task.rollout.OutOfTime` when ``deadline`` passes before the window is decoded."""
+    check_deadline(deadline)
+    now = [states[i] for i in active]
+    beliefs = None if source is None else source([indices[i] for i in active], now)
+    crisp, perceived = _crisp_states(beliefs, now)
+    priced = None
+    if costs is not None:
+        priced = costs([indices[i] for i in active], crisp, config.restarts)
+    check_deadline(deadline)
+    decoded = _window(
+        domain,
+        [problems[i] for i in active],
+        crisp,
+        config,
+        generator,
+        beliefs,
+        [visited[i] for i in active],
+        priced,
+        deadline,
+    )
+    retried = _retry_frozen(
+        domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
+    )
+    return decoded, priced, retried, crisp, perceived
+
+
 def _run(
     domain: Domain,
     problems: Sequence[Problem],
@@ -127,8 +178,12 @@ def _run(
 ) -> list[PlanResult]:
     """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems.
 
-    ``indices``: the problems' positions in the caller's list (what ``source`` is told)."""
+    ``indices``: the problems' positions in the caller's list (what ``source`` and ``costs``
+    are told). ``config.time_limit_s`` holds inside a window too: a window the limit cuts
+    short is abandoned (none of its moves are kept)."""
     start = time.perf_counter()
+    limit = config.time_limit_s
+    deadline = None if limit is None else start + limit
     states = [domain.initial_state(p) for p in problems]  # the world
     visited = [{s} for s in states]  # per problem, every world state its plan passed through
     moves: list[list] = [[] for _ in problems]
@@ -141,25 +196,25 @@ def _run(
     for _ in range(config.max_windows):
         if not active:
             break
-        if config.time_limit_s is not None and time.perf_counter() - start >= config.time_limit_s:
+        try:
+            decoded, priced, retried, crisp, perceived = _next_window(
+                domain,
+                problems,
+                active,
+                states,
+                indices,
+                visited,
+                config,
+                generator,
+                source,
+                costs,
+                deadline,
+            )
+        except OutOfTime:
             timed_out = True  # stop with the moves so far; each unsolved problem says so
             break
-        now = [states[i] for i in active]
-        beliefs = None if source is None else source([indices[i] for i in active], now)
-        crisp, perceived = _crisp_states(beliefs, now)
-        priced = None if costs is None else costs([indices[i] for i in active], crisp)
-        decoded = _window(
-            domain,
-            [problems[i] for i in active],
-            crisp,
-            config,
-            generator,
-            beliefs,
-            [visited[i] for i in active],
-            priced,
-        )
-        _retry_frozen(domain, problems, active, crisp, config, generator, beliefs, visited, decoded)
         hoped = []  # perceived: windows that predict the goal, for a new image to confirm
+        executed = []
         for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1
             misread[i] += seen != states[i]
@@ -167,12 +222,16 @@ def _run(
                 domain, problems[i], states[i], win.moves, visited[i]
             )
             moves[i].extend(tried)
+            executed.append(tried)
             if not perceived:
                 solved[i] = win.reached  # decoded on the world: the world reached the goal
             elif domain.is_goal(problems[i], seen):
                 solved[i] = True  # the image already showed the goal (no move was decoded)
             elif win.reached and illegal[i] is None:
                 hoped.append(i)
+        if priced is not None:  # the placements each executed move was decided with
+            rows = [None if k in retried else w.row for k, w in enumerate(decoded)]
+            priced.commit(rows, executed)
         if hoped:  # look again: done when the new image shows the goal
             looked = source([indices[i] for i in hoped], [states[i] for i in hoped])
             seen_now, _ = _crisp_states(looked, [states[i] for i in hoped])
@@ -195,7 +254,7 @@ def _run(
         if timed_out and not solved[i] and illegal[i] is None:
             left = domain.lower_bound(p, states[i])
             stats["time_limit"] = (
-                f"stopped at the {config.time_limit_s:g} s time limit after {windows[i]} "
+                f"stopped at the {limit:g} s time limit after {windows[i]} "
                 f"windows and {len(moves[i])} moves; at least {left:g} more moves needed"
             )
         if illegal[i] is not None:

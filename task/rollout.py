@@ -5,6 +5,7 @@ Shared by every domain: the domain supplies its soft step and its T_P consistenc
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import torch
@@ -14,6 +15,18 @@ from task.config import PlannerConfig
 from task.domains.base import Domain, SoftBatch, resolve_goal_loss
 
 NEG = -1e9  # logit of a masked action
+
+
+class OutOfTime(Exception):
+    """The planning time limit (`task.config.PlannerConfig.time_limit_s`) passed in the middle
+    of a window: the planner abandons the window and reports the limit."""
+
+
+def check_deadline(deadline: float | None) -> None:
+    """Raise `OutOfTime` when ``deadline`` (a `time.perf_counter` value; None: none) has
+    passed."""
+    if deadline is not None and time.perf_counter() >= deadline:
+        raise OutOfTime
 
 
 @dataclass(frozen=True)
@@ -47,12 +60,14 @@ def rollout(
     config: PlannerConfig,
     tau: float | None = None,
     costs: Tensor | None = None,
+    deadline: float | None = None,
 ) -> Rollout:
     """Roll the window out from ``batch.F0``; logits: (B, T, N, A); steps: (B, T) live steps.
 
     ``tau`` overrides ``config.tau`` (the optimiser anneals it). ``costs`` (B, N, Y): move
     costs, whose expectation under the applied move mass joins the loss with weight
-    ``config.lambda_motion`` (`task.costs`).
+    ``config.lambda_motion`` (`task.costs`). ``deadline``: raise `OutOfTime` at the first step
+    after it (`check_deadline`), so that even a very long window stops at the time limit.
     """
     M = action_probs(logits, batch, config.tau if tau is None else tau, steps)  # (B, T, N, A)
     F = batch.F0
@@ -60,6 +75,7 @@ def rollout(
     fp = torch.zeros(F.shape[0], dtype=F.dtype, device=F.device)
     cycle = domain.cycle_loss(F, batch)
     for t in range(M.shape[1]):
+        check_deadline(deadline)
         F, g = domain.step(F, M[:, t], batch)  # (B, N, Y), (B, N, A - 1)
         refined = domain.consistency(F, batch)
         fp = fp + (refined - F).pow(2).sum((-1, -2))  # fixed-point loss before refinement

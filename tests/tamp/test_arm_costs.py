@@ -63,10 +63,23 @@ def test_a_tower_at_its_slots_clearance_blocks_one_more_block(solver):
     assert c[0, 5, 4] >= BLOCKED and c[0, 5, 6] < BLOCKED  # f onto e (6th), f onto the table
 
 
-def test_a_motion_aware_episode_reaches_the_goal(solver):
+def test_a_motion_aware_episode_takes_the_move_the_arm_prefers(solver):
+    """a must leave b: onto d or onto the table, two moves either way. Planning for the task
+    alone, this episode (seed 0) puts a onto d; with the arm's costs it puts a on a table
+    place that the arm prices below a onto d, at that place's centre, and both moves run."""
+    from tamp.slots import PlacedMove, slotted
+
     config = LoopConfig(planner=PlannerConfig(lambda_motion=0.05))
     report = run_episode(FOUR, config, seed=0, solver=solver)
-    assert report.reached_goal and len(report.moves) == 2
+    assert report.reached_goal and len(report.moves) == 2 and all(m.ok for m in report.moves)
+    first = report.moves[0].move
+    assert isinstance(first, PlacedMove) and first.entity == "a" and first.target == TABLE
+    poses = layout(FOUR.entities, FOUR.init, config.scene, 0)  # the episode's layout
+    problem, at = slotted(FOUR, FOUR.init, poses, config.scene)
+    source = ArmCosts([problem], [poses], config.scene, solver, PANDA.q_home, places=[at])
+    c = source([0], [problem.init]).compute()[0]
+    assert first.at == at[first.place]
+    assert c[0, problem.n + problem.fixed.index(first.place)] < c[0, 3]  # below a onto d
 
 
 def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places(monkeypatch):

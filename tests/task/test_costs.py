@@ -66,7 +66,7 @@ class FixedCosts:
     lr: float = 0.0
     calls: list = field(default_factory=list)
 
-    def __call__(self, indices, states):
+    def __call__(self, indices, states, restarts):
         self.calls.append(tuple(states))
         return self
 
@@ -75,6 +75,9 @@ class FixedCosts:
 
     def parameters(self):
         return []
+
+    def commit(self, rows, moves):
+        pass
 
 
 @pytest.mark.parametrize("cheap", [D, TABLE_COL])
