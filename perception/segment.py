@@ -8,14 +8,18 @@ Two kinds of block colour are looked for:
   ``hue_tol`` (nearest, so that neighbouring hues such as orange and yellow never share a pixel);
 - one dark colour (every RGB channel at most ``dark_colour_max``, e.g. black): hue means nothing
   there, so a pixel belongs to it when it is dark (``dark_value``), nearly grey (``dark_chroma``)
-  and much darker than its local background (``dark_ratio`` of the median brightness around it).
-  The last test is what keeps shadows and a dark floor out: it assumes that a soft shadow keeps
-  more than half of the floor's brightness (fill light and bounces reach it) while a black
-  surface under the same light reflects well under half, and a uniformly dark floor is never
-  darker than itself. A shadow deeper than that, next to no black block, would be taken for one.
+  and much darker than its local background: at most ``dark_ratio`` of the median brightness
+  around it, and at least ``dark_contrast`` grey levels below it. The ratio is what keeps
+  shadows and a dark floor out: it assumes that a soft shadow keeps more than half of the
+  floor's brightness (fill light and bounces reach it) while a black surface under the same
+  light reflects well under half. A shadow deeper than that, next to no black block, would be
+  taken for one. The contrast is what keeps a black (or nearly black) image out: there a pixel
+  of value 0 is "at most half" of a background of 0, and every pixel used to be the black block.
 
 A block's region is the largest connected component of its pixels after a small morphological
-opening. Both scale with the image: the 2x2 opening is skipped on images whose shorter side is
+opening; a region over ``max_area_share`` of the image is the background, not a block (a block
+is a small part of any scene here, and an image of one colour shows none). The opening and
+``min_area`` scale with the image: the 2x2 opening is skipped on images whose shorter side is
 below ``open_min_side`` (at 45x30 a block is about 5 pixels wide), and ``min_area`` shrinks
 with the image area below ``ref_area`` (never under ``min_area_floor``), so results at the cube
 scenes' resolutions (160x120 and more) are unchanged. When no dark colour is looked for, labels
@@ -47,11 +51,13 @@ class SegmentConfig:
     ref_area: int = 160 * 120  # below this image area, min_area shrinks in proportion ...
     min_area_floor: int = 3  # ... but never below this many pixels
     open_min_side: int = 60  # the 2x2 opening runs only when the shorter side has this many px
+    max_area_share: float = 0.25  # a larger region of one colour is background, not a block
     dark_colour_max: float = 0.3  # a colour with every RGB channel <= this is looked for as dark
     dark_value: int = 70  # dark pixels: V (max channel) at most this ...
     dark_chroma: int = 32  # ... max - min channel below this (with a dark colour looked for,
     # vivid pixels need at least this spread, so a dark pixel is never given a hue) ...
     dark_ratio: float = 0.5  # ... and V at most this share of the local background's V,
+    dark_contrast: int = 10  # ... and at least this many grey levels below it,
     background_window: float = 0.5  # the median V over a square of this share of the short side
 
 
@@ -99,7 +105,8 @@ def _split_colours(colours: Sequence[Sequence[float]], config: SegmentConfig) ->
 
 
 def _dark_pixels(image: np.ndarray, value: np.ndarray, config: SegmentConfig) -> np.ndarray:
-    """(H, W) bool: dark, nearly grey, and much darker than the median V around them."""
+    """(H, W) bool: dark, nearly grey, and much darker than the median V around them (by
+    ``dark_ratio`` and by ``dark_contrast`` grey levels)."""
     rgb = image.astype(np.int16)  # (H, W, 3)
     chroma = rgb.max(-1) - rgb.min(-1)  # (H, W)
     side = round(config.background_window * min(value.shape))
@@ -109,6 +116,7 @@ def _dark_pixels(image: np.ndarray, value: np.ndarray, config: SegmentConfig) ->
         (value <= config.dark_value)
         & (chroma < config.dark_chroma)
         & (value <= config.dark_ratio * background)
+        & (value <= background - config.dark_contrast)
     )
 
 
@@ -149,7 +157,8 @@ def scaled_min_area(shape: Sequence[int], config: SegmentConfig = SegmentConfig(
 
 def _largest_regions(image, colours, config: SegmentConfig) -> list[tuple[tuple, int]]:
     """Per colour, the box (x0, y0, x1, y1) and pixel area of its largest connected region
-    after the small opening (area 0 and a dummy box when the colour shows nowhere)."""
+    after the small opening (area 0 and a dummy box when the colour shows nowhere, or only as
+    a region over ``max_area_share`` of the image: a background)."""
     labels = colour_labels(image, colours, config)  # (H, W)
     opening = min(image.shape[:2]) >= config.open_min_side
     kernel = np.ones((2, 2), np.uint8)
@@ -164,6 +173,9 @@ def _largest_regions(image, colours, config: SegmentConfig) -> list[tuple[tuple,
             continue
         best = 1 + int(np.argmax(stats[1:, cv2.CC_STAT_AREA]))
         x, y, w, hh, area = (int(v) for v in stats[best])
+        if area > config.max_area_share * mask.size:
+            out.append(((0.0, 0.0, 1.0, 1.0), 0))
+            continue
         out.append(((float(x), float(y), float(x + w), float(y + hh)), area))
     return out
 
