@@ -83,9 +83,10 @@ class Guarded:
     phases: tuple[Phase, ...]
     failure: str | None = None
     evidence: dict = field(default_factory=dict)
-    rerouted: tuple[str, ...] = ()
+    rerouted: tuple[str, ...] = ()  # phases replaced by a motion-planner detour
     check_time_s: float = 0.0
     plan_time_s: float = 0.0
+    planner_runs: int = 0  # motion-planner runs, whether or not they found a detour
 
 
 def thin(positions: np.ndarray, step: float) -> np.ndarray:
@@ -181,7 +182,7 @@ def guard_pick_place(
 ) -> Guarded:
     """Check every arm phase of a pick-and-place (see the module docstring); ``seed`` seeds
     the motion planner, so the same scene and seed give the same detour."""
-    out, rerouted, t_check, t_plan = [], [], 0.0, 0.0
+    out, rerouted, t_check, t_plan, runs = [], [], 0.0, 0.0, 0
     for phase in phases:
         if phase.name in ("close", "open"):  # standstills
             out.append(phase)
@@ -191,12 +192,13 @@ def guard_pick_place(
         model.hold(held)
         run, evidence, checked, planned = _guard_phase(phase, model, fingers, ignore, config, seed)
         t_check, t_plan = t_check + checked, t_plan + planned
+        runs += (run is not None and run is not phase) or "planner" in evidence
         if run is None:
-            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan)
+            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan, runs)
         out.append(run)
         if run is not phase:
             rerouted.append(phase.name)
-    return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan)
+    return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan, runs)
 
 
 def guard_free_move(

@@ -3,7 +3,8 @@
 `VideoWriter` writes the frames it is given as they come, so a long episode never holds its
 video in memory. `EpisodeVideo` records an episode off its physics loop's critical path: a frame
 is a `tamp.sim.base.Snapshot` of the world (joint positions and block poses, a few hundred
-bytes) sent to a spawned process, which poses its own copy of the world (``video=True``),
+bytes, read through the simulator's ground truth under its ``recording()`` grant) sent to a
+spawned process, which poses its own copy of the world (``video=True``),
 renders it at `VIDEO_SIZE` with ``render_video`` and writes it. The episode's simulator, and so
 every camera image perception sees, is untouched.
 """
@@ -132,7 +133,10 @@ class EpisodeVideo:
         self._process.start()  # its imports overlap the episode's start
 
     def write(self, sim: Simulator, caption: str = "", notes: Sequence[str] = ()) -> None:
-        snapshot = sim.snapshot()
+        """Queue what ``sim`` shows now: its snapshot (the true block poses), read under the
+        ground truth's ``recording()`` grant, which an episode's lock answers."""
+        with sim.truth.recording():
+            snapshot = sim.truth.snapshot()
         if self.frames == 0:
             centres = zip(sim.entities, snapshot.centres, strict=True)
             poses = {n: Pose(tuple(float(v) for v in c)) for n, c in centres}

@@ -144,6 +144,7 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
         "moves ok",
         "replans",
         "disturbed",
+        "unreadable",
         "wall/move",
         "sim/move",
         "x real",
@@ -162,6 +163,7 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
                 f"{s['moves_ok']}/{s['moves']}",
                 s["replans"],
                 s["disturbed"],
+                s.get("unreadable", "-"),  # of the disturbed; "-": results from before it
                 f"{s['wall_per_move_s']:.2f}s",
                 f"{s['sim_per_move_s']:.2f}s",
                 f"{s['sim_per_move_s'] / max(s['wall_per_move_s'], 1e-9):.1f}",
@@ -177,7 +179,8 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
             lines.append(
                 f"{sim}: collisions in executed trajectories: {s['collided']} episodes "
                 f"(touched: {hit}); collision checks {s['check_per_move_s']:.3f} s/move; "
-                f"motion planner on {s['rerouted']} moves, {s['path_per_move_s']:.3f} s/move"
+                f"{s['rerouted']} moves rerouted by the motion planner"
+                f"{_planner_failures(s)}, {s['path_per_move_s']:.3f} s/move"
             )
         if "arm_path_rad" in s:
             lines.append(
@@ -190,6 +193,14 @@ def motion_table(rows: dict[str, dict], inject: str) -> str:
                 f"{s['recovered']} of them still reached the goal"
             )
     return "\n".join(lines)
+
+
+def _planner_failures(s: dict) -> str:
+    """The motion planner's runs that found no way, in a motion summary ("" in one from before
+    they were counted)."""
+    if "planner_failures" not in s:
+        return ""
+    return f", {s['planner_failures']} planner runs found no way"
 
 
 def perception_table(summaries: list[dict]) -> str:

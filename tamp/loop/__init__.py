@@ -1,7 +1,8 @@
 """tamp.loop: the closed loop observe -> perceive -> plan -> execute -> check -> recover/replan.
 
-- ``episode``: `Episode`, one problem in one simulator, as a short loop of named steps, and
-  `run_episode`;
+- ``episode``: `Episode`, one problem in one simulator, as a short loop of public steps
+  (``start``, ``step``, ``execute``, ``check``, ``observe``, ``report``) that ``given`` drives
+  too, and `run_episode`;
 - ``config``: `LoopConfig`, the settings of an episode;
 - ``report``: `EpisodeStatus` and `EpisodeReport`, what an episode returns;
 - ``observe``: what the robot senses: block poses (for the arm) and the symbolic state (for the
@@ -12,8 +13,9 @@
 - ``given``: a plan from any source (4-op PDDL actions or moves) executed open-loop, with a
   task-level verdict, the motion outcome and what physically followed, per step;
 - ``score``: `Scorer`, the reader of simulator ground truth in the loop (the goal check and
-  disturbed stacks; ``given`` also reads it, to score each step); an episode locks
-  ``sim.truth`` for the rest;
+  each move's `MoveScore`: clean, disturbed, or unreadable, which counts against the plan;
+  ``given`` also reads it, to score each step, and under the experimenter's grant for
+  ``stop_at_invalid``); an episode locks ``sim.truth`` for the rest;
 - ``recover``: tidying loose blocks, injected nudges, failure descriptions;
 - ``faults``: fault injection settings (drop, nudge, noise).
 """

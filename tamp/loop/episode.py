@@ -12,12 +12,18 @@ read raises `tamp.sim.truth.GroundTruthLeak`.
 With ``observe="camera"`` the goal is the perceived goal scene; each planning window starts
 from the soft state perceived in the current image (frozen or planning-optimised perception),
 only that window's moves are executed, and the next window starts from a new image.
+
+The loop is a few public steps, which `run` (through `play`) and
+`tamp.loop.given.GivenPlanEpisode` both drive: `start` a tally, `step` (plan when nothing is
+queued, then the next move), `execute` one move with its faults and its score, `check` what
+the robot observes after it, `observe`, `close`, and `report`.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import time
+from collections import Counter
 from collections.abc import Callable
 from contextlib import contextmanager
 
@@ -33,7 +39,7 @@ from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
-from tamp.loop.score import Scorer
+from tamp.loop.score import MoveScore, Scorer
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
@@ -104,23 +110,22 @@ class Episode:
         return self.eyes.belief_lines()
 
     def run(self) -> EpisodeReport:
-        """Run the episode to the goal or a stop; closes the simulator."""
+        """Run the episode to the goal or a stop (`play`); closes the simulator."""
         with _torch_threads(1):  # one small problem: thread hand-offs cost more than they give
-            return self._run()
+            return self.play()
 
-    def _run(self) -> EpisodeReport:
+    def play(self) -> EpisodeReport:
+        """The closed loop: `start`, then `step` until the goal or a stop; scores the goal on
+        ground truth, closes the simulator and returns the `report`."""
         wall0 = time.perf_counter()
-        init = self.problem.init
-        p = Progress(init, self.domain.is_goal(self.target, init))
         try:
-            self._first_observation(p)
-            while not p.stopped and not self.domain.is_goal(self.target, p.state):
-                self._step(p)
+            p = self.start()
+            while not self.finished(p):
+                self.step(p)
             reached = self.score.reached(self.domain)
         finally:
-            self._close()
-        report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
-        return dataclasses.replace(report, touched=dict(self.sim.touched))
+            self.close()
+        return self.report(p, reached, wall0)
 
     def _home_guard(self, way):
         """The trip home to look again, checked against the scene's obstacles (the blocks are
@@ -128,22 +133,40 @@ class Episode:
         fixed = obstacle_boxes(self.config.scene)
         return guard_free_move(way, self.collision, fixed, self.config.execution.guard, self.seed)
 
-    def _close(self) -> None:
+    # --- the public steps ------------------------------------------------------------------
+    def start(self) -> Progress:
+        """A fresh tally at the problem's initial state. With the camera, the first state is
+        read from the first image, not given (a stop when it is unreadable)."""
+        init = self.problem.init
+        p = Progress(init, self.domain.is_goal(self.target, init))
+        if self.config.observe != "camera":
+            return p
+        reading = self.observe()
+        p.state = reading.state
+        if p.state is None:
+            p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
+        return p
+
+    def finished(self, p: Progress) -> bool:
+        """The episode stopped, or the observed state satisfies the (perceived) goal."""
+        return p.stopped or self.domain.is_goal(self.target, p.state)
+
+    def close(self) -> None:
+        """Free the simulator and the collision model."""
         self.sim.close()
         if self.collision is not None:
             self.collision.close()
 
-    # --- the steps -------------------------------------------------------------------------
-    def _first_observation(self, p: Progress) -> None:
-        """With the camera, the first state is read from the first image, not given."""
-        if self.config.observe != "camera":
-            return
-        reading = self._read()
-        p.state = reading.state
-        if p.state is None:
-            p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
+    def report(self, p: Progress, reached: bool, wall0: float) -> EpisodeReport:
+        """The EpisodeReport of tally ``p``: ``reached`` the goal (ground truth), the scored
+        contacts, and the ground-truth reads by grant; ``wall0``: the start on perf_counter."""
+        report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
+        reads = Counter()
+        for (grant, _), n in self.sim.truth.reads.items():
+            reads[grant] += n
+        return dataclasses.replace(report, touched=dict(self.sim.touched), truth_reads=dict(reads))
 
-    def _step(self, p: Progress) -> None:
+    def step(self, p: Progress) -> None:
         """Plan when no move is queued, then execute the next move and check what it did."""
         if not p.queue and not self._next_plan(p):
             return
@@ -153,10 +176,10 @@ class Episode:
         move = p.queue.pop(0)
         start, expected = p.planned, self.domain.apply_move(self.problem, p.planned, move)
         p.planned = expected
-        done = self._execute_next(p, move)
+        done = self.execute(p, move)
         if not done.ok and done.failure in ARM_FAILURES:  # motion-aware: priced out next time
             self._avoid.setdefault(start, set()).add(failed_key(move))
-        self._check(p, move, done, expected)
+        self.check(p, move, done, expected)
 
     def _next_plan(self, p: Progress) -> bool:
         """Plan from the observed state and queue its moves; False when there is none to run
@@ -220,9 +243,11 @@ class Episode:
         window = dataclasses.replace(self.config.planner, max_windows=1)
         return plan(current, window, seed=seed, beliefs=beliefs, costs=costs)
 
-    def _execute_next(self, p: Progress, move: Move) -> ExecutionResult:
+    def execute(self, p: Progress, move: Move) -> ExecutionResult:
         """Execute ``move`` with the injected faults (a drop in transit, a nudge after), let
-        the blocks settle, and count it if another block's support changed."""
+        the blocks settle, and score it on ground truth (`Scorer.move`): counted in
+        ``p.disturbed`` unless clean, and in ``p.unreadable`` too when the true state before or
+        after could not be read."""
         inject, k = self.config.inject, len(p.moves)
         drop = draw(self.rng, inject.drop) or k in inject.drop_moves
         drop_at = float(self.rng.uniform(0.2, 0.8)) if drop else None
@@ -236,24 +261,26 @@ class Episode:
             p.faults.append(f"nudge@{k}")
         p.moves.append(done)
         self._settle()
-        p.disturbed += self.score.disturbed(move, before)
+        scored = self.score.move(move, before)
+        p.disturbed += scored is not MoveScore.CLEAN
+        p.unreadable += scored is MoveScore.UNREADABLE
         return done
 
-    def _expect(self, state, move: Move):
+    def expect(self, state, move: Move):
         """The state ``move`` gives from ``state`` (None when it is illegal there)."""
         if self.domain.check_move(self.target, state, move) is None:
             return self.domain.apply_move(self.target, state, move)
         return None
 
-    def _check(self, p: Progress, move: Move, done: ExecutionResult, expected) -> None:
-        """Read the new state (tidying loose blocks if it is unreadable) and decide: go on,
-        replan, or stop."""
-        reading = self._read()
+    def check(self, p: Progress, move: Move, done: ExecutionResult, expected) -> None:
+        """Observe the new state (tidying loose blocks if it is unreadable) and decide: go on,
+        replan, or stop (robot-side signals only: ``done`` and the observation)."""
+        reading = self.observe()
         self.say(f"{move}: " + ("ok" if done.ok else done.failure.value))
         if reading.state is None and p.tidies < self.config.max_tidies:
             p.tidies += 1
             p.moves += tidy(reading, self._act, self._settle, self.say)
-            reading = self._read()
+            reading = self.observe()
         if reading.state is None:
             p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
             return
@@ -297,7 +324,8 @@ class Episode:
     def _poses(self) -> dict[str, Pose]:
         return self.eyes.poses(self.on_frame, self._show)
 
-    def _read(self) -> Reading:
+    def observe(self) -> Reading:
+        """The symbolic state the robot observes now (`Observer.read`)."""
         return self.eyes.read(self.on_frame, self._show)
 
     def _show(self, text: str) -> None:

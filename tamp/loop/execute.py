@@ -7,7 +7,13 @@ block-wide object?), and a post-place check of the observed block pose. Every po
 ``observe``: the motion-capture oracle with ``observe="state"``, the depth camera with
 ``observe="camera"`` (`tamp.loop.observe.Observer.poses`). When the camera cannot see a block
 the move needs, even from home, the move fails as ``unobservable``. The simulator's ground
-truth is not read here (an episode locks it; `tamp.loop.score` alone scores).
+truth is not read here (an episode locks it; `tamp.loop.score` alone scores). With the ``weld``
+grasp, what is welded is the block between the closed fingers (`Simulator.attach`), not the
+block the move names: a hand closed on nothing, or on the wrong block, holds what it holds.
+
+Each phase tells the simulator which contacts it is meant to make (`tamp.sim.base.Expected`:
+the arm on the block it handles; the held block on what it leaves and what it is put onto), so
+the experimenter's contact scoring counts every other touch of the arm or the carried block.
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ from motion.trajectory import JointTrajectory
 from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
-from tamp.sim.base import Simulator
+from tamp.sim.base import Expected, Simulator
 from task.errors import TampError, one_of
 from task.problem import TABLE, Move
 
@@ -82,8 +88,11 @@ class ExecutionResult:
     wall_time_s: float = 0.0
     ik_time_s: float = 0.0
     check_time_s: float = 0.0  # collision checks of the planned trajectories
-    path_time_s: float = 0.0  # the motion planner's detours
+    path_time_s: float = 0.0  # the motion planner's runs, detours found or not
     path_rad: float = 0.0  # joint-space length (rad) of the arm phases started: sum of |dq|
+    rerouted: tuple[str, ...] = ()  # phases started on a motion-planner detour
+    planner_runs: int = 0  # motion-planner runs over every grasp and slot tried
+    planner_failures: int = 0  # ... of which found no collision-free detour
 
 
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
@@ -114,14 +123,9 @@ def obstacle_boxes(scene: SceneConfig):
     return tuple(Box(o.name, o.centre, o.half, o.yaw) for o in scene.obstacles)
 
 
-def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig):
-    """The collision world of a move: the observed blocks as boxes, the scene's obstacles,
-    what the picked block stands on and what it goes onto (block names or "table")."""
-    from robots.collision import Box
-
-    half = (scene.block_size / 2,) * 3
-    blocks = tuple(Box(k, p.xyz, half, p.yaw) for k, p in poses.items())
-    fixed = obstacle_boxes(scene)
+def _supports(move: Move, poses: dict[str, Pose], scene: SceneConfig) -> tuple[str, str]:
+    """What the picked block stands on, as observed, and what it goes onto (block names or
+    "table")."""
     pick = poses[move.entity]
     below = [
         k
@@ -130,35 +134,50 @@ def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig)
         and np.linalg.norm(p.xy - pick.xy) <= scene.tol_xy
         and abs(pick.xyz[2] - p.xyz[2] - scene.block_size) <= 2 * scene.tol_z
     ]
-    onto = "table" if move.target == TABLE else move.target
+    return below[0] if below else "table", "table" if move.target == TABLE else move.target
+
+
+def _world(move: Move, poses: dict[str, Pose], target: Pose, scene: SceneConfig):
+    """The collision world of a move: the observed blocks as boxes, the scene's obstacles,
+    what the picked block stands on and what it goes onto (block names or "table")."""
+    from robots.collision import Box
+
+    half = (scene.block_size / 2,) * 3
+    blocks = tuple(Box(k, p.xyz, half, p.yaw) for k, p in poses.items())
+    fixed = obstacle_boxes(scene)
+    below, onto = _supports(move, poses, scene)
     placed = Box(move.entity, target.xyz, half, target.yaw)
-    return PickPlaceWorld(
-        blocks + fixed,
-        move.entity,
-        below[0] if below else "table",
-        onto,
-        placed,
-        scene.block_size,
-    )
+    return PickPlaceWorld(blocks + fixed, move.entity, below, onto, placed, scene.block_size)
 
 
-def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame) -> None:
+def _expected(phase: str, block: str, supports: tuple[str, str]) -> Expected:
+    """The contacts ``phase`` of the move of ``block`` is meant to make (contact scoring): the
+    arm on the block throughout; once it is held, the block on what it leaves while lifted and
+    on what it goes onto while lowered, nothing in transit."""
+    rests = {"lift": supports[0], "transit": None, "lower": supports[1]}
+    if phase not in rests:
+        return Expected(block)
+    return Expected(block, block, frozenset({rests[phase]} - {None}))
+
+
+def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:
     """After a failure at the block: open the gripper and undo the descent (a safe pose)."""
     sim.detach()
     q = sim.arm_q()
     hold = JointTrajectory.hold(q, 0.3, sim.dt)
-    sim.run(hold, "open", on_frame=on_frame)
+    sim.run(hold, "open", on_frame=on_frame, expected=expected)
     phase = next(ph for ph in phases if ph.name == "descend")
     up = phase.trajectory
     back = JointTrajectory(
         up.times, up.positions[::-1].copy(), -up.velocities[::-1], up.accelerations[::-1]
     )
     if np.abs(back.positions[0] - q).max() < 0.05:
-        sim.run(back, "open", on_frame=on_frame)
+        sim.run(back, "open", on_frame=on_frame, expected=expected)
 
 
 def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
-    """(target pose, phases, IK time) of the move, or (Failure, IK time, evidence). A move
+    """(target pose, phases, IK time, rerouted phases) of the move, or (Failure, IK time,
+    evidence); adds to ``times`` (check s, planner s, path rad, planner runs, failures). A move
     whose motion fails tries the quarter-turned grasp (a neighbour touching the block on one
     side leaves the other pair of faces free), and a table placement the next free slots (up
     to ``config.slot_tries``)."""
@@ -186,14 +205,16 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
             last = (Failure(planned.failure), ik, planned.evidence)
             continue
         if collision is None or config.collision == "off":
-            return target, planned.phases, ik
+            return target, planned.phases, ik, ()
         world = _world(move, poses, target, scene)
         guard = replace(config.guard, plan=config.collision == "plan")
         checked = guard_pick_place(planned.phases, collision, world, guard, seed)
         times[0] += checked.check_time_s
         times[1] += checked.plan_time_s
+        times[3] += checked.planner_runs
+        times[4] += "planner" in checked.evidence  # the detour the planner found no way for
         if checked.ok:
-            return target, checked.phases, ik
+            return target, checked.phases, ik, checked.rerouted
         last = (Failure.COLLISION, ik, checked.evidence)
     return last
 
@@ -218,7 +239,9 @@ def execute_move(
     """
     wall0, sim0 = time.perf_counter(), sim.time
 
-    times = [0.0, 0.0, 0.0]  # collision checks, motion planner, path run (rad)
+    # collision checks (s), motion planner (s), path run (rad), planner runs, planner failures
+    times = [0.0, 0.0, 0.0, 0, 0]
+    started: list[str] = []  # rerouted phases started
 
     def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
         return ExecutionResult(
@@ -229,10 +252,12 @@ def execute_move(
             sim.time - sim0,
             time.perf_counter() - wall0,
             ik_time,
-            *times,
+            *times[:3],
+            rerouted=tuple(started),
+            planner_runs=times[3],
+            planner_failures=times[4],
         )
 
-    sim.moving = move.entity  # scoring: the arm touching this block is no collision
     try:
         poses = observe()
     except PerceptionError as err:
@@ -240,7 +265,8 @@ def execute_move(
     planned = _plan(sim, solver, move, poses, config, scene, collision, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
         return result(planned[0], planned[1], **planned[2])
-    target, phases, ik = planned
+    target, phases, ik, rerouted = planned
+    supports, handling = _supports(move, poses, scene), Expected(move.entity)
     worst = 0.0
     for phase in phases:
         release = None
@@ -248,24 +274,29 @@ def execute_move(
             release = drop_at * phase.trajectory.duration
         if phase.name == "open":
             sim.detach()
+        if phase.name in rerouted:
+            started.append(phase.name)
         q = phase.trajectory.positions  # (S, J)
         times[2] += float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum())
-        worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame))
+        expected = _expected(phase.name, move.entity, supports)
+        worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame, expected))
         if worst > config.max_tracking:
-            _back_off(sim, phases, on_frame)
+            _back_off(sim, phases, on_frame, handling)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
             missed = _holding(sim, config, fresh=True)
+            if missed is None and sim.grasp == "weld" and not sim.attach():
+                r = sim.gripper()  # block-wide, but no one block touches both fingers
+                missed = {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
             if missed is not None:
-                _back_off(sim, phases, on_frame)
+                _back_off(sim, phases, on_frame, handling)
                 return result(Failure.GRASP_MISSED, ik, **missed)
-            if sim.grasp == "weld":
-                sim.attach(move.entity)
         elif phase.name in ("lift", "transit"):
             gone = _holding(sim, config, fresh=False)
             if gone is not None:
                 sim.detach()
-                sim.run(JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt), "open", on_frame=on_frame)
+                hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
+                sim.run(hold, "open", on_frame=on_frame, expected=handling)
                 injected = release is not None  # the fault injection opened the gripper
                 return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **gone)
     try:

@@ -12,9 +12,15 @@ Actions pair up into pick-and-place moves (`read_given`). Per step, `GivenPlanEp
 - what physically followed: other blocks that moved (fell or were pushed) and where the carried
   block came to rest, from the true poses before and after the step.
 
-A step invalid at task level is still attempted unless ``stop_at_invalid``. With ``replan`` the
-robot observes after every step and the planner takes over from the observed state when a step
-failed or the observed state is not the one the step should give (robot-side signals only).
+A step invalid at task level is still attempted unless ``stop_at_invalid``: an explicit
+experimenter grant (``GroundTruth.experimenter()``), under which the experimenter, not the
+robot, reads the TRUE state before each step and skips the first step invalid there; the step's
+report says so, and the episode's ``truth_reads`` count those reads. With ``replan`` the robot
+observes after every step and the planner takes over from the observed state when a step failed
+or the observed state is not the one the step should give (robot-side signals only).
+
+The episode drives `tamp.loop.episode.Episode`'s public steps (``execute``, ``check``,
+``observe``, ``step``, ``report``), as the closed loop does.
 """
 
 from __future__ import annotations
@@ -68,6 +74,10 @@ class StepReport:
     carried_to: str = ""  # where the carried block came to rest: a block, "table" or "loose"
     # ("" when it never left its place: the move was refused or failed before the lift)
 
+    # who decided not to attempt the step: "experimenter" (the ``stop_at_invalid`` grant, from
+    # the true state); "" when it was attempted or its actions do not pair into a move
+    skipped_by: str = ""
+
     def line(self) -> str:
         """One line, e.g. ``3-4 (unstack a d) (stack a b): INVALID at task level: ...``."""
         if self.valid is None:
@@ -76,7 +86,10 @@ class StepReport:
             verdict = "valid" if self.valid else f"INVALID at task level: {self.reason}"
         ev = ", ".join(f"{k} {v}" for k, v in self.evidence.items() if not isinstance(v, dict))
         outcome = self.outcome + (f" ({ev})" if ev and self.outcome != "executed" else "")
-        text = f"{self.label}: {verdict}; attempted: {outcome if self.attempted else 'no'}"
+        attempted = outcome if self.attempted else "no"
+        if self.skipped_by:
+            attempted += f" ({self.skipped_by} grant --stop-at-invalid: invalid in the true state)"
+        text = f"{self.label}: {verdict}; attempted: {attempted}"
         if self.attempted:
             text += f"; disturbed: {', '.join(self.disturbed) or 'none'}"
             rest = "loose" if self.carried_to == "loose" else f"on {self.carried_to}"
@@ -201,23 +214,24 @@ class GivenPlanEpisode(Episode):
         self.pddl = _pddl(problem)
         self.records: list[StepReport] = []
 
-    def _run(self) -> EpisodeReport:
+    def play(self) -> EpisodeReport:
+        """The given steps, then (``replan``) the closed loop's `step` until the goal or a
+        stop; scores the goal on ground truth, closes the simulator, returns the report."""
         wall0 = time.perf_counter()
         p = Progress(self.problem.init, False)
         p.plans.append(tuple(s.label for s in self.steps))
         try:
             handed = self._given(p)
-            while handed and not p.stopped and not self.domain.is_goal(self.target, p.state):
-                self._step(p)
+            while handed and not self.finished(p):
+                self.step(p)
             reached = self.score.reached(self.domain)
         finally:
-            self._close()
+            self.close()
         if not (p.stopped or handed or reached):
             bad = [r.label for r in self.records if r.valid is False or r.outcome != "executed"]
             why = f"first problem at {bad[0]}" if bad else "every step executed"
             p.stop(EpisodeStatus.PLAN_ENDED, f"the goal does not hold at the end; {why}")
-        report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
-        return replace(report, steps=tuple(self.records), touched=dict(self.sim.touched))
+        return replace(self.report(p, reached, wall0), steps=tuple(self.records))
 
     def _given(self, p: Progress) -> bool:
         """Run the given steps; True when the planner is to take over (``replan``)."""
@@ -225,17 +239,27 @@ class GivenPlanEpisode(Episode):
             before = self._true_poses()
             truth = read_state(self.problem.entities, before, self.config.scene).state
             valid, failed, reason = verdict(step, self.problem, truth, self.pddl)
-            if step.move is None or (valid is False and self.stop_at_invalid):
+            skipped = self._experimenter_skips(step)
+            if step.move is None or skipped:
+                by = "experimenter" if skipped else ""
                 self._record(
                     StepReport(
-                        step.number, step.label, valid, failed, reason, False, "not attempted"
+                        step.number,
+                        step.label,
+                        valid,
+                        failed,
+                        reason,
+                        False,
+                        "not attempted",
+                        skipped_by=by,
                     )
                 )
                 if not self.replan:
-                    p.stop(EpisodeStatus.INVALID_PLAN, f"{step.label}: {reason}")
+                    who = "the experimenter stopped (--stop-at-invalid) at " if skipped else ""
+                    p.stop(EpisodeStatus.INVALID_PLAN, f"{who}{step.label}: {reason}")
                     return False
                 return self._observe(p)
-            done = self._execute_next(p, step.move)
+            done = self.execute(p, step.move)
             after = self._true_poses()
             x, scene = step.move.entity, self.config.scene
             read0, read1 = (read_state(self.problem.entities, q, scene) for q in (before, after))
@@ -265,14 +289,25 @@ class GivenPlanEpisode(Episode):
             )
             if self.replan:  # the robot's own check: observe, and replan on a surprise
                 replans = p.replans
-                self._check(p, step.move, done, self._expect(p.state, step.move))
+                self.check(p, step.move, done, self.expect(p.state, step.move))
                 if p.stopped or p.replans > replans:
                     return not p.stopped
         return self.replan and self._observe(p)  # the plan ended: the planner finishes it
 
+    def _experimenter_skips(self, step: GivenStep) -> bool:
+        """``stop_at_invalid``: the experimenter, not the robot, decides from the TRUE state
+        (an experimenter grant, ``GroundTruth.experimenter()``) that ``step`` is not attempted
+        because it is invalid there. The robot never reads the truth: without the grant every
+        step that pairs into a move is attempted."""
+        if not self.stop_at_invalid or step.move is None:
+            return False
+        with self.sim.truth.experimenter():
+            truth = self.sim.truth.state(self.problem.entities, self.config.scene)
+        return verdict(step, self.problem, truth, self.pddl)[0] is False
+
     def _observe(self, p: Progress) -> bool:
         """Observe the state the planner takes over from; False if it is unreadable."""
-        reading = self._read()
+        reading = self.observe()
         if reading.state is None:
             p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
             return False

@@ -34,7 +34,9 @@ class EpisodeReport:
     plans: tuple[tuple[str, ...], ...]  # every plan made, as move strings
     replans: int
     faults: tuple[str, ...]  # injected faults, e.g. "drop@3" (move index)
-    disturbed: int  # moves after which a block other than the moved one changed support
+    # moves not scored clean on ground truth (`tamp.loop.score.MoveScore`): another block
+    # changed support, or the true state before or after was unreadable (``unreadable`` of them)
+    disturbed: int
     sim_time_s: float
     wall_time_s: float
     plan_time_s: float
@@ -42,9 +44,14 @@ class EpisodeReport:
     reason: str = ""
     first_plan: tuple[Move, ...] = ()  # the first task plan's moves (camera: its first window)
     steps: tuple = ()  # a given plan: one `tamp.loop.given.StepReport` per step
-    # scoring: what the arm touched in the simulator other than the block it was moving
-    # (block, obstacle or "table" -> contact samples); `collided` is True when any was touched
+    # scoring: what the arm, the hand or the block held in it touched in the simulator that
+    # the move was not meant to touch (`tamp.sim.base.Expected`): block, obstacle or "table",
+    # "held:" + name for the held block's contacts -> physics steps in contact; `collided` is
+    # True when anything was touched
     touched: dict = field(default_factory=dict)
+    unreadable: int = 0  # moves after which (or before which) the true state formed no state
+    # ground-truth reads answered, by grant (`tamp.sim.truth.GRANTS`), e.g. {"scoring": 12}
+    truth_reads: dict = field(default_factory=dict)
 
     @property
     def collided(self) -> bool:
@@ -63,6 +70,9 @@ class EpisodeReport:
                 "sim_time_s": round(r.sim_time_s, 3),
                 "wall_time_s": round(r.wall_time_s, 3),
                 "ik_time_s": round(r.ik_time_s, 4),
+                "rerouted": list(r.rerouted),
+                "planner_runs": r.planner_runs,
+                "planner_failures": r.planner_failures,
             }
             for r in self.moves
         ]
@@ -82,7 +92,8 @@ class Progress:
     queue: list[Move] = field(default_factory=list)  # the planned moves still to execute
     planned: tuple[str, ...] | None = None  # the state the queue was planned from, advanced
     replans: int = 0
-    disturbed: int = 0
+    disturbed: int = 0  # moves not scored clean (`tamp.loop.score.MoveScore`)
+    unreadable: int = 0  # ... of which the true state was unreadable
     tidies: int = 0
     stalls: int = 0  # camera: windows in a row that decoded no move
     plan_time: float = 0.0
@@ -113,4 +124,5 @@ class Progress:
             self.first_solved,
             self.reason,
             self.first_plan,
+            unreadable=self.unreadable,
         )

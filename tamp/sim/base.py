@@ -4,15 +4,20 @@ A backend owns a world with the Panda, a table and the blocks of a scene. The sa
 `motion.trajectory.JointTrajectory` (sampled at the simulator's ``dt`` = 2 ms in both
 backends) drives both: each physics step gets the trajectory's joint targets. What the loop
 may sense is what a real robot has: joint positions, finger opening and the contact force on
-each finger (from whatever it touches), and camera images. The true block poses sit behind
-``sim.truth`` (`tamp.sim.truth.GroundTruth`), which scores episodes and which an episode locks.
+each finger (from whatever it touches), and camera images. The true block poses, and the
+snapshots a video is drawn from, sit behind ``sim.truth`` (`tamp.sim.truth.GroundTruth`), which
+scores episodes and which an episode locks.
+
+Contact scoring (``Simulator.touched``, the experimenter's, never a sensor): after every physics
+step, whatever touches the arm, the hand or the block held in it is counted, except the
+contacts the running trajectory is meant to make (`Expected`).
 """
 
 from __future__ import annotations
 
 import abc
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -26,6 +31,8 @@ from task.errors import TampError, one_of
 SIMULATORS = ("pybullet", "mujoco")
 DT = 0.002  # s, physics step of both backends
 TRACK_EVERY = 5  # steps between tracking-error samples
+ROBOT = "robot"  # `Simulator._contacts`' name for any link of the Panda
+HELD = "held:"  # `Simulator.touched` key prefix of what the held block touched, e.g. "held:c"
 VIDEO_SIZE = (640, 480)  # (width, height) of `Simulator.render_video` frames
 
 
@@ -67,8 +74,21 @@ class GripperReading:
     right_force: float
 
 
+@dataclass(frozen=True)
+class Expected:
+    """The contacts a trajectory is meant to make, which contact scoring does not count
+    (`Simulator.run`): the arm on ``handled``, the block the current move picks and places;
+    and, while ``held`` is in the hand, that block on ``rests`` (what it leaves or is put onto
+    in this phase: block names or "table"). Every other contact of the arm or the held block
+    counts in `Simulator.touched`; the default expects none."""
+
+    handled: str | None = None
+    held: str | None = None
+    rests: frozenset[str] = frozenset()
+
+
 class Snapshot(NamedTuple):
-    """What a video frame shows (`Simulator.snapshot`, `Simulator.show`), in any backend:
+    """What a video frame shows (`GroundTruth.snapshot`, `Simulator.show`), in any backend:
     arm and finger joint positions (J + 2,), block centres (N, 3) and orientations (N, 4) as
     quaternions (w, x, y, z), blocks in ``entities`` order."""
 
@@ -104,11 +124,11 @@ class Simulator(abc.ABC):
         self.time = 0.0
         self.frame_period = 0.2  # simulated seconds between ``on_frame`` calls
         self._next_frame = 0.0  # simulated time of the next ``on_frame`` call, across runs
-        self.truth = GroundTruth(self._block_poses)  # scoring only; see tamp.sim.truth
-        # scoring only: what the arm touched while running trajectories (name -> samples),
-        # apart from ``moving``, the block the current move handles
+        # scoring and videos only; see tamp.sim.truth
+        self.truth = GroundTruth(self._block_poses, self._snapshot)
+        # scoring only: what the arm, the hand or the held block touched while running
+        # trajectories and was not expected to (name, or "held:" + name -> physics steps)
         self.touched: dict[str, int] = {}
-        self.moving: str | None = None
 
     # --- what a backend implements -------------------------------------------------------
     @abc.abstractmethod
@@ -129,8 +149,9 @@ class Simulator(abc.ABC):
         robot (the finger sensors)."""
 
     @abc.abstractmethod
-    def _robot_touching(self) -> set[str]:
-        """Names of what touches the arm or hand now: blocks, obstacles, "table" (scoring)."""
+    def _contacts(self) -> set[tuple[str, str]]:
+        """Every pair of things in contact now, by name: blocks, obstacles, "table", and
+        `ROBOT` for any link of the Panda (scoring only, see `Simulator.run`)."""
 
     @abc.abstractmethod
     def _block_poses(self) -> dict[str, Pose]:
@@ -141,8 +162,11 @@ class Simulator(abc.ABC):
         """Teleport a block (fault injection); its velocity is zeroed."""
 
     @abc.abstractmethod
-    def attach(self, block: str) -> None:
-        """Weld ``block`` to the hand where it is now (the ``weld`` grasp mode)."""
+    def attach(self) -> bool:
+        """The ``weld`` grasp mode: weld to the hand, where it is now, the block the closed
+        fingers hold, i.e. the one body that both fingers touch (what the finger contacts give a
+        real gripper). False, and nothing welded, when the fingers hold no block. The caller
+        learns no name: the robot cannot tell which block it holds."""
 
     @abc.abstractmethod
     def detach(self) -> None:
@@ -169,8 +193,9 @@ class Simulator(abc.ABC):
         ``video=True``, which then draws nothing else; TinyRenderer otherwise)."""
 
     @abc.abstractmethod
-    def snapshot(self) -> Snapshot:
-        """The arm, fingers and blocks as they are now (for videos, not a sensor)."""
+    def _snapshot(self) -> Snapshot:
+        """The arm, fingers and blocks as they are now: the true block poses, so read it through
+        ``self.truth.snapshot()`` only (for videos, not a sensor)."""
 
     @abc.abstractmethod
     def show(self, snapshot: Snapshot) -> None:
@@ -202,12 +227,15 @@ class Simulator(abc.ABC):
         gripper: str,
         release_at: float | None = None,
         on_frame: Callable[[Simulator], None] | None = None,
+        expected: Expected = Expected(),
     ) -> float:
         """Track ``trajectory`` step by step with the gripper held at ``gripper``.
 
         ``release_at`` (s into the trajectory) opens the gripper there (fault injection: a
-        drop). ``on_frame(self)`` is called every ``self.frame_period`` simulated seconds, on
-        one clock across runs (a video's frames stay evenly spaced over many moves). Returns
+        drop; from then on nothing is held). ``on_frame(self)`` is called every
+        ``self.frame_period`` simulated seconds, on one clock across runs (a video's frames stay
+        evenly spaced over many moves). After every physics step, the contacts of the arm and
+        of the held block that ``expected`` does not name are counted in ``touched``. Returns
         the largest joint tracking error (rad) seen every ``TRACK_EVERY`` steps and at the end.
         """
         worst = 0.0
@@ -215,17 +243,29 @@ class Simulator(abc.ABC):
             if release_at is not None and trajectory.times[k] >= release_at:
                 gripper = "open"
                 self.detach()
+                expected = replace(expected, held=None, rests=frozenset())
             self._command(trajectory.positions[k], trajectory.velocities[k], gripper)
             self._step()
             self.time += self.dt
+            self._count_contacts(expected)
             if k % TRACK_EVERY == 0 or k == len(trajectory.times) - 1:
                 worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
-                for name in self._robot_touching() - {self.moving}:
-                    self.touched[name] = self.touched.get(name, 0) + 1
             if on_frame is not None and self.time >= self._next_frame:
                 on_frame(self)
                 self._next_frame = max(self._next_frame + self.frame_period, self.time)
         return worst
+
+    def _count_contacts(self, expected: Expected) -> None:
+        """Count in ``touched`` this step's unexpected contacts of the arm and the held block."""
+        hit = set()
+        for pair in self._contacts():
+            for me, other in (pair, pair[::-1]):
+                if me == ROBOT and other not in (ROBOT, expected.handled):
+                    hit.add(other)
+                elif me == expected.held and other != ROBOT and other not in expected.rests:
+                    hit.add(HELD + other)
+        for name in hit:
+            self.touched[name] = self.touched.get(name, 0) + 1
 
     def __enter__(self) -> Simulator:
         return self

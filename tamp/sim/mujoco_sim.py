@@ -20,7 +20,15 @@ import numpy as np
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import VIDEO_SIZE, Camera, GripperReading, Lighting, Simulator, Snapshot
+from tamp.sim.base import (
+    ROBOT,
+    VIDEO_SIZE,
+    Camera,
+    GripperReading,
+    Lighting,
+    Simulator,
+    Snapshot,
+)
 from task.errors import TampError
 
 FINGER_BODIES = ("panda_leftfinger", "panda_rightfinger")
@@ -138,6 +146,15 @@ class MuJoCoSim(Simulator):
         self._geom_names = {m.geom("floor").id: "table"}
         self._geom_names |= {m.geom(f"obstacle_{o.name}").id: o.name for o in scene.obstacles}
         self._geom_names |= {m.geom(f"block_{n}").id: n for n in self.entities}
+        # contact scoring: each geom's index in _labels (the robot's are all ROBOT), or -1
+        self._labels = [ROBOT, *dict.fromkeys(self._geom_names.values())]
+        self._geom_label = np.array(
+            [
+                self._labels.index(self._geom_names[g]) if g in self._geom_names else -1
+                for g in range(m.ngeom)
+            ]
+        )
+        self._geom_label[m.body_rootid[m.geom_bodyid] == m.body_rootid[self._hand]] = 0
         d.qpos[self._arm_q] = PANDA.q_home
         d.qpos[self._fingers] = PANDA.finger_open
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
@@ -174,17 +191,14 @@ class MuJoCoSim(Simulator):
         width = float(d.qpos[self._fingers].sum())
         return GripperReading(width, forces[0], forces[1])
 
-    def _robot_touching(self) -> set[str]:
-        m, d = self.model, self.data
-        robot = m.body_rootid[self._hand]
-        out = set()
-        for i in range(d.ncon):
-            g = (d.contact[i].geom1, d.contact[i].geom2)
-            roots = [m.body_rootid[m.geom_bodyid[k]] for k in g]
-            if (roots[0] == robot) != (roots[1] == robot):  # the arm and something else
-                other = g[1] if roots[0] == robot else g[0]
-                out.add(self._geom_names.get(int(other), "?"))
-        return out
+    def _contacts(self) -> set[tuple[str, str]]:
+        if self.data.ncon == 0:
+            return set()
+        codes = self._geom_label[self.data.contact.geom]  # (C, 2): -1 for unnamed geoms
+        labels = self._labels
+        return {
+            (labels[a], labels[b]) for a, b in set(map(tuple, codes.tolist())) if min(a, b) >= 0
+        }
 
     def _block_poses(self) -> dict[str, Pose]:
         out = {}
@@ -201,8 +215,26 @@ class MuJoCoSim(Simulator):
         self.data.qvel[vadr : vadr + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
 
-    def attach(self, block: str) -> None:
+    def _between_fingers(self) -> str | None:
+        """The block both fingers touch (the one between them), or None."""
+        m, d = self.model, self.data
+        touched: list[set[str]] = [set(), set()]
+        blocks = {i: n for n, i in self._block_ids.items()}
+        for i in range(d.ncon):
+            bodies = (m.geom_bodyid[d.contact[i].geom1], m.geom_bodyid[d.contact[i].geom2])
+            for k, finger in enumerate(self._finger_ids):
+                if finger in bodies:
+                    other = bodies[1] if bodies[0] == finger else bodies[0]
+                    if int(other) in blocks:
+                        touched[k].add(blocks[int(other)])
+        both = touched[0] & touched[1]
+        return next(iter(both)) if len(both) == 1 else None
+
+    def attach(self) -> bool:
         self.detach()
+        block = self._between_fingers()
+        if block is None:
+            return False
         m, d = self.model, self.data
         i = self._weld_ids[block]
         hand_q, block_q, inv, rel = np.zeros(4), np.zeros(4), np.zeros(4), np.zeros(3)
@@ -216,6 +248,7 @@ class MuJoCoSim(Simulator):
         mujoco.mju_mulQuat(quat, inv, block_q)
         m.eq_data[i, 6:10] = quat
         d.eq_active[i] = 1
+        return True
 
     def detach(self) -> None:
         # only the grasp welds: the finger coupling (a joint equality) must stay active
@@ -274,7 +307,7 @@ class MuJoCoSim(Simulator):
         self._video.update_scene(self.data, camera="scene")
         return self._video.render().copy()
 
-    def snapshot(self) -> Snapshot:
+    def _snapshot(self) -> Snapshot:
         q = self.data.qpos
         joints = np.concatenate([q[self._arm_q], q[self._fingers]])  # (J + 2,)
         free = np.array([q[a : a + 7] for a in self._block_q.values()]).reshape(-1, 7)  # (N, 7)

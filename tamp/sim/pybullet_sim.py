@@ -18,7 +18,15 @@ import pybullet as p
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
 from tamp.scene import Pose, colour, cube_yaw
-from tamp.sim.base import VIDEO_SIZE, Camera, GripperReading, Lighting, Simulator, Snapshot
+from tamp.sim.base import (
+    ROBOT,
+    VIDEO_SIZE,
+    Camera,
+    GripperReading,
+    Lighting,
+    Simulator,
+    Snapshot,
+)
 from task.errors import TampError
 
 FINGER_FORCE = 40.0  # N per finger
@@ -185,10 +193,10 @@ class PyBulletSim(Simulator):
         ]
         return GripperReading(width, forces[0], forces[1])
 
-    def _robot_touching(self) -> set[str]:
-        c, names = self.client, self._names
-        found = {pt[2] for pt in p.getContactPoints(self.robot.body, physicsClientId=c)}
-        return {names[b] for b in found if b in names}
+    def _contacts(self) -> set[tuple[str, str]]:
+        names = {**self._names, self.robot.body: ROBOT}
+        pairs = {(pt[1], pt[2]) for pt in p.getContactPoints(physicsClientId=self.client)}
+        return {(names[a], names[b]) for a, b in pairs if a in names and b in names}
 
     def _block_poses(self) -> dict[str, Pose]:
         out = {}
@@ -203,18 +211,32 @@ class PyBulletSim(Simulator):
         p.resetBasePositionAndOrientation(body, pose.xyz, _quat(pose.yaw), physicsClientId=c)
         p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=c)
 
-    def attach(self, block: str) -> None:
+    def _between_fingers(self) -> int | None:
+        """The block body both fingers touch (the one between them), or None."""
+        r, c, blocks = self.robot, self.client, set(self.blocks.values())
+        touched = [
+            {pt[2] for pt in p.getContactPoints(r.body, linkIndexA=link, physicsClientId=c)}
+            & blocks
+            for link in r.fingers
+        ]
+        both = touched[0] & touched[1]
+        return next(iter(both)) if len(both) == 1 else None
+
+    def attach(self) -> bool:
         self.detach()
+        body = self._between_fingers()
+        if body is None:
+            return False
         r, c = self.robot, self.client
         link = p.getLinkState(r.body, r.tcp, computeForwardKinematics=True, physicsClientId=c)
-        b_pos, b_orn = p.getBasePositionAndOrientation(self.blocks[block], physicsClientId=c)
+        b_pos, b_orn = p.getBasePositionAndOrientation(body, physicsClientId=c)
         inv_pos, inv_orn = p.invertTransform(link[4], link[5])
         rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, b_pos, b_orn)
         # the TCP link is massless, so its inertial frame is its link frame
         self._weld = p.createConstraint(
             r.body,
             r.tcp,
-            self.blocks[block],
+            body,
             -1,
             p.JOINT_FIXED,
             [0, 0, 0],
@@ -223,6 +245,7 @@ class PyBulletSim(Simulator):
             parentFrameOrientation=rel_orn,
             physicsClientId=c,
         )
+        return True
 
     def detach(self) -> None:
         if self._weld is not None:
@@ -269,7 +292,7 @@ class PyBulletSim(Simulator):
         )
         return np.asarray(rgb, dtype=np.uint8).reshape(h, w, 4)[..., :3].copy()
 
-    def snapshot(self) -> Snapshot:
+    def _snapshot(self) -> Snapshot:
         r, c = self.robot, self.client
         joints = [s[0] for s in p.getJointStates(r.body, [*r.arm, *r.fingers], physicsClientId=c)]
         bases = [

@@ -2,14 +2,19 @@
 
 Simulator ground truth only scores episodes: a real robot has joint encoders, finger sensors
 and a camera, not the world's state. Every ground-truth query (block poses, the true symbolic
-state) goes through ``sim.truth``. An episode locks it; a locked `GroundTruth` answers only
-inside one of three named grants, and anything else that reads it raises `GroundTruthLeak`
-naming the caller:
+state, the snapshot a video frame is drawn from) goes through ``sim.truth``. An episode locks
+it; a locked `GroundTruth` answers only inside one of four named grants, and anything else that
+reads it raises `GroundTruthLeak` naming the caller:
 
-- ``scoring()``: the experimenter scores the episode (the goal check, disturbed stacks);
-- ``experimenter()``: fault injection reads what it perturbs (the nudged block's pose);
+- ``scoring()``: the experimenter scores the episode (the goal check, disturbed stacks, a given
+  plan's per-step verdicts); what it reads never changes what the robot does;
+- ``experimenter()``: the experimenter's own interventions, which do change the episode: fault
+  injection reads what it perturbs (the nudged block's pose), and a given plan run with
+  ``stop_at_invalid`` has the experimenter, not the robot, skip a step invalid in the true state;
 - ``oracle()``: the motion-capture pose sensor of ``observe="state"``, whose documented sensor
-  is exactly the true block poses (plus optional noise).
+  is exactly the true block poses (plus optional noise);
+- ``recording()``: a video of the episode for people to watch (`tamp.video`), drawn from
+  ``snapshot()``; nothing it reads flows back into the episode.
 
 ``reads`` counts every answered read by grant and calling function, so a test can check that a
 camera episode read nothing but scoring. Teleports (``Simulator.set_block_pose``) write the
@@ -22,11 +27,15 @@ import sys
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 from tamp.scene import Pose, SceneConfig, read_state
 from task.errors import TampError
 
-GRANTS = ("scoring", "experimenter", "oracle")
+if TYPE_CHECKING:
+    from tamp.sim.base import Snapshot
+
+GRANTS = ("scoring", "experimenter", "oracle", "recording")
 RULE = "simulator ground truth only scores episodes"
 
 
@@ -45,14 +54,21 @@ def _caller() -> str:
 
 
 class GroundTruth:
-    """Ground-truth queries of one simulator; ``read_poses`` gives the true block poses.
+    """Ground-truth queries of one simulator; ``read_poses`` gives the true block poses and
+    ``read_snapshot`` the arm and the true block poses as a video frame shows them.
 
     Unlocked (the default: tests, renderers, dataset builders), every read is answered.
-    Locked, only reads inside ``scoring()``, ``experimenter()`` or ``oracle()`` are.
+    Locked, only reads inside ``scoring()``, ``experimenter()``, ``oracle()`` or
+    ``recording()`` are.
     """
 
-    def __init__(self, read_poses: Callable[[], dict[str, Pose]]) -> None:
+    def __init__(
+        self,
+        read_poses: Callable[[], dict[str, Pose]],
+        read_snapshot: Callable[[], Snapshot] | None = None,
+    ) -> None:
         self._read_poses = read_poses
+        self._read_snapshot = read_snapshot
         self.locked = False
         self._grants: list[str] = []
         self.reads: Counter[tuple[str, str]] = Counter()  # (grant or "unlocked", caller) -> n
@@ -72,7 +88,8 @@ class GroundTruth:
 
     @contextmanager
     def experimenter(self) -> Iterator[GroundTruth]:
-        """Reads by the experimenter's fault injection (what it perturbs), not by the robot."""
+        """Reads by the experimenter's interventions, not by the robot: fault injection (what
+        it perturbs) and ``stop_at_invalid`` (whether a given step is attempted at all)."""
         with self._grant("experimenter"):
             yield self
 
@@ -80,6 +97,12 @@ class GroundTruth:
     def oracle(self) -> Iterator[GroundTruth]:
         """Reads by the motion-capture oracle of ``observe="state"`` (its sensor is the truth)."""
         with self._grant("oracle"):
+            yield self
+
+    @contextmanager
+    def recording(self) -> Iterator[GroundTruth]:
+        """Reads by an episode's video (`tamp.video`): snapshots for people to watch."""
+        with self._grant("recording"):
             yield self
 
     @contextmanager
@@ -107,6 +130,14 @@ class GroundTruth:
         they form none (a block leaning or on an edge)."""
         self._check("state")
         return read_state(entities, self._read_poses(), scene).state
+
+    def snapshot(self) -> Snapshot:
+        """The arm, fingers and true block poses now (`tamp.sim.base.Snapshot`), what a video
+        frame shows; raises `GroundTruthLeak` outside a grant when locked."""
+        self._check("snapshot")
+        if self._read_snapshot is None:
+            raise TampError("this ground truth has no snapshots (it was made from poses only)")
+        return self._read_snapshot()
 
     def _check(self, query: str) -> None:
         caller = _caller()

@@ -70,10 +70,19 @@ def test_the_motion_planner_routes_the_transit_around_the_wall(model, planned):
 
 
 def test_a_blocked_vertical_phase_fails_without_a_detour(model, planned):
-    lid = Box("lid", (PICK[0], PICK[1], 0.14), (0.08, 0.08, 0.01))  # over the block to pick
-    out = guard_pick_place(planned, model, _world(lid))
-    assert not out.ok and out.evidence["other"] == "lid"
-    assert out.evidence["phase"] in ("approach", "descend")
+    """A neighbour beside the block to pick leaves the approach above it free but stands in the
+    open fingers' way down; a board just above the place leaves the transit free but stops the
+    held block coming down. Each vertical phase fails as planned, with the motion planner
+    (which would reroute a free-space phase) never run."""
+    side = Box("b", (PICK[0], PICK[1] + 0.05, 0.025), HALF)
+    board = Box("board", (PLACE[0], PLACE[1], 0.11), (0.03, 0.03, 0.005))
+    for box, phase, part in ((side, "descend", "finger"), (board, "lower", "held")):
+        out = guard_pick_place(planned, model, _world(box))
+        assert not out.ok and out.failure == "collision"
+        assert (out.evidence["phase"], out.evidence["other"]) == (phase, box.name)
+        assert part in out.evidence["part"]
+        assert out.planner_runs == 0 and out.plan_time_s == 0 and "planner" not in out.evidence
+        assert out.rerouted == ()
 
 
 def test_the_fingers_may_touch_the_block_they_pick_but_not_a_neighbour(model, planned):

@@ -1,7 +1,8 @@
-"""Both simulators: one pick-and-place (friction and weld grasps), an unreachable block, renders
-that look alike, video frames (their size, a second world posed from a snapshot, one frame clock
-across runs) and ``tamp run`` writing its video. Each takes seconds. Whole episodes of the
-closed loop are tested in ``tests/tamp/loop/test_episode.py``."""
+"""Both simulators: one pick-and-place (friction and weld grasps; the weld holds what is between
+the fingers), an unreachable block, renders that look alike, video frames (their size, a second
+world posed from a snapshot, one frame clock across runs) and ``tamp run`` writing its video.
+Each takes seconds. Whole episodes of the closed loop are tested in
+``tests/tamp/loop/test_episode.py``."""
 
 from __future__ import annotations
 
@@ -48,6 +49,25 @@ def test_weld_grasp_mode_also_stacks_the_block(sim_name, solver):
         done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses)
         assert done.ok, done.evidence
         assert read_state(entities, sim.truth.block_poses()).state == ("b", TABLE)
+
+
+@pytest.mark.parametrize("sim_name", SIMULATORS)
+def test_the_weld_holds_the_block_between_the_fingers_not_the_one_the_move_names(sim_name, solver):
+    """The robot is told a is where b is (a misread): it closes on b, and the weld holds b,
+    what is between its fingers; a, named by the move, stays where it is."""
+    entities = ("a", "b", "c")
+    poses = layout(entities, (TABLE, TABLE, TABLE), seed=0, slots=[0, 4, 7])
+    with make_simulator(sim_name, entities, poses, grasp="weld") as sim:
+
+        def misread():
+            true = sim.truth.block_poses()
+            return {**true, "a": true["b"], "b": true["a"]}
+
+        done = execute_move(sim, solver, Move("a", "c"), misread)
+        after = sim.truth.block_poses()
+        assert done.ok, done.evidence
+        assert np.linalg.norm(np.subtract(after["a"].xyz, poses["a"].xyz)) < 0.005
+        assert read_state(entities, after).state == (TABLE, "c", TABLE)
 
 
 def test_an_unreachable_block_is_an_ik_infeasible_failure(solver):
@@ -133,8 +153,10 @@ def test_a_second_world_posed_from_a_snapshot_renders_the_same_image(sim_name):
         sim.set_block_pose("b", Pose((0.45, 0.2, 0.025), 0.4))
         with make_simulator(sim_name, entities, elsewhere) as copy:
             before = copy.render()
-            copy.show(sim.snapshot())
-            np.testing.assert_allclose(copy.snapshot().joints, sim.snapshot().joints, atol=1e-9)
+            copy.show(sim.truth.snapshot())
+            np.testing.assert_allclose(
+                copy.truth.snapshot().joints, sim.truth.snapshot().joints, atol=1e-9
+            )
             shown, original = copy.render().astype(int), sim.render().astype(int)
     assert np.abs(before - original).mean() > 1  # the arm and the blocks moved (2.3, 5.6)
     assert np.abs(shown - original).mean() < 0.5  # 0.0 in both when written

@@ -1,22 +1,26 @@
-"""Simulator ground truth only scores episodes: the `GroundTruth` lock, the finger sensors that
-cannot tell what they touch, and who in the code may reach the truth at all. No simulator
-runs here; `tests/tamp/loop/test_camera_episode.py` runs locked episodes."""
+"""Simulator ground truth only scores episodes: the `GroundTruth` lock (poses, states and the
+snapshots videos are drawn from), the finger sensors and the weld that cannot tell what they
+touch, and who in the code may reach the truth at all. No simulator runs here;
+`tests/tamp/loop/test_camera_episode.py` runs locked episodes."""
 
 from __future__ import annotations
 
 import ast
+import dataclasses
 import inspect
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tamp.scene import Pose
-from tamp.sim.base import Simulator
-from tamp.sim.truth import RULE, GroundTruth, GroundTruthLeak
+from tamp.sim.base import GripperReading, Simulator, Snapshot
+from tamp.sim.truth import GRANTS, RULE, GroundTruth, GroundTruthLeak
 from task.problem import TABLE
 
 ROOT = Path(__file__).resolve().parents[2]
 POSES = {"a": Pose((0.4, 0.0, 0.025)), "b": Pose((0.4, 0.0, 0.075))}
+SNAPSHOT = Snapshot(np.zeros(9), np.array([[0.4, 0.0, 0.025]]), np.array([[1.0, 0, 0, 0]]))
 
 
 def robot_side_read(truth: GroundTruth) -> dict[str, Pose]:
@@ -52,13 +56,37 @@ def test_reads_inside_a_grant_are_answered_and_counted_by_grant_and_caller():
         truth.block_poses()
 
 
-def test_the_finger_sensors_take_no_block():
-    """A fingertip sensor cannot tell what it touches: ``gripper()`` names no block."""
+def test_a_snapshot_is_ground_truth_answered_only_under_a_grant():
+    truth = GroundTruth(lambda: dict(POSES), lambda: SNAPSHOT)
+    assert truth.snapshot() is SNAPSHOT  # unlocked: answered
+    truth.lock()
+    with pytest.raises(GroundTruthLeak, match=r"\(snapshot\)"):
+        truth.snapshot()
+    with truth.recording():
+        assert truth.snapshot() is SNAPSHOT
+    assert truth.purposes() == {"unlocked", "recording"} and "recording" in GRANTS
+
+
+def test_the_finger_sensors_and_the_weld_take_and_give_no_block():
+    """A fingertip sensor cannot tell what it touches: ``gripper()`` names no block, and its
+    reading holds the opening and the two finger forces only. The weld attaches what is between
+    the fingers: ``attach()`` is told no block and says only whether it held one, and the
+    executor never names one to it."""
     from tamp.sim.mujoco_sim import MuJoCoSim
     from tamp.sim.pybullet_sim import PyBulletSim
 
     for cls in (Simulator, PyBulletSim, MuJoCoSim):
         assert list(inspect.signature(cls.gripper).parameters) == ["self"], cls
+        assert list(inspect.signature(cls.attach).parameters) == ["self"], cls
+        assert inspect.signature(cls.attach).return_annotation in (bool, "bool"), cls
+    reading = [(f.name, f.type) for f in dataclasses.fields(GripperReading)]
+    assert reading == [("width", "float"), ("left_force", "float"), ("right_force", "float")]
+    calls = [
+        node
+        for node in ast.walk(ast.parse((ROOT / "tamp/loop/execute.py").read_text()))
+        if isinstance(node, ast.Call) and getattr(node.func, "attr", "") == "attach"
+    ]
+    assert calls and all(not c.args and not c.keywords for c in calls)
 
 
 def _uses(attribute: str, folder: str) -> set[str]:
@@ -73,10 +101,33 @@ def _uses(attribute: str, folder: str) -> set[str]:
     }
 
 
+def _granted(path: Path, attribute: str) -> list[str]:
+    """The calls of ``x.<attribute>(...)`` in ``path`` that no ``with ...<grant>():`` block
+    around them grants, as ``line N``."""
+    tree = ast.parse(path.read_text())
+    inside = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.With) and any(
+            getattr(getattr(i.context_expr, "func", None), "attr", "") in GRANTS for i in node.items
+        ):
+            inside |= {id(n) for n in ast.walk(node)}
+    return [
+        f"line {node.lineno}"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and getattr(node.func, "attr", "") == attribute
+        and id(node) not in inside
+    ]
+
+
 def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the_truth():
     sims = {"tamp/sim/base.py", "tamp/sim/pybullet_sim.py", "tamp/sim/mujoco_sim.py"}
     assert _uses("_block_poses", "tamp") <= sims
+    assert _uses("_snapshot", "tamp") <= sims
     assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py"}
+    # a snapshot (the true block poses) is read by the video alone, inside its recording grant
+    assert _uses("snapshot", "tamp") <= {"tamp/sim/truth.py", "tamp/video.py"}
+    assert _granted(ROOT / "tamp/video.py", "snapshot") == []
     # in the loop: the scorer, the nudge (experimenter), the state-mode mocap oracle and the
     # per-step verdicts of a given plan (scoring: what the report says, never what the robot does)
     assert _uses("truth", "tamp/loop") <= {
@@ -87,4 +138,5 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
         "tamp/loop/given.py",
     }
     for room in ("tamp/camera", "tamp/bench", "tamp/cli", "motion", "perception"):
-        assert not _uses("truth", room) | _uses("block_poses", room), room
+        reach = _uses("truth", room) | _uses("block_poses", room) | _uses("snapshot", room)
+        assert not reach, room

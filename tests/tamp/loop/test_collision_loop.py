@@ -43,6 +43,7 @@ def test_a_transit_through_a_wall_is_rerouted_and_runs_untouched(sim_name, solve
     result, after, touched = _move(sim_name, solver, "plan")
     assert result.ok, result.evidence
     assert result.path_time_s > 0 and result.check_time_s > 0
+    assert result.rerouted == ("transit",) and result.planner_failures == 0
     assert after == ("b", TABLE) and touched == {}
 
 

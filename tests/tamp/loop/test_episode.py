@@ -90,7 +90,11 @@ def test_an_episode_report_turns_into_plain_json():
         "sim_time_s": 1.235,
         "wall_time_s": 0.0,
         "ik_time_s": 0.0,
+        "rerouted": [],
+        "planner_runs": 0,
+        "planner_failures": 0,
     }
+    assert out["unreadable"] == 0 and out["truth_reads"] == {}
     assert out["moves"][1]["failure"] == "ik_infeasible"
     assert out["plans"] == [["move(a -> b)"]] and out["faults"] == ["drop@0"]
 

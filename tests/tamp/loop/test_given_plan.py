@@ -1,7 +1,8 @@
 """Given plans (`tamp.loop.given`, ``tamp run --plan``): plan files read into steps with
 one-line errors, then executed open-loop in PyBullet: a valid plan reaches the goal; a plan that
 stacks onto a block that is not clear is reported at its first invalid step, attempted
-physically, and not attempted with ``--stop-at-invalid``."""
+physically, and not attempted with ``--stop-at-invalid`` (the experimenter's ground-truth grant,
+named as such)."""
 
 from __future__ import annotations
 
@@ -10,8 +11,8 @@ import json
 import pytest
 
 from tamp.cli import main
-from tamp.loop import EpisodeStatus
-from tamp.loop.given import parse_given
+from tamp.loop import EpisodeStatus, LoopConfig
+from tamp.loop.given import GivenPlanEpisode, parse_given
 from task.errors import TampError
 from task.problem import TABLE, Move, Problem
 
@@ -105,6 +106,27 @@ def test_stop_at_invalid_does_not_attempt_the_invalid_step(tmp_path):
     assert code == 1 and report["status"] == EpisodeStatus.INVALID_PLAN.value
     assert step["failed"] == ["(clear a)"] and not step["attempted"]
     assert step["outcome"] == "not attempted" and report["moves"] == []
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("stop", [True, False])
+def test_stop_at_invalid_is_the_experimenters_grant_not_a_scoring_read(stop):
+    """Whether the robot attempts a step is decided from the true state only under the
+    experimenter's grant, and only with ``stop_at_invalid``; the report names who decided and
+    counts the reads by grant."""
+    steps = parse_given(ONTO_NOT_CLEAR, "plan", THREE)
+    episode = GivenPlanEpisode(THREE, steps, LoopConfig(), seed=0, stop_at_invalid=stop)
+    report = episode.run()
+    deciders = {c for g, c in episode.sim.truth.reads if g == "experimenter"}
+    (step,) = report.steps
+    if stop:
+        assert deciders == {"tamp.loop.given.GivenPlanEpisode._experimenter_skips"}
+        assert step.skipped_by == "experimenter" and not step.attempted
+        assert "experimenter grant --stop-at-invalid" in step.line()
+        assert "experimenter" in report.reason and report.truth_reads["experimenter"] == 1
+    else:
+        assert deciders == set() and step.attempted and step.skipped_by == ""
+        assert "experimenter" not in report.truth_reads
 
 
 @pytest.mark.sim
