@@ -4,6 +4,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+# moves per window (horizon, lookahead): far beyond any plan the windows decode, and the window's
+# (B, T, N, A) logits and T-step rollout graph grow with it (1_000_000 hung before planning)
+MAX_HORIZON = 1000
+
 
 @dataclass(frozen=True)
 class PlannerConfig:
@@ -29,7 +33,8 @@ class PlannerConfig:
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
     max_windows: int = 40  # replanning windows before giving up
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
-    # in one batch start together and share it); None: only max_windows stops the planner
+    # in one batch start together and share it), checked at every Adam and rollout step: a
+    # window it cuts short is abandoned; None: only max_windows stops the planner
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
     rank_prefixes: bool = True  # rank (and cut) each window by its best prefix (`task.decode`)
     park_free: bool = False  # count parking moves (to the table) as free in that ranking
@@ -55,6 +60,11 @@ class PlannerConfig:
         for name in ("horizon", "iters", "restarts", "max_windows"):
             if getattr(self, name) < 1:
                 raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")
+        for name in ("horizon", "lookahead"):
+            if not 1 <= getattr(self, name) <= MAX_HORIZON:
+                raise TampError(
+                    f"PlannerConfig.{name} must be in 1..{MAX_HORIZON}, got {getattr(self, name)}"
+                )
         if not 0.0 < self.threshold <= 1.0:
             raise TampError(f"PlannerConfig.threshold must be in (0, 1], got {self.threshold}")
         if not 0.0 <= self.lookahead_share <= 1.0:

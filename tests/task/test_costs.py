@@ -4,15 +4,16 @@ preferring, among equally short plans, the one whose moves cost less."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import pytest
 import torch
 
 from task.config import PlannerConfig
+from task.costs import IMPOSSIBLE
 from task.domains import get_domain
 from task.planner import plan
-from task.problem import TABLE, Problem
+from task.problem import TABLE, Move, Problem
 from task.rollout import rollout
 
 BW = get_domain("blocksworld")
@@ -80,10 +81,14 @@ class FixedCosts:
         pass
 
 
+EXPENSIVE = 3.0  # below IMPOSSIBLE: the decoder may take it, only the costs can steer away
+
+
 @pytest.mark.parametrize("cheap", [D, TABLE_COL])
 def test_among_equally_short_plans_the_cheaper_moves_win(cheap):
     matrix = torch.ones((1, 4, 5))
-    matrix[0, A, D if cheap == TABLE_COL else TABLE_COL] = 10.0  # the other way for a costs 10
+    matrix[0, A, D if cheap == TABLE_COL else TABLE_COL] = EXPENSIVE  # the other way for a
+    assert EXPENSIVE < IMPOSSIBLE
     source = FixedCosts(matrix)
     config = PlannerConfig(lambda_motion=0.05)
     result = plan(UNSTACK, config, seed=0, costs=source)
@@ -93,8 +98,14 @@ def test_among_equally_short_plans_the_cheaper_moves_win(cheap):
     assert source.calls and source.calls[0][0] == BW.initial_state(UNSTACK)
 
 
-def test_without_costs_the_planner_is_unchanged():
-    """A weight without a cost source changes nothing."""
-    config = PlannerConfig()
-    heavy = replace(config, lambda_motion=3.0)
-    assert plan(UNSTACK, config, 0).plan == plan(UNSTACK, heavy, 0).plan
+def test_the_weighted_motion_term_steers_the_logits():
+    """One restart (no ranking among restarts): the task alone puts a onto d on every seed;
+    with a onto d priced above a to the table, the weighted term lambda_motion * L_motion
+    in the loss moves a to the table instead."""
+    matrix = torch.ones((1, 4, 5))
+    matrix[0, A, D] = EXPENSIVE
+    for weight, target in ((0.0, "d"), (0.2, TABLE)):
+        config = PlannerConfig(lambda_motion=weight, restarts=1, lookahead_share=0.0)
+        for seed in range(4):
+            result = plan(UNSTACK, config, seed=seed, costs=FixedCosts(matrix))
+            assert result.solved and result.plan.moves[0] == Move("a", target), (weight, seed)

@@ -9,12 +9,12 @@ from dataclasses import replace
 import pytest
 import torch
 
-from task.config import PlannerConfig
+from task.config import MAX_HORIZON, PlannerConfig
 from task.decode import decode_row
 from task.domains import get_domain
 from task.errors import ProblemError, TampError
 from task.planner import plan, plan_batch
-from task.problem import Problem
+from task.problem import PlanStatus, Problem
 from task.rollout import rollout
 from task.symbolic.generate import random_problem
 from task.symbolic.search import optimal_moves
@@ -245,6 +245,25 @@ def test_a_time_limit_stops_the_planner_and_says_how_far_it_got():
     assert "time_limit" not in plan(problem, PlannerConfig(time_limit_s=600), seed=0).stats
     with pytest.raises(TampError, match="time_limit_s must be > 0"):
         PlannerConfig(time_limit_s=0)
+
+
+@pytest.mark.parametrize(
+    "long", [{"iters": 5000}, {"horizon": MAX_HORIZON, "lookahead": MAX_HORIZON}]
+)
+def test_the_time_limit_holds_inside_a_window(long):
+    """A first window far longer than the limit (5000 Adam steps, or 1000-step rollouts) is
+    cut at the limit and abandoned: no move of it is kept and the result says why."""
+    problem = random_problem(6, 11)
+    result = plan(problem, PlannerConfig(time_limit_s=0.5, **long), seed=0)
+    assert result.status is PlanStatus.NO_PLAN and result.plan.moves == ()
+    assert result.stats["windows"] == 0
+    assert result.stats["time_limit"].startswith("stopped at the 0.5 s time limit after 0 windows")
+
+
+def test_a_window_longer_than_the_bound_is_refused():
+    for name in ("horizon", "lookahead"):
+        with pytest.raises(TampError, match=f"{name} must be in 1..{MAX_HORIZON}"):
+            PlannerConfig(**{name: MAX_HORIZON + 1})
 
 
 def test_the_planners_adam_is_torch_adam_step_for_step():
