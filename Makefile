@@ -33,7 +33,7 @@ $(STAMP): pyproject.toml | $(PY)
 # the embedded 5-block example from camera images: perception, planning and the simulated Panda
 # (SIM=mujoco for MuJoCo)
 demo: $(STAMP) sysdeps
-	$(VENV)/bin/tamp run --sim $(SIM) --observe camera --out out/demo
+	$(VENV)/bin/tamp demo --sim $(SIM)  # = tamp run --observe camera --out out/demo
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check .

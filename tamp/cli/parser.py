@@ -13,7 +13,10 @@ from tamp.bench.suites import DEFAULT_DATA
 from tamp.cli.bench_motion import suite_options, sweep_options
 from tamp.cli.options import (
     IMAGE_SCENES,
+    MAX_BLOCKS,
     Parser,
+    block_counts,
+    bounded,
     data_option,
     episode_options,
     executability_options,
@@ -22,7 +25,6 @@ from tamp.cli.options import (
     perception_bench_options,
     planner_options,
     positive,
-    positive_list,
     progress_option,
     radius,
     rules_option,
@@ -213,7 +215,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
     )
     random_.add_argument(
         "--blocks",
-        type=positive_list,
+        type=block_counts,
         default=(6, 8, 10, 15, 20),
         metavar="B[,B...]",
         help="block counts (6,8,10,15,20)",
@@ -342,8 +344,8 @@ def _poses_benchmark(bench) -> None:
     )
     p.add_argument("--n", type=positive, default=200, help="random scenes per simulator (200)")
     p.add_argument("--seed", type=seed, default=0, help="scene seed (0)")
-    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
-    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument("--min-blocks", type=bounded(1, MAX_BLOCKS), default=3, help="(3)")
+    p.add_argument("--max-blocks", type=bounded(1, MAX_BLOCKS), default=6, help="(6)")
     p.add_argument(
         "--jitter", action="store_true", help="random camera and light, as in perception dataset"
     )
@@ -397,8 +399,8 @@ def _perception_commands(sub) -> None:
         metavar="SIM[,SIM]",
         help="simulators, samples alternate (pybullet,mujoco)",
     )
-    p.add_argument("--min-blocks", type=positive, default=3, help="(3)")
-    p.add_argument("--max-blocks", type=positive, default=6, help="(6)")
+    p.add_argument("--min-blocks", type=bounded(1, MAX_BLOCKS), default=3, help="(3)")
+    p.add_argument("--max-blocks", type=bounded(1, MAX_BLOCKS), default=6, help="(6)")
     p.add_argument(
         "--image-scene",
         choices=IMAGE_SCENES,

@@ -56,13 +56,33 @@ def test_plan_json_parses(capsys, files):
     assert report["config"]["horizon"] == 2 and report["config"]["restarts"] == 8
 
 
-def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(capsys, files, tmp_path):
+def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(
+    capsys, files, tmp_path, monkeypatch
+):
+    """The arm's costs reach the planner (a cost source that prices the laid-out problem's
+    moves unequally, weighted by lambda_motion) and the printed plan is the priced one."""
+    import tamp.slots
+    from task.planner import plan as real_plan
+
+    priced = []
+
+    def spy(problem, config, seed=0, costs=None, **kw):
+        result = real_plan(problem, config, seed=seed, costs=costs, **kw)
+        priced.append((problem, config, costs, result))
+        return result
+
+    monkeypatch.setattr(tamp.slots, "plan", spy)
     files[1].write_text(data.read_text(data.EXAMPLE_FILE))  # unstacks onto the table
     args = ["plan", *map(str, files), *FAST, "--motion-aware", "--scene", "shelf", "--json"]
     assert main(args) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["status"] == "solved" and report["valid"]
     assert report["config"]["lambda_motion"] == 0.05
+    ((problem, config, costs, result),) = priced
+    assert config.lambda_motion == 0.05 and costs is not None
+    matrix = costs([0], [problem.init]).compute()  # (1, N, Y): the arm's cost of each move
+    assert matrix.shape[:2] == (1, problem.n) and float(matrix.std()) > 0
+    assert [m[0] for m in report["moves"]] == [m.entity for m in result.plan.moves]
     onto_table = [m for m in report["moves"] if m[1] == "table"]
     assert onto_table and all(len(m) == 3 and len(m[2]) == 2 for m in onto_table)  # its place
     places = {tuple(m[2]) for m in onto_table}

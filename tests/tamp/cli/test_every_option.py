@@ -210,3 +210,20 @@ def test_the_image_scene_and_the_workcell_scene_have_different_names():
         assert len(flags) <= 1, command
         if flags:
             assert flags[0].help == COMMANDS["run"]._option_string_actions["--motion-aware"].help
+
+
+@pytest.mark.parametrize("command", sorted(COMMANDS))
+def test_every_count_is_bounded(command):
+    """An integer option beyond any machine (10**12: threads, blocks, a window, a seed, a
+    radius, instances) is a usage error, never a crash or a hang."""
+    for action in COMMANDS[command]._actions:
+        if action.type is None or action.type in (float, str) or not action.option_strings:
+            continue
+        try:
+            action.type("1")
+        except (argparse.ArgumentTypeError, ValueError):
+            continue  # not a count (e.g. seconds > 0 take 1 too; a spec)
+        if isinstance(action.type("1"), float):
+            continue
+        with pytest.raises(argparse.ArgumentTypeError):
+            action.type(str(10**12))
