@@ -540,3 +540,40 @@ def executability_options(p: argparse.ArgumentParser) -> None:
     scene_options(p)
     progress_option(p)
     output_options(p, "write results.json and plans.csv into this folder")
+
+
+def sweep_options(p: argparse.ArgumentParser) -> None:
+    """``--workers`` and ``--ray``: where the episodes run."""
+    p.add_argument(
+        "--workers",
+        type=threads,
+        default=1,
+        metavar="N",
+        help="run the episodes in N processes at once, one torch thread each (1: in "
+        "this process); the rows do not depend on N",
+    )
+    p.add_argument(
+        "--ray",
+        metavar="ADDRESS",
+        help="run the episodes as Ray tasks instead (overrides --workers): auto (the "
+        "cluster this machine joined with 'ray start'), local (a Ray instance on this "
+        "machine only) or HOST:6379; needs pip install 'soft-tamp[ray]'",
+    )
+
+
+def suite_options(p: argparse.ArgumentParser) -> None:
+    """What ``bench motion`` runs: a spread of PlanBench, or random problems (``--blocks``)."""
+    data_option(p)
+    p.add_argument(
+        "--n",
+        type=positive,
+        default=100,
+        help="instances, spread over sizes; with --blocks, per block count (100)",
+    )
+    p.add_argument(
+        "--blocks",
+        type=block_counts,
+        metavar="B[,B...]",
+        help="random problems of these block counts instead of PlanBench, seeded by --seed, "
+        "those whose towers fit --scene (episodes.csv lists them)",
+    )

@@ -10,7 +10,6 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.suites import DEFAULT_DATA
-from tamp.cli.bench_motion import suite_options, sweep_options
 from tamp.cli.options import (
     IMAGE_SCENES,
     MAX_BLOCKS,
@@ -30,6 +29,8 @@ from tamp.cli.options import (
     rules_option,
     run_options,
     seed,
+    suite_options,
+    sweep_options,
     threads,
     workcell_options,
 )
