@@ -189,7 +189,7 @@ def perception_command(args: argparse.Namespace) -> int:
     import torch
 
     from perception.perceive import Perceiver
-    from tamp.bench import perception as bench
+    from tamp.bench.vision import perception as bench
     from tamp.camera.from_images import PerceptionMode
 
     recorded = perception_bench_config(args)
@@ -283,8 +283,8 @@ def latplan_command(args: argparse.Namespace) -> int:
 
     import torch
 
-    from tamp.bench import latplan
-    from tamp.bench.perception import choices
+    from tamp.bench.vision import latplan
+    from tamp.bench.vision.perception import choices
 
     recorded = latplan_config(args)
     output_folder(args.out)
@@ -331,7 +331,7 @@ def latplan_command(args: argparse.Namespace) -> int:
 
 def poses_command(args: argparse.Namespace) -> int:
     """Block poses from RGB-D images of ``--n`` random scenes in each ``--sim``, against truth."""
-    from tamp.bench import poses
+    from tamp.bench.vision import poses
 
     recorded = poses_config(args)
     output_folder(args.out)

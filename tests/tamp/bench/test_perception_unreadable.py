@@ -5,7 +5,7 @@ from __future__ import annotations
 import torch
 
 from perception.errors import PerceptionError
-from tamp.bench.perception import _plan
+from tamp.bench.vision.perception import _plan
 from task.config import PlannerConfig
 from task.symbolic.generate import random_problem
 

@@ -8,7 +8,7 @@ import math
 
 import pytest
 
-from tamp.bench.poses import BlockRow, summarise, yaw_error
+from tamp.bench.vision.poses import BlockRow, summarise, yaw_error
 from tamp.cli import main
 
 

@@ -7,11 +7,12 @@ import numpy as np
 import pytest
 
 from perception.errors import PerceptionError
-from tamp.bench import motion, perception
+from tamp.bench import motion
 from tamp.bench import planning as bench
 from tamp.bench.planning import Row
 from tamp.bench.summary import is_optimal, summarise
 from tamp.bench.tables import motion_table, perception_table
+from tamp.bench.vision import perception
 from tamp.cli import build_parser
 from tamp.cli.options import planner_config
 from tamp.loop import EpisodeReport, EpisodeStatus

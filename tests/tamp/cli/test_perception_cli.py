@@ -87,7 +87,7 @@ def test_bad_blur_is_a_usage_error(capsys):
 
 def test_corruption_specs_read_back():
     from perception.corrupt import Corruption
-    from tamp.bench.perception import parse_corruption
+    from tamp.bench.vision.perception import parse_corruption
 
     assert parse_corruption("") == Corruption()
     spec = parse_corruption("noise:8, dim:0.35,occlude")

@@ -4,7 +4,7 @@ how far the found dark (black) blocks sit from each threshold of the dark class.
 
 Run on ``tamp perception dataset`` files (fresh seeds, never the LatPlan-40 images)::
 
-    python -m tamp.bench.segmentation FILE.npz [MORE.npz ...] --checkpoint FILE.pt
+    python -m tamp.bench.vision.segmentation FILE.npz [MORE.npz ...] --checkpoint FILE.pt
 
 Every image is first resized to the checkpoint's ``input_hw`` when it has one, as
 `perception.perceive.Perceiver` does before segmenting. Each file gets its counts under the
@@ -115,7 +115,7 @@ def _spread(values: np.ndarray, threshold: float, high: bool) -> dict:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m tamp.bench.segmentation")
+    parser = argparse.ArgumentParser(prog="python -m tamp.bench.vision.segmentation")
     parser.add_argument("data", nargs="+", metavar="FILE.npz")
     parser.add_argument("--checkpoint", required=True, metavar="FILE.pt")
     args = parser.parse_args(argv)
