@@ -10,6 +10,8 @@ The one package that sees every other one. Its rooms:
 - ``tamp.bench``: every benchmark (PlanBench, random, motion, perception), one results writer,
   one table printer;
 - ``tamp.cli``: the ``tamp`` command (parsing and printing only);
+- ``tamp.world``: scene files (table, regions, obstacles, movable objects) and the symbolic
+  state and goals read from their geometry;
 - ``tamp.scene``: the table, its slots and block poses <-> symbolic states;
   ``tamp.obstacles``: the named scenes and the clearance they leave;
   ``tamp.arm_costs``: the arm's cost of each move, for motion-aware planning;

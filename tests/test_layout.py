@@ -38,11 +38,12 @@ ROOM_FORBIDDEN = {
     "tamp/camera": ("tamp.loop", "tamp.bench", "tamp.cli"),
     "tamp/loop": ("tamp.bench", "tamp.cli"),
     "tamp/bench": ("tamp.cli",),
+    "tamp/world": ("tamp.loop", "tamp.camera", "tamp.bench", "tamp.cli"),
     "task/symbolic": (*OPTIMISER, "task.domains", "torch"),
     "task/domains": OPTIMISER,
 }
 ROOMS = {
-    "tamp": ("bench", "camera", "cli", "loop", "sim"),
+    "tamp": ("bench", "camera", "cli", "loop", "sim", "world"),
     "task": ("data", "domains", "symbolic"),
 }
 

@@ -1,0 +1,54 @@
+"""tamp.world: scenes as input. A scene file describes the table, its regions, fixed obstacles
+and movable objects; the symbolic state is read from that geometry, never given.
+
+- ``tamp.world.schema``: the versioned JSON schema (documented field by field) and the frozen
+  dataclasses a file parses into (`Scene`, `Table`, `Region`, `Movable`, `Slots`; obstacles are
+  `tamp.obstacles.Obstacle`);
+- ``tamp.world.load``: `load_scene` (a path or a dict -> a checked `Scene`, or one
+  `SceneFileError` line naming the field and the problem), `scene_dict` / `save_scene`, and
+  the shipped scenes (`load_named`: ``tabletop``, ``shelf``, ``clutter``, ``cramped`` and
+  examples, in ``tamp/world/scenes/*.json``);
+- ``tamp.world.geometry``: upright solids, overlaps and what each object rests on;
+- ``tamp.world.relations``: `read_facts`, the ``on`` / ``in`` / ``ontable`` / ``clear`` facts
+  read from the poses, and the objects the geometry cannot explain;
+- ``tamp.world.goal``: `load_goal` / `parse_goal`, a PDDL goal over the scene's objects and
+  regions, checked against the scene.
+
+World frame = the robot base frame (``panda_link0``), the table surface at z = 0, metres and
+radians, as in `tamp.scene`.
+"""
+
+from tamp.world.geometry import Tolerances
+from tamp.world.goal import Goal, load_goal, parse_goal
+from tamp.world.load import (
+    load_named,
+    load_scene,
+    named_scenes,
+    save_scene,
+    scene_config,
+    scene_dict,
+)
+from tamp.world.relations import Facts, read_facts
+from tamp.world.schema import SCHEMA, Movable, Region, Scene, SceneFileError, Slots, Table
+
+__all__ = [
+    "SCHEMA",
+    "Facts",
+    "Goal",
+    "Movable",
+    "Region",
+    "Scene",
+    "SceneFileError",
+    "Slots",
+    "Table",
+    "Tolerances",
+    "load_goal",
+    "load_named",
+    "load_scene",
+    "named_scenes",
+    "parse_goal",
+    "read_facts",
+    "save_scene",
+    "scene_config",
+    "scene_dict",
+]
