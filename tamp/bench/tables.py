@@ -3,13 +3,14 @@
 `table` pads columns to their widest cell (numbers right-aligned); `planning_report` prints a
 planning benchmark (by horizon and seed, then by block count), `motion_table` the executability
 table of the motion benchmark, `perception_table` the rows of planning from images,
-`poses_table` the pose errors of the pose benchmark. Pure string formatting: nothing here runs a
+`poses_table` the pose errors of the pose benchmark, `segmentation_table` and
+`dark_margins_table` the segmentation check. Pure string formatting: nothing here runs a
 benchmark or prints.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from tamp.bench.planning import Bench
 from tamp.bench.summary import Summary, latency_rows, main_rows, size_rows
@@ -395,3 +396,69 @@ def lengths_table(bench: Bench) -> str:
 
 def _num(value: float | None, scale: float = 1.0) -> str:
     return "-" if value is None else f"{value * scale:.2f}"
+
+
+def segmentation_table(files: Mapping[str, dict]) -> str:
+    """The segmentation check: per dataset file, the blocks of each palette colour found out of
+    those shown, under the current thresholds and unguarded; with the current ones, the images
+    in which every block was found and the scenes (and relations) the model read right. Below
+    it, each palette colour as RGB 0-255."""
+    names = list(dict.fromkeys(name for f in files.values() for name in f["blocks_shown"]))
+    head = ["file", "thresholds", "images", *names, "all found", "scenes right", "relations"]
+    body = []
+    for path, f in files.items():
+        for label in ("current", "unguarded"):
+            found = [
+                f"{f['blocks_found'][label][n]}/{f['blocks_shown'][n]}"
+                if n in f["blocks_shown"]
+                else "-"
+                for n in names
+            ]
+            read = label == "current" and f["scenes_read"] > 0
+            body.append(
+                [
+                    path if label == "current" else "",
+                    label,
+                    str(f["images"]),
+                    *found,
+                    str(f["images_with_every_block_found"]) if label == "current" else "-",
+                    f"{f['scenes_right']}/{f['scenes_read']}" if read else "-",
+                    f"{f['relation_accuracy']:.1%}" if read else "-",
+                ]
+            )
+    palettes = {
+        ", ".join(f"#{k} {tuple(round(255 * c) for c in rgb)}" for k, rgb in enumerate(p))
+        for p in (tuple(map(tuple, f["palette"])) for f in files.values())
+    }
+    return table(head, body, indent="") + "".join(f"\ncolours: {p}" for p in sorted(palettes))
+
+
+def dark_margins_table(files: Mapping[str, dict]) -> str:
+    """The dark class's margins per file and measure: the threshold, then the worst, the 5%
+    tail on the threshold's side and the median of the per-image medians."""
+    head = ["file", "images", "measure", "threshold", "worst", "5% tail", "median"]
+    body = []
+    for path, f in files.items():
+        margins = f.get("dark_margins")
+        if margins is None:
+            continue
+        measures = [(k, v) for k, v in margins.items() if k != "images"]
+        for k, (measure, s) in enumerate(measures):
+            tail = s["p95"] if "p95" in s else s["p5"]
+            body.append(
+                [
+                    path if k == 0 else "",
+                    str(margins["images"]),
+                    measure,
+                    *(
+                        _margin(v, "ratio" in measure)
+                        for v in (s["threshold"], s["worst"], tail, s["median"])
+                    ),
+                ]
+            )
+    return table(head, body, indent="")
+
+
+def _margin(value: float, ratio: bool) -> str:
+    """A ratio with two decimals; a grey level with one, dropped when it is 0 (25, 27.5)."""
+    return f"{value:.2f}" if ratio else f"{value:.1f}".removesuffix(".0")

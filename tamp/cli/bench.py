@@ -1,5 +1,5 @@
-"""``tamp bench planbench|pddl|random|motion|executability|perception|latplan|poses``: options in,
-`tamp.bench` runs, tables out.
+"""``tamp bench planbench|pddl|random|motion|executability|perception|latplan|poses|segmentation``:
+options in, `tamp.bench` runs, tables out.
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
 bar on stderr, prints its table (``--json``: ``results.json``'s content), and with ``--out DIR``
@@ -34,6 +34,7 @@ from tamp.cli.recorded import (
     perception_bench_config,
     planning_config,
     poses_config,
+    segmentation_config,
 )
 from tamp.cli.recorded import out_folder as output_folder
 from task.errors import TampError
@@ -47,6 +48,7 @@ __all__ = [  # the handlers `tamp.cli.parser` dispatches to
     "planbench_command",
     "poses_command",
     "random_command",
+    "segmentation_command",
 ]
 
 
@@ -379,6 +381,64 @@ def poses_command(args: argparse.Namespace) -> int:
     )
     if args.out:
         print(f"wrote results.json, blocks.csv to {args.out}")
+    return 0
+
+
+def segmentation_command(args: argparse.Namespace) -> int:
+    """The colour segmentation's thresholds on each dataset file, read as ``--checkpoint``
+    reads images: blocks found per colour, scenes read right, margins of the dark class."""
+    from perception import data as pdata
+    from perception.train import load_checkpoint
+    from tamp.bench.vision import segmentation
+
+    recorded = segmentation_config(args)  # missing files: before any work
+    output_folder(args.out)
+    checkpoint(args.checkpoint)
+    model, meta = load_checkpoint(args.checkpoint)
+    datasets = {str(path): pdata.load(path) for path in args.data}
+    for path, data in datasets.items():
+        segmentation.check_scene(path, data.meta, meta)
+    input_hw = meta.get("input_hw")
+    head = {
+        "benchmark": "segmentation",
+        "config": recorded,
+        "input_hw": list(input_hw) if input_hw is not None else None,
+        "thresholds": segmentation.thresholds(),
+    }
+    files: dict[str, dict] = {}
+    total = sum(len(d) for d in datasets.values())
+    with _bar(total, f"segmentation ({len(datasets)} files)", args.progress, "image") as update:
+        try:
+            for path, data in datasets.items():
+                files[path] = segmentation.check(data, model, input_hw, update)
+        except KeyboardInterrupt:
+            if args.out is not None:
+                body = {
+                    **head,
+                    "partial": {"done": len(files), "of": len(datasets)},
+                    "machine": results.machine(args.argv),
+                    "files": files,
+                }
+                results.write_json(results.out_folder(args.out) / "results.json", body)
+            return interrupted(args.out, len(files), len(datasets), "files")
+    body = {**head, "machine": results.machine(args.argv), "files": files}
+    if args.out is not None:
+        results.write_json(results.out_folder(args.out) / "results.json", body)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    size = "" if input_hw is None else f", images resized to {input_hw[1]}x{input_hw[0]}"
+    guards = ", ".join(f"{k} {v}" for k, v in head["thresholds"]["unguarded"].items())
+    print(
+        f"segmentation check: {len(files)} file(s), {total} images, read by {args.checkpoint}"
+        f"{size}; blocks found under the current thresholds and unguarded ({guards})"
+    )
+    print(tables.segmentation_table(files))
+    if any("dark_margins" in f for f in files.values()):
+        print("\ndark-class margins of the found black regions (per image: median over its pixels)")
+        print(tables.dark_margins_table(files))
+    if args.out is not None:
+        print(f"\nwrote results.json to {args.out}")
     return 0
 
 

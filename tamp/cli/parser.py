@@ -55,6 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     _perception_benchmark(bench, bench_opts)
     _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
+    _segmentation_benchmark(bench)
     _record_command(bench)
     _perception_commands(sub)
     return parser
@@ -355,6 +356,31 @@ def _poses_benchmark(bench) -> None:
     p.set_defaults(
         func=_lazy("tamp.cli.bench", "poses_command"),
         recorded=_lazy("tamp.cli.recorded", "poses_config"),
+    )
+
+
+def _segmentation_benchmark(bench) -> None:
+    p = bench.add_parser(
+        "segmentation",
+        help="the colour segmentation's thresholds checked on fresh renders (not evaluation data)",
+    )
+    p.add_argument(
+        "data",
+        nargs="+",
+        metavar="FILE.npz",
+        help="datasets from `tamp perception dataset` (fresh seeds, never the evaluation images)",
+    )
+    p.add_argument(
+        "--checkpoint",
+        required=True,
+        metavar="FILE.pt",
+        help="perception weights that read the scenes (images resized to its input size)",
+    )
+    progress_option(p)
+    output_options(p, "write results.json into this folder")
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench", "segmentation_command"),
+        recorded=_lazy("tamp.cli.recorded", "segmentation_config"),
     )
 
 

@@ -281,6 +281,21 @@ def poses_config(args: argparse.Namespace) -> dict:
     }
 
 
+def segmentation_config(args: argparse.Namespace) -> dict:
+    """``bench segmentation``: the datasets and the checkpoint it reads; refused in one line,
+    before any work, when one of them is not a file or a dataset is given twice."""
+    missing = [str(p) for p in (*args.data, args.checkpoint) if not Path(p).is_file()]
+    if missing:
+        raise TampError(
+            f"no such file: {', '.join(missing)} (datasets come from `tamp perception dataset`, "
+            "checkpoints from `tamp perception train`)"
+        )
+    twice = sorted({str(p) for p in args.data if args.data.count(p) > 1})
+    if twice:
+        raise TampError(f"dataset(s) given twice: {', '.join(twice)}; give each file once")
+    return {"data": [str(p) for p in args.data], "checkpoint": str(args.checkpoint)}
+
+
 def dataset_config(args: argparse.Namespace) -> dict:
     """``perception dataset``."""
     if args.image_scene == "latplan" and (args.min_blocks, args.max_blocks) != (3, 6):

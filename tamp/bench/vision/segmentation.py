@@ -4,7 +4,7 @@ how far the found dark (black) blocks sit from each threshold of the dark class.
 
 Run on ``tamp perception dataset`` files (fresh seeds, never the LatPlan-40 images)::
 
-    python -m tamp.bench.vision.segmentation FILE.npz [MORE.npz ...] --checkpoint FILE.pt
+    tamp bench segmentation FILE.npz [MORE.npz ...] --checkpoint FILE.pt [--out DIR]
 
 Every image is first resized to the checkpoint's ``input_hw`` when it has one, as
 `perception.perceive.Perceiver` does before segmenting. Each file gets its counts under the
@@ -17,17 +17,16 @@ their worst and 5th-percentile values across images next to the thresholds.
 
 from __future__ import annotations
 
-import argparse
-import json
+from collections.abc import Callable
 from dataclasses import asdict, replace
-from pathlib import Path
 
 import cv2
 import numpy as np
 
 from perception import data as pdata
+from perception.errors import PerceptionError
 from perception.segment import SegmentConfig, colour_labels, is_dark, present
-from perception.train import evaluate, load_checkpoint
+from perception.train import checkpoint_scene, evaluate
 
 UNGUARDED = replace(SegmentConfig(), dark_contrast=0, max_area_share=1.0)
 
@@ -54,9 +53,15 @@ def _margins(image: np.ndarray, palette: np.ndarray, dark: int, config: SegmentC
     )
 
 
-def check(data: pdata.SupportData, model, input_hw=None) -> dict:
+def check(
+    data: pdata.SupportData,
+    model,
+    input_hw=None,
+    progress: Callable[[int], None] | None = None,
+) -> dict:
     """Blocks found per colour (current and unguarded thresholds), scenes read right by
-    ``model``, and the dark class's margins, on every image of ``data``."""
+    ``model``, and the dark class's margins, on every image of ``data``; ``input_hw``: the
+    model's (H, W), each image resized to it first; ``progress(1)`` after each image."""
     if input_hw is not None:
         images = np.stack([pdata.resize_image(im, input_hw) for im in data.images])
         data = pdata.SupportData(images, data.colours, data.supports, data.palette, data.meta)
@@ -78,15 +83,19 @@ def check(data: pdata.SupportData, model, input_hw=None) -> dict:
             margin = _margins(image, data.palette[colours], colours.index(dark), SegmentConfig())
             if margin is not None:
                 margins.append(margin)
+        if progress is not None:
+            progress(1)
     scores = evaluate(model, pdata.tensors(data))
     out = {
         "images": len(data),
+        "palette": [[round(float(c), 4) for c in rgb] for rgb in data.palette],
         "blocks_shown": shown,
         "blocks_found": found,
         "images_with_every_block_found": all_found,
         "relation_accuracy": scores["relation_accuracy"],
         "scene_accuracy": scores["scene_accuracy"],
         "scenes_read": scores["scenes"],
+        "scenes_right": round(scores["scene_accuracy"] * scores["scenes"]),
         "unreadable": scores["unreadable"],
     }
     if margins:
@@ -114,22 +123,21 @@ def _spread(values: np.ndarray, threshold: float, high: bool) -> dict:
     }
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m tamp.bench.vision.segmentation")
-    parser.add_argument("data", nargs="+", metavar="FILE.npz")
-    parser.add_argument("--checkpoint", required=True, metavar="FILE.pt")
-    args = parser.parse_args(argv)
-    model, meta = load_checkpoint(args.checkpoint)
-    report = {
-        "checkpoint": args.checkpoint,
-        "segment_config": asdict(SegmentConfig()),
-        "files": {
-            str(Path(p)): check(pdata.load(p), model, meta.get("input_hw")) for p in args.data
-        },
-    }
-    print(json.dumps(report, indent=2))
-    return 0
+def thresholds() -> dict:
+    """The two threshold sets every file is counted under: ``current`` (`SegmentConfig`) and
+    what ``unguarded`` changes in it."""
+    current = asdict(SegmentConfig())
+    unguarded = {k: v for k, v in asdict(UNGUARDED).items() if current[k] != v}
+    return {"current": current, "unguarded": unguarded}
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+def check_scene(path: str, data_meta: dict, checkpoint_meta: dict) -> None:
+    """One PerceptionError line when the dataset at ``path`` shows another image scene than
+    the checkpoint was trained on: its readings would be confidently wrong, and the scene
+    counts would measure the wrong model."""
+    shown, trained = data_meta.get("scene"), checkpoint_scene(checkpoint_meta)
+    if shown is not None and trained is not None and shown != trained:
+        raise PerceptionError(
+            f"{path} shows the {shown} scene but the checkpoint was trained on {trained}; "
+            f"pass a checkpoint trained on {shown} images"
+        )

@@ -13,8 +13,11 @@ from __future__ import annotations
 import argparse
 import json
 
+import numpy as np
 import pytest
 
+from perception import CHECKPOINT
+from perception import data as pdata
 from tamp.cli import build_parser, main
 from tamp.cli.recorded import PRESENTATION
 from task.errors import TampError
@@ -74,6 +77,24 @@ NEEDS = {
 }
 # commands with no run configuration: what they write is named by their options
 NOT_RUNS = {"bench record"}
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _inputs(tmp_path_factory):
+    """The base invocation of commands that refuse missing input files before any work: a
+    tiny support dataset (one blank 30x45 image, no block; the walk reads no pixel) and the
+    shipped checkpoint."""
+    blank = pdata.SupportData(
+        images=np.zeros((1, 30, 45, 3), np.uint8),
+        colours=np.full((1, 4), -1, np.int8),
+        supports=np.full((1, 4), pdata.PAD, np.int8),
+        palette=np.eye(3, dtype=np.float32),
+        meta={"scene": "latplan"},
+    )
+    path = pdata.save(tmp_path_factory.mktemp("inputs") / "tiny.npz", blank)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setitem(BASE, "bench segmentation", [str(path), "--checkpoint", str(CHECKPOINT)])
+        yield
 
 
 def _leaves(parser: argparse.ArgumentParser, path: tuple[str, ...] = ()):
