@@ -39,6 +39,10 @@ class PlannerConfig:
     rank_prefixes: bool = True  # rank (and cut) each window by its best prefix (`task.decode`)
     park_free: bool = False  # count parking moves (to the table) as free in that ranking
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
+    fallback: bool | None = None  # when the windows revisit a state or run out, search on from
+    # the world state, complete over the moves the cost source allows (`task.symbolic.lazy_search`);
+    # None: only with a cost source (motion-aware planning); never with beliefs (perception)
+    fallback_nodes: int = 20_000  # state expansions the fallback may spend per problem
 
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:
@@ -57,7 +61,7 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         from task.errors import TampError
 
-        for name in ("horizon", "iters", "restarts", "max_windows"):
+        for name in ("horizon", "iters", "restarts", "max_windows", "fallback_nodes"):
             if getattr(self, name) < 1:
                 raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")
         for name in ("horizon", "lookahead"):

@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import torch
 
 from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig
-from task.costs import CostSource, WindowCosts
+from task.costs import IMPOSSIBLE, CostSource, WindowCosts
 from task.decode import decode_best
 from task.domains import get_domain
 from task.domains.base import Domain, State, resolve_goal_loss
@@ -32,6 +33,7 @@ from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 from task.rollout import OutOfTime, check_deadline
+from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first
 
 
 def _window(
@@ -107,21 +109,98 @@ def _crisp_states(
 
 def _execute(
     domain: Domain, problem: Problem, state: State, moves: Sequence[Move], visited: set
-) -> tuple[tuple[Move, ...], State, str | None]:
+) -> tuple[tuple[Move, ...], State, str | None, bool]:
     """Apply ``moves`` to the world ``state`` until one is illegal there; each state reached
     joins ``visited``.
 
-    Returns the moves tried (an illegal one last), the world state after the legal ones, and
-    why the illegal one is illegal (None when all were legal)."""
-    done = []
+    Returns the moves tried (an illegal one last), the world state after the legal ones, why
+    the illegal one is illegal (None when all were legal) and whether a state reached had been
+    visited before (the windows cycle)."""
+    done, looped = [], False
     for move in moves:
         done.append(move)
         reason = domain.check_move(problem, state, move)
         if reason is not None:
-            return tuple(done), state, f"{move}: {reason}"
+            return tuple(done), state, f"{move}: {reason}", looped
         state = domain.apply_move(problem, state, move)
+        looped = looped or state in visited
         visited.add(state)
-    return tuple(done), state, None
+    return tuple(done), state, None, looped
+
+
+def _fallback_on(
+    config: PlannerConfig, source: BeliefSource | None, costs: CostSource | None
+) -> bool:
+    """Whether the complete fallback search runs (`PlannerConfig.fallback`): by default only
+    with a cost source; never while planning from perception (the search plans on the world
+    state, which the planner does not see there)."""
+    if source is not None:
+        if config.fallback:
+            raise TampError(
+                "PlannerConfig.fallback=True plans on the world state: it cannot run with beliefs"
+            )
+        return False
+    return costs is not None if config.fallback is None else config.fallback
+
+
+def _cost_checks(domain: Domain, problem: Problem, costs: CostSource, index: int):
+    """``feasible(state, move)`` from a cost source: a move is ruled out where its price
+    reaches `task.costs.IMPOSSIBLE` (as the decoder rules it out), one pricing per state, and
+    the priced windows by state (their ``commit`` records the moves the fallback chose)."""
+    windows: dict[State, WindowCosts] = {}
+    prices: dict[State, dict[Move, float]] = {}
+
+    def feasible(state: State, move: Move) -> bool:
+        if state not in prices:
+            windows[state] = costs([index], [state], 1)
+            with torch.no_grad():
+                matrix = windows[state].compute()[0]  # (N, A - 1) action columns of row 0
+            rows, cols = matrix.shape
+            prices[state] = {
+                domain.decode(problem, r, c, rows): float(matrix[r, c])
+                for r in range(rows)
+                for c in range(cols)
+            }
+        return prices[state].get(move, 0.0) < IMPOSSIBLE
+
+    return feasible, windows
+
+
+def _fall_back(
+    domain: Domain,
+    problem: Problem,
+    state: State,
+    costs: CostSource | None,
+    indices: Sequence[int],
+    i: int,
+    config: PlannerConfig,
+    deadline: float | None,
+) -> LazyResult:
+    """The complete fallback search for problem ``i`` from its world ``state``, over the moves
+    the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is committed
+    to the cost source move by move (restart row 0 of a one-row window priced in the state
+    the move starts from). When no plan exists from ``state`` but ``state`` is not the initial
+    state, the initial state is searched too: UNSOLVABLE only when neither has a plan within
+    these choices (the windows may have led into a dead end)."""
+    feasible, windows = (
+        (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
+    )
+    found = lazy_best_first(domain, problem, state, feasible, config.fallback_nodes, deadline)
+    start = domain.initial_state(problem)
+    if found.status is SearchStatus.UNSOLVABLE and state != start:
+        left = max(1, config.fallback_nodes - found.expanded)
+        again = lazy_best_first(domain, problem, start, feasible, left, deadline)
+        if again.status is not SearchStatus.UNSOLVABLE:
+            why = (
+                "the windows reached a state from which no plan exists within these choices, "
+                f"and from the initial state the search ended {again.status.value}"
+            )
+            return replace(found, status=SearchStatus.DEAD_END, reason=why)
+        found = replace(found, reason=found.reason + ", from the initial state too")
+    for move in found.moves if costs is not None else ():
+        windows[state].commit([0], [(move,)])
+        state = domain.apply_move(problem, state, move)
+    return found
 
 
 def _next_window(
@@ -193,6 +272,8 @@ def _run(
     active = [i for i in range(len(problems)) if not solved[i]]
     on_done(len(problems) - len(active))
     timed_out = False
+    fallback = _fallback_on(config, source, costs)
+    trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
     for _ in range(config.max_windows):
         if not active:
             break
@@ -218,9 +299,11 @@ def _run(
         for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1
             misread[i] += seen != states[i]
-            tried, states[i], illegal[i] = _execute(
+            tried, states[i], illegal[i], looped = _execute(
                 domain, problems[i], states[i], win.moves, visited[i]
             )
+            if looped and fallback and trigger[i] is None:
+                trigger[i] = "cycle"  # the windows revisit a state: the fallback takes over
             moves[i].extend(tried)
             executed.append(tried)
             if not perceived:
@@ -237,9 +320,16 @@ def _run(
             seen_now, _ = _crisp_states(looked, [states[i] for i in hoped])
             for i, seen in zip(hoped, seen_now, strict=True):
                 solved[i] = domain.is_goal(problems[i], seen)
-        still = [i for i in active if illegal[i] is None and not solved[i]]
+        still = [i for i in active if illegal[i] is None and not solved[i] and not trigger[i]]
         on_done(len(active) - len(still))
         active = still
+    searched: dict[int, LazyResult] = {}
+    for i, p in enumerate(problems):
+        if fallback and not solved[i] and illegal[i] is None:
+            trigger[i] = trigger[i] or ("time_limit" if timed_out else "windows")
+            searched[i] = _fall_back(domain, p, states[i], costs, indices, i, config, deadline)
+            moves[i].extend(searched[i].moves)
+            solved[i] = searched[i].status is SearchStatus.SOLVED
     on_done(len(active))
     elapsed = time.perf_counter() - start
     results = []
@@ -259,6 +349,10 @@ def _run(
             )
         if illegal[i] is not None:
             status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
+        if i in searched:
+            stats["fallback"] = {"trigger": trigger[i], **searched[i].stats()}
+            if searched[i].status is SearchStatus.UNSOLVABLE:
+                status = PlanStatus.UNSOLVABLE
         results.append(PlanResult(status, Plan(tuple(moves[i])), p, None, stats))
     return results
 

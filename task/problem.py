@@ -74,6 +74,8 @@ class Problem:
 class PlanStatus(enum.Enum):
     SOLVED = "solved"
     NO_PLAN = "no_plan"  # the window budget ran out before the goal was reached
+    UNSOLVABLE = "unsolvable"  # the fallback search exhausted every state reachable with the
+    # moves allowed: no plan exists within these choices (``stats["fallback"]`` says how many)
     INVALID = "invalid"  # a planned move is illegal in the true state (perceived protocol or
     # no crisp check; the plan ends with that move, ``stats["illegal"]`` says why)
 

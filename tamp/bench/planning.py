@@ -110,7 +110,7 @@ def check(domain: Domain, instance: Instance, result: PlanResult) -> tuple[str, 
 
     Every plan the planner returns is replayed (`replay`), an inexecutable one too; only a
     window budget that ran out is ``no_plan``."""
-    if result.status is PlanStatus.NO_PLAN:
+    if result.status in (PlanStatus.NO_PLAN, PlanStatus.UNSOLVABLE):
         return "no_plan", None
     validation = replay(domain, instance, result.plan.moves)
     return validation.status.value, validation.length

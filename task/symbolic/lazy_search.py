@@ -1,0 +1,167 @@
+"""Best-first search over crisp states with feasibility checked lazily: the planner's complete
+fallback (`task.planner`), PDDLStream's incremental idea in its simplest form.
+
+The search runs A* (``weight`` 1; weighted A* above 1) over the crisp states of any domain that
+gives ``legal_moves``, ``apply_move``, ``is_goal`` and an admissible ``lower_bound`` (every
+`task.domains.base.Domain` does), with unit move costs. Each move is also a geometric choice
+that may not be executable (the arm cannot reach it, it failed there before): a callback
+``feasible(state, move) -> bool`` says so. It is called only when the search pops the move, i.e.
+when the move would close its successor state, and each answer is cached: a move found
+infeasible is pruned from that state only (the successor may still be reached another way), and
+the search continues. Successors are generated optimistically, so a move that is never popped
+is never checked.
+
+The search is complete over these choices (the domain's crisp moves, minus the ones ``feasible``
+rules out, states the lower bound calls dead ends cut): it ends ``SOLVED`` with a plan,
+``UNSOLVABLE`` when the reachable feasible space is exhausted without a goal (no plan exists
+within these choices), or ``BUDGET`` when ``max_nodes`` expansions or the deadline run out.
+With ``weight`` 1 a plan is a shortest one among the feasible moves.
+"""
+
+from __future__ import annotations
+
+import enum
+import heapq
+import itertools
+import math
+import time
+from collections.abc import Callable, Hashable
+from dataclasses import dataclass
+from typing import Protocol
+
+from task.problem import Move, Problem
+
+Feasible = Callable[[Hashable, Move], bool]  # (state, move) -> whether it can be executed
+
+
+class CrispDomain(Protocol):
+    """The crisp side of a domain the search needs (`task.domains.base.Domain` has it)."""
+
+    def legal_moves(self, problem: Problem, state: Hashable) -> list[Move]: ...
+
+    def apply_move(self, problem: Problem, state: Hashable, move: Move) -> Hashable: ...
+
+    def is_goal(self, problem: Problem, state: Hashable) -> bool: ...
+
+    def lower_bound(self, problem: Problem, state: Hashable) -> float: ...
+
+
+class SearchStatus(enum.Enum):
+    SOLVED = "solved"
+    UNSOLVABLE = "unsolvable"  # every reachable state expanded: no plan within these choices
+    BUDGET = "budget"  # the node budget or the deadline ran out first
+    DEAD_END = "dead_end"  # none from this state, though one may exist from an earlier one
+    # (`task.planner` says so when the windows led into such a state)
+
+
+@dataclass(frozen=True)
+class LazyResult:
+    """What the lazy search found, and what it cost."""
+
+    status: SearchStatus
+    moves: tuple[Move, ...]  # the plan (empty unless SOLVED; empty too when start is a goal)
+    expanded: int  # states expanded (their legal moves generated)
+    checked: int  # feasibility checks made (cache misses of ``feasible``)
+    ruled_out: int  # distinct (state, move) pairs ``feasible`` ruled out
+    time_s: float
+    reason: str  # one line: what the status means here
+
+    def stats(self) -> dict:
+        """A JSON-ready summary for a planner result's ``stats``."""
+        return {
+            "status": self.status.value,
+            "moves": len(self.moves),
+            "expanded": self.expanded,
+            "checked": self.checked,
+            "ruled_out": self.ruled_out,
+            "time_s": self.time_s,
+            "reason": self.reason,
+        }
+
+
+def lazy_best_first(
+    domain: CrispDomain,
+    problem: Problem,
+    start: Hashable,
+    feasible: Feasible | None = None,
+    max_nodes: int = 20_000,
+    deadline: float | None = None,
+    weight: float = 1.0,
+) -> LazyResult:
+    """Plan from crisp ``start`` to ``problem``'s goal over ``domain``'s moves that ``feasible``
+    allows (None: all), checked lazily (see the module docstring). ``deadline``: a
+    ``time.perf_counter()`` value after which the search stops with BUDGET."""
+    t0 = time.perf_counter()
+    allowed: dict[tuple[Hashable, Move], bool] = {}
+    checked = 0
+
+    def ok(state: Hashable, move: Move) -> bool:
+        nonlocal checked
+        key = (state, move)
+        if key not in allowed:
+            checked += 1
+            allowed[key] = True if feasible is None else bool(feasible(state, move))
+        return allowed[key]
+
+    def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
+        ruled = sum(not v for v in allowed.values())
+        elapsed = time.perf_counter() - t0
+        return LazyResult(status, moves, expanded, checked, ruled, elapsed, reason)
+
+    # one heap entry per (state, g); the moves reaching the state at that g wait in ``pending``
+    # and are checked in order when the entry pops, until one is feasible
+    parent: dict[Hashable, tuple[Hashable, Move] | None] = {}  # closed states
+    pending: dict[Hashable, dict[int, list[tuple[Hashable, Move]]]] = {}
+    tie = itertools.count()
+    frontier: list[tuple[float, int, int, Hashable]] = []
+    expanded = 0
+    h0 = domain.lower_bound(problem, start)
+    if math.isinf(h0):
+        return done(SearchStatus.UNSOLVABLE, (), "the start is a dead end (lower bound INF)")
+    heapq.heappush(frontier, (weight * h0, 0, next(tie), start))
+    pending[start] = {0: []}
+    while frontier:
+        _, neg_g, _, state = heapq.heappop(frontier)
+        if state in parent:
+            continue
+        g = -neg_g
+        ways = pending[state].pop(g, [])
+        if state == start and g == 0:
+            parent[state] = None
+        else:
+            way = next((w for w in ways if ok(*w)), None)
+            if way is None:
+                continue  # every move reaching it at this depth is ruled out: maybe later
+            parent[state] = way
+        del pending[state]
+        if domain.is_goal(problem, state):
+            path = []
+            while parent[state] is not None:
+                state, move = parent[state]
+                path.append(move)
+            path.reverse()
+            return done(SearchStatus.SOLVED, tuple(path), f"a plan of {len(path)} moves")
+        if expanded >= max_nodes:
+            return done(SearchStatus.BUDGET, (), f"stopped after {expanded} expansions (budget)")
+        if deadline is not None and time.perf_counter() > deadline:
+            return done(SearchStatus.BUDGET, (), f"stopped after {expanded} expansions (time)")
+        expanded += 1
+        for move in domain.legal_moves(problem, state):
+            nxt = domain.apply_move(problem, state, move)
+            if nxt in parent:
+                continue
+            h = domain.lower_bound(problem, nxt)
+            if math.isinf(h):
+                continue  # a dead end: no plan passes through it
+            at = pending.setdefault(nxt, {})
+            if g + 1 not in at:
+                at[g + 1] = []
+                heapq.heappush(frontier, (g + 1 + weight * h, -(g + 1), next(tie), nxt))
+            at[g + 1].append((state, move))
+    ruled = sum(not v for v in allowed.values())
+    return done(
+        SearchStatus.UNSOLVABLE,
+        (),
+        f"no plan exists within these choices: {len(parent)} reachable states expanded, "
+        f"{ruled} moves ruled out",
+    )
