@@ -1,0 +1,350 @@
+"""The declared binding of a pick-and-place PDDL domain to the motion layer.
+
+A user's domain names its own actions and arguments; the motion layer carries one object at a
+time onto a target (another object, or a region such as a peg, a tray or the table). The
+binding says, per action, its role and which argument is what:
+
+- ``pick``: takes ``object`` into the hand (``pick-up ?x``, ``unstack ?x ?y``);
+- ``place``: puts the held ``object`` onto ``target`` (``stack ?x ?y``; ``put-down ?x`` onto the
+  fixed region ``table``);
+- ``move``: both at once (Hanoi's ``move ?d ?from ?to``).
+
+``object`` is a parameter (``"?x"``); ``target`` is a parameter or, without the ``?``, a fixed
+region the action always places on. A binding is declared as a tiny JSON or TOML text::
+
+    {"domain": "blocksworld-4ops",
+     "actions": {"pick-up": {"role": "pick", "object": "?x"},
+                 "stack": {"role": "place", "object": "?x", "target": "?y"}, ...}}
+
+`load_text` reads it into a `BindingSpec` (what was declared); `bind` checks it against the
+domain's action schemas and returns a `Binding`: an unknown action, argument, role or key, and
+an action that neither picks nor places what it names, are one-line `BindingError`s listing
+the valid names. The schema checks are structural: a pick adds an atom of its object (the
+hold, e.g. ``(holding ?x)``) and needs none that a pick adds; a place needs and deletes such a
+hold and adds an atom of its object (with its target, when the target is a parameter); a move
+deletes an atom of its object and adds one of object and target. `to_moves` pairs a plan's
+actions into `task.problem.Move`s (object -> target): a pick must be followed by the place of
+the same object; anything else is a one-line error naming the plan step.
+"""
+
+from __future__ import annotations
+
+import enum
+import json
+import tomllib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from pddl.core import Domain
+
+from task.errors import ProblemError, one_of
+from task.problem import Action, Move
+from task.symbolic import strips
+
+
+class BindingError(ProblemError):
+    """A binding names what the domain lacks, or declares a role its action cannot play."""
+
+
+class Role(enum.Enum):
+    PICK = "pick"
+    PLACE = "place"
+    MOVE = "move"  # pick and place in one action
+
+
+ROLES = tuple(r.value for r in Role)
+KEYS = ("role", "object", "target")
+
+# the embedded 4-op blocksworld (`task/data/blocksworld-4ops.pddl`): put-down places on the table
+BLOCKSWORLD = """{
+  "domain": "blocksworld-4ops",
+  "actions": {
+    "pick-up": {"role": "pick", "object": "?x"},
+    "unstack": {"role": "pick", "object": "?x"},
+    "put-down": {"role": "place", "object": "?x", "target": "table"},
+    "stack": {"role": "place", "object": "?x", "target": "?y"}
+  }
+}"""
+
+
+@dataclass(frozen=True)
+class ActionSpec:
+    """One declared action: its role, its object parameter (``?x``) and its target (a
+    parameter ``?y``, a fixed region name, or None for a pick)."""
+
+    role: Role
+    object: str
+    target: str | None = None
+
+
+@dataclass(frozen=True)
+class BindingSpec:
+    """A binding as declared, before it is checked against a domain (``domain``: the PDDL
+    domain name it is for, None: any)."""
+
+    actions: tuple[tuple[str, ActionSpec], ...]
+    domain: str | None = None
+
+
+@dataclass(frozen=True)
+class BoundAction:
+    """A checked action: ``object`` the index of its object argument; ``target`` the index of
+    its target argument, or the fixed region's name, or None (a pick)."""
+
+    name: str
+    role: Role
+    object: int
+    target: int | str | None
+
+
+@dataclass(frozen=True)
+class Binding:
+    """A binding checked against the action schemas of domain ``domain``."""
+
+    domain: str
+    actions: tuple[BoundAction, ...]
+
+    def get(self, name: str) -> BoundAction | None:
+        return next((a for a in self.actions if a.name == name.lower()), None)
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        return tuple(a.name for a in self.actions)
+
+
+# ------------------------------------------------------------------------------ declaration
+
+
+def _action_spec(name: str, entry: object, source: str) -> ActionSpec:
+    where = f"{source}: action {name}"
+    if not isinstance(entry, Mapping):
+        raise BindingError(f"{where}: expected a table of {', '.join(KEYS)}, got {entry!r}")
+    for key in entry:
+        if key not in KEYS:
+            raise BindingError(f"{where}: unknown key {one_of(key, KEYS)}")
+    for key in KEYS:
+        value = entry.get(key)
+        if key != "target" and value is None:
+            raise BindingError(f"{where}: missing {key!r}")
+        if value is not None and (not isinstance(value, str) or not value.strip("?")):
+            raise BindingError(f"{where}: {key} must be a name, got {value!r}")
+    if entry["role"] not in ROLES:
+        raise BindingError(f"{where}: unknown role {one_of(entry['role'], ROLES)}")
+    role = Role(entry["role"])
+    target = entry.get("target")
+    if role is Role.PICK and target is not None:
+        raise BindingError(f"{where}: a pick names no target (its place does), got {target!r}")
+    if role is not Role.PICK and target is None:
+        raise BindingError(f"{where}: a {role.value} needs a target (a ?parameter or a region)")
+    return ActionSpec(role, entry["object"].lower(), target and target.lower())
+
+
+def from_mapping(data: object, source: str = "<binding>") -> BindingSpec:
+    """The `BindingSpec` of a decoded JSON or TOML document."""
+    if not isinstance(data, Mapping):
+        raise BindingError(f"{source}: expected a table with 'actions', got {type(data).__name__}")
+    for key in data:
+        if key not in ("domain", "actions"):
+            raise BindingError(f"{source}: unknown key {one_of(key, ('domain', 'actions'))}")
+    actions = data.get("actions")
+    if not isinstance(actions, Mapping) or not actions:
+        raise BindingError(f"{source}: 'actions' must map at least one action to its role")
+    domain = data.get("domain")
+    if domain is not None and not isinstance(domain, str):
+        raise BindingError(f"{source}: 'domain' must be a name, got {domain!r}")
+    specs = tuple((str(n).lower(), _action_spec(str(n), e, source)) for n, e in actions.items())
+    return BindingSpec(specs, domain and domain.lower())
+
+
+def load_text(text: str, fmt: str = "json", source: str = "<binding>") -> BindingSpec:
+    """Read a binding from JSON (``fmt="json"``) or TOML (``fmt="toml"``) text."""
+    if fmt not in ("json", "toml"):
+        raise BindingError(f"{source}: unknown binding format {one_of(fmt, ('json', 'toml'))}")
+    try:
+        data = json.loads(text) if fmt == "json" else tomllib.loads(text)
+    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
+        first = str(exc).splitlines()[0]
+        raise BindingError(f"{source}: not valid {fmt.upper()}: {first}") from None
+    return from_mapping(data, source)
+
+
+def load(path: str | Path) -> BindingSpec:
+    """Read a binding file: ``.json`` or ``.toml``."""
+    path = Path(path)
+    fmt = path.suffix.lower().lstrip(".")
+    if fmt not in ("json", "toml"):
+        raise BindingError(
+            f"{path}: a binding file ends in {one_of(path.suffix, ('.json', '.toml'))}"
+        )
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise BindingError(f"{path}: cannot read the binding ({exc.strerror})") from None
+    return load_text(text, fmt, str(path))
+
+
+# ---------------------------------------------------------------------------------- checking
+
+
+def _schema_atoms(domain: Domain, name: str) -> tuple[list, list, list]:
+    """The (pre, add, delete) atoms of action ``name``'s schema, parameters as ``?p``."""
+    schema = {str(a.name).lower(): a for a in domain.actions}[name]
+    params = {str(p.name).lower(): f"?{str(p.name).lower()}" for p in schema.parameters}
+    pre = strips._literals(schema.precondition, f"action {name}: precondition")
+    eff = strips._literals(schema.effect, f"action {name}: effect")
+    pre_atoms = [strips._atom(p, params) for positive, p in pre if positive]
+    add = [strips._atom(p, params) for positive, p in eff if positive]
+    delete = [strips._atom(p, params) for positive, p in eff if not positive]
+    return pre_atoms, add, delete
+
+
+def _of(atoms: list, *args: str) -> list:
+    """The atoms that name every one of ``args``."""
+    return [a for a in atoms if all(x in a[1:] for x in args)]
+
+
+def _both(atoms: tuple[list, list, list]) -> list:
+    """The precondition atoms an action also deletes."""
+    pre, _, delete = atoms
+    return [a for a in pre if a in delete]
+
+
+def _shape(atom: tuple, obj: str) -> tuple:
+    """An atom with its object written ``?`` and its other parameters ``*``: the holds of
+    different actions compare alike whatever they call their parameters."""
+    return tuple("?" if x == obj else "*" if x.startswith("?") else x for x in atom)
+
+
+def bind(spec: BindingSpec, domain: Domain) -> Binding:
+    """Check ``spec`` against ``domain``'s action schemas (see the module docstring)."""
+    dname = str(domain.name).lower()
+    if spec.domain is not None and spec.domain != dname:
+        raise BindingError(f"binding is for domain {spec.domain!r}, not {dname!r}")
+    schemas = {str(a.name).lower(): a for a in domain.actions}
+    bound, atoms = [], {}
+    for name, entry in spec.actions:
+        if name not in schemas:
+            raise BindingError(f"binding: unknown action {one_of(name, sorted(schemas))}")
+        params = tuple(f"?{str(p.name).lower()}" for p in schemas[name].parameters)
+        if entry.object not in params:
+            raise BindingError(f"binding: action {name}: object {one_of(entry.object, params)}")
+        target: int | str | None = entry.target
+        if entry.target is not None and entry.target.startswith("?"):
+            if entry.target not in params:
+                what = one_of(entry.target, params)
+                raise BindingError(f"binding: action {name}: target {what} (or a region name)")
+            if entry.target == entry.object:
+                raise BindingError(f"binding: action {name}: {entry.object} is object and target")
+            target = params.index(entry.target)
+        atoms[name] = _schema_atoms(domain, name)
+        bound.append(BoundAction(name, entry.role, params.index(entry.object), target))
+    binding = Binding(dname, tuple(bound))
+    _check_roles(binding, spec, atoms)
+    return binding
+
+
+def _check_roles(binding: Binding, spec: BindingSpec, atoms: dict) -> None:
+    """BindingError for an action whose schema cannot play its declared role."""
+    entries = dict(spec.actions)
+    picks = [a for a in binding.actions if a.role is Role.PICK]
+    places = [a for a in binding.actions if a.role is Role.PLACE]
+    if bool(picks) != bool(places):
+        have, lacks = ("pick", "place") if picks else ("place", "pick")
+        names = ", ".join(a.name for a in picks or places)
+        raise BindingError(f"binding has {have} actions ({names}) but no {lacks} action")
+
+    def shapes(action: BoundAction, atoms_: list) -> set:
+        return {_shape(a, entries[action.name].object) for a in atoms_}
+
+    # the hold: an atom of its object that a pick adds and a place needs and deletes
+    made = set().union(*(shapes(a, _of(atoms[a.name][1], entries[a.name].object)) for a in picks))
+    used = set().union(
+        *(shapes(a, _of(_both(atoms[a.name]), entries[a.name].object)) for a in places)
+    )
+    holds = made & used
+    for action in binding.actions:
+        entry = entries[action.name]
+        pre, add, delete = atoms[action.name]
+        obj, target = entry.object, entry.target
+        held = [a for a in _of(pre, obj) if _shape(a, obj) in holds]
+        if action.role is not Role.PLACE and held:
+            raise BindingError(
+                f"binding: action {action.name} ({action.role.value}) needs "
+                f"{strips.atom_str(held[0])}, which a pick makes: it places, it does not pick"
+            )
+        if action.role is Role.PICK and not [a for a in _of(add, obj) if _shape(a, obj) in holds]:
+            raise BindingError(
+                f"binding: action {action.name} (pick) adds no atom of {obj} that a place needs "
+                f"and deletes: it picks nothing a place puts down"
+            )
+        if not _of(add, obj):
+            raise BindingError(
+                f"binding: action {action.name} neither picks nor places {obj}: "
+                f"it adds no atom of {obj}"
+            )
+        if action.role is Role.PLACE and not [a for a in held if a in delete]:
+            raise BindingError(
+                f"binding: action {action.name} (place) needs and deletes no atom of {obj} that "
+                f"a pick adds: it places nothing that was picked"
+            )
+        if action.role is not Role.PICK and target.startswith("?") and not _of(add, obj, target):
+            raise BindingError(
+                f"binding: action {action.name} ({action.role.value}) adds no atom of "
+                f"{obj} and {target}: it does not place {obj} on {target}"
+            )
+        if action.role is Role.MOVE and not _of(delete, obj):
+            raise BindingError(
+                f"binding: action {action.name} (move) deletes no atom of {obj}: "
+                f"it does not take {obj} from anywhere"
+            )
+
+
+def bind_text(text: str, domain: Domain, fmt: str = "json", source: str = "<binding>") -> Binding:
+    """`bind` of a binding text."""
+    return bind(load_text(text, fmt, source), domain)
+
+
+# -------------------------------------------------------------------------------------- plans
+
+
+def to_moves(binding: Binding, plan: Sequence[Action]) -> tuple[Move, ...]:
+    """The ``(object -> target)`` moves of a validated plan, in order (see the module
+    docstring); BindingError naming the 1-based plan step otherwise."""
+    moves: list[Move] = []
+    held: tuple[str, int] | None = None  # (object, the step that picked it)
+    for step, action in enumerate(plan, start=1):
+        where = f"plan step {step} {action}"
+        bound = binding.get(action.name)
+        if bound is None:
+            bound_names = ", ".join(binding.names)
+            raise BindingError(f"{where}: neither picks nor places (bound: {bound_names})")
+        args = tuple(a.lower() for a in action.args)
+        needs = max(i for i in (bound.object, bound.target, 0) if isinstance(i, int)) + 1
+        if len(args) < needs:
+            raise BindingError(f"{where}: {bound.name} needs {needs} arguments, got {len(args)}")
+        obj = args[bound.object]
+        if bound.role is Role.PICK:
+            if held is not None:
+                raise BindingError(
+                    f"{where}: the hand holds {held[0]} (picked at step {held[1]}); "
+                    f"a pick must be followed by its place"
+                )
+            held = (obj, step)
+            continue
+        if bound.role is Role.PLACE and held is None:
+            raise BindingError(f"{where}: places {obj}, which no pick holds")
+        if bound.role is Role.PLACE and held[0] != obj:
+            raise BindingError(
+                f"{where}: places {obj}, but the hand holds {held[0]} (picked at step {held[1]})"
+            )
+        if bound.role is Role.MOVE and held is not None:
+            raise BindingError(
+                f"{where}: moves {obj} while the hand holds {held[0]} (picked at step {held[1]})"
+            )
+        target = args[bound.target] if isinstance(bound.target, int) else bound.target
+        moves.append(Move(obj, target))
+        held = None
+    if held is not None:
+        raise BindingError(f"plan ends holding {held[0]} (picked at step {held[1]}), unplaced")
+    return tuple(moves)
