@@ -42,7 +42,8 @@ class PlannerConfig:
     fallback: bool | None = None  # when the windows revisit a state or run out, search on from
     # the world state, complete over the moves the cost source allows (`task.symbolic.lazy_search`);
     # None: only with a cost source (motion-aware planning); never with beliefs (perception)
-    fallback_nodes: int = 20_000  # state expansions the fallback may spend per problem
+    fallback_nodes: int = 5_000  # state expansions the fallback may spend per problem (each
+    # expanded state is priced once by the cost source when one of its moves is checked)
 
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:

@@ -210,7 +210,7 @@ def test_every_move_keeps_the_placement_its_window_decided(solver):
     poses = layout(five.entities, five.init, SCENE, seed=1)
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05, restarts=2, iters=40)
     whole = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, config, reach=0.02)
-    first = dataclasses.replace(config, max_windows=1)
+    first = dataclasses.replace(config, max_windows=1, fallback=False)  # the first window only
     cut = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, first, reach=0.02)
     assert whole.solved and whole.stats["windows"] >= 2 and cut.stats["windows"] == 1
     table = [m for m in whole.plan if m.target == TABLE]
