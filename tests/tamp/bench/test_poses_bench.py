@@ -49,7 +49,7 @@ def test_bench_poses_prints_the_table_and_writes_artefacts(capsys, tmp_path):
     ("argv", "needle"),
     [
         (["--sim", "gazebo"], "unknown simulator"),
-        (["--min-blocks", "5", "--max-blocks", "4"], "--min-blocks/--max-blocks"),
+        (["--min-blocks", "5", "--max-blocks", "4"], "--min-blocks 5 is more than --max-blocks 4"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(capsys, argv, needle):
