@@ -5,6 +5,10 @@ per step.
 Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise
 (an empty ``--plan`` file included, as ``tamp validate``). ``tamp demo`` is this command with
 ``--observe camera --out out/demo``: the camera-to-arm episode ``make demo`` runs.
+
+With ``--scene FILE.json --goal GOAL`` (or a shipped scene's name, e.g. ``--scene tower``) the
+problem is the scene file's (`tamp.world.blocks.scene_task`): its objects start where the file
+puts them and the initial state is read from their geometry, never given.
 """
 
 from __future__ import annotations
