@@ -301,8 +301,11 @@ def output_options(p: argparse.ArgumentParser, out_help: str) -> None:
     p.add_argument("--out", metavar="PATH", help=out_help)
 
 
-def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None:
-    """Options of commands that run closed-loop episodes in a simulator."""
+def episode_options(
+    p: argparse.ArgumentParser, multi_sim: bool = False, scene_files: bool = False
+) -> None:
+    """Options of commands that run closed-loop episodes in a simulator (``scene_files``:
+    ``--scene`` also takes a scene file, `workcell_options`)."""
     if multi_sim:
         p.add_argument(
             "--sim",
@@ -356,13 +359,13 @@ def episode_options(p: argparse.ArgumentParser, multi_sim: bool = False) -> None
         help="decode moves against the observed state, or the simulator's true "
         "state (an oracle) (perceived)",
     )
-    scene_options(p)
+    scene_options(p, scene_files)
 
 
-def scene_options(p: argparse.ArgumentParser) -> None:
+def scene_options(p: argparse.ArgumentParser, files: bool = False) -> None:
     """The scene's obstacles, what happens to a trajectory that would hit one, and
     motion-aware planning on it (`workcell_options`)."""
-    workcell_options(p)
+    workcell_options(p, files)
     p.add_argument(
         "--collision",
         choices=("plan", "check", "off"),
@@ -372,15 +375,26 @@ def scene_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def workcell_options(p: argparse.ArgumentParser) -> None:
+def workcell_options(p: argparse.ArgumentParser, files: bool = False) -> None:
     """The robot's table (``--scene``) and motion-aware planning on it (``--motion-aware``,
-    ``--placements``): the one place these options are defined."""
-    p.add_argument(
-        "--scene",
-        choices=SCENES,
-        default="tabletop",
-        help="the workcell: obstacles on the robot's table (tabletop: none)",
-    )
+    ``--placements``): the one place these options are defined. With ``files``, ``--scene``
+    also takes a scene file (`tamp.world`), checked by `tamp.cli.recorded.run_config`."""
+    if files:
+        p.add_argument(
+            "--scene",
+            default="tabletop",
+            metavar="NAME|FILE.json",
+            help=f"the workcell ({', '.join(SCENES)}; tabletop: no obstacles), or a scene "
+            "file whose objects start where it puts them, their state read from the geometry "
+            "(with --goal)",
+        )
+    else:
+        p.add_argument(
+            "--scene",
+            choices=SCENES,
+            default="tabletop",
+            help="the workcell: obstacles on the robot's table (tabletop: none)",
+        )
     p.add_argument(
         "--motion-aware",
         dest="lambda_motion",
@@ -428,6 +442,12 @@ def run_options(p: argparse.ArgumentParser) -> None:
     """``tamp run``'s own options: the video, and a given plan to execute instead of planning."""
     p.add_argument("--no-video", action="store_true", help="skip the camera video")
     p.add_argument("--video-format", choices=("mp4", "gif"), default="mp4", help="(mp4)")
+    p.add_argument(
+        "--goal",
+        metavar="PDDL|FILE",
+        help="--scene FILE.json: the goal over its objects, inline such as '(and (on a b) "
+        "(on b c))' or a file (a PDDL goal or problem); on and ontable atoms",
+    )
     p.add_argument(
         "--plan",
         metavar="PLAN",

@@ -153,7 +153,7 @@ def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
         p.add_argument(
             "problem", nargs="?", metavar="PROBLEM.pddl", help="blocksworld problem (the example)"
         )
-        episode_options(p)
+        episode_options(p, scene_files=True)
         p.add_argument("--seed", type=seed, default=0, help="scene, planner and fault seed (0)")
         run_options(p)
         output_options(p, "write the episode video and report.json into this folder")

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from perception import CHECKPOINT
 from tamp.bench.suites import default_data
-from tamp.cli.options import check_workcell, planner_config, sim_list
+from tamp.cli.options import SCENES, check_workcell, planner_config, sim_list
 from task.errors import TampError
 
 # options that change where or how the output is shown, never what is computed: checked by
@@ -61,10 +61,10 @@ def loop_config(args: argparse.Namespace):
     from tamp.loop import LoopConfig
     from tamp.loop.execute import ExecConfig
     from tamp.loop.faults import Injection
-    from tamp.obstacles import with_scene
-    from tamp.scene import SceneConfig
+    from tamp.world import load_named, scene_config
 
     check_workcell(args, executes=True)
+    task = scene_run(args)
     config = LoopConfig(
         sim=args.sim,
         grasp=args.grasp,
@@ -74,13 +74,52 @@ def loop_config(args: argparse.Namespace):
         perception=PerceptionMode(args.perception, blur=args.blur),
         checkpoint=args.checkpoint,
         crisp=args.crisp,
-        scene=with_scene(SceneConfig(), args.scene),
+        scene=scene_config(load_named(args.scene)) if task is None else task.config,
         execution=replace(ExecConfig(), collision=args.collision),
         placements=args.placements,
     )
     if args.max_replans is not None:
         config = replace(config, max_replans=args.max_replans)
     return config
+
+
+def scene_run(args: argparse.Namespace):
+    """``run`` and ``demo`` with ``--scene FILE.json --goal GOAL``: the scene file's episode
+    (`tamp.world.blocks.SceneTask`), None with a named workcell. Refused in one line before any
+    work: ``--goal`` without a scene file or with a PDDL problem, a scene file without
+    ``--goal``, with ``--plan`` or with the camera, and what `scene_task` refuses. A shipped
+    scene (`tamp.world.named_scenes`) other than the workcells is a scene file by its name."""
+    goal = getattr(args, "goal", None)
+    name = getattr(args, "scene", "tabletop")
+    if goal is not None and getattr(args, "problem", None) is not None:
+        raise TampError("--goal with PROBLEM.pddl: the goal is the scene file's or the problem's")
+    if name in SCENES:
+        if goal is not None:
+            raise TampError(
+                f"--goal needs --scene FILE.json (the objects it names); --scene {name} is a "
+                "named workcell, whose problem is PROBLEM.pddl"
+            )
+        return None
+    from tamp.world import named_scenes
+    from tamp.world.blocks import scene_task
+    from tamp.world.load import SCENES_DIR
+
+    path = SCENES_DIR / f"{name}.json" if name in named_scenes() else Path(name)
+    if not name.endswith(".json") and not path.is_file():
+        raise TampError(
+            f"--scene {name}: neither a named scene ({', '.join(named_scenes())}) nor a scene "
+            "file (FILE.json)"
+        )
+    if goal is None:
+        raise TampError(f"--scene {name} needs --goal: the goal over the scene file's objects")
+    if getattr(args, "plan", None) is not None:
+        raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
+    if getattr(args, "observe", "state") == "camera":
+        raise TampError(
+            "--observe camera with a scene file: the camera's goal image is laid out from a "
+            "PDDL problem (yet); use --observe state"
+        )
+    return scene_task(path, goal)
 
 
 def _loop_dict(config) -> dict:
@@ -114,8 +153,11 @@ def run_config(args: argparse.Namespace) -> dict:
     if args.out is None and (args.no_video or args.video_format != "mp4"):
         raise TampError("--no-video and --video-format apply with --out DIR (the video's folder)")
     config = loop_config(args)
+    task = scene_run(args)
     return {
         **_loop_dict(config),
+        "scene_file": None if task is None else args.scene,
+        "goal": None if task is None else task.goal.text(),
         "problem": args.problem,
         "domain": args.domain,
         "seed": args.seed,

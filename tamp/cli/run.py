@@ -5,6 +5,10 @@ per step.
 Exit code 0 when the episode reaches the goal (scored on simulator ground truth), 1 otherwise
 (an empty ``--plan`` file included, as ``tamp validate``). ``tamp demo`` is this command with
 ``--observe camera --out out/demo``: the camera-to-arm episode ``make demo`` runs.
+
+With ``--scene FILE.json --goal GOAL`` (or a shipped scene's name, e.g. ``--scene tower``) the
+problem is the scene file's (`tamp.world.blocks.scene_task`): its objects start where the file
+puts them and the initial state is read from their geometry, never given.
 """
 
 from __future__ import annotations
@@ -15,7 +19,7 @@ import sys
 import time
 from pathlib import Path
 
-from tamp.cli.recorded import checkpoint, loop_config, out_folder, run_config
+from tamp.cli.recorded import checkpoint, loop_config, out_folder, run_config, scene_run
 from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.video import EpisodeVideo
@@ -77,7 +81,8 @@ def _given_steps(path: str | None, problem: Problem):
 def run_command(args: argparse.Namespace) -> int:
     recorded = run_config(args)  # refused combinations: before any work
     out_folder(args.out)
-    problem = load_problem(args.problem, args.domain)
+    task = scene_run(args)
+    problem = load_problem(args.problem, args.domain) if task is None else task.problem
     config = loop_config(args)
     if config.observe == "camera":
         checkpoint(config.checkpoint)
@@ -98,7 +103,8 @@ def run_command(args: argparse.Namespace) -> int:
             print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
     if steps is None:
-        episode = Episode(problem, config, args.seed, on_event=say)
+        poses = None if task is None else dict(task.poses)  # a scene file's: where it puts them
+        episode = Episode(problem, config, args.seed, on_event=say, poses=poses)
     else:
         episode = GivenPlanEpisode(
             problem, steps, config, args.seed, args.replan, args.stop_at_invalid, on_event=say
@@ -117,6 +123,8 @@ def run_command(args: argparse.Namespace) -> int:
         if seen == "camera":
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
         given = f", given plan {args.plan} ({len(steps)} steps)" if steps is not None else ""
+        if task is not None:
+            given += f", scene file {args.scene}, goal {task.goal.text()}"
         print(
             f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
             file=sys.stderr,

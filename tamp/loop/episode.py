@@ -24,7 +24,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from contextlib import contextmanager
 
 import numpy as np
@@ -61,7 +61,9 @@ ARM_FAILURES = frozenset(
 
 
 class Episode:
-    """One problem in one simulator. ``run()`` returns the EpisodeReport."""
+    """One problem in one simulator. ``run()`` returns the EpisodeReport. The blocks start at
+    ``poses`` (a scene file's; they must read as ``problem.init``) or, by default, at a
+    `tamp.scene.layout` of the problem's initial state drawn with ``seed``."""
 
     def __init__(
         self,
@@ -71,6 +73,7 @@ class Episode:
         on_frame: Callable[[Simulator], None] | None = None,
         on_event: Callable[[str], None] | None = None,
         solver: IKSolver | None = None,
+        poses: Mapping[str, Pose] | None = None,
     ) -> None:
         self.problem, self.config, self.seed = problem, config, seed
         self.domain = get_domain(problem.domain)
@@ -78,7 +81,9 @@ class Episode:
         self.on_frame = on_frame
         self.say = on_event or (lambda text: None)
         self.solver = solver or IKSolver()
-        poses = layout(problem.entities, problem.init, config.scene, seed)
+        if poses is None:  # laid out from the problem's initial state
+            poses = layout(problem.entities, problem.init, config.scene, seed)
+        poses = dict(poses)
         self.status_text = ""
         self.target = problem  # what the robot plans for and tests: the goal it perceives
         perceiver = self.goal_image = None

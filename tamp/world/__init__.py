@@ -13,6 +13,8 @@ and movable objects; the symbolic state is read from that geometry, never given.
   read from the poses, and the objects the geometry cannot explain;
 - ``tamp.world.goal``: `load_goal` / `parse_goal`, a PDDL goal over the scene's objects and
   regions, checked against the scene.
+- ``tamp.world.blocks``: `scene_task`, a scene file and a goal as the closed loop's Blocksworld
+  episode (``tamp run --scene FILE.json --goal GOAL``), or one line saying what it cannot run.
 
 World frame = the robot base frame (``panda_link0``), the table surface at z = 0, metres and
 radians, as in `tamp.scene`.

@@ -59,6 +59,8 @@ SAMPLES = {
     "--limit": "2",
     "--n": "2",
     "--max-replans": "3",
+    "--scene": "shelf",  # run and demo: a name or a scene file (the other commands: choices)
+    "--goal": "(on b c)",
 }
 # what an option needs to take effect, per command where it differs; tried in order
 NEEDS = {
@@ -74,6 +76,8 @@ NEEDS = {
     "--domain": [["problem.pddl"]],
     "--min-blocks": [["--max-blocks", "9"]],
     "--data": [["--blocks", "4"]],
+    # a scene file (the shipped example's name), another goal, and the state observed
+    "--goal": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
 }
 # commands with no run configuration: what they write is named by their options
 NOT_RUNS = {"bench record"}
@@ -206,6 +210,12 @@ def test_presentation_options_are_only_these():
         ),
         (["bench", "executability", "--plans", "x.csv", "--placements", "0.02"], "--motion-aware"),
         (["run", "--replan"], "apply to a given plan"),
+        (["run", "--goal", "(on a b)"], "--goal needs --scene FILE.json"),
+        (["run", "p.pddl", "--scene", "tower", "--goal", "(on a b)"], "--goal with PROBLEM.pddl"),
+        (["run", "--scene", "tower"], "needs --goal"),
+        (["run", "--scene", "attic"], "neither a named scene"),
+        (["demo", "--scene", "tower", "--goal", "(on b c)"], "--observe camera with a scene"),
+        (["run", "--scene", "tower", "--goal", "(on b c)", "--plan", "x"], "--plan with a scene"),
     ],
 )
 def test_options_that_cannot_apply_are_one_line_usage_errors(capsys, argv, expected):

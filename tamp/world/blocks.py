@@ -1,0 +1,131 @@
+"""A scene file as a Blocksworld episode: what ``tamp run --scene FILE --goal GOAL`` runs.
+
+`scene_task` loads the scene, reads its symbolic state from the geometry (`read_facts`), and
+builds the Blocksworld `task.problem.Problem` the closed loop plans for: the movable objects are
+the entities, the supports read from their poses the initial state, the goal's ``on`` and
+``ontable`` atoms the goal. The episode starts from the file's object poses, among its
+obstacles (and its regions' walls and floors), on its slot grid (`scene_config`), with each
+object's colour.
+
+What the loop cannot do yet is one `SceneFileError` line, before any work: an object the
+geometry cannot explain, an object that is not a cube of the loop's block size, an object
+resting in a region, a goal atom other than ``on`` / ``ontable`` (``in``: regions are not
+planning targets yet), and poses the loop's own state reader (`tamp.scene.read_state`, whose
+tolerances are looser than the scene file's) would read as another state.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from tamp.scene import Pose, SceneConfig, read_state
+from tamp.world.goal import Goal, load_goal
+from tamp.world.load import load_scene, scene_config
+from tamp.world.relations import Facts, read_facts
+from tamp.world.schema import Scene, SceneFileError
+from task.problem import TABLE, Problem
+
+GOAL_PREDICATES = ("on", "ontable")  # what a Blocksworld goal names: supports
+
+
+@dataclass(frozen=True)
+class SceneTask:
+    """A scene file and its goal, ready for `tamp.loop.Episode`: the ``problem`` (its init read
+    from the geometry), the objects' ``poses`` (entity order) and the ``config`` of the table."""
+
+    scene: Scene
+    goal: Goal
+    facts: Facts
+    problem: Problem
+    poses: tuple[tuple[str, Pose], ...]
+    config: SceneConfig
+
+
+def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConfig()) -> SceneTask:
+    """The Blocksworld episode of the scene file at ``path`` and the goal ``goal`` (inline PDDL
+    or a file, `load_goal`), on ``base``'s block size; SceneFileError, one line, when the loop
+    cannot run it (see the module docstring)."""
+    scene = load_scene(path)
+    label = str(path)
+    if not scene.objects:
+        raise SceneFileError(f"{label}: objects: the scene has no movable object to plan for")
+    _check_blocks(scene, base.block_size, label)
+    facts = read_facts(scene)
+    if facts.unexplained:
+        raise SceneFileError(
+            f"{label}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
+            + "; ".join(facts.issues)
+        )
+    in_regions = [f"{x} in {s}" for x, s in facts.supports if s in {r.name for r in scene.regions}]
+    if in_regions:
+        raise SceneFileError(
+            f"{label}: {', '.join(in_regions)}: objects in regions cannot be planned yet "
+            "(regions are not planning targets); put them on the table or on an object"
+        )
+    wanted = load_goal(goal, scene)
+    for atom in wanted.atoms:
+        if atom[0] not in GOAL_PREDICATES:
+            why = (
+                "regions are not planning targets yet"
+                if atom[0] == "in"
+                else "a Blocksworld goal names supports"
+            )
+            raise SceneFileError(
+                f"goal: ({' '.join(atom)}): the loop plans goals of "
+                f"{' and '.join(GOAL_PREDICATES)} atoms only ({why})"
+            )
+    entities = tuple(o.name for o in scene.objects)
+    support = dict(facts.supports)
+    problem = Problem(
+        name=scene.name,
+        domain="blocksworld",
+        entities=entities,
+        init=tuple(support[x] for x in entities),
+        goal=tuple((a[1], a[2] if a[0] == "on" else TABLE) for a in wanted.atoms),
+    )
+    config = _table(scene, base)
+    poses = tuple((o.name, o.pose) for o in scene.objects)
+    _check_reader(problem, dict(poses), config, label)
+    return SceneTask(scene, wanted, facts, problem, poses, config)
+
+
+def _check_blocks(scene: Scene, size: float, label: str) -> None:
+    for i, o in enumerate(scene.objects):
+        if o.kind != "cube" or abs(o.size[0] - size) > 1e-9:
+            shape = o.kind if o.kind == "cube" else f"a {o.kind}"
+            raise SceneFileError(
+                f"{label}: objects[{i}] ({o.name}): {shape} of size "
+                f"{', '.join(f'{v:g}' for v in o.size)} m; the loop moves cubes of "
+                f"{size:g} m only (yet)"
+            )
+
+
+def _table(scene: Scene, base: SceneConfig) -> SceneConfig:
+    """``base`` with the scene's obstacles, its regions' walls and floors as fixed boxes, its
+    slot grid and its objects' colours (object i: colour i)."""
+    config = scene_config(scene, base)
+    boxes = [b for r in scene.regions for b in (*r.walls(), r.slab()) if b is not None]
+    palette = tuple((o.name, o.rgb) for o in scene.objects)
+    return replace(config, obstacles=(*config.obstacles, *boxes), palette=palette)
+
+
+def _check_reader(problem: Problem, poses: dict, config: SceneConfig, label: str) -> None:
+    """The loop reads each new state with `tamp.scene.read_state`: the file's poses must read
+    as the state the geometry gives, or the loop would replan from the first observation."""
+    reading = read_state(problem.entities, poses, config)
+    if reading.state == problem.init:
+        return
+    if reading.state is None:
+        detail = "; ".join(reading.issues)
+    else:
+        detail = ", ".join(
+            f"{x} on {r} (geometry: on {g})"
+            for x, r, g in zip(problem.entities, reading.state, problem.init, strict=True)
+            if r != g
+        )
+    raise SceneFileError(
+        f"{label}: the loop's state reader (centres within {config.tol_xy * 1000:.0f} mm, "
+        f"heights within {config.tol_z * 1000:.0f} mm of a block) reads the poses otherwise: "
+        f"{detail}"
+    )
