@@ -190,12 +190,14 @@ def train_command(args: argparse.Namespace) -> int:
 
 
 def eval_command(args: argparse.Namespace) -> int:
+    import numpy as np
+
     from perception import data as pdata
     from perception.train import evaluate, load_checkpoint
 
     recorded = eval_config(args)
     checkpoint(args.checkpoint)
-    model, _ = load_checkpoint(args.checkpoint)
+    model, meta = load_checkpoint(args.checkpoint)
     data = pdata.load(args.data)
     if args.blur:
         from perception.perceive import blur
@@ -203,13 +205,27 @@ def eval_command(args: argparse.Namespace) -> int:
         data = pdata.SupportData(
             blur(data.images, args.blur), data.colours, data.supports, data.palette, data.meta
         )
+    # as planning does (`perception.perceive.Perceiver`): every image at the checkpoint's
+    # training input size when it records one
+    hw = meta.get("input_hw")
+    resized = hw is not None and tuple(data.images.shape[1:3]) != tuple(hw)
+    if resized:
+        data = pdata.SupportData(
+            np.stack([pdata.resize_image(im, hw) for im in data.images]),
+            data.colours,
+            data.supports,
+            data.palette,
+            data.meta,
+        )
     scores = evaluate(model, pdata.tensors(data))
+    scores["resized_to"] = list(hw) if resized else None
     if args.json:
         print(json.dumps({**scores, "config": recorded}))
     else:
+        size = f"; resized to {hw[0]}x{hw[1]} as planning does" if resized else ""
         print(
             f"relation accuracy {scores['relation_accuracy']:.4%} ({scores['blocks']} blocks), "
             f"scene accuracy {scores['scene_accuracy']:.2%} ({scores['scenes']} images; "
-            f"{scores['unreadable']} unreadable, left out)"
+            f"{scores['unreadable']} unreadable, left out{size})"
         )
     return 0

@@ -93,3 +93,42 @@ def test_corruption_specs_read_back():
     spec = parse_corruption("noise:8, dim:0.35,occlude")
     assert spec == Corruption(noise=8.0, dim=0.35, occlude=True)
     assert spec.name == "noise 8 + dim 0.35 + occluder"
+
+
+@pytest.mark.sim
+def test_eval_resizes_to_the_checkpoints_input_size_as_planning_does(capsys, tmp_path, monkeypatch):
+    """A 45x30 LatPlan file is scored at the LatPlan checkpoint's 150x100 input, as
+    `perception.perceive.Perceiver` plans from it (before, eval scored the small images as they
+    were: 77% of scenes read right against 98.5% resized)."""
+    import numpy as np
+
+    from perception import train
+
+    path = tmp_path / "l.npz"
+    made = ["perception", "dataset", "--image-scene", "latplan", "--n", "2", "--seed", "5"]
+    assert main([*made, "--out", str(path), "--no-progress", "--json"]) == 0
+    data = pdata.load(path)
+    small = pdata.SupportData(
+        np.stack([pdata.resize_image(im, (30, 45)) for im in data.images]),
+        data.colours,
+        data.supports,
+        data.palette,
+        data.meta,
+    )
+    pdata.save(tmp_path / "small.npz", small)
+    seen = []
+    real = train.evaluate
+    monkeypatch.setattr(
+        train, "evaluate", lambda model, d: seen.append(tuple(d["images"].shape)) or real(model, d)
+    )
+    latplan = str(CHECKPOINT.with_name("support-latplan.pt"))
+    capsys.readouterr()
+    argv = ["perception", "eval", str(tmp_path / "small.npz"), "--checkpoint", latplan]
+    assert main([*argv, "--json"]) == 0
+    scores = json.loads(capsys.readouterr().out)
+    assert scores["resized_to"] == [100, 150]
+    assert seen[-1] == (2, 3, 100, 150)  # (M, 3, H, W): the model saw 150x100 images
+    assert main(argv) == 0
+    assert "resized to 100x150 as planning does" in capsys.readouterr().out
+    assert main(["perception", "eval", str(path), "--checkpoint", latplan, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["resized_to"] is None  # already 150x100
