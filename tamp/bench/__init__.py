@@ -12,5 +12,5 @@
 - ``results``: the one results writer (output folder, machine record, JSON, CSV, plots);
 - ``tables``: the one table printer.
 
-The command-line handlers that call these live in `tamp.cli.bench`.
+The command-line handlers that call these live in `tamp.cli.bench` (one module per kind).
 """

@@ -208,11 +208,11 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             help="a spread of N instances over the sizes (all)",
         )
     planbench.set_defaults(
-        func=_lazy("tamp.cli.bench", "planbench_command"),
+        func=_lazy("tamp.cli.bench.planning", "planbench_command"),
         recorded=_lazy("tamp.cli.recorded", "planning_config"),
     )
     folder.set_defaults(
-        func=_lazy("tamp.cli.bench", "pddl_command"),
+        func=_lazy("tamp.cli.bench.planning", "pddl_command"),
         recorded=_lazy("tamp.cli.recorded", "planning_config"),
     )
     random_.add_argument(
@@ -245,7 +245,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         "bench extra)",
     )
     random_.set_defaults(
-        func=_lazy("tamp.cli.bench", "random_command"),
+        func=_lazy("tamp.cli.bench.planning", "random_command"),
         recorded=_lazy("tamp.cli.recorded", "planning_config"),
     )
 
@@ -261,7 +261,7 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json and episodes.csv into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "motion_command"),
+        func=_lazy("tamp.cli.bench.arm", "motion_command"),
         recorded=_lazy("tamp.cli.recorded", "motion_config"),
     )
 
@@ -275,7 +275,7 @@ def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     executability_options(p)
     sweep_options(p)
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "executability_command"),
+        func=_lazy("tamp.cli.bench.arm", "executability_command"),
         recorded=_lazy("tamp.cli.recorded", "executability_config"),
     )
 
@@ -294,7 +294,7 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json, instances.csv and example.png into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "perception_command"),
+        func=_lazy("tamp.cli.bench.vision", "perception_command"),
         recorded=_lazy("tamp.cli.recorded", "perception_bench_config"),
     )
 
@@ -331,7 +331,7 @@ def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json and instances.csv into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "latplan_command"),
+        func=_lazy("tamp.cli.bench.vision", "latplan_command"),
         recorded=_lazy("tamp.cli.recorded", "latplan_config"),
     )
 
@@ -354,7 +354,7 @@ def _poses_benchmark(bench) -> None:
     progress_option(p)
     output_options(p, "write results.json and blocks.csv into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "poses_command"),
+        func=_lazy("tamp.cli.bench.vision", "poses_command"),
         recorded=_lazy("tamp.cli.recorded", "poses_config"),
     )
 
@@ -379,7 +379,7 @@ def _segmentation_benchmark(bench) -> None:
     progress_option(p)
     output_options(p, "write results.json into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench", "segmentation_command"),
+        func=_lazy("tamp.cli.bench.vision", "segmentation_command"),
         recorded=_lazy("tamp.cli.recorded", "segmentation_config"),
     )
 
@@ -409,7 +409,7 @@ def _record_command(bench) -> None:
         help="the file whose current-results table is regenerated (%(default)s)",
     )
     p.add_argument("--json", action="store_true", help="the records written, as JSON")
-    p.set_defaults(func=_lazy("tamp.cli.record", "record_command"))
+    p.set_defaults(func=_lazy("tamp.cli.bench.record", "record_command"))
 
 
 def _perception_commands(sub) -> None:

@@ -1,0 +1,195 @@
+"""``tamp bench motion|executability``: the arm benchmarks, many independent episodes.
+
+``--workers N`` runs them in N processes, ``--ray ADDRESS`` as Ray tasks
+(`tamp.sweep.run_items`); each episode has its own seed, so the rows are the same either way."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from functools import partial
+
+from tqdm import tqdm
+
+from tamp.bench import results, suites, tables
+from tamp.cli.bench import interrupted
+from tamp.cli.options import sim_list
+from tamp.cli.recorded import (
+    checkpoint,
+    executability_config,
+    given_config,
+    loop_config,
+    motion_config,
+)
+from tamp.cli.recorded import out_folder as output_folder
+from task.errors import TampError
+
+DEFAULT_N = 20  # bench executability: instances when --n is not given (fewer if fewer named)
+
+
+def motion_command(args: argparse.Namespace) -> int:
+    """Closed-loop episodes on a ``--n`` spread of PlanBench (or random ``--blocks``
+    problems) in each ``--sim``."""
+    from tamp.bench import motion
+    from tamp.slots import fits
+
+    recorded = motion_config(args)  # refused combinations: before any work
+    output_folder(args.out)
+    if args.observe == "camera":
+        checkpoint(args.checkpoint)
+    sims, base = sim_list(args.sim), loop_config(args)
+    if args.blocks:
+        suite = suites.generated(
+            args.blocks, args.n, args.seed, keep=partial(fits, scene=base.scene)
+        )
+    else:
+        suite = suites.planbench(args.data, args.n)
+    recorded |= {"n": len(suite.instances), "source": suite.source}
+    goals, done = dict.fromkeys(sims, 0), []
+    total = len(sims) * len(suite.instances)
+    with tqdm(
+        total=total, desc="motion", unit="episode", file=sys.stderr, disable=not args.progress
+    ) as bar:
+
+        def progress(sim: str, report) -> None:
+            done.append(report)
+            goals[sim] += report.reached_goal
+            bar.set_postfix(sim=sim, goal=goals[sim], refresh=False)
+            bar.update(1)
+
+        try:
+            result = motion.run(suite, base, sims, args.seed, progress, args.workers, args.ray)
+        except KeyboardInterrupt:
+            if args.out:
+                _motion_partial(args.out, recorded, suite, done, sims, base, total)
+            return interrupted(args.out, len(done), total, "episodes")
+    inject = str(base.inject)
+    body = {
+        "config": recorded,
+        "machine": results.machine(args.argv),
+        "ik_batch": result.ik,
+        "summary": result.summary,
+    }
+    if args.out:
+        out = results.out_folder(args.out)
+        results.write_json(out / "results.json", body)
+        rows = motion.episode_rows(result.reports)
+        results.write_csv(out / "episodes.csv", rows, motion.EPISODE_COLUMNS)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    seen = base.observe + (
+        f" ({base.perception.mode} perception)" if base.observe == "camera" else ""
+    )
+    kind = "PlanBench" if not args.blocks else f"random ({base.scene.name} scene)"
+    print(
+        f"motion benchmark: {len(suite.instances)} {kind} instances, grasp {base.grasp}, "
+        f"observe {seen}, crisp {base.crisp}, faults {inject}, seed {args.seed}"
+    )
+    print(tables.motion_table(result.summary, inject))
+    ik = result.ik
+    print(
+        f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
+        f"({ik['converged']}/{ik['n']} converged)"
+    )
+    if args.out:
+        print(f"wrote results.json, episodes.csv to {args.out}")
+    return 0
+
+
+def _motion_partial(out, recorded: dict, suite, done: list, sims, base, total: int) -> None:
+    """The episodes done before Ctrl-C: episodes.csv and a results.json marked partial."""
+    from tamp.bench import motion
+
+    named = {i.name: i for i in suite.instances}
+    summary = {}
+    for sim in sims:
+        mine = [r for r in done if r.sim == sim]
+        if mine:
+            instances = [named[r.problem] for r in mine]
+            camera = base.observe == "camera"
+            summary[sim] = motion.summarise(mine, instances, suite.domain, camera)
+    folder = results.out_folder(out)
+    body = {
+        "config": recorded,
+        "partial": {"done": len(done), "of": total},
+        "machine": results.machine(),
+        "summary": summary,
+    }
+    results.write_json(folder / "results.json", body)
+    results.write_csv(folder / "episodes.csv", motion.episode_rows(done), motion.EPISODE_COLUMNS)
+
+
+def executability_command(args: argparse.Namespace) -> int:
+    """Each ``--plans`` source's plans and ours, executed open-loop in each ``--sim``, on the
+    instances the plan files name (``--n``: a spread of at most N of them)."""
+    import torch
+
+    from tamp.bench import executability as bench
+
+    recorded = executability_config(args)  # refused combinations: before any work
+    output_folder(args.out)
+    sims, sources = sim_list(args.sim), bench.read_sources(args.plans)
+    names = bench.named(sources)
+    if args.n is not None and args.n > len(names):
+        raise TampError(
+            f"--n {args.n}: the plan files name {len(names)} instance"
+            f"{'' if len(names) == 1 else 's'}; give at most that many (or leave --n out)"
+        )
+    limit = args.n if args.n is not None else min(DEFAULT_N, len(names))
+    suite = suites.planbench(args.data, limit, names=names)
+    torch.set_num_threads(args.threads)
+    base = given_config(args)
+    ours, wall0 = base.planner if args.ours else None, time.perf_counter()
+    recorded["instances"] = [i.name for i in suite.instances]
+    total = len(sims) * len(suite.instances) * (len(sources) + bool(ours))
+    done = []
+    with tqdm(
+        total=total, desc="executability", unit="plan", file=sys.stderr, disable=not args.progress
+    ) as bar:
+
+        def progress(sim: str, row) -> None:
+            done.append(row)
+            bar.update(1)
+
+        try:
+            rows = bench.run_given(
+                suite, sources, base, sims, args.seed, ours, progress, args.workers, args.ray
+            )
+        except KeyboardInterrupt:
+            if args.out:
+                folder = results.out_folder(args.out)
+                body = {
+                    "config": recorded,
+                    "partial": {"done": len(done), "of": total},
+                    "machine": results.machine(args.argv),
+                    "summary": bench.given_summary(done, sims) if done else [],
+                }
+                results.write_json(folder / "results.json", body)
+                results.write_csv(folder / "plans.csv", done, digits=2)
+            return interrupted(args.out, len(done), total, "plans")
+    summary, wall = bench.given_summary(rows, sims), time.perf_counter() - wall0
+    body = {
+        "config": recorded,
+        "machine": results.machine(args.argv),
+        "wall_s": wall,
+        "summary": summary,
+    }
+    if args.out:
+        out = results.out_folder(args.out)
+        results.write_json(out / "results.json", body)
+        results.write_csv(out / "plans.csv", rows, digits=2)
+    if args.json:
+        print(json.dumps(body, indent=2))
+        return 0
+    print(
+        f"executability: {len(suite.instances)} PlanBench instances named by --plans, "
+        f"open-loop, grasp {args.grasp}, seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
+        tables.executability_table(summary, sims),
+        sep="\n",
+    )
+    if args.out:
+        print(f"wrote results.json, plans.csv to {args.out}")
+    return 0

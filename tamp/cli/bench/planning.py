@@ -1,0 +1,147 @@
+"""``tamp bench planbench|pddl|random``: the planning benchmarks on PDDL sets and seeded random
+Blocksworld problems, optionally with LAMA beside."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from contextlib import contextmanager
+from dataclasses import replace
+
+from tqdm import tqdm
+
+from tamp.bench import planning, results, suites, tables
+from tamp.cli.bench import bar, interrupted
+from tamp.cli.options import planner_config
+from tamp.cli.recorded import out_folder as output_folder
+from tamp.cli.recorded import (
+    planning_config,
+)
+from task.errors import TampError
+
+
+def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -> int:
+    """Plan ``suite`` as ``args`` say; ``lengths``: also print the plan-length table (and run
+    LAMA beside with ``args.lama``)."""
+    import torch
+
+    torch.set_num_threads(args.threads)
+    rules = {i.problem.domain for i in suite.instances}
+    domain = rules.pop() if len(rules) == 1 else None
+    recorded = planning_config(args, domain)
+    config = planner_config(args, domain)
+    if getattr(args, "one_at_a_time", False):
+        config = replace(config, batched=False)
+    horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
+    total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
+    runs: list[planning.Run] = []
+    with bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
+        try:
+            result = planning.run(
+                suite, config, seeds, horizons, args.sequential, update, runs.append
+            )
+        except KeyboardInterrupt:
+            done = [row for run in runs for row in run.rows]
+            if args.out is not None:
+                out = results.out_folder(args.out)
+                partial = {
+                    "done": len(done),
+                    "of": len(suite.instances) * len(seeds) * len(horizons),
+                    "complete_runs": len(runs),  # a batched run keeps nothing until complete
+                }
+                body = {
+                    "config": recorded,
+                    "partial": partial,
+                    "machine": results.machine(args.argv),
+                }
+                results.write_json(out / "results.json", body)
+                results.write_csv(out / "instances.csv", done)
+            return interrupted(args.out, len(done), total, "plans (complete horizon-seed runs)")
+    if getattr(args, "lama", False):
+        result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
+    body = results.results(result, args.argv)
+    body["config"] = {**body["config"], **recorded}
+    if args.out is not None:
+        paths = results.write(result, args.out, body)
+    if args.json:
+        print(json.dumps(body, indent=2))
+    else:
+        print(tables.planning_report(result))
+        if lengths:
+            print(f"\nplan lengths by {result.size_name} (mean over seeds):")
+            print(tables.lengths_table(result))
+        if args.out is not None:
+            print(f"\nwrote {', '.join(p.name for p in paths)} to {args.out}")
+    return 0
+
+
+def _lama(suite: suites.Suite, bench: planning.Bench, limit: float, progress: bool):
+    """``bench`` with LAMA's lengths and times; unchanged, and one line on stderr, when the
+    ``bench`` extra (Fast Downward) is not installed."""
+    from tamp.bench import fast_downward
+
+    if not fast_downward.available():
+        print(
+            f"LAMA skipped: Fast Downward is not installed (pip install 'soft-tamp[bench]', "
+            f"the package {fast_downward.PACKAGE})",
+            file=sys.stderr,
+        )
+        return bench
+    with bar(len(suite.instances), "LAMA (lama-first)", progress, "instance") as update:
+        return planning.with_lama(bench, suite, limit, update)
+
+
+def planbench_command(args: argparse.Namespace) -> int:
+    """An official PlanBench set of ``--domain`` (or a ``--limit`` spread of it)."""
+    planning_config(args)  # refused combinations: before any work
+    output_folder(args.out)
+    data = args.data if args.data is not None else suites.default_data(args.domain)
+    with _searching(args.progress) as update:
+        suite = suites.planbench(data, args.limit, args.out, args.domain, update, args.domain_rules)
+    return _run(suite, args)
+
+
+def pddl_command(args: argparse.Namespace) -> int:
+    """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
+    planning_config(args)
+    output_folder(args.out)
+    with _searching(args.progress) as update:
+        suite = suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules, update)
+    return _run(suite, args)
+
+
+@contextmanager
+def _searching(enabled: bool):
+    """A bar for optimal lengths the data lack, opened at the first one searched (if any)."""
+    bars = []
+
+    def update(k: int) -> None:
+        if not bars:
+            bars.append(
+                tqdm(
+                    desc="optimal lengths the data lack",
+                    unit="problem",
+                    file=sys.stderr,
+                    disable=not enabled,
+                )
+            )
+        bars[0].update(k)
+
+    try:
+        yield update
+    finally:
+        for bar in bars:
+            bar.close()
+
+
+def random_command(args: argparse.Namespace) -> int:
+    """``--n`` generated instances per ``--blocks`` count, optima from A* within a budget."""
+    if min(args.blocks) < 2:
+        raise TampError(f"--blocks: random problems need at least 2 blocks, got {min(args.blocks)}")
+    planning_config(args)
+    output_folder(args.out)
+    total = len(args.blocks) * args.n
+    with bar(total, "instances, A* optima", args.progress, "instance") as update:
+        suite = suites.generated(args.blocks, args.n, args.seed, args.max_nodes, update)
+    return _run(suite, args, lengths=True)
