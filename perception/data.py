@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -91,6 +91,12 @@ def resize_image(image: np.ndarray, hw: Sequence[int]) -> np.ndarray:
         return image
     shrink = h * w < image.shape[0] * image.shape[1]
     return cv2.resize(image, (w, h), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+
+
+def resize_data(data: SupportData, hw: Sequence[int]) -> SupportData:
+    """``data`` with every image resized to ``hw`` = (H', W') (`resize_image`); the labels are
+    unchanged (boxes are found on the images later, at their new size)."""
+    return replace(data, images=np.stack([resize_image(im, hw) for im in data.images]))
 
 
 def load_many(paths: str | Sequence[str | Path]) -> SupportData:

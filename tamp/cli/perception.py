@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import shlex
 import sys
@@ -107,7 +108,6 @@ DATASET_KEYS = (
 
 
 def train_command(args: argparse.Namespace) -> int:
-    import numpy as np
     import torch
 
     from perception import data as pdata
@@ -139,14 +139,7 @@ def train_command(args: argparse.Namespace) -> int:
     scores = evaluate(model, test_data)
     more = {}  # each further test file, resized to the training input size
     for path in args.test.split(",")[1:]:
-        extra = pdata.load_many([path])
-        resized = pdata.SupportData(
-            np.stack([pdata.resize_image(im, hw) for im in extra.images]),
-            extra.colours,
-            extra.supports,
-            extra.palette,
-            extra.meta,
-        )
+        resized = pdata.resize_data(pdata.load_many([path]), hw)
         more[path] = evaluate(model, pdata.tensors(resized))
     meta = {
         "command": _command_line(),
@@ -190,7 +183,6 @@ def train_command(args: argparse.Namespace) -> int:
 
 
 def eval_command(args: argparse.Namespace) -> int:
-    import numpy as np
 
     from perception import data as pdata
     from perception.train import evaluate, load_checkpoint
@@ -202,21 +194,13 @@ def eval_command(args: argparse.Namespace) -> int:
     if args.blur:
         from perception.perceive import blur
 
-        data = pdata.SupportData(
-            blur(data.images, args.blur), data.colours, data.supports, data.palette, data.meta
-        )
+        data = dataclasses.replace(data, images=blur(data.images, args.blur))
     # as planning does (`perception.perceive.Perceiver`): every image at the checkpoint's
     # training input size when it records one
     hw = meta.get("input_hw")
     resized = hw is not None and tuple(data.images.shape[1:3]) != tuple(hw)
     if resized:
-        data = pdata.SupportData(
-            np.stack([pdata.resize_image(im, hw) for im in data.images]),
-            data.colours,
-            data.supports,
-            data.palette,
-            data.meta,
-        )
+        data = pdata.resize_data(data, hw)
     scores = evaluate(model, pdata.tensors(data))
     scores["resized_to"] = list(hw) if resized else None
     if args.json:

@@ -63,8 +63,7 @@ def check(
     ``model``, and the dark class's margins, on every image of ``data``; ``input_hw``: the
     model's (H, W), each image resized to it first; ``progress(1)`` after each image."""
     if input_hw is not None:
-        images = np.stack([pdata.resize_image(im, input_hw) for im in data.images])
-        data = pdata.SupportData(images, data.colours, data.supports, data.palette, data.meta)
+        data = pdata.resize_data(data, input_hw)
     names = [f"#{k}" for k in range(len(data.palette))]
     dark = next((k for k, rgb in enumerate(data.palette) if is_dark(rgb)), None)
     found = {"current": dict.fromkeys(names, 0), "unguarded": dict.fromkeys(names, 0)}
