@@ -1,10 +1,12 @@
 """The scene model: a symbolic Blocksworld state <-> block poses on a table, and back.
 
 Blocks are cubes (5 cm by default), or upright cylinders as tall as they are wide, with distinct
-colours from the scene's palette. Each tower stands on a *table slot*, a fixed grid of positions
-in front of the robot; a block moved onto the table goes to a free slot. ``layout`` turns a
-state into poses (with small seeded jitter); ``read_state`` turns observed poses into a state,
-with tolerances, and says which block it cannot explain.
+colours from the scene's palette; ``SceneConfig.bodies`` may give any entity its own solid
+(`Body`: a cube, cuboid or cylinder of any size), which the simulators build. Each tower
+stands on a *table slot*, a fixed grid of positions in front of the robot; a block moved onto
+the table goes to a free slot. ``layout`` turns a state into poses (with small seeded jitter);
+``read_state`` turns observed poses into a state, with tolerances, and says which block it
+cannot explain.
 
 World frame = the robot base frame (``panda_link0``); the table surface is z = 0.
 """
@@ -39,6 +41,7 @@ PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
 )
 CAMERA_COLOURS = 8  # blocks that camera perception can tell apart by colour
 SHAPES = ("cube", "cylinder")
+BODY_KINDS = ("cube", "cuboid", "cylinder")
 
 
 class SceneError(TampError):
@@ -55,6 +58,34 @@ class Pose:
     @property
     def xy(self) -> np.ndarray:
         return np.asarray(self.xyz[:2])
+
+
+@dataclass(frozen=True)
+class Body:
+    """One movable object's solid: ``kind`` (one of `BODY_KINDS`) and its half extents (m) in
+    the object's frame, centre at the origin, z up; a cylinder stands upright with
+    ``half = (r, r, h / 2)``."""
+
+    kind: str
+    half: tuple[float, float, float]
+
+    def __post_init__(self) -> None:
+        if self.kind not in BODY_KINDS:
+            raise SceneError(f"unknown body kind {one_of(self.kind, BODY_KINDS)}")
+        if len(self.half) != 3 or not all(math.isfinite(h) and h > 0 for h in self.half):
+            raise SceneError(f"body half extents must be three positive numbers, got {self.half}")
+        if self.kind == "cylinder" and self.half[0] != self.half[1]:
+            raise SceneError(f"a cylinder's half extents are (r, r, h / 2), got {self.half}")
+        if self.kind == "cube" and len(set(self.half)) != 1:
+            raise SceneError(f"a cube's half extents are equal, got {self.half}")
+
+    @property
+    def volume(self) -> float:
+        """m^3."""
+        hx, hy, hz = self.half
+        if self.kind == "cylinder":
+            return math.pi * hx * hx * 2 * hz
+        return 8 * hx * hy * hz
 
 
 @dataclass(frozen=True)
@@ -83,10 +114,25 @@ class SceneConfig:
     backdrop_grey: float = 0.45
     obstacles: tuple = ()  # fixed boxes (`tamp.obstacles.Obstacle`); see tamp.obstacles.SCENES
     name: str = "tabletop"  # the named scene the obstacles come from
+    # each listed entity's own solid (`Body`); an entity not listed is the default block
+    bodies: tuple[tuple[str, Body], ...] = ()
 
     def __post_init__(self) -> None:
         if self.shape not in SHAPES:
             raise SceneError(f"unknown block shape {one_of(self.shape, SHAPES)}")
+
+    @property
+    def default_body(self) -> Body:
+        """The scene's block: a cube of ``block_size``, or an upright cylinder as tall as wide."""
+        half = self.block_size / 2
+        return Body(self.shape, (half, half, half))
+
+    def body(self, name: str) -> Body:
+        """The solid of entity ``name``: its entry in ``bodies``, else `default_body`."""
+        for key, body in self.bodies:
+            if key == name:
+                return body
+        return self.default_body
 
     @property
     def slots(self) -> tuple[tuple[float, float], ...]:
@@ -204,15 +250,17 @@ def read_state(
     entities: Sequence[str], poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()
 ) -> Reading:
     """Observed poses -> crisp supports. A block rests on the table when its centre is half a
-    block high, on block b when it sits one block above b's centre within the tolerances."""
+    block high, on block b when it sits one block above b's centre within the tolerances (with
+    ``config.bodies``, each entity's own half height: x on b when x's centre is b's half height
+    plus x's above b's)."""
     missing = [x for x in entities if x not in poses]
     if missing:
         raise SceneError(f"no pose for blocks {missing} (poses given: {sorted(poses)})")
-    s = config.block_size
+    hz = {x: config.body(x).half[2] for x in entities}  # half heights, m
     support, issues, loose = {}, [], []
     for x in entities:
         px = poses[x]
-        if abs(px.xyz[2] - s / 2) <= config.tol_z:
+        if abs(px.xyz[2] - hz[x]) <= config.tol_z:
             support[x] = TABLE
             continue
         below = [
@@ -220,7 +268,7 @@ def read_state(
             for b in entities
             if b != x
             and np.linalg.norm(px.xy - poses[b].xy) <= config.tol_xy
-            and abs(px.xyz[2] - poses[b].xyz[2] - s) <= config.tol_z
+            and abs(px.xyz[2] - poses[b].xyz[2] - (hz[b] + hz[x])) <= config.tol_z
         ]
         if len(below) == 1:
             support[x] = below[0]

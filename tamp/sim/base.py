@@ -16,6 +16,7 @@ contacts the running trajectory is meant to make (`Expected`).
 from __future__ import annotations
 
 import abc
+import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, NamedTuple
@@ -24,7 +25,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from motion.trajectory import JointTrajectory
-from tamp.scene import Pose, SceneConfig
+from tamp.scene import Body, Pose, SceneConfig, cube_yaw
 from tamp.sim.truth import GroundTruth
 from task.errors import TampError, one_of
 
@@ -34,6 +35,33 @@ TRACK_EVERY = 5  # steps between tracking-error samples
 ROBOT = "robot"  # `Simulator._contacts`' name for any link of the Panda
 HELD = "held:"  # `Simulator.touched` key prefix of what the held block touched, e.g. "held:c"
 VIDEO_SIZE = (640, 480)  # (width, height) of `Simulator.render_video` frames
+# the heaviest movable object, kg: 0.3 kg hangs on the friction grasp of either backend with
+# margin at any width in the stroke (the weakest: MuJoCo's tendon grip on a 2 cm object)
+MAX_MASS = 0.3
+MIN_MASS = 0.01  # kg, the lightest (a 2 cm cube would weigh 6 g at the default density)
+
+
+def body_mass(scene: SceneConfig, name: str) -> float:
+    """Mass (kg) of entity ``name``: the default block's density (``block_mass`` over the
+    default body's volume; 800 kg/m^3 for 0.1 kg 5 cm cubes) times its body's volume, within
+    [`MIN_MASS`, `MAX_MASS`]; the default block weighs exactly ``block_mass``."""
+    body = scene.body(name)
+    if body == scene.default_body:
+        return scene.block_mass
+    density = scene.block_mass / scene.default_body.volume
+    return min(max(density * body.volume, MIN_MASS), MAX_MASS)
+
+
+def body_yaw(rotation, body: Body) -> float:
+    """Yaw (rad) of a body from its rotation matrix (3, 3), modulo its symmetry about the
+    vertical: an upright cuboid's x axis in [-pi/2, pi/2); a cube's, as `tamp.scene.cube_yaw`
+    reads it, in [-pi/4, pi/4), and so a cylinder's (it has no yaw of its own), a cuboid's
+    with a square footprint or one that is not upright."""
+    r = np.asarray(rotation, dtype=float).reshape(3, 3)  # columns: body axes in the world
+    square = body.half[0] == body.half[1]
+    if body.kind != "cuboid" or square or int(np.argmax(np.abs(r[2]))) != 2:
+        return cube_yaw(r)
+    return (math.atan2(r[1, 0], r[0, 0]) + math.pi / 2) % math.pi - math.pi / 2
 
 
 @dataclass(frozen=True)
@@ -99,7 +127,8 @@ class Snapshot(NamedTuple):
 
 class Simulator(abc.ABC):
     """A headless world: the Panda (at home, fingers open), a table, and blocks at ``poses``
-    (cubes or cylinders, as ``scene.shape`` says; block i has ``scene.palette[i]``'s colour)."""
+    (each entity's solid is ``scene.body(name)``: by default cubes or cylinders, as
+    ``scene.shape`` says; its mass `body_mass`; block i has ``scene.palette[i]``'s colour)."""
 
     name: str = ""
     dt: float = DT

@@ -19,7 +19,7 @@ import numpy as np
 
 from robots.mujoco_loader import GRIP_ACTUATOR, actuator_name, panda_spec
 from robots.panda import PANDA
-from tamp.scene import Pose, colour, cube_yaw
+from tamp.scene import Body, Pose, colour
 from tamp.sim.base import (
     ROBOT,
     VIDEO_SIZE,
@@ -28,6 +28,8 @@ from tamp.sim.base import (
     Lighting,
     Simulator,
     Snapshot,
+    body_mass,
+    body_yaw,
 )
 from task.errors import TampError
 
@@ -50,6 +52,14 @@ def _look_at(eye, target, up) -> list[float]:
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.column_stack([right, upv, back]).ravel())
     return list(quat)
+
+
+def _geom(body: Body) -> tuple[mujoco.mjtGeom, list[float]]:
+    """MuJoCo geom type and size of a block: a box's half extents, a cylinder's radius and half
+    height."""
+    if body.kind == "cylinder":
+        return mujoco.mjtGeom.mjGEOM_CYLINDER, [body.half[0], body.half[2]]
+    return mujoco.mjtGeom.mjGEOM_BOX, list(body.half)
 
 
 class MuJoCoSim(Simulator):
@@ -90,9 +100,8 @@ class MuJoCoSim(Simulator):
                 quat=_quat(o.yaw),
                 rgba=[*o.rgb, 1],
             )
-        shape, size = mujoco.mjtGeom.mjGEOM_BOX, [scene.block_size / 2] * 3
-        if scene.shape == "cylinder":  # radius, half height; matte like LatPlan's rubber
-            shape, size = mujoco.mjtGeom.mjGEOM_CYLINDER, [scene.block_size / 2] * 2
+        bodies = {name: scene.body(name) for name in self.entities}
+        if any(b.kind == "cylinder" for b in bodies.values()):  # matte like LatPlan's rubber
             s.add_material(name="block", specular=0.1, shininess=0.1)
         world.add_light(
             name="sun",
@@ -111,17 +120,18 @@ class MuJoCoSim(Simulator):
             pose = poses[name]
             body = world.add_body(name=f"block_{name}", pos=list(pose.xyz), quat=_quat(pose.yaw))
             body.add_freejoint(name=f"block_{name}")
+            shape, size = _geom(bodies[name])
             geom = body.add_geom(
                 name=f"block_{name}",
                 type=shape,
                 size=size,
-                mass=scene.block_mass,
+                mass=body_mass(scene, name),
                 rgba=[*colour(i, scene.palette), 1],
                 friction=[1.0, 0.03, 0.0001],
                 condim=4,
                 solref=[0.004, 1.0],
             )
-            if scene.shape == "cylinder":
+            if bodies[name].kind == "cylinder":
                 geom.material = "block"
             s.add_equality(
                 type=mujoco.mjtEq.mjEQ_WELD,
@@ -204,7 +214,7 @@ class MuJoCoSim(Simulator):
         out = {}
         for name, adr in self._block_q.items():
             pos = self.data.qpos[adr : adr + 3]
-            yaw = cube_yaw(self.data.xmat[self._block_ids[name]])
+            yaw = body_yaw(self.data.xmat[self._block_ids[name]], self.scene.body(name))
             out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
 

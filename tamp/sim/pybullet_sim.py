@@ -17,7 +17,7 @@ import pybullet as p
 
 from robots.panda import PANDA
 from robots.pybullet_loader import load_panda
-from tamp.scene import Pose, colour, cube_yaw
+from tamp.scene import Body, Pose, colour
 from tamp.sim.base import (
     ROBOT,
     VIDEO_SIZE,
@@ -26,6 +26,8 @@ from tamp.sim.base import (
     Lighting,
     Simulator,
     Snapshot,
+    body_mass,
+    body_yaw,
 )
 from task.errors import TampError
 
@@ -99,11 +101,9 @@ class PyBulletSim(Simulator):
         self.robot = load_panda(c)
         self.blocks: dict[str, int] = {}
         for i, name in enumerate(self.entities):
-            col, vis = self._block_shapes(colour(i, self.scene.palette))
-            pose = poses[name]
-            body = p.createMultiBody(
-                self.scene.block_mass, col, vis, pose.xyz, _quat(pose.yaw), physicsClientId=c
-            )
+            col, vis = self._block_shapes(self.scene.body(name), colour(i, self.scene.palette))
+            pose, mass = poses[name], body_mass(self.scene, name)
+            body = p.createMultiBody(mass, col, vis, pose.xyz, _quat(pose.yaw), physicsClientId=c)
             p.changeDynamics(
                 body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=c
             )
@@ -130,16 +130,17 @@ class PyBulletSim(Simulator):
         )
         return p.createMultiBody(0, col, vis, list(o.centre), _quat(o.yaw), physicsClientId=c)
 
-    def _block_shapes(self, rgb) -> tuple[int, int]:
-        """Collision and visual shape of one block (a cube, or an upright cylinder)."""
-        c, s = self.client, self.scene.block_size
-        if self.scene.shape == "cylinder":
-            col = p.createCollisionShape(p.GEOM_CYLINDER, radius=s / 2, height=s, physicsClientId=c)
+    def _block_shapes(self, body: Body, rgb) -> tuple[int, int]:
+        """Collision and visual shape of one block (a box, or an upright cylinder)."""
+        c = self.client
+        if body.kind == "cylinder":
+            r, h = body.half[0], 2 * body.half[2]
+            col = p.createCollisionShape(p.GEOM_CYLINDER, radius=r, height=h, physicsClientId=c)
             vis = p.createVisualShape(
-                p.GEOM_CYLINDER, radius=s / 2, length=s, rgbaColor=[*rgb, 1], physicsClientId=c
+                p.GEOM_CYLINDER, radius=r, length=h, rgbaColor=[*rgb, 1], physicsClientId=c
             )
             return col, vis
-        half = [s / 2] * 3
+        half = list(body.half)
         col = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=c)
         vis = p.createVisualShape(
             p.GEOM_BOX, halfExtents=half, rgbaColor=[*rgb, 1], physicsClientId=c
@@ -202,7 +203,7 @@ class PyBulletSim(Simulator):
         out = {}
         for name, body in self.blocks.items():
             pos, orn = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
-            yaw = cube_yaw(p.getMatrixFromQuaternion(orn))
+            yaw = body_yaw(p.getMatrixFromQuaternion(orn), self.scene.body(name))
             out[name] = Pose(tuple(float(v) for v in pos), yaw)
         return out
 
