@@ -18,6 +18,14 @@ from pathlib import Path
 
 from pddl.core import Domain
 
+from tamp.bench.official import (  # noqa: F401  (re-exported: the sets and their data)
+    DEFAULT_DATA,
+    DEFAULT_PLANBENCH,
+    OFFICIAL,
+    PLANBENCH_SOURCE,
+    Official,
+    default_data,
+)
 from tamp.bench.optimal import digest, optimal_lengths
 from task import data
 from task.domains import blocksworld
@@ -27,57 +35,8 @@ from task.symbolic import pddl_io
 from task.symbolic.generate import random_problem
 from task.symbolic.search import optimal_moves
 
-PLANBENCH_SOURCE = "github.com/karthikv792/LLMs-Planning, folder llm_planning_analysis/instances"
-DEFAULT_DATA = Path("..") / "shared" / "data"
-DEFAULT_PLANBENCH = DEFAULT_DATA / "planbench" / "blocksworld"
 _DOMAIN_FILES = ("domain.pddl", "generated_domain.pddl")  # ours, PlanBench's own name
 FD_CACHE, FD_LIMIT_S, FD_WORKERS = "fd_optima.json", 120.0, 2  # Fast Downward optima
-
-
-@dataclass(frozen=True)
-class Official:
-    """An official PlanBench set: its files by name and its ``manifest.csv`` columns."""
-
-    domain: str
-    names: tuple[str, ...]  # paths below instances/ without .pddl, in manifest order
-    flag: str  # manifest column: 1 for the official rows
-    size: str  # manifest column: the size the domain's `size` counts
-    optimal: str | None  # manifest column of optimal lengths (blank: unknown)
-    reference: str | None  # manifest column of reference lengths (not necessarily optimal)
-
-
-# Blocksworld-600: PlanBench's zero-shot configs run blocksworld_3 instances 1..100 and
-# blocksworld instances 1..500; Logistics-200: 1..200; Sokoban-55: 1..55 (README there).
-OFFICIAL = {
-    "blocksworld": Official(
-        "blocksworld",
-        tuple(
-            f"{sub}/instance-{i}"
-            for sub, n in (("generated_basic_3", 100), ("generated_basic", 500))
-            for i in range(1, n + 1)
-        ),
-        "in_official_600",
-        "n_blocks",
-        "optimal_plan_length",
-        None,
-    ),
-    "logistics": Official(
-        "logistics",
-        tuple(f"instance-{i}" for i in range(1, 201)),
-        "in_official_200",
-        "n_packages",
-        None,
-        "planbench_ground_truth_plan_length",
-    ),
-    "sokoban": Official(
-        "sokoban",
-        tuple(f"instance-{i}" for i in range(1, 56)),
-        "in_official_55",
-        "n_boxes",
-        "optimal_plan_length_astar",
-        None,
-    ),
-}
 
 
 @dataclass(frozen=True)
@@ -98,10 +57,6 @@ def spread(items: Sequence, limit: int | None, key: Callable) -> list:
     if limit is None or limit >= len(ordered):
         return ordered
     return [ordered[(2 * i + 1) * len(ordered) // (2 * limit)] for i in range(limit)]
-
-
-def default_data(domain: str) -> Path:  # where `planbench` looks by default
-    return DEFAULT_DATA / "planbench" / domain
 
 
 def _missing(root: Path, domain: str) -> DataError:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from tamp.bench.suites import OFFICIAL, default_data
+from tamp.bench.official import OFFICIAL, default_data
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains import names

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 
 from perception import CHECKPOINT
-from tamp.bench.suites import DEFAULT_DATA
+from tamp.bench.official import DEFAULT_DATA
 from tamp.cli.options import (
     IMAGE_SCENES,
     MAX_BLOCKS,
@@ -39,8 +39,22 @@ from tamp.sim.base import SIMULATORS
 EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
 
 
+def version() -> str:
+    """The installed distribution's version (``soft-tamp``), or "unknown" when not installed."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as installed
+
+    try:
+        return installed("soft-tamp")
+    except PackageNotFoundError:
+        return "unknown"
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="tamp", description="Differentiable soft-T_P task planning.")
+    parser.add_argument(
+        "--version", action="version", version=f"tamp {version()}", help="print the version"
+    )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     plan_opts, bench_opts = planner_options(False), planner_options(True)
     _plan_commands(sub, plan_opts)

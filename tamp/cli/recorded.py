@@ -19,7 +19,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 
 from perception import CHECKPOINT
-from tamp.bench.suites import default_data
+from tamp.bench.official import default_data
 from tamp.cli.options import SCENES, check_workcell, planner_config, sim_list
 from task.errors import TampError
 
