@@ -16,7 +16,7 @@ tolerances are looser than the scene file's) would read as another state.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from tamp.scene import Pose, SceneConfig, read_state
@@ -84,7 +84,7 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
         init=tuple(support[x] for x in entities),
         goal=tuple((a[1], a[2] if a[0] == "on" else TABLE) for a in wanted.atoms),
     )
-    config = _table(scene, base)
+    config = scene_config(scene, base)  # obstacles, walls, floors, slots, bodies, colours
     poses = tuple((o.name, o.pose) for o in scene.objects)
     _check_reader(problem, dict(poses), config, label)
     return SceneTask(scene, wanted, facts, problem, poses, config)
@@ -99,15 +99,6 @@ def _check_blocks(scene: Scene, size: float, label: str) -> None:
                 f"{', '.join(f'{v:g}' for v in o.size)} m; the loop moves cubes of "
                 f"{size:g} m only (yet)"
             )
-
-
-def _table(scene: Scene, base: SceneConfig) -> SceneConfig:
-    """``base`` with the scene's obstacles, its regions' walls and floors as fixed boxes, its
-    slot grid and its objects' colours (object i: colour i)."""
-    config = scene_config(scene, base)
-    boxes = [b for r in scene.regions for b in (*r.walls(), r.slab()) if b is not None]
-    palette = tuple((o.name, o.rgb) for o in scene.objects)
-    return replace(config, obstacles=(*config.obstacles, *boxes), palette=palette)
 
 
 def _check_reader(problem: Problem, poses: dict, config: SceneConfig, label: str) -> None:

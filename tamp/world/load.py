@@ -19,7 +19,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from tamp.obstacles import Obstacle
-from tamp.scene import PALETTE, Pose, SceneConfig
+from tamp.scene import PALETTE, Body, Pose, SceneConfig
 from tamp.sim.base import Camera
 from tamp.world.geometry import (
     TIGHT,
@@ -104,10 +104,19 @@ def load_named(name: str, tolerances: Tolerances = TIGHT) -> Scene:
 
 
 def scene_config(scene: Scene, base: SceneConfig = SceneConfig()) -> SceneConfig:
-    """Today's scene model (`tamp.scene.SceneConfig`) with this scene's name, obstacles and
-    slot grid (``base``'s grid when the scene has none)."""
+    """The simulators' scene model (`tamp.scene.SceneConfig`) of this scene: ``base`` with the
+    scene's name, its obstacles followed by its regions' walls and base slabs as fixed boxes,
+    its slot grid (``base``'s grid when the scene has none) and, when it has movable objects,
+    each object's solid (``bodies``, `tamp.scene.Body` from its kind and half extents) and
+    colour (``palette``: object i, in the scene's order, has colour i)."""
     grid = {} if scene.slots is None else {"slot_xs": scene.slots.xs, "slot_ys": scene.slots.ys}
-    return replace(base, name=scene.name, obstacles=scene.obstacles, **grid)
+    boxes = [b for r in scene.regions for b in (*r.walls(), r.slab()) if b is not None]
+    config = replace(base, name=scene.name, obstacles=(*scene.obstacles, *boxes), **grid)
+    if not scene.objects:  # a workcell: the loop's blocks keep base's bodies and colours
+        return config
+    bodies = tuple((o.name, Body(o.kind, o.half)) for o in scene.objects)
+    palette = tuple((o.name, o.rgb) for o in scene.objects)
+    return replace(config, bodies=bodies, palette=palette)
 
 
 class _Fault(Exception):
