@@ -1,4 +1,4 @@
-"""MuJoCo backend: the Panda from `robots.mujoco_loader`, a table plane, free-joint cubes.
+"""MuJoCo backend: the Panda from `robots.mujoco_loader`, a table plane, free-joint blocks.
 
 Offscreen rendering goes through EGL by default (``MUJOCO_GL=egl``, Mesa llvmpipe on a CPU
 machine); set ``MUJOCO_GL`` yourself before anything imports mujoco to choose another backend.
