@@ -1,0 +1,829 @@
+"""The field's canonical TAMP problems as scenes: seeded generators of variants, shipped at seed 0.
+
+Six problems (`PROBLEMS`), each a `tamp.world.schema.Scene` and a `tamp.world.goal.Goal` in our
+world (the Panda at the origin facing +x, the table top at z = 0, metres and radians):
+
+- ``blocked`` (PDDLStream's *blocked*): the target ``t`` hemmed in by 3 or 4 neighbours 4-8 mm
+  away on its sides; the goal names only the target, ``(in t goal_zone)``;
+- ``packed`` (PDDLStream's *packed*, cuTAMP's packing): 4-6 boxes into the marked area ``tray``
+  that holds them only in two columns with a finger lane between them;
+- ``nonmonotonic`` (Lagriffoul et al. 2018, problem 4): the target ``t`` at the back of an
+  alcove behind 2-3 front objects that must go out and come back;
+- ``sorting`` (Lagriffoul problem 3): 4-8 objects of 2-3 colours among posts, each to its
+  colour's zone;
+- ``tall``: a tower of 8-10 cubes built or taken down at the edge of the arm's reach;
+- ``hanoi``: Tower of Hanoi, 3-5 discs on three pegs (marked regions); `hanoi_pddl` writes the
+  problem for ``task/data/hanoi.pddl`` from the scene's geometry.
+
+`generate(problem, seed, **size)` draws a variant from ``numpy.random.default_rng(seed)``
+(positions, yaws, colours, counts); every variant passes `tamp.world.load.load_scene`'s checks
+(it is round-tripped through `scene_dict`), keeps its objects within the arm's reach and has a
+goal the initial state does not meet. `write_all` writes the seed-0 variants to
+``tamp/world/scenes/canonical/<name>.json`` and ``<name>.goal.pddl``; `shipped` reads them back.
+
+What makes each problem hard is geometric, and `free_top_axes` measures it with a reference
+model of the open hand (the boxes of `motion.grasps`: fingers 4.2-6.6 cm either side of the
+grasp axis, 2 cm across, from 8 mm below the TCP up; the palm 20.4 x 6 cm from 4 cm above the
+TCP; the TCP at the object's centre, at most 2.5 cm below its top): which top-down closing axes
+of an object are free of everything else. The generators draw until the intended axes are free
+or blocked (with a margin), and the tests check the same.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from tamp.obstacles import Obstacle
+from tamp.scene import PALETTE, Pose
+from tamp.sim.base import Camera
+from tamp.world.geometry import Solid, fixed_solids, footprint_gap, of_box, of_movable
+from tamp.world.goal import Goal, parse_goal
+from tamp.world.load import dumps, load_scene, scene_dict
+from tamp.world.relations import read_facts
+from tamp.world.schema import Movable, Region, Scene, Table
+from task.errors import ProblemError, one_of
+
+PROBLEMS = ("blocked", "packed", "nonmonotonic", "sorting", "tall", "hanoi")
+SCENES_DIR = Path(__file__).resolve().parent / "scenes" / "canonical"
+TABLE_TOP = Table((-0.3, -0.7), (1.0, 0.7))  # the shipped scenes' table
+
+# The reference open hand, top-down, in the grasp frame (closing axis, across, z up from the
+# TCP); the boxes of `motion.grasps.HAND_BOXES` (pybullet_data's Panda, fingers fully open).
+FINGER_IN = 0.042  # m, an open finger's inner face from the grasp axis
+FINGER_OUT = 0.066  # m, its outer face
+FINGER_ACROSS = 0.01  # m, half its width across the closing axis
+FINGER_TIP = 0.008  # m, the fingertips below the TCP
+PALM_ABOVE = 0.040  # m, the palm's lowest face above the TCP
+PALM_ALONG = 0.102  # m, half the palm's length along the closing axis
+PALM_ACROSS = 0.03  # m, half its thickness across
+GRASP_DEPTH = 0.025  # m, the TCP at most this far below the top (never below the centre)
+TIP_CLEARANCE = 0.013  # m, the TCP at least this far above the bottom (fingertips 5 mm clear)
+MAX_WIDTH = 0.07  # m, widest face between the open fingers (0.08 m stroke, 5 mm a side)
+
+# Top-down reach at the edge (`motion.ik.IKSolver`, TCP pointing down, from the home pose): the
+# highest reachable TCP falls from 0.58 m at 0.64 m out to 0.46 m at 0.72 m, about linearly.
+REACH_EDGE = (0.64, 0.58, 1.5)  # (radius m, highest TCP z m there, drop per m farther out)
+APPROACH = 0.10  # m, the pre-grasp above an object's top (`motion.pick_place`)
+
+POST_HALF = (0.01, 0.01, 0.075)  # m, a sorting post: 2 x 2 cm, 15 cm tall
+KERB = (0.015, 0.016)  # m, the alcove's walls: thickness, height
+
+SIZES = {  # the keyword arguments each problem takes: name -> (low, high) or choices
+    "blocked": {"n": (3, 4)},
+    "packed": {"n": (4, 6)},
+    "nonmonotonic": {"n": (2, 3)},
+    "sorting": {"n": (4, 8), "colours": (2, 3)},
+    "tall": {"n": (8, 10), "mode": ("build", "down")},
+    "hanoi": {"n": (3, 5)},
+}
+TRIES = 200  # draws per variant before giving up (a generator bug, not bad luck)
+
+
+@dataclass(frozen=True)
+class CanonicalProblem:
+    """One variant of a canonical problem: its scene, its goal and one line on why it is hard.
+
+    ``witness``: for ``packed``, poses (name, pose) of every object in the tray that meet the
+    goal, each with a free top-down grasp among the others: the goal is reachable. Empty for
+    the other problems.
+    """
+
+    name: str
+    seed: int
+    scene: Scene
+    goal: Goal
+    note: str
+    witness: tuple[tuple[str, Pose], ...] = ()
+
+    def goal_text(self) -> str:
+        """The goal as a goal file: a comment with the note, then the formula, one atom a line."""
+        atoms = "\n".join(f"  ({' '.join(a)})" for a in self.goal.atoms)
+        return f"; {self.name}, seed {self.seed}: {self.note}\n(and\n{atoms})\n"
+
+
+def generate(problem: str, seed: int, **size) -> CanonicalProblem:
+    """The variant ``seed`` of ``problem`` (one of `PROBLEMS`); ``size`` overrides what is
+    drawn: ``n`` (the count of the problem's objects) for every problem, ``colours`` for
+    sorting, ``mode`` (``build`` or ``down``) for tall; see `SIZES` for the ranges."""
+    if problem not in PROBLEMS:
+        raise ProblemError(f"unknown canonical problem {one_of(problem, PROBLEMS)}")
+    valid = SIZES[problem]
+    for key, value in size.items():
+        if key not in valid:
+            raise ProblemError(f"{problem}: unknown size {one_of(key, sorted(valid))}")
+        allowed = valid[key]
+        if isinstance(allowed[0], str):
+            if value not in allowed:
+                raise ProblemError(f"{problem}: {key} {one_of(value, allowed)}")
+        elif not (isinstance(value, int) and allowed[0] <= value <= allowed[1]):
+            raise ProblemError(
+                f"{problem}: {key} must be a whole number in {allowed[0]}..{allowed[1]}, "
+                f"got {value!r}"
+            )
+    rng = np.random.default_rng(seed)
+    drawn = {
+        key: (str(rng.choice(v)) if isinstance(v[0], str) else int(rng.integers(v[0], v[1] + 1)))
+        for key, v in valid.items()
+    }
+    drawn |= size
+    make = {
+        "blocked": _blocked,
+        "packed": _packed,
+        "nonmonotonic": _nonmonotonic,
+        "sorting": _sorting,
+        "tall": _tall,
+        "hanoi": _hanoi,
+    }[problem]
+    for _ in range(TRIES):
+        made = make(rng, **drawn)
+        if made is not None:
+            break
+    else:
+        raise ProblemError(f"{problem}: no variant found for seed {seed} in {TRIES} draws")
+    objects, regions, obstacles, atoms, note, witness = made
+    return _finish(problem, seed, objects, regions, obstacles, atoms, note, witness)
+
+
+def write_all(directory: str | Path = SCENES_DIR) -> tuple[Path, ...]:
+    """Write every problem's seed-0 variant to ``directory``: ``<name>.json`` (the scene) and
+    ``<name>.goal.pddl`` (the goal); the paths written."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name in PROBLEMS:
+        p = generate(name, 0)
+        scene_path = directory / f"{name}.json"
+        scene_path.write_text(dumps(scene_dict(p.scene)))
+        goal_path = directory / f"{name}.goal.pddl"
+        goal_path.write_text(p.goal_text())
+        out += [scene_path, goal_path]
+    return tuple(out)
+
+
+def shipped(problem: str) -> tuple[Scene, Goal]:
+    """The shipped seed-0 scene and goal of ``problem``, read from `SCENES_DIR`."""
+    if problem not in PROBLEMS:
+        raise ProblemError(f"unknown canonical problem {one_of(problem, PROBLEMS)}")
+    scene = load_scene(SCENES_DIR / f"{problem}.json")
+    path = SCENES_DIR / f"{problem}.goal.pddl"
+    return scene, parse_goal(path.read_text(), scene, source=f"goal file {path}")
+
+
+# ---- the hand's reference model ----------------------------------------------------------------
+
+
+def tcp_height(o: Movable) -> float:
+    """z (m) of a top-down grasp's TCP on ``o``: its centre, or 2.5 cm below its top when it
+    is taller than 5 cm, or higher where a short object would put the fingertips near its
+    bottom (`motion.grasps`' rule)."""
+    hz = o.half[2]
+    return o.pose.xyz[2] + max(0.0, hz - GRASP_DEPTH, TIP_CLEARANCE - hz)
+
+
+def free_top_axes(
+    scene: Scene, name: str, pad: float = 0.0, without: Sequence[str] = ()
+) -> tuple[int, ...]:
+    """The closing axes (0: the object's x, 1: its y) along which a top-down grasp of object
+    ``name`` fits: the face between the fingers is at most `MAX_WIDTH` and the reference open
+    hand (module docstring) touches nothing else: no solid taller than the fingertips meets a
+    finger's footprint (swept in to the object's face), none taller than the palm's lower face
+    meets the palm's. ``pad`` (m) grows the hand's footprints (negative: shrinks them);
+    ``without`` names objects to leave out (as if moved away)."""
+    o = scene.object(name)
+    z = tcp_height(o)
+    others = [of_movable(x) for x in scene.objects if x.name != name and x.name not in without]
+    others += fixed_solids(scene)
+    reach = math.hypot(PALM_ALONG, PALM_ACROSS) + abs(pad)  # nothing farther can touch the hand
+    others = [
+        s
+        for s in others
+        if math.dist(s.centre[:2], o.pose.xyz[:2]) <= reach + math.hypot(s.half[0], s.half[1])
+    ]
+    free = []
+    for axis in (0, 1):
+        if 2 * o.half[axis] > MAX_WIDTH:
+            continue
+        hand = _hand(o, axis, z, pad)
+        if all(
+            footprint_gap(part, s) > 0.0 for part, floor in hand for s in others if s.top > floor
+        ):
+            free.append(axis)
+    return tuple(free)
+
+
+def _hand(o: Movable, axis: int, z: float, pad: float) -> list[tuple[Solid, float]]:
+    """The open hand's footprints for a top-down grasp of ``o`` closing along ``axis``, each
+    with the height of its lowest point: two fingers (from the object's face to their outer
+    face) and the palm."""
+    yaw = o.pose.yaw + axis * math.pi / 2  # the closing axis's direction
+    u = (math.cos(yaw), math.sin(yaw))
+    x, y = o.pose.xyz[0], o.pose.xyz[1]
+    face = min(o.half[axis], FINGER_IN)
+    mid, half = (face + FINGER_OUT) / 2, (FINGER_OUT - face) / 2
+    parts = [
+        (
+            Solid(
+                "finger",
+                False,
+                (x + s * mid * u[0], y + s * mid * u[1], z),
+                (half + pad, FINGER_ACROSS + pad, 0.0),
+                yaw,
+            ),
+            z - FINGER_TIP,
+        )
+        for s in (1.0, -1.0)
+    ]
+    palm = Solid("palm", False, (x, y, z), (PALM_ALONG + pad, PALM_ACROSS + pad, 0.0), yaw)
+    return [*parts, (palm, z + PALM_ABOVE)]
+
+
+def top_reach(radius: float) -> float:
+    """The highest top-down TCP z (m) the arm reaches at ``radius`` m from its base axis, at the
+    edge of its reach (`REACH_EDGE`, measured from 0.64 to 0.72 m)."""
+    r0, z0, slope = REACH_EDGE
+    return z0 - slope * (radius - r0)
+
+
+# ---- the centre-first greedy packer -------------------------------------------------------
+
+
+def centre_first(scene: Scene, region: str, names: Sequence[str], step: float = 0.0025) -> tuple:
+    """Where a naive packer gets: each object of ``names`` in turn at the free spot of the
+    region's inner rectangle nearest its centre (a ``step`` m grid, yaw 0 or a quarter turn,
+    footprints only, no room for fingers). The names it placed, in order; fewer than
+    ``names`` when it got stuck."""
+    (x0, y0), (x1, y1) = scene.region(region).inner()
+    centre = np.array([(x0 + x1) / 2, (y0 + y1) / 2])
+    xs = np.arange(x0, x1 + 1e-9, step)
+    ys = np.arange(y0, y1 + 1e-9, step)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")  # (X, Y)
+    dist = np.hypot(gx - centre[0], gy - centre[1])  # (X, Y)
+    placed: list[tuple[float, float, float, float]] = []  # (xlo, xhi, ylo, yhi)
+    done = []
+    for name in names:
+        o = scene.object(name)
+        best = None
+        for ex, ey in ((o.half[0], o.half[1]), (o.half[1], o.half[0])):
+            ok = (gx - ex >= x0 - 1e-9) & (gx + ex <= x1 + 1e-9)  # (X, Y)
+            ok &= (gy - ey >= y0 - 1e-9) & (gy + ey <= y1 + 1e-9)
+            for ax0, ax1, ay0, ay1 in placed:
+                ok &= ~((gx + ex > ax0) & (gx - ex < ax1) & (gy + ey > ay0) & (gy - ey < ay1))
+            if ok.any():
+                i = np.unravel_index(np.where(ok, dist, np.inf).argmin(), dist.shape)
+                if best is None or dist[i] < best[0] - 1e-12:
+                    best = (dist[i], gx[i], gy[i], ex, ey)
+        if best is None:
+            break
+        _, cx, cy, ex, ey = best
+        placed.append((cx - ex, cx + ex, cy - ey, cy + ey))
+        done.append(name)
+    return tuple(done)
+
+
+# ---- Hanoi as PDDL ---------------------------------------------------------------------------
+
+
+def hanoi_pddl(problem: CanonicalProblem) -> str:
+    """The problem PDDL of ``problem``'s scene and goal for ``task/data/hanoi.pddl``
+    (``hanoi-pick-place``): its objects are the discs, its regions the pegs; ``smaller`` from
+    the discs' widths (every disc is smaller than every peg); the initial state read from the
+    geometry (`read_facts`), ``(in d peg)`` written ``(on d peg)``. ProblemError when a disc
+    rests elsewhere than on a peg or a disc, or the goal names another predicate."""
+    from task.symbolic.pickplace.hanoi import DOMAIN  # crisp, light; only Hanoi needs it
+
+    scene = problem.scene
+    facts = read_facts(scene)
+    if facts.unexplained:
+        raise ProblemError(f"hanoi: {facts.issues[0]}")
+    width = {o.name: 2 * max(o.half[0], o.half[1]) for o in scene.objects}
+    discs = sorted(width, key=lambda d: (width[d], d))
+    pegs = [r.name for r in scene.regions]
+    init = sorted(_hanoi_atom(a, "initial state") for a in facts.atoms if a[0] != "clear")
+    held = {a[2] for a in init}
+    clear = [d for d in discs if ("clear", d) in facts.atoms] + [p for p in pegs if p not in held]
+    smaller = [f"(smaller {a} {b})" for a in discs for b in discs if width[a] < width[b]]
+    smaller += [f"(smaller {d} {p})" for d in discs for p in pegs]
+    goal = [_hanoi_atom(a, "goal") for a in problem.goal.atoms]
+    lines = [
+        f"(define (problem {scene.name}) (:domain {DOMAIN})",
+        f"  (:objects {' '.join(discs)} - disc {' '.join(pegs)} - peg)",
+        "  (:init",
+        *(f"    (on {a[1]} {a[2]})" for a in init),
+        *(f"    (clear {x})" for x in clear),
+        *(f"    {a}" for a in smaller),
+        "  )",
+        f"  (:goal (and {' '.join(f'(on {a[1]} {a[2]})' for a in goal)})))",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _hanoi_atom(atom: tuple[str, ...], where: str) -> tuple[str, ...]:
+    if atom[0] not in ("on", "in"):
+        raise ProblemError(
+            f"hanoi: {where} holds ({' '.join(atom)}); discs rest on a disc or a peg only"
+        )
+    return ("on", atom[1], atom[2])
+
+
+# ---- shared pieces -------------------------------------------------------------------------------
+
+_Made = tuple  # (objects, regions, obstacles, goal atoms, note, witness)
+
+
+def _m(value: float) -> float:
+    """A length rounded to 0.1 mm (files stay readable; every margin is millimetres)."""
+    return round(float(value), 4) + 0.0
+
+
+def _size(value: float) -> float:
+    """A size rounded to 1 mm."""
+    return round(float(value), 3) + 0.0
+
+
+def _rgb(colour: str) -> tuple[float, float, float]:
+    return dict(PALETTE)[colour]
+
+
+def _movable(name, kind, size, colour: str, xyz, yaw: float = 0.0) -> Movable:
+    size = tuple(_size(s) for s in size)
+    return Movable(name, kind, size, _rgb(colour), Pose(tuple(_m(v) for v in xyz), _m(yaw)))
+
+
+def _at(o: Movable, xyz, yaw: float | None = None) -> Movable:
+    """``o`` moved to ``xyz`` (yaw kept unless given)."""
+    yaw = o.pose.yaw if yaw is None else yaw
+    return replace(o, pose=Pose(tuple(_m(v) for v in xyz), _m(yaw)))
+
+
+def _zone(name: str, centre, side, colour: str) -> Region:
+    """A marked rectangle (no floor, no walls) of ``side`` (sx, sy) m around ``centre``."""
+    (cx, cy), (sx, sy) = centre, side
+    lo, hi = (_m(cx - sx / 2), _m(cy - sy / 2)), (_m(cx + sx / 2), _m(cy + sy / 2))
+    return Region(name, lo, hi, rgb=_rgb(colour))
+
+
+def _polar(r: float, theta: float) -> tuple[float, float]:
+    return r * math.cos(theta), r * math.sin(theta)
+
+
+def _rot(yaw: float, u: float, v: float) -> tuple[float, float]:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return c * u - s * v, s * u + c * v
+
+
+def _clear_of(solid: Solid, others, gap: float) -> bool:
+    """True when ``solid``'s footprint keeps ``gap`` m from every one of ``others``."""
+    return all(footprint_gap(solid, s) >= gap for s in others)
+
+
+def _in_zone(o: Movable, zones: Sequence[Region], margin: float) -> bool:
+    """True when ``o``'s footprint comes within ``margin`` of any of ``zones``."""
+    me = of_movable(o)
+    for r in zones:
+        box = Solid(
+            r.name,
+            False,
+            ((r.lo[0] + r.hi[0]) / 2, (r.lo[1] + r.hi[1]) / 2, 0.0),
+            ((r.hi[0] - r.lo[0]) / 2, (r.hi[1] - r.lo[1]) / 2, 1.0),
+        )
+        if footprint_gap(me, box) < margin:
+            return True
+    return False
+
+
+def _camera(objects: Sequence[Movable], regions: Sequence[Region]) -> Camera:
+    """A camera from the default's direction (front right, above) at the distance that fits
+    every object and region in its view with a margin."""
+    default = Camera()
+    pts = []
+    for o in objects:
+        for cx, cy in of_movable(o).corners():
+            pts += [(cx, cy, o.bottom), (cx, cy, o.top)]
+    for r in regions:
+        pts += [(x, y, r.surface) for x in (r.lo[0], r.hi[0]) for y in (r.lo[1], r.hi[1])]
+    p = np.asarray(pts)  # (P, 3)
+    lo, hi = p.min(0), p.max(0)
+    target = np.array([(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, 0.4 * hi[2]])
+    away = np.subtract(default.eye, default.target)
+    away /= np.linalg.norm(away)
+    for d in np.arange(0.6, 4.0, 0.05):
+        eye = target + d * away
+        if in_view(p, eye, target, default, margin=0.9):
+            break
+    return Camera(tuple(_m(v) for v in eye), tuple(_m(v) for v in target))
+
+
+def in_view(points, eye, target, camera: Camera = Camera(), margin: float = 1.0) -> bool:
+    """True when every point of ``points`` (P, 3) projects inside the pinhole image of a camera
+    at ``eye`` looking at ``target`` (``camera``'s fovy, up and aspect), within ``margin`` of
+    the half field of view."""
+    f = np.subtract(target, eye)
+    f = f / np.linalg.norm(f)
+    right = np.cross(f, camera.up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, f)
+    v = np.asarray(points, dtype=float) - np.asarray(eye)  # (P, 3)
+    depth = v @ f  # (P,)
+    ty = math.tan(math.radians(camera.fovy) / 2) * margin
+    tx = ty * camera.width / camera.height
+    return bool(
+        (depth > 0).all()
+        and (np.abs(v @ up) <= ty * depth).all()
+        and (np.abs(v @ right) <= tx * depth).all()
+    )
+
+
+def _finish(name, seed, objects, regions, obstacles, atoms, note, witness) -> CanonicalProblem:
+    """The variant as a checked scene: round-tripped through the file format and the loader's
+    checks (a failure here is a generator bug), its goal parsed and unmet."""
+    scene = Scene(
+        f"{name}-{seed}",
+        TABLE_TOP,
+        tuple(regions),
+        tuple(obstacles),
+        tuple(objects),
+        None,
+        _camera(objects, regions),
+    )
+    scene = load_scene(scene_dict(scene))
+    text = "(and " + " ".join(f"({' '.join(a)})" for a in atoms) + ")"
+    goal = parse_goal(text, scene, source=f"{name} goal")
+    if goal.holds(read_facts(scene)):
+        raise ProblemError(f"{name}: seed {seed} draws a scene that already meets its goal")
+    return CanonicalProblem(name, seed, scene, goal, note, tuple(witness))
+
+
+COLOURS = ("red", "blue", "green", "yellow", "orange", "purple", "cyan", "magenta")
+
+
+# ---- the six problems ----------------------------------------------------------------------------
+
+
+def _blocked(rng: np.random.Generator, n: int) -> _Made | None:
+    """The target cube with n neighbours along its faces, 4-8 mm away, as tall as it or a few
+    mm taller; with 3 the open side leaves one axis blocked only by the opposite neighbour."""
+    colours = [str(c) for c in rng.permutation(COLOURS)]
+    s = _size(rng.uniform(0.045, 0.05))
+    r, theta = rng.uniform(0.45, 0.56), rng.uniform(-0.45, 0.45)
+    cx, cy = _polar(r, theta)
+    yaw = rng.uniform(-math.pi / 4, math.pi / 4)
+    target = _movable("t", "cube", (s,), colours[0], (cx, cy, s / 2), yaw)
+    sides = [(1, 0), (-1, 0), (0, 1), (0, -1)]
+    open_side = None
+    if n == 3:
+        open_side = sides[int(rng.integers(4))]
+        sides.remove(open_side)
+    objects = [target]
+    for k, (du, dv) in enumerate(sides, start=1):
+        depth = _size(rng.uniform(0.04, 0.05))
+        across = depth if rng.random() < 0.4 else _size(rng.uniform(0.045, 0.06))
+        h = _size(rng.uniform(s, s + 0.004))
+        gap = rng.uniform(0.004, 0.008)
+        off = s / 2 + gap + depth / 2
+        ox, oy = _rot(yaw, du * off, dv * off)
+        size = (depth, across, h) if du else (across, depth, h)
+        kind = "cube" if depth == across == h else "cuboid"
+        size = (depth,) if kind == "cube" else size
+        objects.append(_movable(f"n{k}", kind, size, colours[k], (cx + ox, cy + oy, h / 2), yaw))
+    gtheta = theta - math.copysign(rng.uniform(0.75, 0.95), theta if theta else 1.0)
+    zone = _zone("goal_zone", _polar(rng.uniform(0.45, 0.55), gtheta), (0.12, 0.12), "white")
+    scene = Scene("draft", TABLE_TOP, (zone,), (), tuple(objects))
+    if free_top_axes(scene, "t", pad=-0.003):
+        return None
+    if not all(free_top_axes(scene, o.name, pad=0.004) for o in objects[1:]):
+        return None
+    if n == 3:  # moving the neighbour opposite the open side frees the target
+        du, dv = open_side
+        opposite = f"n{sides.index((-du, -dv)) + 1}"
+        if not free_top_axes(scene, "t", pad=0.004, without=(opposite,)):
+            return None
+        why = f"until {opposite}, opposite the open side, moves"
+    else:
+        why = "until two opposite neighbours move"
+    note = (
+        f"target t hemmed in by {n} neighbours 4-8 mm away (a finger is 2.4 cm thick): "
+        f"no top-down grasp is collision-free {why}"
+    )
+    return objects, (zone,), (), [("in", "t", "goal_zone")], note, ()
+
+
+def _packed(rng: np.random.Generator, n: int) -> _Made | None:
+    """n boxes of one width and several lengths; the tray fits them as two columns along y
+    with a finger lane between; the objects start spread out on the other side."""
+    colours = [str(c) for c in rng.permutation(COLOURS)]
+    w = _size(rng.uniform(0.055, 0.062))
+    lengths = [_size(rng.uniform(0.055, 0.09)) for _ in range(n)]
+    heights = [_size(rng.uniform(0.04, 0.055)) for _ in range(n)]
+    gap_y, margin = 0.004, 0.002
+    columns: list[list[int]] = [[], []]
+    for i in sorted(range(n), key=lambda i: -lengths[i]):  # longest first, to the shorter
+        col = min((0, 1), key=lambda c: sum(lengths[j] for j in columns[c]) + 1e-6 * c)
+        columns[col].append(i)
+    span = [sum(lengths[j] for j in c) + gap_y * (len(c) - 1) for c in columns]
+    pitch = FINGER_OUT + 0.003 + w / 2  # column centres: a finger lane between the columns
+    width = w + pitch + 2 * margin
+    height = max(span) + 2 * margin
+    side = 1.0 if rng.random() < 0.5 else -1.0
+    tx, ty = rng.uniform(0.48, 0.53), side * rng.uniform(0.17, 0.2)
+    tray = _zone("tray", (tx, ty), (width, height), "brown")
+    (x0, y0), _ = tray.inner()
+    objects, witness = [], []
+    starts = [(x, -side * y) for y in (0.12, 0.25, 0.38) for x in (0.42, 0.55)]
+    order = rng.permutation(len(starts))
+    for i in range(n):
+        kind = "cuboid" if abs(lengths[i] - w) > 1e-9 or abs(heights[i] - w) > 1e-9 else "cube"
+        sx, sy = starts[order[i]]
+        jx, jy = rng.uniform(-0.01, 0.01, 2)
+        yaw = rng.uniform(-0.3, 0.3)
+        size = (w, lengths[i], heights[i])
+        objects.append(
+            _movable(f"o{i + 1}", kind, size, colours[i % len(colours)], (sx + jx, sy + jy, 0), yaw)
+        )
+        objects[-1] = _at(objects[-1], (sx + jx, sy + jy, objects[-1].half[2]))
+    for c, col in enumerate(columns):
+        x = x0 + margin + w / 2 + c * pitch
+        y = y0 + margin + (height - 2 * margin - span[c]) / 2
+        for j in col:
+            o = objects[j]
+            witness.append((o.name, Pose((_m(x), _m(y + o.half[1]), o.pose.xyz[2]), 0.0)))
+            y += 2 * o.half[1] + gap_y
+    footprint = sum(4 * o.half[0] * o.half[1] for o in objects)
+    (ix0, iy0), (ix1, iy1) = tray.inner()
+    fill = footprint / ((ix1 - ix0) * (iy1 - iy0))
+    if not 0.6 <= fill <= 0.75:
+        return None
+    done = dict(witness)
+    packed = Scene(
+        "draft", TABLE_TOP, (tray,), (), tuple(_at(o, done[o.name].xyz, 0.0) for o in objects)
+    )
+    if not all(free_top_axes(packed, o.name, pad=0.003) for o in objects):
+        return None
+    names = [o.name for o in objects]
+    biggest = sorted(names, key=lambda m: -packed.object(m).half[1])
+    if len(centre_first(packed, "tray", biggest)) == n:
+        return None
+    if len(centre_first(packed, "tray", names)) == n:
+        return None
+    note = (
+        f"{n} boxes fill {fill:.0%} of the tray: they fit only as two columns with a finger "
+        "lane between; the first box at the centre leaves no room for the last"
+    )
+    atoms = [("in", o.name, "tray") for o in objects]
+    return objects, (tray,), (), atoms, note, witness
+
+
+def _nonmonotonic(rng: np.random.Generator, n: int) -> _Made | None:
+    """A kerbed alcove along +x, open towards the robot: the wide, low target at its back with
+    room behind it, n tall narrow front objects in a row before it, 5-8 mm apart."""
+    colours = [str(c) for c in rng.permutation(COLOURS)]
+    cy = rng.uniform(-0.1, 0.1)
+    mouth = rng.uniform(0.38, 0.42)
+    bx, by = _size(rng.uniform(0.045, 0.05)), _size(rng.uniform(0.066, 0.07))
+    bh = _size(rng.uniform(0.03, 0.034))
+    inner = by + 2 * rng.uniform(0.005, 0.008)  # the alcove's inner width
+    fh = _size(rng.uniform(0.062, 0.066))
+    fronts = []
+    x = mouth + rng.uniform(0.005, 0.01)
+    sizes = [(_size(rng.uniform(0.035, 0.04)), _size(rng.uniform(0.035, 0.04))) for _ in range(n)]
+    for k in range(n, 0, -1):  # from the mouth inwards: f_n first, f1 last (next to t)
+        fx, fy = sizes[k - 1]
+        x += fx / 2
+        dy = rng.uniform(-0.002, 0.002)
+        fronts.append(_movable(f"f{k}", "cuboid", (fx, fy, fh), colours[k], (x, cy + dy, fh / 2)))
+        x += fx / 2 + rng.uniform(0.005, 0.008)
+    target = _movable("t", "cuboid", (bx, by, bh), colours[0], (x + bx / 2, cy, bh / 2))
+    back = x + bx + rng.uniform(0.048, 0.052)  # the back kerb's inner face
+    t, h = KERB
+    length = back - mouth
+    walls = (
+        Obstacle("kerb_back", (_m(back + t / 2), _m(cy), h / 2), (t / 2, _m(inner / 2 + t), h / 2)),
+        Obstacle(
+            "kerb_left",
+            (_m(mouth + length / 2), _m(cy + inner / 2 + t / 2), h / 2),
+            (_m(length / 2), t / 2, h / 2),
+        ),
+        Obstacle(
+            "kerb_right",
+            (_m(mouth + length / 2), _m(cy - inner / 2 - t / 2), h / 2),
+            (_m(length / 2), t / 2, h / 2),
+        ),
+    )
+    alcove = Region(
+        "alcove",
+        (_m(mouth), _m(cy - inner / 2)),
+        (_m(back), _m(cy + inner / 2)),
+        rgb=_rgb("white"),
+    )
+    gtheta = -math.copysign(rng.uniform(0.6, 0.8), cy if cy else 1.0)
+    zone = _zone("goal_zone", _polar(rng.uniform(0.45, 0.52), gtheta), (0.12, 0.12), "brown")
+    objects = [target, *reversed(fronts)]
+    scene = Scene("draft", TABLE_TOP, (alcove, zone), walls, tuple(objects))
+    if free_top_axes(scene, "t", pad=-0.003):
+        return None
+    if not all(free_top_axes(scene, f.name, pad=0.004) for f in fronts):
+        return None
+    blockers = ("f1", "f2")
+    if free_top_axes(scene, "t", pad=-0.003, without=("f1",)):
+        return None
+    if not free_top_axes(scene, "t", pad=0.004, without=blockers):
+        return None
+    note = (
+        f"target t at the back of a kerbed alcove behind {n} objects: f1 blocks its fingers, "
+        "f2 its palm; both must go out and come back"
+    )
+    atoms = [("in", "t", "goal_zone"), *(("in", f"f{k}", "alcove") for k in range(1, n + 1))]
+    return objects, (alcove, zone), walls, atoms, note, ()
+
+
+def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
+    """n objects scattered over a sector in front of the robot, each with a post 4.5-6 cm
+    from its centre that blocks one of its two top-down grasp axes; a zone per colour on
+    the sides, sized for its objects; a few free posts between."""
+    names = [str(c) for c in rng.permutation(("red", "blue", "green", "yellow"))[:colours]]
+    of = [names[i % colours] for i in range(n)]
+    of = [of[i] for i in rng.permutation(n)]
+    angles = {2: (-1.0, 1.0), 3: (-1.65, -1.05, 1.05)}[colours]
+    zones = []
+    for c, a in zip(names, angles, strict=True):
+        count = of.count(c)
+        side = {1: 0.12, 2: 0.12, 3: 0.16}.get(count, 0.2)
+        zones.append(_zone(f"{c}_zone", _polar(0.5, a), (side, side), c))
+    objects: list[Movable] = []
+    posts: list[Obstacle] = []
+    blocked: dict[str, int] = {}
+    for i in range(n):
+        for _ in range(TRIES):
+            r, theta = rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65)
+            x, y = _polar(r, theta)
+            yaw = rng.uniform(-math.pi / 4, math.pi / 4)
+            kind = str(rng.choice(("cube", "cuboid", "cylinder")))
+            if kind == "cube":
+                size = (rng.uniform(0.045, 0.05),)
+            elif kind == "cuboid":
+                size = (
+                    rng.uniform(0.045, 0.05),
+                    rng.uniform(0.05, 0.065),
+                    rng.uniform(0.045, 0.06),
+                )
+            else:
+                size = (rng.uniform(0.045, 0.05), rng.uniform(0.05, 0.06))
+            o = _movable(f"o{i + 1}", kind, size, of[i], (x, y, 0.0), yaw)
+            o = _at(o, (x, y, o.half[2]))
+            axis = int(rng.integers(2))
+            signs = (1.0, -1.0) if rng.random() < 0.3 else (float(rng.choice((1.0, -1.0))),)
+            mine = []
+            for s in signs:
+                d = rng.uniform(0.046, 0.056) + POST_HALF[0]
+                across = rng.uniform(-0.003, 0.003)
+                u, v = (s * d, across) if axis == 0 else (across, s * d)
+                px, py = _rot(yaw, u, v)
+                mine.append(
+                    Obstacle(
+                        f"post_{len(posts) + len(mine)}",
+                        (_m(x + px), _m(y + py), POST_HALF[2]),
+                        POST_HALF,
+                        _m(yaw),
+                    )
+                )
+            solids = [of_movable(p) for p in objects] + [of_box(p) for p in posts]
+            new = [of_movable(o)] + [of_box(p) for p in mine]
+            if not all(_clear_of(s, solids, 0.03) for s in new):
+                continue
+            if _in_zone(o, zones, 0.03) or any(
+                math.hypot(*p.centre[:2]) > 0.7 or math.hypot(*p.centre[:2]) < 0.3 for p in mine
+            ):
+                continue
+            if _sorted_grasps(zones, [*posts, *mine], [*objects, o], blocked | {o.name: axis}):
+                objects.append(o)
+                posts += mine
+                blocked[o.name] = axis
+                break
+        else:
+            return None
+    for _ in range(n // 2):  # free posts between the objects
+        for _ in range(20):
+            x, y = _polar(rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65))
+            post = Obstacle(f"post_{len(posts)}", (_m(x), _m(y), POST_HALF[2]), POST_HALF)
+            solid = of_box(post)
+            if (
+                _clear_of(solid, [of_movable(o) for o in objects], 0.03)
+                and _clear_of(solid, [of_box(p) for p in posts], 0.04)
+                and _sorted_grasps(zones, [*posts, post], objects, blocked)
+            ):
+                posts.append(post)
+                break
+    note = (
+        f"{n} objects of {colours} colours among {len(posts)} posts 15 cm tall: a post 4.5-6 cm "
+        "from each object blocks one of its two top-down grasp axes"
+    )
+    atoms = [("in", o.name, f"{c}_zone") for o, c in zip(objects, of, strict=True)]
+    return objects, tuple(zones), tuple(posts), atoms, note, ()
+
+
+def _sorted_grasps(zones, posts, objects, blocked: dict[str, int]) -> bool:
+    """True when each object's top-down grasps are free along the axis ``blocked`` does not
+    name (with a 4 mm margin) and blocked along the one it names (even 3 mm thinner)."""
+    scene = Scene("draft", TABLE_TOP, tuple(zones), tuple(posts), tuple(objects))
+    for o in objects:
+        if free_top_axes(scene, o.name, pad=0.004) != (1 - blocked[o.name],):
+            return False
+        if blocked[o.name] in free_top_axes(scene, o.name, pad=-0.003):
+            return False
+    return True
+
+
+def _tall(rng: np.random.Generator, n: int, mode: str) -> _Made | None:
+    """n cubes: ``down``, a tower at the edge of reach rebuilt upside down on a near pad;
+    ``build``, three short stacks near the robot built into one tower on a far pad."""
+    colours = [COLOURS[i % len(COLOURS)] for i in rng.permutation(n)]
+    top_max = top_reach(0.655) - APPROACH - 0.02  # the tallest tower reachable at 0.655 m
+    s = _size(rng.uniform(0.038, min(0.045, top_max / n)))
+    top = n * s
+    r_max = min(0.70, REACH_EDGE[0] + (REACH_EDGE[1] - APPROACH - 0.02 - top) / REACH_EDGE[2])
+    r = rng.uniform(0.65, r_max)
+    theta = rng.uniform(-0.45, 0.45)
+    fx, fy = _polar(r, theta)
+    ntheta = theta - math.copysign(rng.uniform(0.6, 0.85), theta if theta else 1.0)
+    near = _polar(rng.uniform(0.42, 0.48), ntheta)
+    names = [f"c{i + 1}" for i in range(n)]
+    pad_side = (s + 0.04, s + 0.04)
+    if mode == "down":
+        yaw = rng.uniform(-0.4, 0.4)
+        objects = []
+        for i, name in enumerate(names):
+            jx, jy = rng.uniform(-0.002, 0.002, 2)
+            z = s / 2 + i * s
+            objects.append(
+                _movable(
+                    name,
+                    "cube",
+                    (s,),
+                    colours[i],
+                    (fx + jx, fy + jy, z),
+                    yaw + rng.uniform(-0.05, 0.05),
+                )
+            )
+        pad = _zone("near_pad", near, pad_side, "white")
+        chain = list(reversed(names))  # bottom first: the old top at the bottom
+        note = (
+            f"a {n}-cube tower ({top:.2f} m) {r:.2f} m out, at the edge of the arm's reach, "
+            "to rebuild upside down on a near pad"
+        )
+        atoms = [("in", chain[0], "near_pad")]
+    else:
+        sizes = [n // 3 + (1 if k < n % 3 else 0) for k in range(3)]
+        away = -math.copysign(1.0, theta if theta else 1.0)
+        spots = [_polar(0.45, theta + away * a) for a in (0.55, 0.85, 1.15)]
+        objects, i = [], 0
+        for (x, y), count in zip(spots, sizes, strict=True):
+            yaw = rng.uniform(-0.4, 0.4)
+            for level in range(count):
+                objects.append(
+                    _movable(names[i], "cube", (s,), colours[i], (x, y, s / 2 + level * s), yaw)
+                )
+                i += 1
+        pad = _zone("far_pad", (fx, fy), pad_side, "white")
+        chain = [names[i] for i in rng.permutation(n)]
+        note = (
+            f"build a {n}-cube tower ({top:.2f} m) on a pad {r:.2f} m out: its top cubes go "
+            "where top-down reach runs out"
+        )
+        atoms = [("in", chain[0], "far_pad")]
+    atoms += [("on", chain[k + 1], chain[k]) for k in range(n - 1)]
+    return objects, (pad,), (), atoms, note, ()
+
+
+def _hanoi(rng: np.random.Generator, n: int) -> _Made | None:
+    """n discs (flat cylinders or square boxes, widths evenly from ~3 to ~7 cm) stacked on
+    peg1 of three marked pegs 15-17 cm apart in a row across the robot's view."""
+    kind = "cylinder" if rng.random() < 0.5 else "cuboid"
+    widths = np.linspace(rng.uniform(0.03, 0.034), rng.uniform(0.066, 0.069), n)
+    h = _size(rng.uniform(0.024, 0.028))
+    x0, y0 = rng.uniform(0.46, 0.54), rng.uniform(-0.03, 0.03)
+    pitch = rng.uniform(0.15, 0.17) * (1.0 if rng.random() < 0.5 else -1.0)
+    side = _size(max(widths) + rng.uniform(0.03, 0.035))
+    pegs = tuple(
+        _zone(f"peg{k + 1}", (x0, y0 + (k - 1) * pitch), (side, side), "white") for k in range(3)
+    )
+    colours = [str(c) for c in rng.permutation(COLOURS)]
+    yaw = rng.uniform(-0.3, 0.3) if kind == "cuboid" else 0.0
+    cx, cy = (pegs[0].lo[0] + pegs[0].hi[0]) / 2, (pegs[0].lo[1] + pegs[0].hi[1]) / 2
+    objects = []
+    for level, i in enumerate(range(n, 0, -1)):  # the largest (d_n) at the bottom
+        w = _size(widths[i - 1])
+        size = (w, h) if kind == "cylinder" else (w, w, h)
+        jx, jy = rng.uniform(-0.002, 0.002, 2)
+        z = h / 2 + level * h
+        objects.append(_movable(f"d{i}", kind, size, colours[i - 1], (cx + jx, cy + jy, z), yaw))
+    objects.reverse()  # d1 .. dn
+    atoms = [("in", f"d{n}", "peg3"), *(("on", f"d{i}", f"d{i + 1}") for i in range(1, n))]
+    note = (
+        f"{n} discs from peg1 to peg3 ({2**n - 1} moves at best): a disc goes only on a wider "
+        "one or an empty peg"
+    )
+    return objects, pegs, (), atoms, note, ()
