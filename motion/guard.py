@@ -2,9 +2,10 @@
 around obstacles with the joint-space motion planner.
 
 Each arm phase is checked against the world as it is during that phase (arm, fingers and, once
-grasped, the held block against the table, the blocks and the obstacles), with the contacts the
-move needs allowed: the open fingers around the block they pick (descend, retreat), the held
-block on what it leaves (lift) and on what it is placed onto (lower). A blocked free-space phase
+grasped, the held object against the table, the blocks and the obstacles; the object a box of
+any size, held where its grasp puts it, see `PickPlaceWorld`), with the contacts the move needs
+allowed: the open fingers around the object they pick (descend, retreat), the held object on
+what it leaves (lift) and on what it is placed onto (lower). A blocked free-space phase
 (``approach`` or ``transit``) is replanned with `motion.rrt.plan_path` and timed along the new
 path with ruckig; a blocked vertical phase, or a free-space phase the planner cannot route, is a
 ``collision`` failure with the contact as evidence.
@@ -27,6 +28,7 @@ from motion.pick_place import Phase
 from motion.trajectory import SpeedLimits
 
 if TYPE_CHECKING:
+    from motion.grasps import Grasp
     from motion.rrt import PathPlannerConfig
     from robots.collision import Box, PathCheck
 
@@ -37,7 +39,7 @@ class CollisionModel(Protocol):
     margin: float  # m
 
     def set_boxes(self, boxes: Sequence[Box]) -> None: ...
-    def hold(self, size: float | None) -> None: ...
+    def hold(self, size: float | None = ..., half=..., pose=...) -> None: ...
     def valid(self, q, fingers: float = ..., ignore=...) -> bool: ...
     def check_path(
         self, path, fingers: float = ..., ignore=..., max_step: float = ...
@@ -65,7 +67,14 @@ class GuardConfig:
 class PickPlaceWorld:
     """What the move changes: the boxes before it (blocks and obstacles), the picked block's
     name, what it stands on and what it is placed onto (box names, or "table"), the placed box,
-    and the block edge (the fingers close to half of it each)."""
+    and the block edge (the fingers close to half of it each).
+
+    Any other held object: ``half``, its half extents (3,) m, and ``grasp``, how the hand
+    holds it (`MotionResult.grasp`: the grasp the move was planned with). The held box then
+    rides at the inverse of the grasp's TCP pose in the TCP frame, and the fingers close to
+    half the grasp's width each; ``half`` None: the cube of edge ``block``; ``grasp`` None:
+    the object centred at the TCP, turned with the hand (top-down), the fingers at ``block``
+    / 2 each."""
 
     boxes: tuple[Box, ...]
     picked: str
@@ -73,6 +82,8 @@ class PickPlaceWorld:
     placed_on: str
     placed: Box
     block: float
+    half: tuple[float, float, float] | None = None
+    grasp: Grasp | None = None
 
 
 @dataclass(frozen=True)
@@ -100,18 +111,31 @@ def thin(positions: np.ndarray, step: float) -> np.ndarray:
 
 
 def _situation(name: str, world: PickPlaceWorld, open_width: float):
-    """Boxes, held block edge, finger opening and allowed contacts during phase ``name``."""
+    """Boxes, whether the object is held, finger opening and allowed contacts during ``name``."""
     before = tuple(world.boxes)
     without = tuple(b for b in before if b.name != world.picked)
-    grip = world.block / 2
+    grip = (world.block if world.grasp is None else world.grasp.width) / 2
     return {
-        "approach": (before, None, open_width, ()),
-        "descend": (before, None, open_width, (("hand", world.picked),)),
-        "lift": (without, world.block, grip, (("held", world.picked_from),)),
-        "transit": (without, world.block, grip, ()),
-        "lower": (without, world.block, grip, (("held", world.placed_on),)),
-        "retreat": ((*without, world.placed), None, open_width, (("hand", world.picked),)),
+        "approach": (before, False, open_width, ()),
+        "descend": (before, False, open_width, (("hand", world.picked),)),
+        "lift": (without, True, grip, (("held", world.picked_from),)),
+        "transit": (without, True, grip, ()),
+        "lower": (without, True, grip, (("held", world.placed_on),)),
+        "retreat": ((*without, world.placed), False, open_width, (("hand", world.picked),)),
     }[name]
+
+
+def hold_picked(model: CollisionModel, world: PickPlaceWorld | None) -> None:
+    """Put ``world``'s picked object in the model's hand as the grasp holds it (see
+    `PickPlaceWorld`); None: empty the hand."""
+    if world is None:
+        model.hold(None)
+    elif world.half is None and world.grasp is None:
+        model.hold(world.block)
+    else:
+        half = world.half if world.half is not None else (world.block / 2,) * 3
+        pose = None if world.grasp is None else np.linalg.inv(world.grasp.matrix)
+        model.hold(half=tuple(half), pose=pose)
 
 
 @contextmanager
@@ -189,7 +213,7 @@ def guard_pick_place(
             continue
         boxes, held, fingers, ignore = _situation(phase.name, world, config.open_width)
         model.set_boxes(boxes)
-        model.hold(held)
+        hold_picked(model, world if held else None)
         run, evidence, checked, planned = _guard_phase(phase, model, fingers, ignore, config, seed)
         t_check, t_plan = t_check + checked, t_plan + planned
         runs += (run is not None and run is not phase) or "planner" in evidence

@@ -1,12 +1,31 @@
-"""One block move as eight phases: approach, descend, close, lift, transit, lower, open, retreat.
+"""One move of an upright object as eight phases: approach, descend, close, lift, transit, lower,
+open, retreat.
 
-Six top-down TCP waypoints (pre-grasp, grasp, lift, pre-place, place, retreat) are solved in one
-batched IK call. Consecutive solutions must be close in joint space (a wrist flip between two
+Six TCP waypoints (pre-grasp, grasp, lift, pre-place, place, retreat) are solved in one batched
+IK call. Consecutive solutions must be close in joint space (a wrist flip between two
 waypoints a few centimetres apart is a bug), so a waypoint whose solution jumps more than
 ``max_joint_jump`` from the previous one is re-solved seeded with that previous solution, and the
 closer valid answer is kept. Each arm phase is a rest-to-rest straight joint segment
 (`motion.trajectory.straight_segment`); the gripper phases are standstills. An unreachable
 waypoint is a returned failure (``ik_infeasible``) with evidence, never an exception.
+
+Two ways to say how the hand holds the object (`PickPlaceRequest`):
+
+- the default (``grasp`` and ``half`` None): today's top-down grasp of a cube of edge
+  ``PickPlaceConfig.block_size`` at its centre, the hand yaw the cube's yaw plus the quarter
+  turn nearest the hand (`motion.ik.grasp_yaw`; ``turn`` takes the other pair of faces);
+- a `motion.grasps.Grasp` and the object's half extents: the TCP at the grasp is
+  ``world_tcp(grasp, pick, pick_yaw)`` and at the place ``world_tcp(grasp, place, place_yaw)``
+  (raised by ``place_gap``). The pre-grasp backs off from the grasp along the approach axis
+  until the TCP is ``approach_height`` outside the object (`motion.grasps.back_out`), the
+  retreat ``approach_height`` from the release point; a vertical approach also rises to hover
+  above every stack and stays under a ceiling there, as the default does; an inclined one backs
+  off less where a ceiling is lower. Lift and lower are vertical and carry the object's bottom
+  ``lift_clearance + hz`` above the highest top (hz: its half height), as the default carries
+  the cube. ``half`` alone (no grasp) takes the top-down grasp (`motion.grasps.grasps`) at the
+  default's hand yaw, or, where the object is too wide across those faces, the other pair.
+  With the top grasp ``top{k}`` of a cube whose yaw the default would choose, both ways give
+  the same waypoints.
 """
 
 from __future__ import annotations
@@ -18,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motion.errors import MotionError
+from motion.grasps import Grasp, back_out, grasps, world_tcp
 from motion.ik import IKSolver, grasp_yaw, pose_yaw, top_down_pose
 from motion.trajectory import JointTrajectory, SpeedLimits, polyline_segment, straight_segment
 
@@ -46,16 +66,19 @@ class PickPlaceConfig:
 
 @dataclass(frozen=True)
 class PickPlaceRequest:
-    """Move the cube centred at ``pick`` so that its centre ends at ``place`` (base frame, m)."""
+    """Move the object centred at ``pick`` so that its centre ends at ``place`` (base frame, m),
+    held as ``grasp`` says (see the module docstring)."""
 
-    pick: tuple[float, float, float]  # block centre now
-    pick_yaw: float  # rad, block yaw now
-    place: tuple[float, float, float]  # block centre after placing (on top of the target)
-    place_yaw: float  # rad, block yaw after placing (modulo pi/2)
+    pick: tuple[float, float, float]  # object centre now
+    pick_yaw: float  # rad, object yaw now
+    place: tuple[float, float, float]  # object centre after placing (on top of the target)
+    place_yaw: float  # rad, object yaw after placing (the default cube: modulo pi/2)
     clear_z: float  # m, height of the highest stack top that transit must clear
     pick_ceiling: float = math.inf  # m, highest TCP height over the pick point (a shelf above)
     place_ceiling: float = math.inf  # m, ... over the place point
     turn: bool = False  # grasp the other pair of faces (the hand turned a quarter turn)
+    grasp: Grasp | None = None  # how the hand holds it (None: top-down, see the module doc)
+    half: tuple[float, float, float] | None = None  # m, half extents (None: a block_size cube)
 
 
 @dataclass(frozen=True)
@@ -77,6 +100,7 @@ class MotionResult:
     failure: str | None
     evidence: dict = field(default_factory=dict)
     ik_time_s: float = 0.0  # IK for all waypoints and knots, plus the ruckig timing
+    grasp: Grasp | None = None  # the grasp planned with (None: the default top-down cube)
 
 
 def _xyz(value, name: str) -> np.ndarray:
@@ -89,11 +113,92 @@ def _xyz(value, name: str) -> np.ndarray:
 def waypoint_targets(
     request: PickPlaceRequest, hand_yaw: float, config: PickPlaceConfig = PickPlaceConfig()
 ) -> np.ndarray:
-    """The six top-down TCP targets (6, 4, 4), in WAYPOINTS order, for a hand now at hand_yaw."""
-    pick, place = _xyz(request.pick, "pick"), _xyz(request.place, "place")
+    """The six TCP targets (6, 4, 4), in WAYPOINTS order, for a hand now at ``hand_yaw`` (rad;
+    it picks the default grasp's yaw, see the module docstring)."""
+    grasp, half = request_grasp(request, hand_yaw, config)
+    if grasp is None:
+        return _cube_targets(request, hand_yaw, config)
+    return _grasp_targets(request, grasp, half, config)
+
+
+def request_grasp(
+    request: PickPlaceRequest, hand_yaw: float, config: PickPlaceConfig = PickPlaceConfig()
+) -> tuple[Grasp | None, tuple[float, float, float]]:
+    """The grasp the move uses (None: the default top-down cube) and the object's half
+    extents (3,) m; checks the request's numbers (a malformed one raises MotionError)."""
+    _xyz(request.pick, "pick")
+    _xyz(request.place, "place")
     for name in ("pick_yaw", "place_yaw", "clear_z"):
         if not math.isfinite(getattr(request, name)):
             raise MotionError(f"request.{name} = {getattr(request, name)}; expected a finite float")
+    if request.half is None:
+        half = (config.block_size / 2,) * 3
+    else:
+        half = tuple(float(v) for v in _xyz(request.half, "half"))
+        if min(half) <= 0:
+            raise MotionError(f"request.half = {request.half!r}; expected half extents > 0 m")
+    if request.grasp is not None:
+        if request.turn:
+            raise MotionError(
+                "request.turn applies to the default grasp; with request.grasp set, "
+                "choose the turned grasp instead"
+            )
+        return request.grasp, half
+    if request.half is None:
+        return None, half
+    # the default hand yaw (a quarter-turn choice), taken by the top grasp with that yaw
+    yaw = grasp_yaw(request.pick_yaw, hand_yaw) + (math.pi / 2 if request.turn else 0.0)
+    k = round((yaw - request.pick_yaw) / (math.pi / 2)) % 4
+    tops = {g.name: g for g in grasps("cuboid", half, ("top",))}
+    for name in (f"top{k}", f"top{(k + 1) % 4}", f"top{(k + 3) % 4}"):
+        if name in tops:
+            return tops[name], half
+    raise MotionError(
+        f"no top-down grasp fits an object of half extents {half} m; set request.grasp"
+    )
+
+
+def _backed(pose: np.ndarray, distance: float, z_hover: float, ceiling: float) -> np.ndarray:
+    """``pose`` (4, 4) with the TCP backed off ``distance`` m along its approach (tool z). A
+    vertical approach then rises at least to ``z_hover`` and at most to ``ceiling``; an
+    inclined one backs off less where it would pass ``ceiling``."""
+    a = pose[:3, 2]  # (3,) the approach in the base frame
+    out = pose.copy()
+    out[:3, 3] = pose[:3, 3] - distance * a
+    if a[2] < -1 + 1e-9:  # straight down: as the default path
+        out[2, 3] = min(max(out[2, 3], z_hover), ceiling)
+    elif a[2] < 0 and out[2, 3] > ceiling:
+        out[:3, 3] = pose[:3, 3] - (ceiling - pose[2, 3]) / -a[2] * a
+    return out
+
+
+def _grasp_targets(
+    request: PickPlaceRequest, grasp: Grasp, half, config: PickPlaceConfig
+) -> np.ndarray:
+    """The six TCP targets (6, 4, 4) of a move held by ``grasp`` (see the module docstring)."""
+    pick, place = _xyz(request.pick, "pick"), _xyz(request.place, "place")
+    hz = half[2]
+    highest = max(request.clear_z, pick[2] + hz, place[2] - hz)  # stack tops to clear
+    above = grasp.matrix[2, 3]  # m, the TCP over the object's centre (any yaw)
+    z_transit = highest + config.lift_clearance + 2 * hz + above
+    z_hover = highest + config.lift_clearance  # the empty hand hovers above every stack
+    take = world_tcp(grasp, pick, request.pick_yaw)  # (4, 4)
+    put = world_tcp(grasp, place, request.place_yaw)
+    put[2, 3] += config.place_gap
+    lift, pre_place = take.copy(), put.copy()
+    lift[2, 3] = min(z_transit, request.pick_ceiling)
+    pre_place[2, 3] = min(z_transit, request.place_ceiling)
+    out = back_out(grasp, half) + config.approach_height
+    pre_grasp = _backed(take, out, z_hover, request.pick_ceiling)
+    retreat = _backed(put, config.approach_height, z_hover, request.place_ceiling)
+    return np.stack([pre_grasp, take, lift, pre_place, put, retreat])  # (6, 4, 4)
+
+
+def _cube_targets(
+    request: PickPlaceRequest, hand_yaw: float, config: PickPlaceConfig = PickPlaceConfig()
+) -> np.ndarray:
+    """The default path's six top-down TCP targets (6, 4, 4) (the cube of edge block_size)."""
+    pick, place = _xyz(request.pick, "pick"), _xyz(request.place, "place")
     half = config.block_size / 2
     highest = max(request.clear_z, pick[2] + half, place[2] - half)  # stack tops to clear
     z_transit = highest + config.lift_clearance + config.block_size  # TCP = held block centre
@@ -167,19 +272,23 @@ def plan_pick_place(
     request: PickPlaceRequest,
     config: PickPlaceConfig = PickPlaceConfig(),
 ) -> MotionResult:
-    """Plan one block move from the arm configuration ``q_now`` (J,); see the module docstring."""
+    """Plan one move from the arm configuration ``q_now`` (J,); see the module docstring."""
     q_now = np.asarray(q_now, dtype=np.float64)
     if q_now.shape != (solver.dof,) or not np.isfinite(q_now).all():
         raise MotionError(f"q_now has shape {q_now.shape}; expected finite ({solver.dof},)")
-    targets = waypoint_targets(request, pose_yaw(solver.fk(q_now)[0]), config)  # (6, 4, 4)
-    room = min(targets[0, 2, 3] - targets[1, 2, 3], targets[5, 2, 3] - targets[4, 2, 3])
+    hand_yaw = pose_yaw(solver.fk(q_now)[0])
+    grasp, _ = request_grasp(request, hand_yaw, config)
+    targets = waypoint_targets(request, hand_yaw, config)  # (6, 4, 4)
+    # how far the hand backs off along its approach (tool z) at the pick and at the place
+    back = (targets[0, :3, 3] - targets[1, :3, 3]) @ -targets[1, :3, 2]
+    room = min(back, (targets[5, :3, 3] - targets[4, :3, 3]) @ -targets[4, :3, 2])
     if room < config.min_approach:  # a ceiling over the pick or the place is too low
         evidence = {
             "pick_ceiling": request.pick_ceiling,
             "place_ceiling": request.place_ceiling,
             "approach_m": round(float(room), 4),
         }
-        return MotionResult(False, (), "no_clearance", evidence)
+        return MotionResult(False, (), "no_clearance", evidence, grasp=grasp)
     start = time.perf_counter()
     ok, q, pos_err, rot_err, resolved = _solve_waypoints(
         solver, targets, q_now, config.max_joint_jump
@@ -195,7 +304,7 @@ def plan_pick_place(
             "rot_err": float(rot_err[k]),
             "unreachable": tuple(bad),
         }
-        return MotionResult(False, (), "ik_infeasible", evidence, ik_time)
+        return MotionResult(False, (), "ik_infeasible", evidence, ik_time, grasp)
 
     w = {"now": q_now, **dict(zip(WAYPOINTS, q, strict=True))}  # name -> (J,)
     plan = (  # phase, from, to (None: standstill), SpeedLimits or standstill seconds, gripper
@@ -232,4 +341,6 @@ def plan_pick_place(
         "max_joint_step": {n: float(s) for n, s in zip(WAYPOINTS, steps, strict=True)},
         "resolved": tuple(resolved),
     }
-    return MotionResult(True, phases, None, evidence, ik_time)
+    if grasp is not None:
+        evidence["grasp"] = grasp.name
+    return MotionResult(True, phases, None, evidence, ik_time, grasp)

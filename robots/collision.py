@@ -4,10 +4,11 @@ The arm's geometry is the pybullet_data Panda URDF's collision meshes (one conve
 loaded by `robots.pybullet_loader.load_panda` into a private ``p.DIRECT`` client and queried with
 PyBullet's ``getClosestPoints``; nothing is stepped. World frame = robot base frame; the table is
 a 6 m slab with its top at z = 0 (link0 stands on it: that pair is always ignored). Boxes come
-from `PandaCollision.set_boxes`; a held cube rides at the TCP. A contact counts when the closest
-distance is below ``margin`` (robot or held cube vs the scene, held cube vs arm) or below
-``self_margin`` (link vs link; default 0 as in MoveIt, so a larger scene margin never makes
-q_home self-colliding). Only pairs whose AABBs come within the threshold reach the narrow phase.
+from `PandaCollision.set_boxes`; a held box (`PandaCollision.hold`) rides in the hand, at the
+TCP or at a grasp's pose relative to it. A contact counts when the closest distance is below
+``margin`` (robot or held box vs the scene, held box vs arm) or below ``self_margin`` (link vs
+link; default 0 as in MoveIt, so a larger scene margin never makes q_home self-colliding). Only
+pairs whose AABBs come within the threshold reach the narrow phase.
 """
 
 from __future__ import annotations
@@ -94,6 +95,38 @@ def _finite(values, n: int, positive: bool = False) -> bool:
     return len(v) == n and all(math.isfinite(x) and (x > 0 or not positive) for x in v)
 
 
+def _pose(pose) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """A (4, 4) rigid transform as PyBullet's (position (3,), quaternion (x, y, z, w))."""
+    try:
+        h = np.asarray(pose, dtype=float)
+    except (TypeError, ValueError):
+        h = np.full(1, np.nan)
+    if h.shape != (4, 4) or not np.isfinite(h).all():
+        raise RobotError(f"held pose must be a finite (4, 4) transform, got shape {h.shape}")
+    r = h[:3, :3]
+    if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
+        raise RobotError("held pose's rotation block is not a rotation (tolerance 1e-6)")
+    # the quaternion from the largest of w, x, y, z (Shepperd), well conditioned everywhere
+    t = np.trace(r)
+    k = int(np.argmax([t, r[0, 0], r[1, 1], r[2, 2]]))
+    if k == 0:
+        w = math.sqrt(1.0 + t) / 2
+        q = (
+            (r[2, 1] - r[1, 2]) / (4 * w),
+            (r[0, 2] - r[2, 0]) / (4 * w),
+            (r[1, 0] - r[0, 1]) / (4 * w),
+            w,
+        )
+    else:
+        i, j, m = k - 1, k % 3, (k + 1) % 3
+        v = [0.0, 0.0, 0.0]
+        v[i] = math.sqrt(1.0 + r[i, i] - r[j, j] - r[m, m]) / 2
+        v[j] = (r[j, i] + r[i, j]) / (4 * v[i])
+        v[m] = (r[m, i] + r[i, m]) / (4 * v[i])
+        q = (*v, (r[m, j] - r[j, m]) / (4 * v[i]))
+    return tuple(float(x) for x in h[:3, 3]), tuple(float(x) for x in q)
+
+
 class PandaCollision:
     """The Panda, its held cube and a set of boxes in a private PyBullet client.
 
@@ -135,7 +168,8 @@ class PandaCollision:
         self._shapes: dict[tuple, int] = {}  # half extents -> shape; PyBullet can't free them
         table = self._new_box((0.0, 0.0, -_TABLE_HALF[2]), _TABLE_HALF, 0.0)
         self._others: list[tuple[str, int]] = [(TABLE, table)]  # (name, body)
-        self._held: int | None = None  # body of the held cube
+        self._held: int | None = None  # body of the held box
+        self._held_pose: tuple | None = None  # its (position, quaternion) in the TCP frame
         self._refresh()
 
     def set_boxes(self, boxes: Sequence[Box]) -> None:
@@ -155,19 +189,30 @@ class PandaCollision:
         self._others[1:] = [(b.name, self._new_box(b.centre, b.half, b.yaw)) for b in boxes]
         self._refresh()
 
-    def hold(self, size: float | None) -> None:
-        """Hold a cube of edge ``size`` m centred at the TCP, turned with the hand; None: nothing.
+    def hold(self, size: float | None = None, half=None, pose=None) -> None:
+        """Hold a box in the hand; nothing when both ``size`` and ``half`` are None.
 
-        The held block's own `Box` should leave `set_boxes` (or be ignored as ("held", name)).
+        ``size``: a cube's edge (m), or ``half``: the box's half extents (3,) m (not both).
+        ``pose``: (4, 4) the box's pose in the TCP frame (e.g. the inverse of a
+        `motion.grasps.Grasp` matrix); None: centred at the TCP and turned with the hand, as
+        a top-down grasp holds a block. The held block's own `Box` should leave `set_boxes`
+        (or be ignored as ("held", name)).
         """
+        if size is not None and half is not None:
+            raise RobotError(f"hold a cube edge or half extents, not both (size {size}, {half})")
         if size is not None and not _finite([size], 1, True):
             raise RobotError(f"held cube size must be a finite edge > 0 in m or None, got {size}")
+        if half is not None and not _finite(half, 3, True):
+            raise RobotError(f"held box half extents must be three finite values > 0, got {half}")
+        relative = None if pose is None else _pose(pose)
         self._check_open()
         if self._held is not None:
             p.removeBody(self._held, physicsClientId=self._c)
             self._held = None
-        if size is not None:
-            self._held = self._new_box((0.0, 0.0, -10.0), (size / 2,) * 3, 0.0)
+        self._held_pose = relative
+        if size is not None or half is not None:
+            extents = (size / 2,) * 3 if size is not None else tuple(half)
+            self._held = self._new_box((0.0, 0.0, -10.0), extents, 0.0)
 
     def _new_box(self, centre, half, yaw: float) -> int:
         c, half = self._c, tuple(float(h) for h in half)
@@ -238,7 +283,10 @@ class PandaCollision:
         boxes = [p.getAABB(body, link, physicsClientId=c) for link in self._links]
         if self._held is not None:
             state = p.getLinkState(body, self._tcp, computeForwardKinematics=1, physicsClientId=c)
-            p.resetBasePositionAndOrientation(self._held, state[4], state[5], physicsClientId=c)
+            at, turn = state[4], state[5]
+            if self._held_pose is not None:
+                at, turn = p.multiplyTransforms(at, turn, *self._held_pose)
+            p.resetBasePositionAndOrientation(self._held, at, turn, physicsClientId=c)
             boxes.append(p.getAABB(self._held, physicsClientId=c))
         else:
             boxes.append(((math.nan,) * 3,) * 2)  # NaN overlaps nothing
