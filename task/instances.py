@@ -1,9 +1,12 @@
 """Problem instances: a domain's problem, its parsed PDDL (for validation), its known lengths.
 
 Two sources here: PDDL files (``from_files`` / ``from_text``) and the embedded example
-(``example``). The domain whose rules plan a problem is recognised from the PDDL domain
-(`task.domains.recognise`: a hand-written domain file, else the generic STRIPS lift) or forced
-with ``rules``. Benchmark suites built from these (PlanBench, IPC folders, seeded random
+(``example``). The domain whose rules plan a problem is recognised from the PDDL domain by its
+structure (`task.domains.match.match_domain`: a hand-written domain up to renaming, else the
+generic STRIPS lift) or forced with ``rules``. A renamed domain's problem is read through the
+renaming (`task.domains.match.to_reference`) and carries it (``Problem.renaming``), so plans
+and atoms come back in the user's names; a near miss is planned by the lift and the instance's
+``note`` says why. Benchmark suites built from these (PlanBench, IPC folders, seeded random
 problems) live in `tamp.bench.suites`. Every instance keeps the parsed PDDL problem so plans
 are checked by `task.symbolic.validate` against the PDDL itself, independently of the
 planner's crisp replay.
@@ -12,14 +15,15 @@ planner's crisp replay.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
 from task import data
-from task.domains import GENERIC, get_domain, names, recognise
+from task.domains import GENERIC, get_domain, names
+from task.domains.match import Match, NearMiss, Renaming, match_domain, to_reference
 from task.errors import PDDLError, ProblemError, one_of
 from task.problem import Problem
 from task.symbolic import pddl_io
@@ -28,13 +32,16 @@ from task.symbolic import pddl_io
 @dataclass(frozen=True)
 class Instance:
     """One benchmark problem. ``optimal``: the optimal plan length in PDDL actions (None:
-    unknown); ``reference``: the length of a reference plan that need not be optimal."""
+    unknown); ``reference``: the length of a reference plan that need not be optimal;
+    ``note``: one line on how the domain was recognised when it is worth saying (a near miss
+    of a hand-written domain, planned by the generic lift instead)."""
 
     name: str
     problem: Problem
     pddl: PDDLProblem
     optimal: int | None = None
     reference: int | None = None
+    note: str | None = None
 
     @property
     def size(self) -> int:
@@ -47,22 +54,48 @@ class Instance:
         return self.problem.n
 
 
-def rules_for(domain: Domain, rules: str | None = None) -> str:
-    """The domain rules that plan ``domain``'s problems: ``rules`` if given (checked: a
-    hand-written domain must match the PDDL domain), else the recognised ones."""
-    if rules is None:
-        return recognise(domain)
-    if rules not in names():
+@dataclass(frozen=True)
+class Rules:
+    """The domain rules that plan a PDDL domain's problems: registered domain ``name``, the
+    ``renaming`` from its PDDL names to the user's (None: its own names), and ``note``, why a
+    near miss of a hand-written domain goes to the generic lift (None otherwise)."""
+
+    name: str
+    renaming: Renaming | None = None
+    note: str | None = None
+
+
+def _wrong_rules(domain: Domain, rules: str, why: str) -> PDDLError:
+    actions = ", ".join(sorted(str(a.name).lower() for a in domain.actions))
+    match = re.search(r"\(\s*domain\s+([^\s()]+)", get_domain(rules).pddl_domain_text(), re.I)
+    wanted = f" {match.group(1).lower()!r}" if match else ""
+    return PDDLError(
+        f"domain {str(domain.name)!r} (actions {actions}) is not the {rules} domain"
+        f"{wanted}{why}; use --domain-rules {GENERIC} to plan it with the generic STRIPS lift"
+    )
+
+
+def choose_rules(domain: Domain, rules: str | None = None) -> Rules:
+    """The `Rules` of ``domain``: ``rules`` if given (checked: a hand-written domain must match
+    the PDDL domain up to renaming), else the hand-written domain it matches, else the lift."""
+    if rules is not None and rules not in names():
         raise ProblemError(f"--domain-rules: unknown domain rules {one_of(rules, names())}")
-    if rules != GENERIC and not get_domain(rules).matches(domain):
-        actions = ", ".join(sorted(str(a.name).lower() for a in domain.actions))
-        match = re.search(r"\(\s*domain\s+([^\s()]+)", get_domain(rules).pddl_domain_text(), re.I)
-        wanted = f" {match.group(1).lower()!r}" if match else ""
-        raise PDDLError(
-            f"domain {str(domain.name)!r} (actions {actions}) is not the {rules} domain"
-            f"{wanted}; use --domain-rules {GENERIC} to plan it with the generic STRIPS lift"
-        )
-    return rules
+    if rules == GENERIC:
+        return Rules(GENERIC)
+    found = match_domain(domain, None if rules is None else (rules,))
+    if isinstance(found, Match):
+        return Rules(found.rules, None if found.renaming.identity else found.renaming)
+    if rules is not None:
+        why = f" ({found.reason})" if isinstance(found, NearMiss) else ""
+        raise _wrong_rules(domain, rules, why)
+    if isinstance(found, NearMiss):
+        return Rules(GENERIC, note=f"{found.reason}: planned with the generic STRIPS lift")
+    return Rules(GENERIC)
+
+
+def rules_for(domain: Domain, rules: str | None = None) -> str:
+    """The name of the domain rules that plan ``domain``'s problems (`choose_rules`)."""
+    return choose_rules(domain, rules).name
 
 
 def from_text(
@@ -74,14 +107,22 @@ def from_text(
     rules: str | None = None,
     reference: int | None = None,
 ) -> Instance:
-    """Parse problem text of ``domain``; errors name ``source``. ``rules``: see `rules_for`."""
+    """Parse problem text of ``domain``; errors name ``source``. ``rules``: see `choose_rules`."""
     parsed = pddl_io.parse_problem(text, source, domain)
-    chosen = get_domain(rules_for(domain, rules))
+    chosen = choose_rules(domain, rules)
+    order = pddl_io.object_order(text)
     try:
-        problem = chosen.from_pddl(domain, parsed, pddl_io.object_order(text))
+        if chosen.renaming is None:
+            problem = get_domain(chosen.name).from_pddl(domain, parsed, order)
+        else:
+            found = Match(chosen.name, chosen.renaming)
+            ref_domain, ref_problem, ref_order = to_reference(found, domain, parsed, order)
+            problem = get_domain(chosen.name).from_pddl(ref_domain, ref_problem, ref_order)
+            problem = replace(problem, renaming=chosen.renaming)
     except (PDDLError, ProblemError) as exc:
-        raise type(exc)(f"{source}: {exc}") from None
-    return Instance(name or problem.name, problem, parsed, optimal, reference)
+        said = str(exc) if chosen.renaming is None else chosen.renaming.speak(str(exc))
+        raise type(exc)(f"{source}: {said}") from None
+    return Instance(name or problem.name, problem, parsed, optimal, reference, chosen.note)
 
 
 def from_files(

@@ -53,6 +53,9 @@ class Problem:
     goal: tuple[tuple[str, str], ...]
     fixed: tuple[str, ...] = (TABLE,)
     data: object = field(default=None, compare=False, repr=False)  # domain-owned, crisp
+    # the user's PDDL names when the domain matched a hand-written one up to renaming
+    # (`task.domains.match.Renaming`; None: the domain's own names)
+    renaming: object = field(default=None, compare=False, repr=False)
 
     @property
     def targets(self) -> tuple[str, ...]:

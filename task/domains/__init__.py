@@ -7,8 +7,10 @@ one file keeps helpers beside it under its own prefix: ``blocksworld_pddl``, ``l
 ``sokoban_pddl`` (problem PDDL in and out), ``logistics_map`` (the static map and routes),
 ``sokoban_grid`` (the grid's static tables), ``strips_soft`` (the lift's tensors). ``strips``
 is the generic soft lift of any grounded STRIPS domain: the planner of a PDDL domain no file is
-written for, and the oracle the hand-written domains are tested on. The domains build on the
-crisp side (`task.symbolic`), which never imports them.
+written for, and the oracle the hand-written domains are tested on. The room ``match`` finds
+the hand-written domain a PDDL domain is up to renaming (by structure, never by name) and
+keeps the user's names in plans. The domains build on the crisp side (`task.symbolic`), which
+never imports them.
 """
 
 from __future__ import annotations
@@ -37,8 +39,9 @@ def get_domain(name: str) -> Domain:
 
 
 def recognise(pddl_domain) -> str:
-    """The name of the hand-written domain a parsed PDDL domain is, else the generic lift."""
-    for name in _NAMES:
-        if name != GENERIC and get_domain(name).matches(pddl_domain):
-            return name
-    return GENERIC
+    """The name of the hand-written domain a parsed PDDL domain is up to renaming (by its
+    structure, `task.domains.match.match_domain`), else the generic lift."""
+    from task.domains.match import Match, match_domain
+
+    found = match_domain(pddl_domain)
+    return found.rules if isinstance(found, Match) else GENERIC

@@ -19,6 +19,7 @@ from torch import Tensor
 
 from task.domains import blocksworld_pddl as _pddl
 from task.domains.base import SoftBatch, encode_supports, relational_decode, relational_step
+from task.domains.match.renaming import user_actions, user_atoms
 from task.errors import ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
 from task.soft import (
@@ -271,10 +272,10 @@ class Blocksworld:
     check_move = staticmethod(check_move)
     apply_move = staticmethod(apply_move)
     is_goal = staticmethod(is_goal)
-    to_actions = staticmethod(moves_to_actions)
+    to_actions = staticmethod(user_actions(moves_to_actions))  # the user's names
     lower_bound = staticmethod(moves_lower_bound)
     legal_moves = staticmethod(legal_moves)
-    to_atoms = staticmethod(to_atoms)
+    to_atoms = staticmethod(user_atoms(to_atoms))
     to_pddl = staticmethod(to_pddl)
     from_pddl = staticmethod(from_pddl)
     samples = staticmethod(samples)

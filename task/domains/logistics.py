@@ -35,6 +35,7 @@ from torch import Tensor
 from task.domains import logistics_map as lm
 from task.domains import logistics_pddl as lp
 from task.domains.base import INF, SoftBatch, encode_supports, relational_decode, zero_cycle_loss
+from task.domains.match.renaming import user_actions, user_atoms
 from task.errors import ProblemError, one_of
 from task.problem import Action, Move, Problem
 from task.soft import goal_cross_entropy, row_normalise
@@ -319,8 +320,8 @@ class Logistics:
     is_goal = staticmethod(is_goal)
     lower_bound = staticmethod(lower_bound)
     legal_moves = staticmethod(legal_moves)
-    to_actions = staticmethod(to_actions)
-    to_atoms = staticmethod(lp.to_atoms)
+    to_actions = staticmethod(user_actions(to_actions))  # the user's names
+    to_atoms = staticmethod(user_atoms(lp.to_atoms))
     to_pddl = staticmethod(lp.to_pddl)
     from_pddl = staticmethod(lp.from_pddl)
     matches = staticmethod(lp.matches)

@@ -37,6 +37,7 @@ from torch import Tensor
 
 from task.domains import sokoban_grid as rules
 from task.domains.base import SoftBatch, zero_cycle_loss
+from task.domains.match.renaming import user_actions, user_atoms
 from task.domains.sokoban_grid import INF, ROBOT, State, grid
 from task.domains.sokoban_pddl import (
     NAME,
@@ -286,8 +287,8 @@ class Sokoban:
     is_goal = staticmethod(rules.is_goal)
     lower_bound = staticmethod(rules.lower_bound)
     from_pddl = staticmethod(from_pddl)
-    to_actions = staticmethod(to_actions)
-    to_atoms = staticmethod(to_atoms)
+    to_actions = staticmethod(user_actions(to_actions))  # the user's names
+    to_atoms = staticmethod(user_atoms(to_atoms))
     to_pddl = staticmethod(to_pddl)
     samples = staticmethod(samples)
     matches = staticmethod(matches)
