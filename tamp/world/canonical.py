@@ -727,9 +727,13 @@ def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
 
 def _sorted_grasps(zones, posts, objects, blocked: dict[str, int]) -> bool:
     """True when each object's top-down grasps are free along the axis ``blocked`` does not
-    name (with a 4 mm margin) and blocked along the one it names (even 3 mm thinner)."""
+    name (with a 4 mm margin) and blocked along the one it names (even 3 mm thinner), and
+    only the posts block it: without them both axes are free."""
     scene = Scene("draft", TABLE_TOP, tuple(zones), tuple(posts), tuple(objects))
+    bare = replace(scene, obstacles=())
     for o in objects:
+        if free_top_axes(bare, o.name) != (0, 1):
+            return False
         if free_top_axes(scene, o.name, pad=0.004) != (1 - blocked[o.name],):
             return False
         if blocked[o.name] in free_top_axes(scene, o.name, pad=-0.003):
