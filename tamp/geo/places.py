@@ -1,0 +1,231 @@
+"""Discretised placements: where an object may go on another object, in a region, on the table.
+
+`candidate_places(scene, obj, target, n, seed)` lists up to ``n`` `Place` choices for object
+``obj`` onto ``target`` in the scene as it is now (the other objects where they stand), each a
+centre and a yaw at which the object rests on the target, inside it, and free of everything
+else. The same call in another world state gives the same name to the same position: names are
+the failure memory's keys (`tamp.geo.search`), so a place is a stable choice, not a sample.
+
+- On an object ``y`` (``"on.y"``): centred on its top, turned as ``y`` is (a cuboid whose
+  footprint is not square also a quarter turn, ``"on.y.r"``), only when the object is
+  *supported*: its footprint at that yaw lies within ``y``'s top grown by `SUPPORT_PAD` (a cube
+  on a cube of its size or larger, a small disc on a large one; never a large object on a
+  small one: it would tip or overhang). ``y`` must be clear of anything but ``obj``.
+- In a region ``r`` (``"r.g<i>"``, ``"r.s<j>"``): the grid over the inner rectangle (inside
+  the walls) at pitch object width + `REGION_GAP`, centred in the rectangle so a full grid
+  holds the most objects, nearest the region's centre first, then ``samples`` seeded uniform
+  positions (nearest the centre first); every one has the object's footprint inside the inner
+  rectangle and `REGION_CLEARANCE` from the other objects. Yaws: the region's axes (a
+  non-square cuboid also turned a quarter, suffix ``.r``).
+- On the table (`task.problem.TABLE`; ``"table.s<i>"``, ``"table.g<i>"``): the scene's slot
+  grid first (if it has one), then a grid of pitch `TABLE_PITCH` over the table within
+  `TABLE_REACH` of the robot base's axis (its phase drawn from ``seed``), nearest the object
+  first; away from the regions and obstacles, and `TABLE_CLEARANCE` from the other objects,
+  so a spot on the table never hems in a neighbour's grasp.
+
+Freedom here is geometry only (footprints and heights); whether the arm can make the move, the
+fingers included, is `tamp.geo.check.check_move`'s to say.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+
+import numpy as np
+
+from tamp.geo.types import Place
+from tamp.world.geometry import Solid, fixed_solids, footprint_gap, of_movable, penetration
+from tamp.world.schema import Movable, Region, Scene, SceneFileError
+from task.errors import one_of
+from task.problem import TABLE
+
+SUPPORT_PAD = 0.002  # m, an object's footprint may reach this far past the top it stands on
+REGION_GAP = 0.02  # m, between neighbouring grid places in a region (a finger's room)
+REGION_CLEARANCE = 0.004  # m, a region place keeps this far from the other objects
+TABLE_PITCH = 0.08  # m, the table grid's spacing
+TABLE_REACH = (0.30, 0.70)  # m, table spots lie this far from the robot base's z axis
+TABLE_CLEARANCE = 0.04  # m, a table spot keeps this far from objects, regions and obstacles
+OVERLAP = 0.001  # m, a place may touch what is around it this deep (contact, not overlap)
+TURN = math.pi / 2
+
+
+def candidate_places(
+    scene: Scene,
+    obj: str,
+    target: str,
+    n: int = 8,
+    seed: int = 0,
+    samples: int | None = None,
+) -> tuple[Place, ...]:
+    """Up to ``n`` places of object ``obj`` onto ``target`` (an object's name, a region's name
+    or `task.problem.TABLE`) in ``scene`` as it stands, in the order a planner should try them
+    (see the module docstring). ``samples``: seeded region positions added after the grid
+    (default ``n``). An unknown name is a `SceneFileError` listing the valid ones; a target
+    nothing fits on gives ``()``."""
+    o = scene.object(obj)
+    objects = {x.name for x in scene.objects}
+    regions = {r.name for r in scene.regions}
+    if target == TABLE:
+        pool = _on_table(scene, o, seed)
+    elif target in regions:
+        pool = _in_region(scene, o, scene.region(target), seed, n if samples is None else samples)
+    elif target in objects:
+        pool = _on_object(scene, o, scene.object(target))
+    else:
+        valid = [*sorted(objects - {obj}), *sorted(regions), TABLE]
+        raise SceneFileError(f"unknown place target {one_of(target, valid)}")
+    out = []
+    for place in pool:
+        if len(out) >= n:
+            break
+        if free(scene, obj, place, _clearance(target, objects, regions)):
+            out.append(place)
+    return tuple(out)
+
+
+def free(scene: Scene, obj: str, place: Place, clearance: float = 0.0) -> bool:
+    """True when object ``obj`` at ``place`` overlaps nothing fixed (obstacles, region walls
+    and floors: at most `OVERLAP` deep) and keeps ``clearance`` (m) from every other object
+    whose height range it shares (objects under it: at most `OVERLAP` deep)."""
+    me = placed_solid(scene.object(obj), place)
+    for s in fixed_solids(scene):
+        if penetration(me, s) > OVERLAP:
+            return False
+    for x in scene.objects:
+        if x.name == obj:
+            continue
+        s = of_movable(x)
+        shared = min(me.top, s.top) - max(me.bottom, s.bottom) > OVERLAP
+        if shared and footprint_gap(me, s) < clearance - 1e-9:
+            return False
+        if penetration(me, s) > OVERLAP:
+            return False
+    return True
+
+
+def placed_solid(o: Movable, place: Place) -> Solid:
+    """The solid ``o`` would be at ``place``."""
+    return Solid(o.name, o.kind == "cylinder", place.xyz, o.half, place.yaw)
+
+
+def supported_on(o: Movable, below: Movable, yaw: float) -> bool:
+    """True when ``o`` turned ``yaw``, centred on ``below``'s top, has its whole footprint
+    within that top grown by `SUPPORT_PAD` (a cylinder's footprint: its bounding square)."""
+    top = of_movable(below)
+    me = Solid(o.name, False, below.pose.xyz, o.half, yaw)
+    return all(top.covers(c, SUPPORT_PAD) for c in me.corners())
+
+
+def _clearance(target: str, objects: set[str], regions: set[str]) -> float:
+    if target == TABLE:
+        return TABLE_CLEARANCE
+    if target in regions:
+        return REGION_CLEARANCE
+    return 0.0  # on an object: only overlaps matter
+
+
+def _yaws(o: Movable, base: float) -> tuple[tuple[str, float], ...]:
+    """(suffix, yaw) choices: ``base``, and a quarter turn when the footprint is not square."""
+    if o.kind == "cuboid" and abs(o.half[0] - o.half[1]) > 1e-6:
+        return (("", base), (".r", base + TURN))
+    return (("", base),)
+
+
+def _on_object(scene: Scene, o: Movable, below: Movable) -> list[Place]:
+    if below.name == o.name:
+        return []
+    z = below.top + o.half[2]
+    return [
+        Place(f"on.{below.name}{suffix}", below.name, (*below.pose.xyz[:2], z), yaw)
+        for suffix, yaw in _yaws(o, below.pose.yaw)
+        if supported_on(o, below, yaw)
+    ]
+
+
+def _stream(seed: int, *names: str) -> np.random.Generator:
+    """A generator seeded by ``seed`` and the names (stable across processes and states)."""
+    key = zlib.crc32("/".join(names).encode())
+    return np.random.default_rng([seed, key])
+
+
+def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> list[Place]:
+    (x0, y0), (x1, y1) = r.inner()
+    z = r.surface + o.half[2]
+    centre = ((x0 + x1) / 2, (y0 + y1) / 2)
+    grid, drawn = [], []
+    for suffix, yaw in _yaws(o, 0.0):
+        hx, hy = _extent(o, yaw)
+        lo, hi = (x0 + hx, y0 + hy), (x1 - hx, y1 - hy)
+        if lo[0] > hi[0] + 1e-9 or lo[1] > hi[1] + 1e-9:
+            continue  # the object does not fit inside the region at this yaw
+        xs = _centred(lo[0], hi[0], 2 * hx + REGION_GAP)
+        ys = _centred(lo[1], hi[1], 2 * hy + REGION_GAP)
+        for i, (x, y) in enumerate((x, y) for x in xs for y in ys):
+            grid.append(Place(f"{r.name}.g{i}{suffix}", r.name, (x, y, z), yaw))
+        rng = _stream(seed, o.name, r.name, suffix)
+        for j in range(samples):
+            x, y = rng.uniform(lo[0], hi[0]), rng.uniform(lo[1], hi[1])
+            drawn.append(Place(f"{r.name}.s{j}{suffix}", r.name, (float(x), float(y), z), yaw))
+
+    def near(place: Place) -> float:
+        return math.dist(place.xyz[:2], centre)
+
+    return sorted(grid, key=near) + sorted(drawn, key=near)
+
+
+def _extent(o: Movable, yaw: float) -> tuple[float, float]:
+    """Half extents along x and y of ``o``'s footprint turned ``yaw`` (its bounding box)."""
+    if o.kind == "cylinder":
+        return o.half[0], o.half[1]
+    c, s = abs(math.cos(yaw)), abs(math.sin(yaw))
+    return c * o.half[0] + s * o.half[1], s * o.half[0] + c * o.half[1]
+
+
+def _centred(lo: float, hi: float, pitch: float) -> list[float]:
+    """Positions ``pitch`` apart from ``lo`` to ``hi``, as many as fit, centred in the span."""
+    count = math.floor((hi - lo) / pitch + 1e-9) + 1
+    start = (lo + hi) / 2 - (count - 1) * pitch / 2
+    return [start + k * pitch for k in range(count)]
+
+
+def _on_table(scene: Scene, o: Movable, seed: int) -> list[Place]:
+    z = o.half[2]
+    slots = []
+    if scene.slots is not None:
+        points = [(x, y) for x in scene.slots.xs for y in scene.slots.ys]
+        slots = [Place(f"table.s{i}", TABLE, (x, y, z), 0.0) for i, (x, y) in enumerate(points)]
+    rng = _stream(seed, "table")
+    phase = rng.uniform(0.0, TABLE_PITCH, size=2)
+    (tx0, ty0), (tx1, ty1) = scene.table.lo, scene.table.hi
+    xs = np.arange(tx0 + phase[0], tx1, TABLE_PITCH)
+    ys = np.arange(ty0 + phase[1], ty1, TABLE_PITCH)
+    grid = [
+        Place(f"table.g{i}", TABLE, (float(x), float(y), z), 0.0)
+        for i, (x, y) in enumerate((x, y) for x in xs for y in ys)
+    ]
+    here = o.pose.xyz[:2]
+    grid.sort(key=lambda place: math.dist(place.xyz[:2], here))
+    return [p for p in (*slots, *grid) if _table_spot(scene, o, p)]
+
+
+def _table_spot(scene: Scene, o: Movable, place: Place) -> bool:
+    """On the table, within `TABLE_REACH`, and `TABLE_CLEARANCE` from regions and obstacles."""
+    me = placed_solid(o, place)
+    if not all(scene.table.holds(c) for c in me.corners()):
+        return False
+    if not TABLE_REACH[0] <= math.hypot(*place.xyz[:2]) <= TABLE_REACH[1]:
+        return False
+    for r in scene.regions:
+        rect = Solid(
+            r.name,
+            False,
+            ((r.lo[0] + r.hi[0]) / 2, (r.lo[1] + r.hi[1]) / 2, 0.0),
+            ((r.hi[0] - r.lo[0]) / 2, (r.hi[1] - r.lo[1]) / 2, 1.0),
+        )
+        if footprint_gap(me, rect) < TABLE_CLEARANCE:
+            return False
+    for s in fixed_solids(scene):
+        if s.bottom < me.top and footprint_gap(me, s) < TABLE_CLEARANCE:
+            return False
+    return True
