@@ -25,7 +25,6 @@ memory keys on.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -33,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from motion.grasps import Grasp, object_frame
-from motion.guard import GuardConfig, PickPlaceWorld, guard_pick_place
-from motion.ik import IKSolver, pose_yaw, top_down_pose
+from motion.grasps import grasps as make_grasps
+from motion.guard import GuardConfig, PickPlaceWorld, guard_pick_place, hold_picked
+from motion.ik import IKSolver, pose_yaw
 from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
 from robots.panda import PANDA
 from tamp.geo.places import free, placed_solid
@@ -50,7 +50,6 @@ STROKE = 0.08  # m, the Panda's widest opening
 PICK_PHASES = ("approach", "descend")  # guard phases that do not depend on the place
 PICK_WAYPOINTS = ("pre_grasp", "grasp")  # IK waypoints that do not depend on the place
 FAILURES = ("not_clear", "unsupported", "no_grasp", "ik_infeasible", "no_clearance", "collision")
-GENERAL = "grasp" in {f.name for f in dataclasses.fields(PickPlaceRequest)}
 
 
 @dataclass(frozen=True)
@@ -124,20 +123,8 @@ class Tools:
 
 
 def candidate_grasps(o: Movable, choices: tuple[str, ...] = ("top", "side", "tilt")):
-    """The grasps of object ``o`` from `motion.grasps.grasps` (the families in ``choices``),
-    or, where that generator is not there yet, the two top-down grasps of today's motion layer
-    (``top0``: fingers along the object's y, ``top1``: along its x)."""
-    import motion.grasps as mg
-
-    make = getattr(mg, "grasps", None)
-    if make is not None and GENERAL:
-        return tuple(make(o.kind, o.half, choices))
-    out = []
-    for k, across in ((0, o.half[1]), (1, o.half[0])):
-        if 2 * across <= STROKE and "top" in choices:
-            tcp = top_down_pose((0.0, 0.0, 0.0), k * math.pi / 2)
-            out.append(Grasp(f"top{k}", tuple(map(tuple, tcp)), (0.0, 0.0, -1.0), 2 * across))
-    return tuple(out)
+    """The grasps of object ``o`` of the families in ``choices`` (`motion.grasps.grasps`)."""
+    return make_grasps(o.kind, o.half, choices)
 
 
 def grasp_order(scene: Scene, o: Movable, grasps) -> tuple[Grasp, ...]:
@@ -213,9 +200,7 @@ def _request(o: Movable, move: GeoMove, grasp: Grasp, clear_z: float, scene: Sce
         ceiling(o.pose.xyz, scene.obstacles),
         ceiling(place.xyz, scene.obstacles),
     )
-    if GENERAL:
-        return PickPlaceRequest(*common, grasp=grasp, half=o.half)
-    return PickPlaceRequest(*common, turn=grasp.name == "top1")
+    return PickPlaceRequest(*common, grasp=grasp, half=o.half)
 
 
 def _world(scene: Scene, o: Movable, move: GeoMove, grasp: Grasp, support: str):
@@ -223,7 +208,9 @@ def _world(scene: Scene, o: Movable, move: GeoMove, grasp: Grasp, support: str):
 
     placed = Box(o.name, move.place.xyz, o.half, move.place.yaw)
     onto = support_box(scene, move.place.target)
-    return PickPlaceWorld(boxes(scene), o.name, support, onto, placed, grasp.width)
+    return PickPlaceWorld(
+        boxes(scene), o.name, support, onto, placed, grasp.width, half=o.half, grasp=grasp
+    )
 
 
 def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -> dict:
@@ -266,8 +253,9 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
                 out[g.name] = ("collision", "pick", _contact("descend", hits[0]))
                 continue
             model.set_boxes(tuple(b for b in world.boxes if b.name != o.name))
-            model.hold(world.block)
-            hits = model.contacts(found.q[at_place], world.block / 2, (("held", world.placed_on),))
+            hold_picked(model, world)
+            grip = g.width / 2
+            hits = model.contacts(found.q[at_place], grip, (("held", world.placed_on),))
             out[g.name] = None if not hits else ("collision", "place", _contact("lower", hits[0]))
     finally:
         model.margin = before
@@ -313,7 +301,7 @@ def check_move(
     if grasps is None:
         grasps = (move.grasp,) if move.grasp is not None else candidate_grasps(o, tools.choices)
         grasps = grasp_order(scene, o, grasps)
-    grasps = tuple(g for g in grasps if g.width <= STROKE + 1e-9)
+    grasps = tuple(g for g in grasps if g.width <= STROKE + 1e-9)  # a move's own grasp too
     if not grasps:
         return verdict(ok=False, failure="no_grasp", evidence={"object": o.name, "kind": o.kind})
     q = tools.q if q_now is None else np.asarray(q_now, dtype=np.float64)

@@ -3,6 +3,8 @@ reached by first moving a neighbour; goals no place serves are UNSOLVABLE at onc
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from tamp.geo.check import check_move
@@ -56,7 +58,7 @@ def test_a_region_out_of_reach_is_unsolvable():
 
 def test_a_tiny_budget_is_budget_not_unsolvable():
     s = blocked()
-    plan = plan_search(s, parse_goal("(in t goal)", s), tools(), SearchConfig(max_nodes=1))
+    plan = plan_search(s, parse_goal("(in t goal)", s), tools(), replace(TOP, max_nodes=1))
     assert plan.status is GeoStatus.BUDGET
 
 
