@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint format bench sysdeps clean
+.PHONY: demo test lint format bench docs sysdeps clean
 
 sysdeps:
 	@missing=$$(for p in $(SYSDEPS); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
@@ -27,7 +27,7 @@ $(PY):
 
 $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install -q torch==2.13.0
-	$(PY) -m pip install -q -e '.[dev,ray]'  # ray: the sweep tests (-m slow); no CUDA packages
+	$(PY) -m pip install -q -e '.[dev,ray,docs]'  # ray: sweep tests; docs: mkdocs; no CUDA packages
 	touch $(STAMP)
 
 # the embedded 5-block example from camera images: perception, planning and the simulated Panda
@@ -45,6 +45,10 @@ test: lint sysdeps
 format: $(STAMP)
 	$(VENV)/bin/ruff format .
 	$(VENV)/bin/ruff check --fix .
+
+# the documentation site from docs/ (mkdocs.yml) into build/docs; --strict: a warning fails
+docs: $(STAMP)
+	$(VENV)/bin/mkdocs build --strict
 
 bench: $(STAMP)
 	$(VENV)/bin/tamp bench planbench --seeds 3 --out results/planbench
