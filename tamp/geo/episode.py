@@ -1,0 +1,324 @@
+"""A geometric TAMP episode: observe -> plan -> check -> run -> observe -> replan, in one
+simulator, with one of three planners side by side.
+
+Planners (`PLANNERS`):
+
+- ``"search-then-check"``: `tamp.geo.baseline.plan_search_then_check`;
+- ``"search"``: `tamp.geo.search.plan_search`, the complete best-first search alone;
+- ``"motion-aware"``: `tamp.geo.ours.plan_motion_aware` (imported when asked for);
+- ``"soft"``: task-only planning with execution, today's loop on these problems: a shortest
+  symbolic plan ignoring geometry (`tamp.geo.baseline.symbolic_plan`), each move bound to the
+  first candidate place of the scene the plan predicts and no grasp chosen; the executor tries
+  the top-down grasps only, as the loop's executor does. Expected to fail where geometry
+  decides the plan.
+
+The robot observes object poses as `tamp.loop`'s ``observe="state"`` does (the motion-capture
+oracle, `tamp.loop.sensors.MocapPoses`: the true poses under the ground truth's ``oracle()``
+grant, a sensor by design) and reads the facts from them with `OBSERVED` tolerances. Before
+each move `check_move` decides it again on the observed scene from the arm's configuration now
+(blocked free-space phases rerouted by the motion planner); the move runs
+(`tamp.geo.execute.run_move`) and the scene is observed again. A failed check, a failed run,
+or observed facts other than those the move was to give end the plan: the planner plans again
+from what is observed, up to ``max_replans`` times. Whether the goal was reached is scored on
+the simulator's ground truth under its ``scoring()`` grant, never used to act.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from contextlib import contextmanager
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from tamp.geo.baseline import plan_search_then_check, symbolic_plan
+from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
+from tamp.geo.execute import RunConfig, rests_of, run_move
+from tamp.geo.places import candidate_places
+from tamp.geo.search import SearchConfig, plan_search
+from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.scene import Pose
+from tamp.sim.base import Simulator
+from tamp.world.geometry import Tolerances
+from tamp.world.goal import Goal
+from tamp.world.relations import read_facts
+from tamp.world.schema import Scene
+from task.errors import TampError, one_of
+
+PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
+OBSERVED = Tolerances(z=0.012, overlap=0.004)  # settled poses: `SceneConfig.tol_z`'s 12 mm
+SETTLE_S = 0.3  # simulated seconds the objects settle before each observation
+
+
+@dataclass(frozen=True)
+class MoveRecord:
+    """One move attempted: its text, the grasp's name ("" when none was found), ok, and the
+    failure (a `check_move` failure, a run failure, or ``unexpected`` when the observed facts
+    differ from what the move was to give)."""
+
+    move: str
+    grasp: str
+    ok: bool
+    failure: str | None = None
+    evidence: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class GeoReport:
+    """An episode's outcome. ``status``: ``reached`` / ``not_reached`` (the plans ran out
+    without the goal), ``no_plan`` (the planner's status and reason in ``reason``),
+    ``replan_budget``, ``move_budget``. ``reached`` is scored on ground truth."""
+
+    reached: bool
+    planner: str
+    backend: str
+    status: str
+    reason: str = ""
+    moves: tuple[MoveRecord, ...] = ()
+    motion_failures: int = 0  # moves whose check or run failed
+    collisions: int = 0  # things the arm or the held object touched unexpectedly
+    touched: dict = field(default_factory=dict)  # thing -> physics steps in contact
+    planning_time_s: float = 0.0
+    plan_times_s: tuple[float, ...] = ()  # per planner call
+    execution_time_s: float = 0.0  # simulated
+    wall_s: float = 0.0
+    arm_path_rad: float = 0.0
+    plan_length: int = 0  # moves of the first plan (0: none)
+    replans: int = 0
+    plan_stats: tuple[dict, ...] = ()  # each planner call's stats
+
+    @property
+    def solved_clean(self) -> bool:
+        """Reached without a motion failure and without a collision."""
+        return self.reached and self.motion_failures == 0 and self.collisions == 0
+
+
+Planner = Callable[[Scene, Goal, Tools, SearchConfig], GeoPlan]
+
+
+def planner_by_name(name: str) -> Planner:
+    """The planner called ``name`` (one of `PLANNERS`)."""
+    if name == "search-then-check":
+        return plan_search_then_check
+    if name == "motion-aware":
+        from tamp.geo.ours import plan_motion_aware
+
+        return plan_motion_aware
+    if name == "soft":
+        return plan_soft
+    if name == "search":
+        return plan_search
+    raise TampError(f"unknown planner {one_of(name, PLANNERS)}")
+
+
+def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> GeoPlan:
+    """Task-only planning: a shortest symbolic plan, each move bound to the first candidate
+    place of the predicted scene, nothing checked, no grasp chosen."""
+    t0 = time.perf_counter()
+    start = tuple(read_facts(scene).supports)
+    targets = (*(r.name for r in scene.regions), TABLE)
+    plan, expanded = symbolic_plan(start, goal, targets, set(), config.max_nodes)
+    stats = {"nodes": expanded, "checks": 0, "failures": 0}
+    if plan is None:
+        stats["time_s"] = time.perf_counter() - t0
+        return GeoPlan(GeoStatus.UNSOLVABLE, (), "no symbolic plan", stats)
+    world, moves = scene, []
+    for obj, target in plan:
+        places = candidate_places(world, obj, target, 1, config.seed)
+        if not places:
+            stats["time_s"] = time.perf_counter() - t0
+            return GeoPlan(GeoStatus.FAILED, (), f"no place for {obj} on {target}", stats)
+        moves.append(GeoMove(obj, places[0]))
+        world = moved(world, obj, places[0].pose)
+    stats["time_s"] = time.perf_counter() - t0
+    return GeoPlan(GeoStatus.SOLVED, tuple(moves), f"a plan of {len(moves)} moves", stats)
+
+
+def observe(sim: Simulator, scene: Scene) -> Scene:
+    """``scene`` with every object at the pose the motion-capture sensor reads now."""
+    with sim.truth.oracle():
+        poses = sim.truth.block_poses()
+    return _with_poses(scene, poses)
+
+
+def _with_poses(scene: Scene, poses: dict[str, Pose]) -> Scene:
+    objects = tuple(replace(o, pose=poses[o.name]) for o in scene.objects)
+    return replace(scene, objects=objects)
+
+
+def run_geo_episode(
+    scene: Scene,
+    goal: Goal,
+    planner: str,
+    backend: str = "pybullet",
+    seed: int = 0,
+    planner_config: SearchConfig | None = None,
+    video: str | Path | None = None,
+    max_moves: int = 20,
+    max_replans: int = 3,
+    inject: dict | None = None,
+    tools: Tools | None = None,
+    grasp: str = "friction",
+) -> GeoReport:
+    """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
+    ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
+    `SearchConfig` with ``seed``); ``video``: a file path to record the episode to (.mp4 or
+    .gif); ``inject``: fault injection, ``{"drop": [k, ...]}`` opens the gripper mid-transit
+    on those move indices; ``tools``: reuse an IK solver and collision model (else built and
+    closed here)."""
+    plan_fn = planner_by_name(planner)
+    config = planner_config or SearchConfig(seed=seed)
+    inject = inject or {}
+    drops = set(inject.get("drop", ()))
+    wall0 = time.perf_counter()
+    own = tools is None
+    tools = tools or Tools()
+    # execution: the same models, blocked free-space phases rerouted by the motion planner
+    runner = Tools(
+        tools.solver,
+        tools.collision,
+        pick_place=tools.pick_place,
+        guard=replace(tools.guard, plan=True),
+        choices=config.choices,
+    )
+    if planner == "soft":
+        runner.choices = ("top",)  # today's executor: top-down grasps only
+    from tamp.geo.sim import open_sim
+
+    sim = open_sim(scene, backend, video=video is not None, grasp=grasp)
+    sim.truth.lock()
+    recorder, on_frame = _recorder(video)
+    records: list[MoveRecord] = []
+    plan_times, plan_stats = [], []
+    path, first_len, replans, failures = 0.0, 0, 0, 0
+    status, reason = "not_reached", ""
+    try:
+        with _torch_threads(1):
+            _settle(sim, on_frame)
+            world = observe(sim, scene)
+            while True:
+                if goal.holds(read_facts(world, OBSERVED)):
+                    status = "reached"
+                    break
+                t0 = time.perf_counter()
+                plan = plan_fn(world, goal, tools, config)
+                plan_times.append(time.perf_counter() - t0)
+                plan_stats.append(dict(plan.stats))
+                if not plan.solved:
+                    status, reason = "no_plan", f"{plan.status.value}: {plan.reason}"
+                    break
+                if not first_len:
+                    first_len = len(plan.moves)
+                replan = False
+                for move in plan.moves:
+                    if len(records) >= max_moves:
+                        status, reason = "move_budget", f"{max_moves} moves used"
+                        break
+                    k = len(records)
+                    record, world, ran = _act(
+                        sim, world, move, runner, seed * 1000 + k, on_frame, k in drops
+                    )
+                    records.append(record)
+                    path += ran
+                    failures += record.failure not in (None, "unexpected")
+                    if not record.ok:
+                        replan = True
+                        break
+                if status == "move_budget":
+                    break
+                if replan or not goal.holds(read_facts(world, OBSERVED)):
+                    replans += 1
+                    if replans > max_replans:
+                        status = "replan_budget"
+                        reason = f"more than {max_replans} replans; last: {records[-1].failure}"
+                        break
+            with sim.truth.scoring():
+                truth = _with_poses(scene, sim.truth.block_poses())
+            reached = goal.holds(read_facts(truth, OBSERVED))
+    finally:
+        sim.close()
+        if recorder is not None:
+            recorder.close()
+        if own:
+            tools.close()
+    if status == "reached" and not reached:
+        status, reason = "not_reached", "the robot saw the goal; the ground truth does not hold it"
+    return GeoReport(
+        reached=reached,
+        planner=planner,
+        backend=backend,
+        status=status,
+        reason=reason,
+        moves=tuple(records),
+        motion_failures=failures,
+        collisions=len(sim.touched),
+        touched=dict(sim.touched),
+        planning_time_s=sum(plan_times),
+        plan_times_s=tuple(plan_times),
+        execution_time_s=sim.time,
+        wall_s=time.perf_counter() - wall0,
+        arm_path_rad=path,
+        plan_length=first_len,
+        replans=replans,
+        plan_stats=tuple(plan_stats),
+    )
+
+
+def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, drop: bool):
+    """Check ``move`` on the observed ``world`` from the arm's configuration now, run it,
+    settle and observe: (record, observed scene, joint path run in rad)."""
+    o = world.object(move.obj)
+    grasps = None
+    if move.grasp is None:
+        grasps = grasp_order(world, o, candidate_grasps(o, runner.choices))
+    verdict = check_move(world, move, runner, grasps=grasps, q_now=sim.arm_q(), seed=seed)
+    if not verdict.ok:
+        return MoveRecord(move.text(), "", False, verdict.failure, verdict.evidence), world, 0.0
+    support = dict(read_facts(world, OBSERVED).supports).get(move.obj, TABLE)
+    rests = rests_of(world, move, support)
+    ran = run_move(sim, move, verdict, rests, RunConfig(), on_frame, 0.5 if drop else None)
+    _settle(sim, on_frame)
+    seen = observe(sim, world)
+    name = verdict.grasp.name
+    if not ran.ok:
+        return MoveRecord(move.text(), name, False, ran.failure, ran.evidence), seen, ran.path_rad
+    want = read_facts(moved(world, move.obj, move.place.pose), OBSERVED).atoms
+    got = read_facts(seen, OBSERVED).atoms
+    if want != got:
+        evidence = {"missing": sorted(want - got), "extra": sorted(got - want)}
+        return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, ran.path_rad
+    return MoveRecord(move.text(), name, True), seen, ran.path_rad
+
+
+def _settle(sim: Simulator, on_frame) -> None:
+    from motion.trajectory import JointTrajectory
+
+    hold = JointTrajectory.hold(sim.arm_q(), SETTLE_S, sim.dt)
+    sim.run(hold, "open", on_frame=on_frame)
+
+
+def _recorder(video: str | Path | None):
+    """(EpisodeVideo, on_frame) writing every frame to ``video``, or (None, None)."""
+    if video is None:
+        return None, None
+    from tamp.video import EpisodeVideo
+
+    recorder = EpisodeVideo(video)
+
+    def on_frame(sim: Simulator) -> None:
+        recorder.write(sim)
+
+    return recorder, on_frame
+
+
+@contextmanager
+def _torch_threads(n: int):
+    """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)

@@ -1,0 +1,152 @@
+"""Run one checked pick-and-place in a simulator and tell from the robot's own signals how it
+went: the geometric room's counterpart of `tamp.loop.execute`.
+
+The phases come from `tamp.geo.check.check_move` on the observed scene (the arm's start
+configuration read from the simulator). Each phase tells the simulator which contacts it is
+meant to make (`tamp.sim.base.Expected`: the hand on the object it handles; the held object on
+what it leaves while lifted and on what it goes onto while lowered), so the experimenter's
+contact scoring (``Simulator.touched``) counts every other touch. Failures are read from the
+gripper as a real robot reads them: after closing, the fingers must stand at the grasp's width
+(within ``width_tol``) pushed on both sides (``missed_grasp``); after the lift and the transit
+they must still stand at that width (``dropped``); a joint tracking error beyond
+``max_tracking`` means the arm was blocked (``tracking_error``). After a failure at the object
+the hand opens and backs out along its descent. Nothing here reads ground truth.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from motion.pick_place import Phase
+from motion.trajectory import JointTrajectory
+from tamp.geo.check import MoveCheck, support_box
+from tamp.geo.types import GeoMove
+from tamp.sim.base import Expected, Simulator
+
+
+@dataclass(frozen=True)
+class RunConfig:
+    """Thresholds of the failure checks (`tamp.loop.execute.ExecConfig`'s values)."""
+
+    width_tol: float = 0.007  # m: a held object keeps the fingers at the grasp's width +- this
+    min_force: float = 0.2  # N: both fingers push at least this on a freshly closed grasp
+    max_tracking: float = 0.3  # rad: beyond this the arm is blocked
+
+
+@dataclass(frozen=True)
+class MoveRun:
+    """What running one move did: ``ok`` or the ``failure`` (``missed_grasp``, ``dropped``,
+    ``tracking_error``) with ``evidence``; simulated seconds, joint path run (rad: the sum of
+    |dq| over the phases started) and wall seconds."""
+
+    ok: bool
+    failure: str | None = None
+    evidence: dict = field(default_factory=dict)
+    sim_time_s: float = 0.0
+    path_rad: float = 0.0
+    wall_s: float = 0.0
+
+
+def expected_contacts(phase: str, obj: str, rests: tuple[str, str]) -> Expected:
+    """The contacts ``phase`` of the move of ``obj`` is meant to make: the hand on ``obj``
+    throughout; once held, ``obj`` on what it leaves (lift) and what it goes onto (lower),
+    ``rests`` = (from, onto) as the simulator names them, nothing in transit."""
+    during = {"lift": rests[0], "transit": None, "lower": rests[1]}
+    if phase not in during:
+        return Expected(obj)
+    return Expected(obj, obj, frozenset({during[phase]} - {None}))
+
+
+def run_move(
+    sim: Simulator,
+    move: GeoMove,
+    check: MoveCheck,
+    rests: tuple[str, str],
+    config: RunConfig = RunConfig(),
+    on_frame: Callable[[Simulator], None] | None = None,
+    drop_at: float | None = None,
+) -> MoveRun:
+    """Run ``check``'s phases (a feasible `MoveCheck` of ``move``) in ``sim``; ``rests``: what
+    the object leaves and goes onto (`support_box` names). ``drop_at`` in [0, 1] opens the
+    gripper at that fraction of the transit (fault injection)."""
+    wall0, sim0, path = time.perf_counter(), sim.time, 0.0
+    width = check.grasp.width
+
+    def done(failure: str | None = None, **evidence) -> MoveRun:
+        return MoveRun(
+            failure is None,
+            failure,
+            evidence,
+            sim.time - sim0,
+            path,
+            time.perf_counter() - wall0,
+        )
+
+    handling = Expected(move.obj)
+    for phase in check.motion:
+        release = None
+        if phase.name == "transit" and drop_at is not None:
+            release = drop_at * phase.trajectory.duration
+        if phase.name == "open":
+            sim.detach()
+        q = phase.trajectory.positions  # (S, J)
+        path += float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum())
+        expected = expected_contacts(phase.name, move.obj, rests)
+        worst = sim.run(phase.trajectory, phase.gripper, release, on_frame, expected)
+        if worst > config.max_tracking:
+            _back_off(sim, check.motion, on_frame, handling)
+            return done("tracking_error", phase=phase.name, error_rad=round(worst, 3))
+        if phase.name == "close":
+            missed = _holding(sim, width, config, fresh=True)
+            if missed is None and sim.grasp == "weld" and not sim.attach():
+                missed = {"weld": "no object between the fingers"}
+            if missed is not None:
+                _back_off(sim, check.motion, on_frame, handling)
+                return done("missed_grasp", **missed)
+        elif phase.name in ("lift", "transit"):
+            gone = _holding(sim, width, config, fresh=False)
+            if gone is not None:
+                sim.detach()
+                hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
+                sim.run(hold, "open", on_frame=on_frame, expected=handling)
+                return done("dropped", after=phase.name, injected=release is not None, **gone)
+    return done()
+
+
+def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:
+    """(what the object leaves, what it goes onto) as the simulator names the bodies."""
+    return support_box(scene, support), support_box(scene, move.place.target)
+
+
+def _holding(sim: Simulator, width: float, config: RunConfig, fresh: bool) -> dict | None:
+    """None when the fingers hold an object ``width`` wide (pushing on both sides when
+    ``fresh``), else the evidence that they do not."""
+    r = sim.gripper()
+    wide = abs(r.width - width) <= config.width_tol
+    floor = config.min_force if fresh else 0.0
+    both = r.left_force > floor and r.right_force > floor
+    if wide and (both or (sim.grasp == "weld" and not fresh)):
+        return None
+    return {
+        "finger_width": round(r.width, 4),
+        "grasp_width": round(width, 4),
+        "left_force": round(r.left_force, 3),
+        "right_force": round(r.right_force, 3),
+    }
+
+
+def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:
+    """After a failure at the object: open the gripper and undo the descent."""
+    sim.detach()
+    q = sim.arm_q()
+    sim.run(JointTrajectory.hold(q, 0.3, sim.dt), "open", on_frame=on_frame, expected=expected)
+    down = next(ph for ph in phases if ph.name == "descend").trajectory
+    back = JointTrajectory(
+        down.times, down.positions[::-1].copy(), -down.velocities[::-1], down.accelerations[::-1]
+    )
+    if np.abs(back.positions[0] - q).max() < 0.05:
+        sim.run(back, "open", on_frame=on_frame, expected=expected)
