@@ -24,13 +24,14 @@ goal the initial state does not meet. `write_all` writes the seed-0 variants to
 What makes each problem hard is geometric, and `free_top_axes` measures it with a reference
 model of the open hand (the boxes of `motion.grasps`: fingers 4.2-6.6 cm either side of the
 grasp axis, 2 cm across, from 8 mm below the TCP up; the palm 20.4 x 6 cm from 4 cm above the
-TCP; the TCP at the object's centre, at most 2.5 cm below its top): which top-down closing axes
-of an object are free of everything else. The generators draw until the intended axes are free
-or blocked (with a margin), and the tests check the same.
+TCP, which sits where `motion.grasps.grasps` puts it: at the centre, at most 2.5 cm below the
+top): which top-down closing axes of an object are free of everything else. The generators
+draw until the intended axes are free or blocked (with a margin), and the tests check the same.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -38,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from motion.grasps import HAND_BOXES, grasps
 from tamp.obstacles import Obstacle
 from tamp.scene import PALETTE, Pose
 from tamp.sim.base import Camera
@@ -53,17 +55,17 @@ SCENES_DIR = Path(__file__).resolve().parent / "scenes" / "canonical"
 TABLE_TOP = Table((-0.3, -0.7), (1.0, 0.7))  # the shipped scenes' table
 
 # The reference open hand, top-down, in the grasp frame (closing axis, across, z up from the
-# TCP); the boxes of `motion.grasps.HAND_BOXES` (pybullet_data's Panda, fingers fully open).
-FINGER_IN = 0.042  # m, an open finger's inner face from the grasp axis
-FINGER_OUT = 0.066  # m, its outer face
-FINGER_ACROSS = 0.01  # m, half its width across the closing axis
-FINGER_TIP = 0.008  # m, the fingertips below the TCP
-PALM_ABOVE = 0.040  # m, the palm's lowest face above the TCP
-PALM_ALONG = 0.102  # m, half the palm's length along the closing axis
-PALM_ACROSS = 0.03  # m, half its thickness across
-GRASP_DEPTH = 0.025  # m, the TCP at most this far below the top (never below the centre)
-TIP_CLEARANCE = 0.013  # m, the TCP at least this far above the bottom (fingertips 5 mm clear)
-MAX_WIDTH = 0.07  # m, widest face between the open fingers (0.08 m stroke, 5 mm a side)
+# TCP): the boxes of `motion.grasps.HAND_BOXES` (pybullet_data's Panda, fingers fully open);
+# where the TCP sits on an object and which faces fit between the fingers come from
+# `motion.grasps.grasps`' top grasps.
+_PALM, _FINGER = HAND_BOXES[0], HAND_BOXES[1]
+FINGER_IN = _FINGER[0][1] - _FINGER[1][1]  # m, an open finger's inner face from the grasp axis
+FINGER_OUT = _FINGER[0][1] + _FINGER[1][1]  # m, its outer face
+FINGER_ACROSS = _FINGER[1][0]  # m, half its width across the closing axis
+FINGER_TIP = _FINGER[0][2] + _FINGER[1][2]  # m, the fingertips below the TCP
+PALM_ABOVE = -(_PALM[0][2] + _PALM[1][2])  # m, the palm's lowest face above the TCP
+PALM_ALONG = _PALM[1][1]  # m, half the palm's length along the closing axis
+PALM_ACROSS = _PALM[1][0]  # m, half its thickness across
 
 # Top-down reach at the edge (`motion.ik.IKSolver`, TCP pointing down, from the home pose): the
 # highest reachable TCP falls from 0.58 m at 0.64 m out to 0.46 m at 0.72 m, about linearly.
@@ -177,25 +179,33 @@ def shipped(problem: str) -> tuple[Scene, Goal]:
 # ---- the hand's reference model ----------------------------------------------------------------
 
 
-def tcp_height(o: Movable) -> float:
-    """z (m) of a top-down grasp's TCP on ``o``: its centre, or 2.5 cm below its top when it
-    is taller than 5 cm, or higher where a short object would put the fingertips near its
-    bottom (`motion.grasps`' rule)."""
-    hz = o.half[2]
-    return o.pose.xyz[2] + max(0.0, hz - GRASP_DEPTH, TIP_CLEARANCE - hz)
+def top_grasp_heights(o: Movable) -> dict[int, float]:
+    """Closing axis (0: the object's x, 1: its y) -> z (m) of the TCP, for each top-down grasp
+    `motion.grasps.grasps` offers for ``o`` (its face between the fingers fits the stroke;
+    the TCP at the centre, at most 2.5 cm below the top, the fingertips clear of the bottom)."""
+    return {axis: o.pose.xyz[2] + dz for axis, dz in _top_offsets(o.kind, o.half)}
+
+
+@functools.lru_cache(maxsize=4096)
+def _top_offsets(kind: str, half: tuple[float, float, float]) -> tuple[tuple[int, float], ...]:
+    """(closing axis, TCP height over the centre m) of each top grasp of a ``kind``, ``half``."""
+    out = {}
+    for g in grasps(kind, half, ("top",)):
+        axis = 0 if int(g.name.removeprefix("top")) % 2 else 1  # even k close along y
+        out[axis] = g.tcp[2][3]
+    return tuple(sorted(out.items()))
 
 
 def free_top_axes(
     scene: Scene, name: str, pad: float = 0.0, without: Sequence[str] = ()
 ) -> tuple[int, ...]:
     """The closing axes (0: the object's x, 1: its y) along which a top-down grasp of object
-    ``name`` fits: the face between the fingers is at most `MAX_WIDTH` and the reference open
+    ``name`` fits: `motion.grasps` offers it (`top_grasp_heights`) and the reference open
     hand (module docstring) touches nothing else: no solid taller than the fingertips meets a
     finger's footprint (swept in to the object's face), none taller than the palm's lower face
     meets the palm's. ``pad`` (m) grows the hand's footprints (negative: shrinks them);
     ``without`` names objects to leave out (as if moved away)."""
     o = scene.object(name)
-    z = tcp_height(o)
     others = [of_movable(x) for x in scene.objects if x.name != name and x.name not in without]
     others += fixed_solids(scene)
     reach = math.hypot(PALM_ALONG, PALM_ACROSS) + abs(pad)  # nothing farther can touch the hand
@@ -205,9 +215,7 @@ def free_top_axes(
         if math.dist(s.centre[:2], o.pose.xyz[:2]) <= reach + math.hypot(s.half[0], s.half[1])
     ]
     free = []
-    for axis in (0, 1):
-        if 2 * o.half[axis] > MAX_WIDTH:
-            continue
+    for axis, z in sorted(top_grasp_heights(o).items()):
         hand = _hand(o, axis, z, pad)
         if all(
             footprint_gap(part, s) > 0.0 for part, floor in hand for s in others if s.top > floor
@@ -514,26 +522,32 @@ def _blocked(rng: np.random.Generator, n: int) -> _Made | None:
 
 def _packed(rng: np.random.Generator, n: int) -> _Made | None:
     """n boxes of one width and several lengths; the tray fits them as two columns along y
-    with a finger lane between; the objects start spread out on the other side."""
+    of equal length with a finger lane between; the objects start spread out on the other
+    side."""
     colours = [str(c) for c in rng.permutation(COLOURS)]
     w = _size(rng.uniform(0.055, 0.062))
-    lengths = [_size(rng.uniform(0.055, 0.09)) for _ in range(n)]
     heights = [_size(rng.uniform(0.04, 0.055)) for _ in range(n)]
     gap_y, margin = 0.004, 0.002
-    columns: list[list[int]] = [[], []]
-    for i in sorted(range(n), key=lambda i: -lengths[i]):  # longest first, to the shorter
-        col = min((0, 1), key=lambda c: sum(lengths[j] for j in columns[c]) + 1e-6 * c)
-        columns[col].append(i)
+    first = (n + 1) // 2
+    longest = 0.085 if n % 2 == 0 else 0.07  # odd n: the column of fewer is as long
+    lengths = [_size(rng.uniform(0.055, longest)) for _ in range(first)]
+    rest = sum(lengths) + gap_y * (first - 1) - gap_y * (n - first - 1)  # the other column's
+    shares = rng.dirichlet([4.0] * (n - first))  # (n - first,) its boxes' shares, near even
+    lengths += [_size(0.055 + (rest - 0.055 * (n - first)) * f) for f in shares]
+    lengths[-1] = _size(rest - sum(lengths[first:-1]))  # the column adds up after rounding
+    if max(lengths) > 0.12:
+        return None
+    columns = [list(range(first)), list(range(first, n))]
     span = [sum(lengths[j] for j in c) + gap_y * (len(c) - 1) for c in columns]
-    pitch = FINGER_OUT + 0.003 + w / 2  # column centres: a finger lane between the columns
+    pitch = FINGER_OUT + 0.006 + w / 2  # column centres: a finger lane between the columns
     width = w + pitch + 2 * margin
-    height = max(span) + 2 * margin
+    height = max(span) + 2 * margin + rng.uniform(0.0, 0.01)
     side = 1.0 if rng.random() < 0.5 else -1.0
     tx, ty = rng.uniform(0.48, 0.53), side * rng.uniform(0.17, 0.2)
     tray = _zone("tray", (tx, ty), (width, height), "brown")
     (x0, y0), _ = tray.inner()
     objects, witness = [], []
-    starts = [(x, -side * y) for y in (0.12, 0.25, 0.38) for x in (0.42, 0.55)]
+    starts = [(x, -side * y) for y in (0.12, 0.26, 0.40) for x in (0.42, 0.56)]
     order = rng.permutation(len(starts))
     for i in range(n):
         kind = "cuboid" if abs(lengths[i] - w) > 1e-9 or abs(heights[i] - w) > 1e-9 else "cube"
@@ -556,6 +570,9 @@ def _packed(rng: np.random.Generator, n: int) -> _Made | None:
     (ix0, iy0), (ix1, iy1) = tray.inner()
     fill = footprint / ((ix1 - ix0) * (iy1 - iy0))
     if not 0.6 <= fill <= 0.75:
+        return None
+    staged = Scene("draft", TABLE_TOP, (tray,), (), tuple(objects))
+    if not all(free_top_axes(staged, o.name, pad=0.004) for o in objects):
         return None
     done = dict(witness)
     packed = Scene(

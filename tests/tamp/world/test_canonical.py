@@ -13,12 +13,12 @@ from dataclasses import replace
 
 import pytest
 
+from motion.grasps import FINGER_SPARE, STROKE
 from tamp.scene import Pose
 from tamp.world.canonical import (
     APPROACH,
     FINGER_IN,
     FINGER_OUT,
-    MAX_WIDTH,
     PROBLEMS,
     SCENES_DIR,
     CanonicalProblem,
@@ -156,7 +156,9 @@ def test_the_hand_model_needs_room_for_a_finger_on_both_sides():
     short = Movable("c", "cuboid", (0.04, 0.04, 0.01), (0, 0, 1), Pose((0.55 + 0.04, 0.0, 0.005)))
     low = replace(alone, objects=(*alone.objects, short))  # under the fingertips: no obstacle
     assert free_top_axes(low, "a") == (0, 1)
-    wide = Movable("w", "cuboid", (MAX_WIDTH + 0.005, 0.05, 0.05), (0, 0, 1), Pose((0.5, 0, 0.025)))
+    wide = Movable(
+        "w", "cuboid", (STROKE - 2 * FINGER_SPARE, 0.05, 0.05), (0, 0, 1), Pose((0.5, 0, 0.025))
+    )
     assert free_top_axes(replace(alone, objects=(wide,)), "w") == (1,)
 
 
@@ -197,6 +199,7 @@ def test_packed_fills_the_tray_and_a_centre_first_packer_gets_stuck():
         assert 0.6 <= fill <= 0.75, seed
         names = [o.name for o in p.scene.objects]
         assert 4 <= len(names) <= 6
+        assert all(free_top_axes(p.scene, n) for n in names), seed  # each can be picked up
         biggest = sorted(names, key=lambda n: -p.scene.object(n).half[1])
         for order in (names, biggest):
             assert len(centre_first(p.scene, "tray", order)) < len(names), seed

@@ -1,4 +1,4 @@
-; packed, seed 0: 6 boxes fill 67% of the tray: they fit only as two columns with a finger lane between; the first box at the centre leaves no room for the last
+; packed, seed 0: 6 boxes fill 68% of the tray: they fit only as two columns with a finger lane between; the first box at the centre leaves no room for the last
 (and
   (in o1 tray)
   (in o2 tray)
