@@ -1,0 +1,140 @@
+"""`tamp.api`, the entry layer: plans come back validated (the planner alone leaves
+``validation`` None), every problem input (PDDL text, a file, a `Problem`, a `PddlTask`) gives
+the same plan, plans from any source are validated, cost sources steer the planner, and bad
+input is one line before any work. The simulated paths (episodes, given plans, scenes, images)
+run in tests/test_examples.py."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import torch
+
+from tamp import api
+from task.config import PlannerConfig
+from task.domains import get_domain
+from task.errors import PDDLError, TampError
+from task.planner import plan as soft_plan
+
+SMALL = api.Problem(
+    "small", "blocksworld", ("a", "b", "c"), ("table", "a", "table"), (("a", "b"), ("b", "c"))
+)
+FAST = PlannerConfig(restarts=4, iters=30)
+SMALL_PDDL = get_domain("blocksworld").to_pddl(SMALL)
+LIGHTS = """(define (domain lights) (:requirements :strips)
+  (:predicates (on ?x) (off ?x))
+  (:action switch :parameters (?x) :precondition (off ?x) :effect (and (on ?x) (not (off ?x)))))"""
+
+
+def test_a_plan_comes_back_validated_where_the_planner_leaves_it_none():
+    assert soft_plan(SMALL, FAST).validation is None
+    planned = api.plan(SMALL, config=FAST)
+    assert planned.valid and planned.validation.status is api.ValidationStatus.VALID
+    assert planned.validation.length == len(planned.actions) == 2 * len(planned.moves)
+    assert api.validate(SMALL, planned.text()).valid  # the plan file round-trips
+
+
+def test_every_problem_input_gives_the_same_plan(tmp_path):
+    domain, problem = tmp_path / "domain.pddl", tmp_path / "problem.pddl"
+    domain.write_text(api.BLOCKSWORLD)
+    problem.write_text(SMALL_PDDL)
+    task = api.load_problem(SMALL_PDDL)
+    plans = {
+        api.plan(source, config=FAST).text()
+        for source in (task, task.problem, SMALL, SMALL_PDDL, problem)
+    }
+    plans.add(api.plan(problem, domain, config=FAST).text())
+    assert len(plans) == 1
+    assert task.problem.entities == SMALL.entities and task.instance.optimal is None
+
+
+def test_an_unfinished_plan_validates_as_not_reaching_the_goal():
+    stuck = PlannerConfig(max_windows=1, horizon=1, lookahead_share=0.0, restarts=2, iters=5)
+    planned = api.plan(api.EXAMPLE, config=stuck)
+    assert planned.status is api.PlanStatus.NO_PLAN
+    assert planned.validation.status is api.ValidationStatus.NON_GOAL_REACHING
+    assert not planned.valid
+
+
+def test_plans_from_any_source_are_validated(tmp_path):
+    bad = [api.Action("unstack", ("a", "b")), api.Action("stack", ("a", "c"))]
+    moves = [api.Move("b", "c"), api.Move("a", "b")]
+    path = tmp_path / "moves.plan"
+    path.write_text("move(b -> c)\nmove(a -> b)\n")
+    assert api.validate(SMALL, moves).valid and api.validate(SMALL, path).valid
+    verdict = api.validate(SMALL, bad)
+    assert verdict.status is api.ValidationStatus.INEXECUTABLE and verdict.step == 1
+    assert "(on a b)" in verdict.reason
+
+
+def test_a_cost_function_steers_the_plan_among_equally_short_ones():
+    """a sits on b and must go first, to the table or onto d: pricing the table steers it."""
+    problem = api.Problem(
+        "unstack",
+        "blocksworld",
+        ("a", "b", "c", "d"),
+        ("b", "table", "table", "table"),
+        (("b", "c"),),
+    )
+
+    def pricing(expensive: int):
+        def price(p: api.Problem, state) -> torch.Tensor:
+            costs = torch.ones(p.n, p.n + 1)  # (N, Y): targets a, b, c, d, table
+            costs[0, expensive] = 3.0  # a onto the expensive target
+            return costs
+
+        return price
+
+    for expensive, other in ((4, "d"), (3, "table")):
+        source = api.CostFunction(pricing(expensive), (problem,))
+        window = source([0], [get_domain("blocksworld").initial_state(problem)], 16)
+        assert window.compute().shape == (1, 4, 5) and window.parameters() == []
+        planned = api.plan(problem, costs=source)
+        assert planned.valid and planned.moves[0] == api.Move("a", other)
+
+
+def test_domain_rules_are_recognised_from_the_pddl():
+    assert api.domain_rules(api.BLOCKSWORLD) == "blocksworld"
+    assert api.domain_rules(LIGHTS) == "strips"
+    assert api.domain_names() == ("blocksworld", "logistics", "sokoban", "strips")
+
+
+def test_the_generic_lift_plans_a_problem_given_as_a_problem():
+    task = api.load_problem(SMALL_PDDL, rules="strips")
+    assert task.problem.domain == "strips"
+    planned = api.plan(task.problem, config=PlannerConfig.for_domain("strips"))
+    assert planned.valid
+
+
+def test_a_shipped_scene_loads_by_name():
+    scene = api.load_scene("tower")
+    assert [o.name for o in scene.objects] == ["a", "b", "c"]
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: api.load_problem("problem.pddl"), "not PDDL text"),
+        (lambda: api.load_problem(42), "expected PDDL text"),
+        (lambda: api.load_problem(Path("/nonexistent/p.pddl")), "/nonexistent/p.pddl"),
+        (lambda: api.load_problem(api.EXAMPLE, rules="towers"), "valid: blocksworld"),
+        (lambda: api.validate(SMALL, "(fly a)"), "fly"),
+        (lambda: api.plan_images("a.png", "b.png", scene="lego"), "valid: cubes, latplan"),
+        (
+            lambda: api.run_episode(next(get_domain("logistics").samples(0))),
+            "executes blocksworld problems only",
+        ),
+        (lambda: api.execute_plan(next(get_domain("sokoban").samples(0)), ""), "blocksworld"),
+    ],
+)
+def test_bad_input_is_one_line(call, words):
+    with pytest.raises(TampError) as caught:
+        call()
+    message = str(caught.value)
+    assert words in message and "\n" not in message
+
+
+def test_text_that_is_no_pddl_says_how_to_pass_a_file():
+    with pytest.raises(PDDLError, match=r"pathlib\.Path"):
+        api.plan("examples/problem.pddl")
