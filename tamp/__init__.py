@@ -1,6 +1,8 @@
 """tamp: the loop observe -> perceive -> plan -> execute -> check -> replan, and the CLI.
 
-The one package that sees every other one. Its rooms:
+The one package that sees every other one. ``tamp.api`` is the entry layer for Python users
+(plan, validate, run an episode, execute a given plan, scenes, images, benchmarks, move costs).
+Its rooms:
 
 - ``tamp.loop``: closed-loop episodes in a simulator (observe, plan a window, execute a move,
   check, recover or replan), fault injection;
