@@ -1,0 +1,280 @@
+"""Gradient-optimised placements in a region: where M objects go, decided jointly.
+
+`pack` places M axis-aligned footprints (half extents ``(M, 2)``) inside a region's inner
+rectangle, free of each other and of F fixed occupants (objects already there, posts), by Adam
+over the centres of R restart rows at once (one tensor program, nanoGPT style), the best row
+winning. Centres are inside by construction: the unbounded variables u map into the rectangle
+shrunk by each footprint,
+
+    x_m = lo + h_m + (hi - lo - 2 h_m) * sigmoid(u_m)                       (per axis)
+
+and the loss of a row is the smooth overlap area of every pair of grown footprints,
+
+    L = sum_{i<j} s(h_i + h_j + g - |x_i - x_j|_x) s(...)_y + sum_{i, f} (same, fixed f)
+
+with s(z) = softplus(beta z) / beta (beta anneals from `PackConfig.beta` to ``beta_end``, so the
+early landscape is smooth and the late one close to the exact area) and |.| smoothed as
+sqrt(d^2 + eps^2). ``g`` is `PackConfig.gap`, a clearance between neighbours. Finger room for a
+top grasp is `PackConfig.fingers` and ``side``: along its closing axis each object's footprint
+reaches at least ``fingers`` from its centre (where the open finger pads are), across it at
+least ``side`` (the fingers' and the hand's width), against the other objects' bodies and the
+region's edges (its walls), and the
+closing axis of each object (x or y) is drawn per restart row, as is each footprint's yaw
+(0 or pi/2: a cuboid turned a quarter turn swaps its half extents). Yaws are thus chosen among
+{0, pi/2} across restarts, not optimised; footprints are axis-aligned (a cylinder's is its
+bounding square). A packing is ``ok`` when no two grown footprints interpenetrate more than
+`PackConfig.tol` and every one lies inside.
+
+`pack_sampled` is the baseline a greedy TAMP system uses: objects in order, each at a uniform
+random position inside until one is free (rejection sampling), starting over from the first
+object when one finds no position in its share of tries, until the budget of samples is spent.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from task.errors import TampError
+
+Rect = tuple[tuple[float, float], tuple[float, float]]  # ((x0, y0), (x1, y1)), m
+
+
+class PackError(TampError):
+    """Bad input to the packer (shapes, a footprint larger than the region)."""
+
+
+@dataclass(frozen=True)
+class PackConfig:
+    """Settings of `pack` (lengths in m)."""
+
+    restarts: int = 32  # R rows optimised together; the best wins
+    steps: int = 150  # Adam steps
+    lr: float = 0.3  # Adam learning rate on the unbounded u
+    beta: float = 100.0  # 1/m, softplus sharpness at the first step ...
+    beta_end: float = 3000.0  # ... and at the last (geometric annealing)
+    eps: float = 1e-4  # m, smoothing of |d|
+    gap: float = 0.002  # m, clearance kept between two footprints (and counted when checking)
+    fingers: float = 0.0  # m, the hand's reach from the object's centre along the closing axis
+    # (open finger pads, with the collision model's margin); 0: no finger room
+    side: float = 0.0  # m, the hand's reach from the centre across the closing axis
+    tol: float = 1e-4  # m, interpenetration still counted as free
+
+
+@dataclass(frozen=True)
+class PackResult:
+    """The best packing: ``positions`` (M, 2) centres, ``yaws`` (M,) in {0, pi/2}, ``axes``
+    (M,) each object's closing axis (0: x, 1: y, in the world frame), ``ok`` when free and
+    inside, ``overlap`` the deepest interpenetration left (m), ``time`` (s), ``tries`` (Adam
+    rows or samples spent)."""
+
+    positions: np.ndarray
+    yaws: np.ndarray
+    axes: np.ndarray
+    ok: bool
+    overlap: float
+    time: float
+    tries: int
+
+
+def _check(inner: Rect, half, fixed_xy, fixed_half) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    half = np.asarray(half, dtype=np.float64).reshape(-1, 2)
+    fxy = np.asarray(fixed_xy if fixed_xy is not None else (), dtype=np.float64).reshape(-1, 2)
+    fh = np.asarray(fixed_half if fixed_half is not None else (), dtype=np.float64).reshape(-1, 2)
+    if fxy.shape != fh.shape:
+        raise PackError(f"fixed centres {fxy.shape} and half extents {fh.shape} differ in shape")
+    (x0, y0), (x1, y1) = inner
+    room = min(x1 - x0, y1 - y0)
+    if len(half) and 2 * half.min(1).max() > room:
+        raise PackError(f"a footprint of half extents {half.min(1).max():g} m exceeds the region")
+    return half, fxy, fh
+
+
+def _grown(half: torch.Tensor, turn: torch.Tensor, axis: torch.Tensor, config: PackConfig):
+    """(R, M, 2) half extents of each row: the bodies, turned (swapped) where ``turn``, and
+    the bodies grown to the hand's reach: ``fingers`` along ``axis`` (the closing axis),
+    ``side`` across it."""
+    h = torch.where(turn[..., None], half.flip(-1), half)  # (R, M, 2)
+    along = torch.nn.functional.one_hot(axis, 2).bool()  # (R, M, 2)
+    return h, torch.where(along, h.clamp_min(config.fingers), h.clamp_min(config.side))
+
+
+def _soft_area(d: torch.Tensor, reach: torch.Tensor, beta: float, eps: float) -> torch.Tensor:
+    """Smooth overlap area of boxes whose centres are ``d`` (..., 2) apart and whose half
+    extents sum to ``reach`` (..., 2): prod over x, y of softplus(beta (reach - |d|)) / beta."""
+    depth = reach - torch.sqrt(d * d + eps * eps)  # (..., 2)
+    return (torch.nn.functional.softplus(beta * depth) / beta).prod(-1)
+
+
+def overlap_loss(
+    xy: torch.Tensor,
+    half: torch.Tensor,
+    body: torch.Tensor,
+    fixed_xy: torch.Tensor,
+    fixed_half: torch.Tensor,
+    beta: float,
+    eps: float,
+    gap: float,
+) -> torch.Tensor:
+    """(R,) the packing loss of each row (module docstring). ``xy`` (R, M, 2) centres, ``half``
+    (R, M, 2) grown half extents (finger room), ``body`` (R, M, 2) the bodies' own; fixed
+    occupants ``fixed_xy`` / ``fixed_half`` (F, 2). A grown footprint must clear the other
+    bodies: pairs count both ways (i's fingers against j's body and j's against i's)."""
+    m = xy.shape[1]
+    d = xy[:, :, None] - xy[:, None]  # (R, M, M, 2)
+    reach = half[:, :, None] + body[:, None] + gap  # (R, M, M, 2): i grown, j body
+    pair = _soft_area(d, reach, beta, eps)  # (R, M, M)
+    off = ~torch.eye(m, dtype=torch.bool)
+    loss = torch.where(off, pair, 0.0).sum((-1, -2))  # (R,)
+    if fixed_xy.shape[0]:
+        df = xy[:, :, None] - fixed_xy  # (R, M, F, 2)
+        loss = loss + _soft_area(df, half[:, :, None] + fixed_half + gap, beta, eps).sum((-1, -2))
+    return loss
+
+
+def _depths(xy, half, body, fxy, fh, gap: float) -> np.ndarray:
+    """(R,) the deepest exact interpenetration (m) of each row's grown footprints, with gap."""
+    d = np.abs(xy[:, :, None] - xy[:, None])  # (R, M, M, 2)
+    pen = (half[:, :, None] + body[:, None] + gap - d).min(-1)  # (R, M, M)
+    m = xy.shape[1]
+    pen[:, np.arange(m), np.arange(m)] = -np.inf
+    worst = pen.reshape(len(xy), -1).max(-1) if m > 1 else np.full(len(xy), -np.inf)
+    if len(fxy):
+        pf = (half[:, :, None] + fh + gap - np.abs(xy[:, :, None] - fxy)).min(-1)  # (R, M, F)
+        worst = np.maximum(worst, pf.reshape(len(xy), -1).max(-1))
+    return worst
+
+
+def pack(
+    inner: Rect,
+    footprints: Sequence,
+    fixed_xy: Sequence = (),
+    fixed_half: Sequence = (),
+    config: PackConfig = PackConfig(),
+    seed: int = 0,
+    turnable: Sequence[bool] | None = None,
+) -> PackResult:
+    """Place the M ``footprints`` (half extents (M, 2), m) inside ``inner`` free of each other
+    and of the fixed occupants (centres (F, 2), half extents (F, 2)); see the module docstring.
+    ``turnable[m]``: whether footprint m may turn a quarter turn (default: when it is not
+    square)."""
+    t0 = time.perf_counter()
+    half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
+    m, r = len(half_np), config.restarts
+    if m == 0:
+        empty = np.zeros((0, 2))
+        return PackResult(empty, np.zeros(0), np.zeros(0, int), True, -math.inf, 0.0, 0)
+    gen = torch.Generator().manual_seed(seed)
+    square = np.isclose(half_np[:, 0], half_np[:, 1])
+    may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
+    turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
+    axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
+    body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
+    lo = torch.tensor(inner[0], dtype=torch.float64)
+    span = torch.tensor(inner[1], dtype=torch.float64) - lo
+    room = (span - 2 * half).clamp_min(0.0)  # (R, M, 2)
+    u = torch.randn(r, m, 2, generator=gen, dtype=torch.float64).requires_grad_(True)
+    opt = torch.optim.Adam([u], lr=config.lr)
+    fxy, fh = torch.from_numpy(fxy_np), torch.from_numpy(fh_np)
+    steps = config.steps
+
+    def centres() -> torch.Tensor:
+        return lo + half + room * torch.sigmoid(u)  # (R, M, 2)
+
+    for k in range(steps):
+        beta = config.beta * (config.beta_end / config.beta) ** (k / max(steps - 1, 1))
+        loss = overlap_loss(centres(), half, body, fxy, fh, beta, config.eps, config.gap)
+        opt.zero_grad()
+        loss.sum().backward()
+        opt.step()
+    with torch.no_grad():
+        xy = centres().numpy()  # (R, M, 2)
+    fits = (room > 0).all(-1).all(-1).numpy()  # (R,) every grown footprint fits the region
+    worst = _depths(xy, half.numpy(), body.numpy(), fxy_np, fh_np, config.gap)  # (R,)
+    worst = np.where(fits, worst, np.inf)
+    best = int(np.argmin(worst))
+    yaws = np.where(turn[best].numpy(), math.pi / 2, 0.0)
+    return PackResult(
+        positions=xy[best],
+        yaws=yaws,
+        axes=axis[best].numpy(),
+        ok=bool(worst[best] <= config.tol),
+        overlap=float(worst[best]),
+        time=time.perf_counter() - t0,
+        tries=r * steps,
+    )
+
+
+def pack_sampled(
+    inner: Rect,
+    footprints: Sequence,
+    fixed_xy: Sequence = (),
+    fixed_half: Sequence = (),
+    budget: int = 1000,
+    seed: int = 0,
+    config: PackConfig = PackConfig(),
+    per_object: int = 50,
+) -> PackResult:
+    """The sampled baseline (module docstring): at most ``budget`` position samples in all,
+    ``per_object`` tries per object before starting over; each object's yaw (for a cuboid)
+    and closing axis drawn at random per attempt. Same result value as `pack` (``tries``:
+    samples spent)."""
+    t0 = time.perf_counter()
+    half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
+    m = len(half_np)
+    rng = np.random.default_rng(seed)
+    lo, hi = np.asarray(inner[0], float), np.asarray(inner[1], float)
+    spent = 0
+    best: PackResult | None = None
+    while spent < budget:
+        xy, yaws, axes = np.zeros((m, 2)), np.zeros(m), np.zeros(m, int)
+        bodies, grown = np.zeros((m, 2)), np.zeros((m, 2))
+        placed = 0
+        for i in range(m):
+            turn = not np.isclose(*half_np[i]) and rng.random() < 0.5
+            axes[i] = rng.integers(2)
+            bodies[i] = half_np[i][::-1] if turn else half_np[i]
+            grown[i] = np.maximum(bodies[i], config.side)
+            grown[i, axes[i]] = max(bodies[i, axes[i]], config.fingers)
+            yaws[i] = math.pi / 2 if turn else 0.0
+            if np.any(hi - lo < 2 * grown[i]):
+                break
+            for _ in range(per_object):
+                if spent >= budget:
+                    break
+                spent += 1
+                p = lo + grown[i] + rng.random(2) * (hi - lo - 2 * grown[i])
+                if _free(
+                    p, grown[i], bodies[i], xy[:i], grown[:i], bodies[:i], fxy_np, fh_np, config
+                ):
+                    xy[i] = p
+                    placed += 1
+                    break
+            if placed <= i:
+                break
+        if placed == m:
+            return PackResult(xy, yaws, axes, True, -math.inf, time.perf_counter() - t0, spent)
+        if best is None or placed > len(best.positions):
+            best = PackResult(xy[:placed], yaws[:placed], axes[:placed], False, math.inf, 0.0, 0)
+    if best is None:
+        best = PackResult(np.zeros((0, 2)), np.zeros(0), np.zeros(0, int), False, math.inf, 0, 0)
+    return PackResult(
+        best.positions, best.yaws, best.axes, False, math.inf, time.perf_counter() - t0, spent
+    )
+
+
+def _free(p, grown, body, xy, others_grown, others_body, fxy, fh, config: PackConfig) -> bool:
+    """Whether a footprint at ``p`` clears the placed ones (both ways) and the fixed ones."""
+    g, tol = config.gap, config.tol
+    if len(xy):
+        d = np.abs(xy - p)  # (k, 2)
+        mine = (grown + others_body + g - d).min(-1)  # my fingers against their bodies
+        theirs = (others_grown + body + g - d).min(-1)
+        if max(mine.max(), theirs.max()) > tol:
+            return False
+    return not (len(fxy) and (grown + fh + g - np.abs(fxy - p)).min(-1).max() > tol)
