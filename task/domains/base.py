@@ -204,11 +204,14 @@ class Domain(Protocol):
         self, problem: Problem, moves: Sequence[Move], strict: bool = True
     ) -> tuple[Action, ...]:
         """The domain's PDDL actions for a sequence of moves (its PDDL mapping);
-        ``strict=False`` also translates illegal moves, for a validator to find."""
+        ``strict=False`` also translates illegal moves, for a validator to find. A problem read
+        from a renamed domain (``problem.renaming``) gets the user's names: wrap the mapping in
+        `task.domains.match.renaming.user_actions`."""
         ...
 
     def to_atoms(self, problem: Problem, state: State) -> frozenset[tuple[str, ...]]:
-        """The PDDL atoms (fluent and static) that hold in ``state``, lowercased."""
+        """The PDDL atoms (fluent and static) that hold in ``state``, lowercased; in the
+        user's names for a renamed domain's problem (`task.domains.match.renaming.user_atoms`)."""
         ...
 
     def to_pddl(self, problem: Problem) -> str:
