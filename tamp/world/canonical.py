@@ -122,7 +122,9 @@ def generate(problem: str, seed: int, **size) -> CanonicalProblem:
         if isinstance(allowed[0], str):
             if value not in allowed:
                 raise ProblemError(f"{problem}: {key} {one_of(value, allowed)}")
-        elif not (isinstance(value, int) and allowed[0] <= value <= allowed[1]):
+        elif isinstance(value, bool) or not (
+            isinstance(value, int) and allowed[0] <= value <= allowed[1]
+        ):
             raise ProblemError(
                 f"{problem}: {key} must be a whole number in {allowed[0]}..{allowed[1]}, "
                 f"got {value!r}"
@@ -260,7 +262,9 @@ def top_reach(radius: float) -> float:
 # ---- the centre-first greedy packer -------------------------------------------------------
 
 
-def centre_first(scene: Scene, region: str, names: Sequence[str], step: float = 0.0025) -> tuple:
+def centre_first(
+    scene: Scene, region: str, names: Sequence[str], step: float = 0.0025
+) -> tuple[str, ...]:
     """Where a naive packer gets: each object of ``names`` in turn at the free spot of the
     region's inner rectangle nearest its centre (a ``step`` m grid, yaw 0 or a quarter turn,
     footprints only, no room for fingers). The names it placed, in order; fewer than
