@@ -4,8 +4,8 @@
 planning benchmark (by horizon and seed, then by block count), `motion_table` the executability
 table of the motion benchmark, `perception_table` the rows of planning from images,
 `poses_table` the pose errors of the pose benchmark, `segmentation_table` and
-`dark_margins_table` the segmentation check. Pure string formatting: nothing here runs a
-benchmark or prints.
+`dark_margins_table` the segmentation check, `tamp_table` the TAMP benchmark. Pure string
+formatting: nothing here runs a benchmark or prints.
 """
 
 from __future__ import annotations
@@ -462,3 +462,41 @@ def dark_margins_table(files: Mapping[str, dict]) -> str:
 def _margin(value: float, ratio: bool) -> str:
     """A ratio with two decimals; a grey level with one, dropped when it is 0 (25, 27.5)."""
     return f"{value:.2f}" if ratio else f"{value:.1f}".removesuffix(".0")
+
+
+def tamp_table(summary: Sequence[dict], sims: Sequence[str]) -> str:
+    """``bench tamp``: one row per problem and planner; per simulator the goals reached (ground
+    truth), those reached without a motion failure, the first plan's median length, planning
+    time p50/p90 (s), median simulated execution (s) and arm path (rad) of solved episodes,
+    and the episodes in which the arm touched something it should not have."""
+    head = [
+        "problem",
+        "planner",
+        *(
+            f"{h} {s}"
+            for s in sims
+            for h in ("solved", "clean", "len", "plan p50/p90 s", "exec s", "path rad", "collided")
+        ),
+    ]
+    by = {(s["problem"], s["planner"], s["sim"]): s for s in summary}
+    keys = list(dict.fromkeys((s["problem"], s["planner"]) for s in summary))
+    body = []
+    for problem, planner in keys:
+        cells: list[object] = [problem, planner]
+        for sim in sims:
+            s = by.get((problem, planner, sim))
+            if s is None:
+                cells += ["-"] * 7
+                continue
+            n = s["episodes"]
+            cells += [
+                f"{s['solved']}/{n}",
+                f"{s['clean']}/{n}",
+                _num(s["plan_length"]),
+                f"{_num(s['planning_p50_s'])}/{_num(s['planning_p90_s'])}",
+                _num(s["execution_s"]),
+                _num(s["arm_path_rad"]),
+                f"{s['collided']}/{n}",
+            ]
+        body.append(cells)
+    return table(head, body, indent="")

@@ -597,3 +597,67 @@ def suite_options(p: argparse.ArgumentParser) -> None:
         help="random problems of these block counts instead of PlanBench, seeded by --seed, "
         "those whose towers fit --scene (episodes.csv lists them)",
     )
+
+
+# `tamp.world.canonical.PROBLEMS` and `tamp.bench.geo.run.PLANNERS` (a test keeps them equal),
+# named here so the parser imports neither
+TAMP_PROBLEMS = ("blocked", "packed", "nonmonotonic", "sorting", "tall", "hanoi")
+TAMP_PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
+
+
+def _names(what: str, valid: tuple[str, ...]):
+    """A type: a comma-separated list of names from ``valid``, duplicates dropped."""
+
+    def parse(text: str) -> tuple[str, ...]:
+        names = tuple(dict.fromkeys(t.strip() for t in text.split(",") if t.strip()))
+        if not names:
+            raise argparse.ArgumentTypeError(f"no {what} named (valid: {', '.join(valid)})")
+        for name in names:
+            if name not in valid:
+                raise argparse.ArgumentTypeError(
+                    f"unknown {what} {name!r} (valid: {', '.join(valid)})"
+                )
+        return names
+
+    return parse
+
+
+def tamp_bench_options(p: argparse.ArgumentParser) -> None:
+    """What ``bench tamp`` runs: problems, variants, planners, simulators."""
+    p.add_argument(
+        "--problems",
+        type=_names("problem", TAMP_PROBLEMS),
+        default=",".join(TAMP_PROBLEMS),
+        metavar="P[,P]",
+        help=f"canonical problems, comma-separated ({','.join(TAMP_PROBLEMS)}; default: all)",
+    )
+    p.add_argument(
+        "--n",
+        type=bounded(1, 1000, "a count"),
+        default=20,
+        help="seeded variants of each problem (20): variant k is seed + k",
+    )
+    p.add_argument(
+        "--seed", type=seed, default=0, help="first variant's seed, and the episodes' (0)"
+    )
+    p.add_argument(
+        "--planner",
+        dest="planners",
+        type=_names("planner", TAMP_PLANNERS),
+        default="soft,motion-aware,search-then-check",
+        metavar="NAME[,NAME]",
+        help="planners side by side (soft: task-only with execution; motion-aware: ours; "
+        "search-then-check: the baseline; search: the complete geometric search alone)",
+    )
+    p.add_argument(
+        "--sim",
+        default=",".join(SIMULATORS),
+        metavar="SIM[,SIM]",
+        help=f"simulators, comma-separated ({','.join(SIMULATORS)})",
+    )
+    p.add_argument(
+        "--video",
+        action="store_true",
+        help="record the first variant of each problem per planner and simulator to "
+        "OUT/videos/ (needs --out)",
+    )

@@ -31,6 +31,7 @@ from tamp.cli.options import (
     seed,
     suite_options,
     sweep_options,
+    tamp_bench_options,
     threads,
     workcell_options,
 )
@@ -66,6 +67,7 @@ def build_parser() -> argparse.ArgumentParser:
     _planning_benchmarks(bench, bench_opts)
     _motion_benchmark(bench, plan_opts)
     _executability_benchmark(bench, plan_opts)
+    _tamp_benchmark(bench)
     _perception_benchmark(bench, bench_opts)
     _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
@@ -291,6 +293,21 @@ def _executability_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     p.set_defaults(
         func=_lazy("tamp.cli.bench.arm", "executability_command"),
         recorded=_lazy("tamp.cli.recorded", "executability_config"),
+    )
+
+
+def _tamp_benchmark(bench) -> None:
+    p = bench.add_parser(
+        "tamp",
+        help="the canonical TAMP problems where geometry decides the plan, planners side by side",
+    )
+    tamp_bench_options(p)
+    sweep_options(p)
+    progress_option(p)
+    output_options(p, "write results.json and episodes.csv (and with --video, videos/) here")
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench.geo", "tamp_command"),
+        recorded=_lazy("tamp.cli.recorded", "tamp_bench_config"),
     )
 
 

@@ -230,6 +230,22 @@ def executability_config(args: argparse.Namespace) -> dict:
     }
 
 
+def tamp_bench_config(args: argparse.Namespace) -> dict:
+    """``bench tamp``."""
+    if args.video and not args.out:
+        raise TampError("--video writes under --out; give --out DIR")
+    return {
+        "problems": list(args.problems),
+        "n": args.n,
+        "seed": args.seed,
+        "planners": list(args.planners),
+        "sims": list(sim_list(args.sim)),
+        "video": args.video,
+        "workers": args.workers,
+        "ray": args.ray,
+    }
+
+
 def motion_config(args: argparse.Namespace) -> dict:
     """``bench motion``."""
     if args.blocks and args.data != str(default_data("blocksworld")):

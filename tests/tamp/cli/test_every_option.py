@@ -61,6 +61,8 @@ SAMPLES = {
     "--max-replans": "3",
     "--scene": "shelf",  # run and demo: a name or a scene file (the other commands: choices)
     "--goal": "(on b c)",
+    "--problems": "blocked,tall",
+    "--planner": "search",
 }
 # what an option needs to take effect, per command where it differs; tried in order
 NEEDS = {
@@ -72,6 +74,7 @@ NEEDS = {
     "--replan": [["--plan", "plan.txt"]],
     "--stop-at-invalid": [["--plan", "plan.txt"]],
     "--video-format": [["--out", "folder"]],
+    "--video": [["--out", "folder"]],
     "--no-video": [["--out", "folder"]],
     "--domain": [["problem.pddl"]],
     "--min-blocks": [["--max-blocks", "9"]],

@@ -1,0 +1,170 @@
+"""Run the TAMP benchmark: problems x seeded variants x planners x simulators, one episode each.
+
+Item ``(problem, k, planner, sim)`` plays variant ``seed + k`` of ``problem``
+(`tamp.world.canonical.generate`) with ``planner`` in ``sim`` (`run_geo_episode`, episode seed
+``seed * 100_003 + k``), so every planner and simulator meets the same scenes and the rows are
+the same whatever ``workers`` (`tamp.sweep.run_items`). A row records the variant's note, the
+episode's status, whether the goal was reached (ground truth), whether it was reached without a
+motion failure, the first plan's length, planning time (s, every planner call of the episode),
+simulated execution time, the arm's joint path and the unexpected contacts.
+
+`summarise` gives, per (problem, planner, simulator): episodes, solved, solved without a motion
+failure, plan length (median over solved), planning time p50/p90, execution time and arm path
+(medians over solved), episodes with a collision and collisions in all.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from tamp.sweep import run_items
+
+PLANNERS = ("soft", "motion-aware", "search-then-check")  # the issue's three, side by side
+ROW_COLUMNS = (
+    "problem",
+    "variant",
+    "planner",
+    "sim",
+    "status",
+    "reached",
+    "clean",
+    "plan_length",
+    "moves",
+    "motion_failures",
+    "replans",
+    "collisions",
+    "planning_time_s",
+    "execution_time_s",
+    "arm_path_rad",
+    "wall_s",
+    "reason",
+    "note",
+)
+
+
+@dataclass(frozen=True)
+class Item:
+    """One episode to play: variant ``variant`` of ``problem`` by ``planner`` in ``sim``;
+    ``video``: a file to record it to (None: no video)."""
+
+    problem: str
+    variant: int
+    planner: str
+    sim: str
+    seed: int
+    video: str | None = None
+
+
+def items(
+    problems: Sequence[str],
+    n: int,
+    planners: Sequence[str],
+    sims: Sequence[str],
+    seed: int,
+    videos: Path | None = None,
+) -> list[Item]:
+    """Every episode of the benchmark, problem-major; with ``videos``, the first variant of
+    each problem gets a video per planner and simulator in that folder."""
+    out = []
+    for problem in problems:
+        for k in range(n):
+            for planner in planners:
+                for sim in sims:
+                    video = None
+                    if videos is not None and k == 0:
+                        video = str(videos / f"{problem}-{planner}-{sim}.mp4")
+                    out.append(Item(problem, seed + k, planner, sim, seed * 100_003 + k, video))
+    return out
+
+
+def play(item: Item) -> dict:
+    """One episode's row (`ROW_COLUMNS`), in the process that runs it."""
+    from tamp.geo.episode import run_geo_episode
+    from tamp.world.canonical import generate
+
+    made = generate(item.problem, item.variant)
+    t0 = time.perf_counter()
+    report = run_geo_episode(
+        made.scene, made.goal, item.planner, item.sim, seed=item.seed, video=item.video
+    )
+    return {
+        "problem": item.problem,
+        "variant": item.variant,
+        "planner": item.planner,
+        "sim": item.sim,
+        "status": report.status,
+        "reached": report.reached,
+        "clean": report.reached and report.motion_failures == 0,
+        "plan_length": report.plan_length,
+        "moves": len(report.moves),
+        "motion_failures": report.motion_failures,
+        "replans": report.replans,
+        "collisions": report.collisions,
+        "planning_time_s": report.planning_time_s,
+        "execution_time_s": report.execution_time_s,
+        "arm_path_rad": report.arm_path_rad,
+        "wall_s": time.perf_counter() - t0,
+        "reason": report.reason,
+        "note": made.note,
+    }
+
+
+def run(
+    todo: Sequence[Item],
+    workers: int = 1,
+    ray_address: str | None = None,
+    progress: Callable[[int, dict], None] | None = None,
+) -> list[dict]:
+    """Every item's row, in item order (``progress(index, row)`` as each episode ends)."""
+    return run_items(play, list(todo), workers, ray_address, progress)
+
+
+def _median(values: Sequence[float]) -> float | None:
+    return float(np.median(values)) if len(values) else None
+
+
+def _quantile(values: Sequence[float], q: float) -> float | None:
+    return float(np.quantile(values, q)) if len(values) else None
+
+
+def summarise(rows: Sequence[dict]) -> list[dict]:
+    """One summary per (problem, planner, simulator), in the order they first appear."""
+    groups: dict[tuple[str, str, str], list[dict]] = {}
+    for row in rows:
+        groups.setdefault((row["problem"], row["planner"], row["sim"]), []).append(row)
+    out = []
+    for (problem, planner, sim), mine in groups.items():
+        solved = [r for r in mine if r["reached"]]
+        times = [r["planning_time_s"] for r in mine]
+        out.append(
+            {
+                "problem": problem,
+                "planner": planner,
+                "sim": sim,
+                "episodes": len(mine),
+                "solved": len(solved),
+                "clean": sum(r["clean"] for r in mine),
+                "plan_length": _median([r["plan_length"] for r in solved]),
+                "moves": _median([r["moves"] for r in solved]),
+                "planning_p50_s": _quantile(times, 0.5),
+                "planning_p90_s": _quantile(times, 0.9),
+                "execution_s": _median([r["execution_time_s"] for r in solved]),
+                "arm_path_rad": _median([r["arm_path_rad"] for r in solved]),
+                "collided": sum(r["collisions"] > 0 for r in mine),
+                "collisions": sum(r["collisions"] for r in mine),
+                "statuses": _count(r["status"] for r in mine),
+            }
+        )
+    return out
+
+
+def _count(values) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for v in values:
+        out[v] = out.get(v, 0) + 1
+    return out

@@ -1,0 +1,104 @@
+"""``tamp bench tamp``: the canonical problems, planners side by side (tamp.bench.geo)."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import pytest
+
+from tamp.bench.geo import run as bench
+from tamp.bench.tables import tamp_table
+from tamp.cli import main
+from tamp.cli.options import TAMP_PLANNERS, TAMP_PROBLEMS
+
+
+def test_the_parser_names_what_the_library_has():
+    from tamp.geo.episode import PLANNERS
+    from tamp.world.canonical import PROBLEMS
+
+    assert TAMP_PROBLEMS == PROBLEMS
+    assert TAMP_PLANNERS == PLANNERS
+    assert set(bench.PLANNERS) <= set(PLANNERS)
+
+
+def test_items_give_every_planner_and_simulator_the_same_variants(tmp_path):
+    todo = bench.items(("blocked", "tall"), 2, ("soft", "search"), ("pybullet", "mujoco"), 5)
+    assert len(todo) == 2 * 2 * 2 * 2
+    for problem in ("blocked", "tall"):
+        variants = {(i.planner, i.sim): [] for i in todo}
+        for i in todo:
+            if i.problem == problem:
+                variants[(i.planner, i.sim)].append((i.variant, i.seed))
+        assert len({tuple(v) for v in variants.values()}) == 1  # same scenes and seeds for all
+        assert [v for v, _ in next(iter(variants.values()))] == [5, 6]
+    assert all(i.video is None for i in todo)
+    videos = bench.items(("blocked",), 2, ("soft",), ("pybullet",), 0, tmp_path)
+    assert [i.video is not None for i in videos] == [True, False]  # the first variant only
+
+
+def _row(problem, planner, sim, reached, failures=0, collisions=0, t=1.0):
+    return {
+        "problem": problem,
+        "variant": 0,
+        "planner": planner,
+        "sim": sim,
+        "status": "reached" if reached else "no_plan",
+        "reached": reached,
+        "clean": reached and failures == 0,
+        "plan_length": 3 if reached else 0,
+        "moves": 3,
+        "motion_failures": failures,
+        "replans": 0,
+        "collisions": collisions,
+        "planning_time_s": t,
+        "execution_time_s": 20.0,
+        "arm_path_rad": 9.0,
+        "wall_s": 30.0,
+        "reason": "",
+        "note": "",
+    }
+
+
+def test_summary_counts_solved_clean_and_collided_per_planner_and_simulator():
+    rows = [
+        _row("blocked", "soft", "pybullet", False, t=0.1),
+        _row("blocked", "soft", "pybullet", True, failures=1, collisions=2, t=0.3),
+        _row("blocked", "search", "pybullet", True, t=2.0),
+        _row("blocked", "search", "pybullet", True, t=4.0),
+    ]
+    summary = {(s["planner"], s["sim"]): s for s in bench.summarise(rows)}
+    soft, search = summary[("soft", "pybullet")], summary[("search", "pybullet")]
+    assert (soft["episodes"], soft["solved"], soft["clean"], soft["collided"]) == (2, 1, 0, 1)
+    assert (search["solved"], search["clean"], search["collided"]) == (2, 2, 0)
+    assert search["planning_p50_s"] == pytest.approx(3.0)
+    assert soft["plan_length"] == 3  # over solved episodes only
+    text = tamp_table(bench.summarise(rows), ("pybullet", "mujoco"))
+    lines = text.splitlines()
+    assert lines[1].split()[:4] == ["blocked", "soft", "1/2", "0/2"]
+    assert lines[1].split()[-1] == "-"  # no mujoco rows: not applicable
+
+
+def test_video_without_out_is_refused_in_one_line(capsys):
+    assert main(["bench", "tamp", "--video", "--n", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "--out" in err
+
+
+def test_unknown_problem_is_refused_naming_the_valid_ones(capsys):
+    assert main(["bench", "tamp", "--problems", "blocked,stacked"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown problem 'stacked'" in err and "nonmonotonic" in err
+
+
+@pytest.mark.sim
+def test_one_episode_writes_results_and_rows(tmp_path):
+    out = tmp_path / "out"
+    argv = ["bench", "tamp", "--problems", "blocked", "--n", "1", "--sim", "pybullet"]
+    assert main([*argv, "--planner", "soft", "--out", str(out), "--no-progress"]) == 0
+    body = json.loads((out / "results.json").read_text())
+    assert body["config"]["problems"] == ["blocked"] and body["config"]["planners"] == ["soft"]
+    (summary,) = body["summary"]
+    assert summary["episodes"] == 1 and summary["planner"] == "soft"
+    rows = list(csv.DictReader((out / "episodes.csv").open()))
+    assert len(rows) == 1 and rows[0]["problem"] == "blocked" and rows[0]["note"]
