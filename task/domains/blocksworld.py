@@ -75,7 +75,9 @@ def check_move(problem: Problem, state: State, move: Move) -> str | None:
     x, y = move.entity, move.target
     if x == y:
         return f"{x} cannot be moved onto itself"
-    if state[i] == y or (slotted(problem) and {state[i], y} <= set(problem.fixed)):
+    if state[i] == y or (
+        slotted(problem) and not hops(problem) and {state[i], y} <= set(problem.fixed)
+    ):
         return f"{x} is already on {'the table' if state[i] != y else y}"
     for z, label in ((x, x), (y, f"target {y}")):
         if not is_clear(problem, state, z):
@@ -149,6 +151,8 @@ def soft_legality(F: Tensor, batch: SoftBatch) -> Tensor:
     empty = (1.0 - F[..., n:] * batch.entity_mask.unsqueeze(-1).to(F.dtype)).prod(-2)  # (B, K)
     cbar = torch.cat([c, torch.where(one[:, 0], empty, 1.0)], dim=-1)  # (B, Y)
     off = 1.0 - (F[..., n:] * one).sum(-1, keepdim=True)  # (B, N, 1): x on no slot
+    if "hop" in batch.static:  # places a block may move between (`with_slots(hop=True)`)
+        one = one & ~batch.static["hop"][:, None, None]
     stay = torch.cat([torch.ones_like(F[..., :n]), torch.where(one, off, 1.0)], dim=-1)
     return c.unsqueeze(-1) * cbar.unsqueeze(-2) * e * (1.0 - F) * stay
 
@@ -222,7 +226,10 @@ def encode(
         one[i, n : n + k] = slotted(p)
         for x, _ in (g for g in p.goal if g[1] == TABLE):
             batch.goal[i, p.entities.index(x), n : n + (k if slotted(p) else 1)] = 1.0
-    return replace(batch, static={**batch.static, "one": one})
+    static = {**batch.static, "one": one}
+    if any(hops(p) for p in problems):
+        static["hop"] = torch.tensor([hops(p) for p in problems])  # (B,)
+    return replace(batch, static=static)
 
 
 def legal_moves(problem: Problem, state: State) -> list[Move]:
@@ -231,9 +238,22 @@ def legal_moves(problem: Problem, state: State) -> list[Move]:
     return [m for m in moves if check_move(problem, state, m) is None]
 
 
-def with_slots(problem: Problem, slots: Sequence[str], bases: dict | None = None) -> Problem:
+HOP = "hop"  # ``Problem.data`` of a slotted problem whose blocks may move place to place
+
+
+def hops(problem: Problem) -> bool:
+    """Whether a block may move from one slot straight to another (`with_slots` ``hop``)."""
+    return slotted(problem) and problem.data == HOP
+
+
+def with_slots(
+    problem: Problem, slots: Sequence[str], bases: dict | None = None, hop: bool = False
+) -> Problem:
     """``problem`` on a table of capacity-one ``slots`` (`slotted`): each block on the table
-    stands on ``bases[block]`` (default: the slots in order, blocks in entity order)."""
+    stands on ``bases[block]`` (default: the slots in order, blocks in entity order).
+    ``hop``: the slots are distinct places (a region's cells, table spots), so a block may move
+    from one straight to another; without it such a move is illegal (it changes nothing a
+    Blocksworld goal can name)."""
     rows = list(zip(problem.entities, problem.init, strict=True))
     on_table = [x for x, s in rows if s == TABLE]
     bases = dict(zip(on_table, slots, strict=False)) if bases is None else bases
@@ -242,7 +262,7 @@ def with_slots(problem: Problem, slots: Sequence[str], bases: dict | None = None
     if len({bases.get(x) for x in on_table} & set(slots)) != len(on_table):
         raise ProblemError(f"{len(on_table)} towers need their own slots of {tuple(slots)}")
     init = tuple(bases[x] if s == TABLE else s for x, s in rows)
-    return replace(problem, init=init, fixed=tuple(slots))
+    return replace(problem, init=init, fixed=tuple(slots), data=HOP if hop else problem.data)
 
 
 def samples(seed: int):

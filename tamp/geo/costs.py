@@ -1,0 +1,252 @@
+"""The arm's price of every candidate move of a bridged scene, for the planner (`task.costs`).
+
+`GeoCosts` is a `task.costs.CostSource` for a `tamp.geo.bridge.Bridged` problem. For a window
+starting in a crisp state it predicts the world (`Bridged.predict`: objects keep their observed
+poses unless moved; on a place: at its position; on an object: centred on its top), then
+prices each legal move x -> y of that state:
+
+- `task.costs.IMPOSSIBLE` when the goal rules it out (`Bridged.banned`), when x does not fit
+  where it would go (the place overlaps something, `tamp.geo.places.free`; a top too small to
+  stand on, `tamp.geo.places.supported_on`), when no grasp of x is free both at the pick and at
+  the place, or when the top-down grasp or release has no IK solution;
+- else the joint distance (rad) between the top-down grasp and release configurations, as
+  `tamp.arm_costs` prices Blocksworld moves (`motion.cost`'s c(x, y) without its sphere terms).
+
+A grasp is free at a pose when the open hand (`motion.grasps.HAND_BOXES`, the palm and both
+fingers, as axis-aligned boxes around their turned corners) at that grasp overlaps no other
+object, obstacle, region wall or floor: the geometric half of `tamp.geo.check.quick_check`,
+without IK, for every grasp family at once. It is a proxy: the planner's moves are bound to a
+grasp by the full check (`tamp.geo.ours`), and what fails there comes back as failure memory:
+`avoid(state, move, grasp, place)` rules the move out only under the grasp (None: every grasp)
+and place that failed, so the same move keeps its price while another of its grasps is left,
+and x -> another place is priced on its own.
+
+Every state is priced once (cached); the IK solutions are cached by target position (to the
+mm) across states, so later windows solve only the targets they have not seen. ``stats``
+records states priced and the time spent (ms per state).
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from motion.grasps import HAND_BOXES, Grasp, world_tcp
+from motion.ik import IKSolver, top_down_pose
+from tamp.geo.bridge import Bridged
+from tamp.geo.places import free, supported_on
+from tamp.world.geometry import Solid, fixed_solids, of_movable
+from tamp.world.schema import Scene
+from task.costs import IMPOSSIBLE
+from task.domains.base import State
+from task.domains.blocksworld import check_move as legal
+from task.problem import Move
+
+CORNERS = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))  # (8, 3)
+TOUCH = 0.001  # m, boxes may touch this deep (contact)
+
+
+@dataclass(frozen=True)
+class GeoCostConfig:
+    """Weights of the move price."""
+
+    joint_weight: float = 1.0  # per rad of joint distance, grasp -> release configuration
+    choices: tuple[str, ...] = ("top", "side", "tilt")  # grasp families priced
+    ik: bool = True  # rule out a grasp or release with no top-down IK solution (needs a solver)
+    margin: float = 0.004  # m, the open hand's boxes grown by this (the collision margin)
+
+
+def hand_boxes(grasp: Grasp, xyz, yaw: float, margin: float = 0.0) -> np.ndarray:
+    """(3, 2, 3) lower and upper corners (m) of the axis-aligned boxes around the open hand's
+    palm and fingers (grown by ``margin``, m) holding an object at centre ``xyz``, turned
+    ``yaw``."""
+    tcp = world_tcp(grasp, xyz, yaw)  # (4, 4)
+    out = []
+    for centre, half in HAND_BOXES:
+        pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
+        world = pts @ tcp[:3, :3].T + tcp[:3, 3]  # (8, 3)
+        out.append((world.min(0), world.max(0)))
+    return np.asarray(out)
+
+
+def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
+    """(S, 2, 3) axis-aligned bounds (m) of upright solids (turned ones: their bounding box)."""
+    out = []
+    for s in solids:
+        c, d = abs(np.cos(s.yaw)), abs(np.sin(s.yaw))
+        hx = c * s.half[0] + d * s.half[1]
+        hy = d * s.half[0] + c * s.half[1]
+        half = np.array([hx, hy, s.half[2]]) if not s.cylinder else np.array(s.half)
+        out.append((np.asarray(s.centre) - half, np.asarray(s.centre) + half))
+    return np.asarray(out).reshape(-1, 2, 3)
+
+
+def hits(hand: np.ndarray, boxes: np.ndarray) -> bool:
+    """Whether any of the hand's boxes (H, 2, 3) overlaps any of ``boxes`` (S, 2, 3) deeper
+    than `TOUCH` along every axis."""
+    if not len(boxes):
+        return False
+    depth = np.minimum(hand[:, None, 1], boxes[None, :, 1]) - np.maximum(
+        hand[:, None, 0], boxes[None, :, 0]
+    )  # (H, S, 3)
+    return bool((depth > TOUCH).all(-1).any())
+
+
+class _Window:
+    """The costs of one window: a fixed (P, N, Y) matrix, alike for every restart row."""
+
+    lr = 0.0
+
+    def __init__(self, matrix: torch.Tensor) -> None:
+        self.matrix = matrix
+
+    def compute(self) -> torch.Tensor:
+        return self.matrix  # (P, N, Y)
+
+    def parameters(self) -> list[torch.Tensor]:
+        return []
+
+    def commit(self, rows, moves) -> None:
+        """Nothing to record: the places are fixed before planning (`tamp.geo.pack`)."""
+
+
+class GeoCosts:
+    """`task.costs.CostSource` of one bridged problem (module docstring). ``solver`` and ``q``
+    (J,): the IK solver and the arm configuration it is seeded from (None: no IK, the price is
+    geometry only and the joint distance 0)."""
+
+    def __init__(
+        self,
+        bridged: Bridged,
+        solver: IKSolver | None = None,
+        q=None,
+        config: GeoCostConfig = GeoCostConfig(),
+        grasps=None,
+    ) -> None:
+        self.bridged, self.solver, self.config = bridged, solver, config
+        self.q = None if q is None else np.asarray(q, dtype=np.float64)
+        if grasps is None:
+            from tamp.geo.check import candidate_grasps
+
+            grasps = {o.name: candidate_grasps(o, config.choices) for o in bridged.scene.objects}
+        self.grasps: dict[str, tuple[Grasp, ...]] = dict(grasps)
+        self._base: dict[State, tuple[np.ndarray, dict]] = {}
+        self._ik: dict[tuple[int, int, int], tuple[np.ndarray, bool]] = {}
+        self.failed: dict[tuple[State, Move, str], set] = {}
+        self.stats = {"states": 0, "price_s": 0.0, "ik_targets": 0}
+
+    # ---- the planner's interface
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State], restarts: int = 1):
+        """The costs of a window (`task.costs.CostSource`): (P, N, Y), one row per problem."""
+        rows = [torch.from_numpy(self.price(s)) for s in states]
+        return _Window(torch.stack(rows))
+
+    def price(self, state: State) -> np.ndarray:
+        """(N, Y) the price of every move x -> y in crisp ``state`` (0 where illegal)."""
+        out = self._priced(state)[0].copy()
+        problem = self.bridged.problem
+        for s, move, _ in self.failed:
+            if s == state and not self.grasps_left(state, move):
+                out[problem.entities.index(move.entity), problem.index(move.target)] = IMPOSSIBLE
+        return out
+
+    # ---- failure memory
+
+    def avoid(self, state: State, move: Move, grasp: str | None, place: str) -> None:
+        """Rule ``move`` out in ``state`` under ``grasp`` (a name; None: every grasp) and the
+        place named ``place``, where it failed."""
+        self.failed.setdefault((tuple(state), move, place), set()).add(grasp)
+
+    def grasps_left(self, state: State, move: Move) -> tuple[str, ...]:
+        """The names of ``move``'s grasps free at both ends in ``state`` (best first: the
+        order of `tamp.geo.check.candidate_grasps`) that no failure ruled out."""
+        _, allowed = self._priced(state)
+        names = allowed.get(move, ())
+        world = self.bridged.predict(state)
+        place = self.bridged.geo_move(world, move).place.name
+        gone = self.failed.get((tuple(state), move, place), set())
+        if None in gone:
+            return ()
+        return tuple(n for n in names if n not in gone)
+
+    # ---- pricing
+
+    def _priced(self, state: State) -> tuple[np.ndarray, dict]:
+        state = tuple(state)
+        if state not in self._base:
+            t0 = time.perf_counter()
+            self._base[state] = self._price(state)
+            self.stats["states"] += 1
+            self.stats["price_s"] += time.perf_counter() - t0
+        return self._base[state]
+
+    def _price(self, state: State) -> tuple[np.ndarray, dict]:
+        b, problem = self.bridged, self.bridged.problem
+        world = b.predict(state)
+        n, y = problem.n, len(problem.targets)
+        out = np.zeros((n, y))
+        allowed: dict[Move, tuple[str, ...]] = {}
+        fixed = solid_boxes(fixed_solids(world))
+        bodies = {o.name: solid_boxes([of_movable(o)]) for o in world.objects}
+        picks = {
+            o.name: self._free_grasps(world, o.name, o.pose.xyz, o.pose.yaw, fixed, bodies)
+            for o in world.objects
+        }
+        moves, ends = [], []
+        for i, x in enumerate(problem.entities):
+            for j, target in enumerate(problem.targets):
+                move = Move(x, target)
+                if legal(problem, state, move) is not None:
+                    continue
+                geo = b.geo_move(world, move)
+                ok = (x, target) not in b.banned and free(world, x, geo.place)
+                if ok and target in problem.entities:
+                    ok = supported_on(world.object(x), world.object(target), geo.place.yaw)
+                names = ()
+                if ok:
+                    at = self._free_grasps(world, x, geo.place.xyz, geo.place.yaw, fixed, bodies)
+                    names = tuple(g for g in picks[x] if g in at)
+                allowed[move] = names
+                if not names:
+                    out[i, j] = IMPOSSIBLE
+                    continue
+                moves.append((i, j))
+                ends.append((world.object(x).pose.xyz, geo.place.xyz))
+        if moves and self.solver is not None:
+            q, reach = self._solve([p for e in ends for p in e])  # (2M, J), (2M,)
+            for k, (i, j) in enumerate(moves):
+                if self.config.ik and not (reach[2 * k] and reach[2 * k + 1]):
+                    out[i, j] = IMPOSSIBLE
+                    continue
+                dist = float(np.linalg.norm(q[2 * k + 1] - q[2 * k]))
+                out[i, j] = min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0)
+        return out, allowed
+
+    def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, fixed, bodies) -> set[str]:
+        """Names of x's grasps whose open hand, x centred at ``xyz`` turned ``yaw``, overlaps
+        nothing but x (the other objects where ``world`` has them, the fixed solids)."""
+        others = [bodies[o.name] for o in world.objects if o.name != x]
+        boxes = np.concatenate([fixed, *others]) if others else fixed
+        m = self.config.margin
+        return {g.name for g in self.grasps[x] if not hits(hand_boxes(g, xyz, yaw, m), boxes)}
+
+    def _solve(self, points: list) -> tuple[np.ndarray, np.ndarray]:
+        """Top-down IK (yaw 0) of every point (m), cached to the mm: (M, J), (M,)."""
+        keys = [tuple(round(float(v) * 1000) for v in p) for p in points]
+        todo = sorted({k for k in keys if k not in self._ik})
+        if todo:
+            targets = np.stack([top_down_pose(np.asarray(k) / 1000.0, 0.0) for k in todo])
+            q_ref = self.q if self.q is not None else np.zeros(self.solver.dof)
+            found = self.solver.solve(targets, q_ref)
+            self.stats["ik_targets"] += len(todo)
+            for k, q, ok in zip(todo, found.q, found.ok, strict=True):
+                self._ik[k] = (np.asarray(q), bool(ok))
+        q = np.stack([self._ik[k][0] for k in keys])
+        ok = np.array([self._ik[k][1] for k in keys])
+        return q, ok

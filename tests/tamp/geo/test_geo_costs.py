@@ -1,0 +1,64 @@
+"""The arm's prices of a bridged scene's moves (`tamp.geo.costs.GeoCosts`): the direct move of
+a hemmed-in target is IMPOSSIBLE (and the full check agrees) until a neighbour has moved, and
+the failure memory rules a move out only under the grasp and place that failed."""
+
+from __future__ import annotations
+
+import pytest
+
+from tamp.geo.bridge import bridge
+from tamp.geo.check import check_move
+from tamp.geo.costs import GeoCosts
+from tamp.world.goal import parse_goal
+from task.costs import IMPOSSIBLE
+from task.domains import blocksworld as bw
+from task.problem import Move
+from tests.tamp.geo.geo_scenes import blocked, tools
+
+
+@pytest.fixture(scope="module")
+def priced():
+    s = blocked()
+    b = bridge(s, parse_goal("(in t goal)", s))
+    kit = tools()
+    return b, GeoCosts(b, kit.solver, kit.q), kit
+
+
+def _price(costs: GeoCosts, state, move: Move) -> float:
+    p = costs.bridged.problem
+    return float(costs.price(state)[p.entities.index(move.entity), p.index(move.target)])
+
+
+def test_the_direct_move_of_a_hemmed_in_target_is_impossible_until_a_neighbour_moves(priced):
+    b, costs, kit = priced
+    p = b.problem
+    direct = Move("t", "goal.c0")  # the two-line plan: (in t goal) in one move
+    assert _price(costs, p.init, direct) >= IMPOSSIBLE
+    assert not costs.grasps_left(p.init, direct)
+    verdict = check_move(b.scene, b.geo_move(b.scene, direct), kit)
+    assert not verdict.ok  # the full check agrees: no grasp reaches t
+    spot = next(x.name for x in b.sites if x.name.startswith("table."))
+    away = Move("n", spot)
+    assert _price(costs, p.init, away) < IMPOSSIBLE  # n can go
+    after = bw.apply_move(p, p.init, away)
+    assert _price(costs, after, direct) < IMPOSSIBLE  # then t can
+    assert costs.stats["states"] == 2 and costs.stats["price_s"] > 0
+
+
+def test_a_failure_rules_a_move_out_only_under_its_grasp_and_place(priced):
+    b, _, kit = priced
+    costs = GeoCosts(b, kit.solver, kit.q)
+    p = b.problem
+    after = bw.apply_move(p, p.init, Move("n", next(x.name for x in b.sites if "table." in x.name)))
+    direct, other = Move("t", "goal.c0"), Move("t", "spot_n")
+    names = costs.grasps_left(after, direct)
+    assert names and _price(costs, after, direct) < IMPOSSIBLE
+    for name in names[:-1]:
+        costs.avoid(after, direct, name, "goal.c0")
+    assert costs.grasps_left(after, direct) == names[-1:]
+    assert _price(costs, after, direct) < IMPOSSIBLE  # one grasp is left
+    costs.avoid(after, direct, names[-1], "goal.c0")
+    assert _price(costs, after, direct) >= IMPOSSIBLE
+    assert _price(costs, after, other) < IMPOSSIBLE  # t may still go to another place
+    costs.avoid(after, other, None, "spot_n")  # every grasp at that place failed
+    assert _price(costs, after, other) >= IMPOSSIBLE
