@@ -1,0 +1,177 @@
+"""Motion-aware planning of a scene-file problem on the project's differentiable planner.
+
+`plan_motion_aware(scene, goal, tools, config)`:
+
+1. bridge the scene and goal to a Blocksworld problem on capacity-one places
+   (`tamp.geo.bridge`: the goal regions' cells placed jointly by gradient, `tamp.geo.pack`);
+2. plan it with `task.planner.plan` and the arm's prices in the objective (`GeoCosts`): the
+   receding windows, then, when they revisit a state or run out, the planner's complete lazy
+   fallback (`task.symbolic.lazy_search`) over the moves the prices allow;
+3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
+   full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
+   no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
+   at that place, under the grasps that failed) and the problem is planned again, at most
+   `OursConfig.replans` times.
+
+The status is SOLVED with the bound moves; UNSOLVABLE only when the planner's fallback proved
+that no plan exists within the discretised places and the moves the prices allow; BUDGET
+otherwise (windows, fallback nodes, replans or time ran out).
+
+`plan_pddl` does the same for a problem named by a PDDL domain instead of Blocksworld (Tower of
+Hanoi): the generic STRIPS lift plans it (its fallback on), the declared binding
+(`task.symbolic.pickplace.binding`) pairs its actions into object -> target moves, and each
+move becomes a `GeoMove` onto a disc (centred on its top) or a peg region (the first of
+`tamp.geo.places.candidate_places` the full check passes).
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+from tamp.geo.bridge import PACK, Bridged, bridge
+from tamp.geo.costs import GeoCostConfig, GeoCosts
+from tamp.geo.pack import PackConfig
+from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
+from tamp.world.goal import Goal
+from tamp.world.schema import Scene, SceneFileError
+from task.config import PlannerConfig
+from task.domains.blocksworld import apply_move
+from task.planner import plan
+from task.problem import PlanStatus
+
+PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True)
+
+
+@dataclass(frozen=True)
+class OursConfig:
+    """Settings of the motion-aware planner."""
+
+    planner: PlannerConfig = PLANNER  # the differentiable planner, fallback on
+    pack: PackConfig = PACK  # the goal regions' cells
+    costs: GeoCostConfig = field(default_factory=GeoCostConfig)
+    table_places: int | None = None  # table spots (None: objects + 2)
+    replans: int = 4  # plans again after a move no grasp passes, at most this often
+    seed: int = 0
+
+
+def _check():
+    from tamp.geo.check import check_move
+
+    return check_move
+
+
+def as_ours(config) -> OursConfig:
+    """``config`` as an `OursConfig`: itself, or from the budgets every geometric planner is
+    called with (`tamp.geo.search.SearchConfig`: its seed, grasp families and wall-clock limit,
+    which bounds the differentiable planner's windows and fallback)."""
+    if isinstance(config, OursConfig):
+        return config
+    limit = getattr(config, "max_time_s", None)
+    planner = replace(PLANNER, time_limit_s=limit) if limit else PLANNER
+    choices = getattr(config, "choices", GeoCostConfig().choices)
+    return OursConfig(
+        planner=planner,
+        costs=GeoCostConfig(choices=tuple(choices)),
+        seed=getattr(config, "seed", 0),
+    )
+
+
+def plan_motion_aware(
+    scene: Scene,
+    goal: Goal,
+    tools,
+    config=OursConfig(),
+    check: Callable | None = None,
+) -> GeoPlan:
+    """Plan ``goal`` in ``scene`` (module docstring). ``tools``: `tamp.geo.check.Tools` (its
+    ``solver`` and ``q`` also price the moves); ``config``: an `OursConfig` or the geometric
+    planners' shared `tamp.geo.search.SearchConfig` (`as_ours`); ``check``: the move check
+    (default `tamp.geo.check.check_move`)."""
+    t0 = time.perf_counter()
+    config = as_ours(config)
+    check = check or _check()
+    try:
+        bridged = bridge(scene, goal, config.table_places, config.pack, config.seed)
+    except SceneFileError as exc:
+        return GeoPlan(GeoStatus.FAILED, reason=str(exc), stats={"time_s": 0.0})
+    stats: dict = {"places": len(bridged.sites), "packs": _packs(bridged)}
+    unpacked = [r for r, p in bridged.packs if not p.ok]
+    if unpacked:
+        stats["time_s"] = time.perf_counter() - t0
+        why = f"no free arrangement of the goal objects in region(s) {', '.join(unpacked)}"
+        return GeoPlan(GeoStatus.BUDGET, reason=why, stats=stats)
+    solver, q = getattr(tools, "solver", None), getattr(tools, "q", None)
+    costs = GeoCosts(bridged, solver, q, config.costs)
+    failures, plans = [], 0
+    for attempt in range(config.replans + 1):
+        plans += 1
+        result = plan(bridged.problem, config.planner, seed=config.seed + attempt, costs=costs)
+        stats.update(_planner_stats(result, costs))
+        if result.status is PlanStatus.UNSOLVABLE:
+            why = result.stats.get("fallback", {}).get("reason", "no plan")
+            why = f"within the discretised places: {why}"
+            return _done(GeoStatus.UNSOLVABLE, (), why, stats, t0, plans, failures)
+        if not result.solved:
+            why = result.stats.get("fallback", {}).get("reason", "the windows ran out")
+            return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+        bound, failed = _bind(bridged, result.plan.moves, tools, costs, check)
+        if failed is None:
+            return _done(GeoStatus.SOLVED, bound, "", stats, t0, plans, failures)
+        failures.append(failed)
+    why = f"{len(failures)} planned moves failed the full check; the replan budget is spent"
+    return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+
+
+def _bind(bridged: Bridged, moves, tools, costs: GeoCosts, check) -> tuple[tuple, dict | None]:
+    """Each planned move as a `GeoMove` with the grasp the full check passes, in the world the
+    moves before it leave. Returns the bound moves and None, or the moves bound so far and the
+    failure (recorded in ``costs``)."""
+    from tamp.geo.check import candidate_grasps
+
+    state, world, bound = bridged.problem.init, bridged.scene, []
+    for move in moves:
+        geo = bridged.geo_move(world, move)
+        o = world.object(move.entity)
+        first = costs.grasps_left(state, move)
+        rest = [g for g in candidate_grasps(o, costs.config.choices) if g.name not in first]
+        by_name = {g.name: g for g in candidate_grasps(o, costs.config.choices)}
+        order = tuple(by_name[n] for n in first) + tuple(rest)
+        verdict = check(world, geo, tools, grasps=order)
+        if not verdict.ok:
+            tried = getattr(verdict, "tried", ())
+            for t in tried:
+                costs.avoid(state, move, t.grasp, geo.place.name)
+            if not tried:  # failed before any grasp: the move, at that place, in that state
+                costs.avoid(state, move, None, geo.place.name)
+            failure = {"move": str(move), "place": geo.place.name, "failure": verdict.failure}
+            return tuple(bound), failure
+        bound.append(GeoMove(geo.obj, geo.place, verdict.grasp))
+        world = moved(world, geo.obj, geo.place.pose)
+        state = apply_move(bridged.problem, state, move)
+    return tuple(bound), None
+
+
+def _packs(bridged: Bridged) -> dict:
+    return {
+        r: {"ok": p.ok, "time_s": round(p.time, 4), "overlap_m": round(p.overlap, 5)}
+        for r, p in bridged.packs
+    }
+
+
+def _planner_stats(result, costs: GeoCosts) -> dict:
+    out = {
+        "windows": result.stats.get("windows", 0),
+        "plan_s": result.stats.get("time_s", 0.0),
+        "priced_states": costs.stats["states"],
+        "ms_per_state": 1000 * costs.stats["price_s"] / max(costs.stats["states"], 1),
+    }
+    if "fallback" in result.stats:
+        out["fallback"] = result.stats["fallback"]
+    return out
+
+
+def _done(status, moves, reason, stats, t0, plans, failures) -> GeoPlan:
+    stats = {**stats, "time_s": time.perf_counter() - t0, "plans": plans, "failures": failures}
+    return GeoPlan(status, tuple(moves), reason, stats)

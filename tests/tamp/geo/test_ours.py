@@ -1,0 +1,130 @@
+"""Motion-aware planning of scene-file problems (`tamp.geo.ours.plan_motion_aware`): a
+hemmed-in target is reached by moving a neighbour first, four cubes go into a tray that holds
+them only when packed (the sampled packer's cells fail at the same budget), a move the full
+check refuses is fed back and planned around, and UNSOLVABLE means the planner's fallback
+proved it within the discretised places."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from tamp.geo.bridge import PACK
+from tamp.geo.check import MoveCheck
+from tamp.geo.ours import PLANNER, OursConfig, as_ours, plan_motion_aware
+from tamp.geo.pack import pack_sampled
+from tamp.geo.search import SearchConfig
+from tamp.geo.types import GeoStatus, moved
+from tamp.world.geometry import of_movable, penetration
+from tamp.world.goal import parse_goal
+from tamp.world.relations import read_facts
+from tests.tamp.geo.geo_scenes import blocked, cube, scene, tools
+
+# walled tray, inner 0.17 x 0.24 m: four 5 cm cubes fit with the hand's room only when packed
+TIGHT = {"name": "tray", "min": [0.44, 0.12], "max": [0.63, 0.38], "wall_height": 0.03}
+
+
+def _replay(world, moves):
+    for m in moves:
+        world = moved(world, m.obj, m.place.pose)
+    return world
+
+
+def _no_overlap(world) -> bool:
+    solids = [of_movable(o) for o in world.objects]
+    return all(penetration(u, v) == 0 for i, u in enumerate(solids) for v in solids[i + 1 :])
+
+
+def test_a_hemmed_in_target_is_reached_by_moving_a_neighbour_first():
+    s = blocked()
+    goal = parse_goal("(in t goal)", s)
+    result = plan_motion_aware(s, goal, tools())
+    assert result.status is GeoStatus.SOLVED, result.reason
+    assert len(result.moves) >= 2 and result.moves[-1].obj == "t"
+    assert result.moves[0].obj in {"n", "w", "e"}  # a neighbour first
+    assert all(m.grasp is not None for m in result.moves)  # each bound by the full check
+    end = _replay(s, result.moves)
+    assert goal.holds(read_facts(end)) and _no_overlap(end)
+    assert result.stats["ms_per_state"] > 0 and result.stats["failures"] == []
+
+
+def test_four_cubes_go_into_a_tray_that_holds_them_only_when_packed():
+    s = scene(
+        cube("a", 0.40, -0.25),
+        cube("b", 0.50, -0.25),
+        cube("c", 0.60, -0.25),
+        cube("d", 0.45, -0.10),
+        regions=[TIGHT],
+    )
+    goal = parse_goal("(and (in a tray) (in b tray) (in c tray) (in d tray))", s)
+    result = plan_motion_aware(s, goal, tools())
+    assert result.status is GeoStatus.SOLVED, result.reason
+    assert len(result.moves) == 4 and {m.place.target for m in result.moves} == {"tray"}
+    end = _replay(s, result.moves)
+    assert goal.holds(read_facts(end)) and _no_overlap(end)
+    # the sampled packer, at the gradient packer's budget (R rows x steps), finds no cells
+    budget = PACK.restarts * PACK.steps
+    half = [(0.025, 0.025)] * 4
+    sampled = pack_sampled(s.region("tray").inner(), half, budget=budget, seed=0, config=PACK)
+    assert not sampled.ok
+    print(
+        f"packed: gradient {result.stats['packs']['tray']}, sampled ok={sampled.ok} "
+        f"in {sampled.time:.3f} s ({sampled.tries} samples); plan {result.stats['time_s']:.1f} s"
+    )
+
+
+class _Refuse:
+    """A move check that refuses the first ``n`` moves it sees, then passes everything."""
+
+    def __init__(self, n: int) -> None:
+        self.n, self.seen = n, []
+
+    def __call__(self, world, move, tools, grasps=()):
+        self.seen.append((move.obj, move.place.name))
+        if len(self.seen) <= self.n:
+            return MoveCheck(ok=False, failure="collision", evidence={"fake": True})
+        return MoveCheck(ok=True, grasp=grasps[0] if grasps else None)
+
+
+FAST = OursConfig(planner=replace(PLANNER, max_windows=4, restarts=4, iters=30), replans=2)
+
+
+def test_a_move_the_full_check_refuses_is_planned_around_and_the_replans_are_bounded():
+    s = scene(cube("a", 0.45, 0.2), cube("b", 0.55, 0.2))
+    goal = parse_goal("(in a goal)", s)
+    once = _Refuse(1)
+    result = plan_motion_aware(s, goal, None, FAST, check=once)
+    assert result.status is GeoStatus.SOLVED and result.stats["plans"] == 2
+    (failed,) = result.stats["failures"]
+    assert (result.moves[0].obj, result.moves[0].place.name) != once.seen[0]  # not that again
+    assert failed["place"] == once.seen[0][1]
+    always = _Refuse(10**6)
+    result = plan_motion_aware(s, goal, None, FAST, check=always)
+    assert result.status is GeoStatus.BUDGET and "replan budget" in result.reason
+    assert len(result.stats["failures"]) == FAST.replans + 1
+    assert len(set(always.seen)) == len(always.seen)  # each failure ruled out where it failed
+
+
+def test_unsolvable_only_when_the_fallback_proves_it_within_the_places():
+    posts = [
+        {"name": f"post{i}", "centre": [0.5 + dx, dy, 0.04], "half": [hx, hy, 0.04]}
+        for i, (dx, dy, hx, hy) in enumerate(
+            [
+                (0.045, 0.0, 0.01, 0.05),
+                (-0.045, 0.0, 0.01, 0.05),
+                (0.0, 0.045, 0.03, 0.01),
+                (0.0, -0.045, 0.03, 0.01),
+            ]
+        )
+    ]
+    s = scene(cube("t", 0.5, 0.0), obstacles=posts)
+    goal = parse_goal("(in t goal)", s)
+    result = plan_motion_aware(s, goal, None, FAST, check=_Refuse(10**6))
+    assert result.status is GeoStatus.UNSOLVABLE
+    assert result.reason.startswith("within the discretised places: no plan exists")
+    assert result.stats["fallback"]["status"] == "unsolvable"
+
+
+def test_the_episode_planners_shared_config_is_accepted():
+    ours = as_ours(SearchConfig(max_time_s=30.0, seed=3, choices=("top",)))
+    assert ours.seed == 3 and ours.planner.time_limit_s == 30.0 and ours.costs.choices == ("top",)
+    assert ours.planner.fallback is True
