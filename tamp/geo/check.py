@@ -273,12 +273,20 @@ def _contact(phase: str, hit) -> dict:
 
 
 def check_move(
-    scene: Scene, move: GeoMove, tools: Tools, grasps=None, q_now=None, seed: int = 0
+    scene: Scene,
+    move: GeoMove,
+    tools: Tools,
+    grasps=None,
+    q_now=None,
+    seed: int = 0,
+    full: bool = True,
 ) -> MoveCheck:
     """Decide ``move`` in ``scene`` (see the module docstring). ``grasps``: the candidates to
     try (default: ``move.grasp`` when set, else `candidate_grasps` in `grasp_order`);
     ``q_now`` (J,): where the arm starts (default ``tools.q``); ``seed`` seeds the motion
-    planner when ``tools.guard.plan`` reroutes blocked phases."""
+    planner when ``tools.guard.plan`` reroutes blocked phases. ``full`` False: the verdict of
+    `quick_check` alone (ok with the first grasp it passes, no phases), the cheap test a search
+    expands with before the full check has the final word."""
     t0 = time.perf_counter()
     tools.checks += 1
 
@@ -306,7 +314,7 @@ def check_move(
         return verdict(ok=False, failure="no_grasp", evidence={"object": o.name, "kind": o.kind})
     q = tools.q if q_now is None else np.asarray(q_now, dtype=np.float64)
     support = support_box(scene, dict(facts.supports).get(o.name, TABLE))
-    quick = quick_check(scene, move, tools, grasps, q) if tools.quick else {}
+    quick = quick_check(scene, move, tools, grasps, q) if tools.quick or not full else {}
     tried, last = [], ("collision", {})
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
     for g in grasps:
@@ -317,6 +325,9 @@ def check_move(
             tried.append(GraspTry(g.name, early[0], early[1], where, other, quick=True))
             last = (early[0], {"grasp": g.name, **early[2]})
             continue
+        if not full:
+            tried.append(GraspTry(g.name, None, quick=True))
+            return verdict(ok=True, grasp=g, tried=tuple(tried), evidence={"quick": True})
         result = _plan_grasp(scene, o, move, g, support, heights, tools, q, seed)
         if isinstance(result, tuple):  # the phases that work
             tried.append(GraspTry(g.name, None))

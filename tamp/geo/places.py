@@ -42,7 +42,9 @@ from task.problem import TABLE
 
 SUPPORT_PAD = 0.002  # m, an object's footprint may reach this far past the top it stands on
 REGION_GAP = 0.02  # m, between neighbouring grid places in a region (a finger's room)
-REGION_CLEARANCE = 0.004  # m, a region place keeps this far from the other objects
+REGION_CLEARANCE = 0.003  # m, a region place keeps this far from the other objects
+PACK_GAP = 0.004  # m, a packing place stands this far from the object it packs against
+PACK_MARGIN = 0.002  # m, ... and this far inside the region's inner rectangle
 TABLE_PITCH = 0.08  # m, the table grid's spacing
 TABLE_REACH = (0.30, 0.70)  # m, table spots lie this far from the robot base's z axis
 TABLE_CLEARANCE = 0.04  # m, a table spot keeps this far from objects, regions and obstacles
@@ -76,10 +78,13 @@ def candidate_places(
         valid = [*sorted(objects - {obj}), *sorted(regions), TABLE]
         raise SceneFileError(f"unknown place target {one_of(target, valid)}")
     out = []
+    clearance = _clearance(target, objects, regions)
     for place in pool:
         if len(out) >= n:
             break
-        if free(scene, obj, place, _clearance(target, objects, regions)):
+        if target == TABLE and not _table_spot(scene, o, place):
+            continue
+        if free(scene, obj, place, clearance):
             out.append(place)
     return tuple(out)
 
@@ -90,18 +95,27 @@ def free(scene: Scene, obj: str, place: Place, clearance: float = 0.0) -> bool:
     whose height range it shares (objects under it: at most `OVERLAP` deep)."""
     me = placed_solid(scene.object(obj), place)
     for s in fixed_solids(scene):
-        if penetration(me, s) > OVERLAP:
+        if not apart(me, s, 0.0) and penetration(me, s) > OVERLAP:
             return False
     for x in scene.objects:
         if x.name == obj:
             continue
         s = of_movable(x)
+        if apart(me, s, clearance):
+            continue
         shared = min(me.top, s.top) - max(me.bottom, s.bottom) > OVERLAP
         if shared and footprint_gap(me, s) < clearance - 1e-9:
             return False
         if penetration(me, s) > OVERLAP:
             return False
     return True
+
+
+def apart(a: Solid, b: Solid, gap: float) -> bool:
+    """True when the footprints of ``a`` and ``b`` are surely more than ``gap`` (m) apart
+    (their bounding circles are): a cheap test before `footprint_gap`."""
+    reach = math.hypot(a.half[0], a.half[1]) + math.hypot(b.half[0], b.half[1])
+    return math.dist(a.centre[:2], b.centre[:2]) - reach > gap
 
 
 def placed_solid(o: Movable, place: Place) -> Solid:
@@ -111,8 +125,11 @@ def placed_solid(o: Movable, place: Place) -> Solid:
 
 def supported_on(o: Movable, below: Movable, yaw: float) -> bool:
     """True when ``o`` turned ``yaw``, centred on ``below``'s top, has its whole footprint
-    within that top grown by `SUPPORT_PAD` (a cylinder's footprint: its bounding square)."""
+    within that top grown by `SUPPORT_PAD` (a disc: its radius within the top's)."""
     top = of_movable(below)
+    if o.kind == "cylinder":
+        room = below.half[0] if below.kind == "cylinder" else min(below.half[:2])
+        return o.half[0] <= room + SUPPORT_PAD
     me = Solid(o.name, False, below.pose.xyz, o.half, yaw)
     return all(top.covers(c, SUPPORT_PAD) for c in me.corners())
 
@@ -153,12 +170,31 @@ def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> 
     (x0, y0), (x1, y1) = r.inner()
     z = r.surface + o.half[2]
     centre = ((x0 + x1) / 2, (y0 + y1) / 2)
-    grid, drawn = [], []
+    grid, drawn, packed = [], [], []
+    inside_now = [
+        of_movable(x)
+        for x in scene.objects
+        if x.name != o.name
+        and r.lo[0] <= x.pose.xyz[0] <= r.hi[0]
+        and r.lo[1] <= x.pose.xyz[1] <= r.hi[1]
+    ]
     for suffix, yaw in _yaws(o, 0.0):
         hx, hy = _extent(o, yaw)
-        lo, hi = (x0 + hx, y0 + hy), (x1 - hx, y1 - hy)
+        lo, hi = (
+            (x0 + hx + PACK_MARGIN, y0 + hy + PACK_MARGIN),
+            (x1 - hx - PACK_MARGIN, y1 - hy - PACK_MARGIN),
+        )
         if lo[0] > hi[0] + 1e-9 or lo[1] > hi[1] + 1e-9:
             continue  # the object does not fit inside the region at this yaw
+        xs, ys = {lo[0], hi[0]}, {lo[1], hi[1]}
+        for s in inside_now:
+            ex, ey = _extent_of(s)
+            xs |= {s.centre[0] + ex + PACK_GAP + hx, s.centre[0] - ex - PACK_GAP - hx}
+            ys |= {s.centre[1] + ey + PACK_GAP + hy, s.centre[1] - ey - PACK_GAP - hy}
+        for x, y in sorted((x, y) for x in xs for y in ys):
+            if lo[0] - 1e-9 <= x <= hi[0] + 1e-9 and lo[1] - 1e-9 <= y <= hi[1] + 1e-9:
+                name = f"{r.name}.p{round(x * 1000)}_{round(y * 1000)}{suffix}"
+                packed.append(Place(name, r.name, (x, y, z), yaw))
         xs = _centred(lo[0], hi[0], 2 * hx + REGION_GAP)
         ys = _centred(lo[1], hi[1], 2 * hy + REGION_GAP)
         for i, (x, y) in enumerate((x, y) for x in xs for y in ys):
@@ -171,7 +207,15 @@ def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> 
     def near(place: Place) -> float:
         return math.dist(place.xyz[:2], centre)
 
-    return sorted(grid, key=near) + sorted(drawn, key=near)
+    return packed + sorted(grid, key=near) + sorted(drawn, key=near)
+
+
+def _extent_of(s: Solid) -> tuple[float, float]:
+    """Half extents along x and y of solid ``s``'s footprint (its bounding box)."""
+    if s.cylinder:
+        return s.half[0], s.half[1]
+    c, n = abs(math.cos(s.yaw)), abs(math.sin(s.yaw))
+    return c * s.half[0] + n * s.half[1], n * s.half[0] + c * s.half[1]
 
 
 def _extent(o: Movable, yaw: float) -> tuple[float, float]:
@@ -206,7 +250,7 @@ def _on_table(scene: Scene, o: Movable, seed: int) -> list[Place]:
     ]
     here = o.pose.xyz[:2]
     grid.sort(key=lambda place: math.dist(place.xyz[:2], here))
-    return [p for p in (*slots, *grid) if _table_spot(scene, o, p)]
+    return [*slots, *grid]  # `_table_spot` filters them as they are taken
 
 
 def _table_spot(scene: Scene, o: Movable, place: Place) -> bool:
@@ -223,9 +267,10 @@ def _table_spot(scene: Scene, o: Movable, place: Place) -> bool:
             ((r.lo[0] + r.hi[0]) / 2, (r.lo[1] + r.hi[1]) / 2, 0.0),
             ((r.hi[0] - r.lo[0]) / 2, (r.hi[1] - r.lo[1]) / 2, 1.0),
         )
-        if footprint_gap(me, rect) < TABLE_CLEARANCE:
+        if not apart(me, rect, TABLE_CLEARANCE) and footprint_gap(me, rect) < TABLE_CLEARANCE:
             return False
     for s in fixed_solids(scene):
-        if s.bottom < me.top and footprint_gap(me, s) < TABLE_CLEARANCE:
+        near = s.bottom < me.top and not apart(me, s, TABLE_CLEARANCE)
+        if near and footprint_gap(me, s) < TABLE_CLEARANCE:
             return False
     return True

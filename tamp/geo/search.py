@@ -4,15 +4,22 @@ planner of the geometric TAMP room over its discretised grasp and placement choi
 A node is a world state (a `Scene` with the objects' poses; its facts read from the geometry),
 its key the objects' poses rounded to a millimetre. A successor moves one clear object onto a
 clear object, into a region or onto the table, at one of `candidate_places` (``places`` per
-target). Successors are queued A*-like, f = g + h with g the moves so far and h (`heuristic`)
-the objects that must still move at least once: the subjects of the unmet goal atoms and
-everything stacked above an object such an atom needs to move or to uncover (admissible, so the
-first plan found is a shortest one among the feasible choices). Ties go to the deeper node,
-then to the better-ranked place, then to objects nearer the goal's objects (the blockers).
+target). Successors are queued with f = g + weight * h, g the moves so far and h
+`_Guide.estimate`: the objects that must still move (`heuristic`: the unmet goal atoms'
+subjects and whatever is stacked on what they move or uncover) plus the neighbours hemming one
+of them in (`_Guide.blockers`, the reference open hand of `tamp.world.canonical`), twice for a
+neighbour that stands where the goal wants it (it must go out and come back). A move of an
+object no goal atom plausibly involves, or of the object the last move moved, costs 1 more.
+These are orderings, not prunings; h is a guide, not a bound, so a plan is short, not
+guaranteed shortest. Ties go to the deeper node, then to the better-ranked place.
 
 Feasibility is decided when a successor is popped, not when it is generated (PDDLStream's
-incremental idea): `tamp.geo.check.check_move` with the grasps the failure memory has not
-ruled out. The memory records what failed where it failed:
+incremental idea), first by the cheap test (`check_move(..., full=False)`: one batched IK call
+of the grasp and place poses of every open grasp, the arm tested for collisions there), and
+when a goal state is reached, by the full check of each of the plan's moves in order
+(`check_move`: every waypoint's IK, every phase guarded). A move the full check refuses goes
+into the failure memory and the search runs again (the cheap verdicts cached), so the full
+check has the final word. The memory records what failed where it failed:
 
 - a grasp that failed on the pick side (reaching or closing on the object) is ruled out for
   that object in that neighbourhood (its pose and those of the objects within `NEAR`), for
@@ -41,7 +48,7 @@ import numpy as np
 
 from motion.grasps import world_tcp
 from tamp.geo.check import MoveCheck, Tools, candidate_grasps, check_move, grasp_order
-from tamp.geo.places import candidate_places, supported_on
+from tamp.geo.places import apart, candidate_places, supported_on
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, Place, moved
 from tamp.world.geometry import fixed_solids, footprint_gap, of_movable
 from tamp.world.goal import Goal
@@ -91,6 +98,10 @@ def heuristic(supports: dict, goal: Goal) -> int:
     """The objects that must move at least once: each unmet goal atom's subject (``clear x``:
     whatever is on x) and everything stacked above an object an unmet atom moves or uncovers.
     ``supports``: object -> what it rests on."""
+    return len(_movers(supports, goal))
+
+
+def _movers(supports: dict, goal: Goal) -> set[str]:
     above: dict[str, list[str]] = {}
     for x, s in supports.items():
         above.setdefault(s, []).append(x)
@@ -114,7 +125,7 @@ def heuristic(supports: dict, goal: Goal) -> int:
         movers |= {atom[1]} | stack(atom[1])
         if atom[0] == "on":
             movers |= stack(atom[2])
-    return len(movers)
+    return movers
 
 
 def _holds(atom: Atom, supports: dict) -> bool:
@@ -129,7 +140,12 @@ def _holds(atom: Atom, supports: dict) -> bool:
 def _neighbourhood(scene: Scene, obj: str) -> tuple:
     """``obj``'s pose and those of the objects within `NEAR` of it, rounded (a memory key)."""
     me = of_movable(scene.object(obj))
-    near = [x for x in scene.objects if x.name == obj or footprint_gap(me, of_movable(x)) < NEAR]
+    near = [
+        x
+        for x in scene.objects
+        if x.name == obj
+        or (not apart(me, of_movable(x), NEAR) and footprint_gap(me, of_movable(x)) < NEAR)
+    ]
     return tuple((x.name, *(round(v, 3) for v in x.pose.xyz)) for x in near)
 
 
@@ -207,32 +223,84 @@ def dead_goal(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> s
 
 def plan_search(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig = DEFAULT) -> GeoPlan:
     """Plan moves from ``scene`` to ``goal`` (see the module docstring). ``stats``: nodes
-    (expanded), generated, checks (`check_move` calls), failures (checks that failed),
+    (expanded, all rounds), generated, checks (`check_move` calls: quick and full),
+    full_checks, failures (checks that failed), restarts (plans a full check refused),
     ruled_out (grasps the failure memory skipped), time_s, check_time_s."""
     t0 = time.perf_counter()
-    stats = {"nodes": 0, "generated": 0, "checks": 0, "failures": 0, "check_time_s": 0.0}
+    stats = {
+        "nodes": 0,
+        "generated": 0,
+        "checks": 0,
+        "full_checks": 0,
+        "failures": 0,
+        "restarts": 0,
+        "check_time_s": 0.0,
+    }
+    memory = _Memory(scene)
 
     def end(status: GeoStatus, reason: str = "", moves=()) -> GeoPlan:
         stats["ruled_out"] = memory.ruled_out
         stats["time_s"] = time.perf_counter() - t0
         return GeoPlan(status, tuple(moves), reason, stats)
 
-    memory = _Memory(scene)
-    start = _Node(scene, dict(read_facts(scene).supports), 0, None, None)
+    if goal.holds(read_facts(scene)):
+        return end(GeoStatus.SOLVED, "the goal holds already")
     dead = dead_goal(scene, goal, tools, config)
     if dead:
         return end(GeoStatus.UNSOLVABLE, f"no plan: {dead}")
+    cache: dict[tuple, MoveCheck] = {}  # (state key, object, place name) -> quick verdict
+    while True:
+        found = _search(scene, goal, tools, config, memory, cache, stats, t0)
+        if isinstance(found, tuple):  # (status, reason): no plan this round
+            return end(*found)
+        verified = _verify(scene, found, tools, config, memory, cache, stats)
+        if verified is not None:
+            return end(GeoStatus.SOLVED, f"a plan of {len(verified)} moves", verified)
+        stats["restarts"] += 1
+
+
+def _verify(scene, moves, tools, config, memory, cache, stats) -> list[GeoMove] | None:
+    """The full check of each move of a plan found with quick checks, in order: the moves
+    with the grasps that passed, or None after recording the first failure in the memory and
+    the cache (the next round searches around it)."""
+    world, out = scene, []
+    for move in moves:
+        key = state_key(world)
+        o = world.object(move.obj)
+        grasps = memory.open(world, key, move, candidate_grasps(o, config.choices))
+        first = [g for g in grasps if move.grasp is not None and g.name == move.grasp.name]
+        grasps = (*first, *grasp_order(world, o, [g for g in grasps if g not in first]))
+        check = check_move(world, GeoMove(move.obj, move.place), tools, grasps=grasps)
+        _count(stats, check, full=True)
+        if not check.ok:
+            memory.record(world, key, move, check)
+            cache[(key, move.obj, move.place.name)] = check
+            return None
+        out.append(replace(move, grasp=check.grasp))
+        world = moved(world, move.obj, move.place.pose)
+    return out
+
+
+def _count(stats: dict, check: MoveCheck, full: bool) -> None:
+    stats["checks"] += 1
+    stats["full_checks"] += full
+    stats["failures"] += not check.ok
+    stats["check_time_s"] += check.time_s
+
+
+def _search(scene, goal, tools, config, memory, cache, stats, t0):
+    """One round of the best-first search with quick checks: the moves of a plan, or
+    (status, reason) when the round ends without one."""
+    start = _Node(scene, dict(read_facts(scene).supports), 0, None, None)
     nodes = [start]
     closed = {state_key(scene)}
-    goal_objects = [of_movable(scene.object(a[1])) for a in goal.atoms]
-    if goal.holds(read_facts(scene)):
-        return end(GeoStatus.SOLVED, "the goal holds already")
+    guide = _Guide(goal)
     tie = itertools.count()
     queue: list = []
-    _expand(0, nodes, goal, config, queue, tie, goal_objects, stats)
+    _expand(0, nodes, goal, config, queue, tie, guide, stats)
     while queue:
         if time.perf_counter() - t0 > config.max_time_s:
-            return end(GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (time)")
+            return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (time)"
         *_, parent_id, move = heapq.heappop(queue)
         parent = nodes[parent_id]
         child = moved(parent.scene, move.obj, move.place.pose)
@@ -240,32 +308,37 @@ def plan_search(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig = D
         if key in closed:
             continue
         parent_key = state_key(parent.scene)
-        o = parent.scene.object(move.obj)
-        grasps = memory.open(parent.scene, parent_key, move, candidate_grasps(o, config.choices))
-        if not grasps:
-            continue
-        check = check_move(parent.scene, move, tools, grasps=grasp_order(parent.scene, o, grasps))
-        stats["checks"] += 1
-        stats["check_time_s"] += check.time_s
-        if not check.ok:
-            stats["failures"] += 1
-            memory.record(parent.scene, parent_key, move, check)
+        known = cache.get((parent_key, move.obj, move.place.name))
+        if known is None:
+            o = parent.scene.object(move.obj)
+            grasps = memory.open(
+                parent.scene, parent_key, move, candidate_grasps(o, config.choices)
+            )
+            if not grasps:
+                continue
+            grasps = grasp_order(parent.scene, o, grasps)
+            known = check_move(parent.scene, move, tools, grasps=grasps, full=False)
+            _count(stats, known, full=False)
+            cache[(parent_key, move.obj, move.place.name)] = known
+            if not known.ok:
+                memory.record(parent.scene, parent_key, move, known)
+        if not known.ok:
             continue
         closed.add(key)
         facts = read_facts(child)
-        done = replace(move, grasp=check.grasp)
+        done = replace(move, grasp=known.grasp)
         node = _Node(child, dict(facts.supports), parent.g + 1, parent_id, done)
         nodes.append(node)
         if goal.holds(facts):
-            return end(GeoStatus.SOLVED, f"a plan of {node.g} moves", _path(nodes, len(nodes) - 1))
+            return _path(nodes, len(nodes) - 1)
         if stats["nodes"] >= config.max_nodes:
-            return end(GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (nodes)")
-        _expand(len(nodes) - 1, nodes, goal, config, queue, tie, goal_objects, stats)
-    grasps = ", ".join(config.choices)
-    return end(
+            return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (nodes)"
+        _expand(len(nodes) - 1, nodes, goal, config, queue, tie, guide, stats)
+    return (
         GeoStatus.UNSOLVABLE,
         f"no plan within the discretised choices: {config.places} places per target, grasps "
-        f"{grasps} ({len(closed)} states reached, {stats['failures']} checks failed)",
+        f"{', '.join(config.choices)} ({len(closed)} states reached, {stats['failures']} "
+        "checks failed)",
     )
 
 
@@ -277,19 +350,79 @@ def _path(nodes: list[_Node], i: int) -> list[GeoMove]:
     return out[::-1]
 
 
-def _expand(i, nodes, goal, config, queue, tie, goal_objects, stats) -> None:
+class _Guide:
+    """The search's guidance beyond `heuristic`: how many neighbours hem in an object that must
+    move (`blockers`), and which objects a plan plausibly moves at all (`relevant`)."""
+
+    def __init__(self, goal: Goal) -> None:
+        self.goal = goal
+        self.subjects = {a[1] for a in goal.atoms if a[0] != "clear"}
+        self._blockers: dict[tuple, frozenset[str]] = {}
+
+    def blockers(self, scene: Scene, x: str) -> frozenset[str]:
+        """The neighbours of ``x`` that hem in every top-down grasp of it (the reference open
+        hand of `tamp.world.canonical.free_top_axes`): none when one is free; else the first
+        neighbour, or pair of neighbours, whose removal frees one; none when no such set
+        exists (posts or walls hem it in, or no top grasp fits: side grasps may)."""
+        from tamp.world.canonical import free_top_axes
+
+        hood = _neighbourhood(scene, x)
+        if hood not in self._blockers:
+            near = [h[0] for h in hood if h[0] != x]
+            found: frozenset[str] = frozenset()
+            if near and not free_top_axes(scene, x):
+                for k in (1, 2):
+                    sets = (frozenset(c) for c in itertools.combinations(near, k))
+                    found = next((c for c in sets if free_top_axes(scene, x, without=c)), found)
+                    if found:
+                        break
+            self._blockers[hood] = found
+        return self._blockers[hood]
+
+    def estimate(self, scene: Scene, supports: dict) -> int:
+        """`heuristic`'s movers plus the objects hemming them in (`blockers`), twice for a
+        blocker whose own goal atoms hold now (it must go out and come back): a guide, not a
+        bound."""
+        must = self.movers(supports)
+        hemming: set[str] = set()
+        for x in must:
+            hemming |= self.blockers(scene, x)
+        back = {y for y in hemming - must if y in self.subjects}
+        return len(must | hemming) + len(back)
+
+    def movers(self, supports: dict) -> set[str]:
+        return _movers(supports, self.goal)
+
+    def relevant(self, scene: Scene, supports: dict) -> set[str]:
+        """The objects that must move, those near them (blockers), and those in or on the
+        regions and objects unmet goal atoms put things in or on."""
+        must = self.movers(supports)
+        out = set(must)
+        solids = {o.name: of_movable(o) for o in scene.objects}
+        for x in must:
+            out |= {y for y, s in solids.items() if footprint_gap(solids[x], s) < NEAR}
+        for atom in self.goal.atoms:
+            if atom[0] in ("in", "on") and not _holds(atom, supports):
+                out |= {y for y, s in supports.items() if s == atom[2]}
+        return out
+
+
+def _expand(i, nodes, goal, config, queue, tie, guide, stats) -> None:
     """Queue every successor of node ``i`` unchecked, keyed (f, -g, place rank, distance of
-    the moved object to the goal's objects, insertion)."""
+    the moved object to the goal's objects, insertion); f = g + weight (h + blockers) plus a
+    penalty of 1 for moving an object no goal atom plausibly involves and 1 for moving the
+    object the last move moved (orderings only: nothing is pruned); h is `_Guide.estimate`."""
     node = nodes[i]
     stats["nodes"] += 1
     scene, supports = node.scene, node.supports
     under = set(supports.values())
     clear = [o.name for o in scene.objects if o.name not in under and o.name in supports]
     targets = [*clear, *(r.name for r in scene.regions), TABLE]
+    relevant = guide.relevant(scene, supports)
+    last = None if node.move is None else node.move.obj
     g = node.g + 1
     for x in clear:
-        me = of_movable(scene.object(x))
-        near = min((footprint_gap(me, s) for s in goal_objects if s.name != x), default=0.0)
+        penalty = (x not in relevant) + (x == last)
         for target in targets:
             if target == x or (target == supports[x] and target not in (TABLE, *_regions(scene))):
                 continue
@@ -300,9 +433,11 @@ def _expand(i, nodes, goal, config, queue, tie, goal_objects, stats) -> None:
                     continue
                 after = dict(supports)
                 after[x] = target
-                f = g + config.weight * heuristic(after, goal)
+                child = moved(scene, x, place.pose)
+                h = guide.estimate(child, after)
+                f = g + config.weight * h + penalty
                 stats["generated"] += 1
-                heapq.heappush(queue, (f, -g, rank, near, next(tie), i, GeoMove(x, place)))
+                heapq.heappush(queue, (f, -g, rank, next(tie), i, GeoMove(x, place)))
 
 
 def _regions(scene: Scene) -> tuple[str, ...]:

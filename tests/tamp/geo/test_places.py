@@ -40,12 +40,17 @@ def test_region_places_lie_inside_the_walls_free_of_the_object_already_there():
     assert len({p.name for p in places}) == len(places)
 
 
-def test_region_places_come_nearest_the_centre_first_and_the_grid_before_samples():
-    s = scene(cube("b", 0.4, -0.1), regions=[TRAY])
-    places = candidate_places(s, "b", "tray", n=40)
+def test_region_places_pack_against_walls_and_objects_then_grid_then_samples():
+    s = scene(cube("a", 0.5, 0.2), cube("b", 0.4, -0.1), regions=[TRAY])
+    places = candidate_places(s, "b", "tray", n=60)
+    packed = [p for p in places if ".p" in p.name]
     grid = [p for p in places if ".g" in p.name]
     drawn = [p for p in places if ".s" in p.name]
-    assert places == (*grid, *drawn) and grid and drawn
+    assert places == (*packed, *grid, *drawn) and packed and grid and drawn
+    # flush against the walls (2 mm in) and 4 mm beside a
+    xs = {round(p.xyz[0], 4) for p in packed}
+    assert {0.487, 0.613, 0.554} <= xs
+    assert "tray.p554_187" in {p.name for p in packed}  # named by its position, in mm
 
     def far(p):
         return math.dist(p.xyz[:2], (0.55, 0.25))
