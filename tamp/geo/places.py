@@ -11,12 +11,15 @@ the failure memory's keys (`tamp.geo.search`), so a place is a stable choice, no
   *supported*: its footprint at that yaw lies within ``y``'s top grown by `SUPPORT_PAD` (a cube
   on a cube of its size or larger, a small disc on a large one; never a large object on a
   small one: it would tip or overhang). ``y`` must be clear of anything but ``obj``.
-- In a region ``r`` (``"r.g<i>"``, ``"r.s<j>"``): the grid over the inner rectangle (inside
-  the walls) at pitch object width + `REGION_GAP`, centred in the rectangle so a full grid
-  holds the most objects, nearest the region's centre first, then ``samples`` seeded uniform
-  positions (nearest the centre first); every one has the object's footprint inside the inner
-  rectangle and `REGION_CLEARANCE` from the other objects. Yaws: the region's axes (a
-  non-square cuboid also turned a quarter, suffix ``.r``).
+- In a region ``r`` (``"r.p<x>_<y>"``, ``"r.g<i>"``, ``"r.s<j>"``): first the packing
+  places, flush against the inner rectangle's edges (`PACK_MARGIN` in) and against the objects
+  already in the region (`PACK_GAP` beside them), every combination of those x and y in
+  order of x then y (columns filled from the low corner), named by their position in mm; then
+  the grid over the inner rectangle at pitch object width + `REGION_GAP`, centred in the
+  rectangle, nearest the region's centre first; then ``samples`` seeded uniform positions
+  (nearest the centre first). Every one has the object's footprint inside the inner rectangle
+  and `REGION_CLEARANCE` from the other objects. Yaws: the region's axes (a non-square cuboid
+  also turned a quarter, suffix ``.r``).
 - On the table (`task.problem.TABLE`; ``"table.s<i>"``, ``"table.g<i>"``): the scene's slot
   grid first (if it has one), then a grid of pitch `TABLE_PITCH` over the table within
   `TABLE_REACH` of the robot base's axis (its phase drawn from ``seed``), nearest the object
