@@ -12,8 +12,8 @@ world (the Panda at the origin facing +x, the table top at z = 0, metres and rad
 - ``sorting`` (Lagriffoul problem 3): 4-8 objects of 2-3 colours among posts, each to its
   colour's zone;
 - ``tall``: a tower of 8-10 cubes built or taken down at the edge of the arm's reach;
-- ``hanoi``: Tower of Hanoi, 3-5 discs on three pegs (marked regions); `hanoi_pddl` writes the
-  problem for ``task/data/hanoi.pddl`` from the scene's geometry.
+- ``hanoi``: Tower of Hanoi, 3-5 square discs on three pegs (marked regions that hold one
+  tower each); `hanoi_pddl` writes the problem for ``task/data/hanoi.pddl`` from the geometry.
 
 `generate(problem, seed, **size)` draws a variant from ``numpy.random.default_rng(seed)``
 (positions, yaws, colours, counts); every variant passes `tamp.world.load.load_scene`'s checks
@@ -824,31 +824,35 @@ def _tall(rng: np.random.Generator, n: int, mode: str) -> _Made | None:
 
 
 def _hanoi(rng: np.random.Generator, n: int) -> _Made | None:
-    """n discs (flat cylinders or square boxes, widths evenly from ~3 to ~7 cm) stacked on
-    peg1 of three marked pegs 15-17 cm apart in a row across the robot's view."""
-    kind = "cylinder" if rng.random() < 0.5 else "cuboid"
-    widths = np.linspace(rng.uniform(0.03, 0.034), rng.uniform(0.066, 0.069), n)
+    """n square discs (widths evenly from ~4 to ~6.7 cm, each 2.4-2.8 cm thick) stacked on
+    peg1 of three marked pegs 15-17 cm apart in a row across the robot's view. A peg is only
+    6-10 mm wider than the largest disc, so no two discs fit in it side by side (two squares
+    fit in a square only when their sides add up to at most its side): every peg holds one
+    tower, as a peg does. Square, not round: two discs fit in a square diagonally when their
+    diameters add up to 1.17 of its side, and a square disc rests wholly on a wider one."""
+    widths = np.linspace(rng.uniform(0.04, 0.042), rng.uniform(0.065, 0.067), n)
     h = _size(rng.uniform(0.024, 0.028))
     x0, y0 = rng.uniform(0.46, 0.54), rng.uniform(-0.03, 0.03)
     pitch = rng.uniform(0.15, 0.17) * (1.0 if rng.random() < 0.5 else -1.0)
-    side = _size(max(widths) + rng.uniform(0.03, 0.035))
+    side = _size(max(widths) + rng.uniform(0.006, 0.01))
     pegs = tuple(
         _zone(f"peg{k + 1}", (x0, y0 + (k - 1) * pitch), (side, side), "white") for k in range(3)
     )
     colours = [str(c) for c in rng.permutation(COLOURS)]
-    yaw = rng.uniform(-0.3, 0.3) if kind == "cuboid" else 0.0
     cx, cy = (pegs[0].lo[0] + pegs[0].hi[0]) / 2, (pegs[0].lo[1] + pegs[0].hi[1]) / 2
     objects = []
     for level, i in enumerate(range(n, 0, -1)):  # the largest (d_n) at the bottom
         w = _size(widths[i - 1])
-        size = (w, h) if kind == "cylinder" else (w, w, h)
-        jx, jy = rng.uniform(-0.002, 0.002, 2)
+        jx, jy = rng.uniform(-0.001, 0.001, 2)
         z = h / 2 + level * h
-        objects.append(_movable(f"d{i}", kind, size, colours[i - 1], (cx + jx, cy + jy, z), yaw))
+        yaw = rng.uniform(-0.02, 0.02)
+        objects.append(
+            _movable(f"d{i}", "cuboid", (w, w, h), colours[i - 1], (cx + jx, cy + jy, z), yaw)
+        )
     objects.reverse()  # d1 .. dn
     atoms = [("in", f"d{n}", "peg3"), *(("on", f"d{i}", f"d{i + 1}") for i in range(1, n))]
     note = (
         f"{n} discs from peg1 to peg3 ({2**n - 1} moves at best): a disc goes only on a wider "
-        "one or an empty peg"
+        "one or an empty peg, which holds no two side by side"
     )
     return objects, pegs, (), atoms, note, ()
