@@ -7,4 +7,16 @@ goes to, and a move's feasibility is decided by the arm (IK and collision checks
 
 - `tamp.geo.types`: the values every part shares (`Place`, `GeoMove`, `GeoPlan`, `GeoStatus`)
   and the world after a move (`moved`).
+- `tamp.geo.places`: `candidate_places`, the discretised placements of an object on an
+  object, in a region or on the table, with names stable across world states.
+- `tamp.geo.check`: `check_move` (and its cheap half `quick_check`), a move decided by the
+  arm's IK and collision model, grasp by grasp; `Tools` builds those models once.
+- `tamp.geo.search`: `plan_search`, best-first search over world states with feasibility
+  checked lazily and a failure memory keyed by where each failure lies (`SearchConfig`).
+- `tamp.geo.baseline`: `plan_search_then_check`, symbolic planning, then binding to
+  geometry, failed moves forbidden, replanning.
+- `tamp.geo.execute`: `run_move`, one checked move run in a simulator with its failures read
+  from the gripper.
+- `tamp.geo.episode`: `run_geo_episode`, observe, plan, check, run and replan with one of the
+  planners (`PLANNERS`), a `GeoReport` scored on ground truth.
 """
