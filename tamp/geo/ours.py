@@ -84,11 +84,15 @@ def plan_motion_aware(
     tools,
     config=OursConfig(),
     check: Callable | None = None,
+    domain: tuple[str, ...] | None = None,
 ) -> GeoPlan:
     """Plan ``goal`` in ``scene`` (module docstring). ``tools``: `tamp.geo.check.Tools` (its
     ``solver`` and ``q`` also price the moves); ``config``: an `OursConfig` or the geometric
     planners' shared `tamp.geo.search.SearchConfig` (`as_ours`); ``check``: the move check
-    (default `tamp.geo.check.check_move`)."""
+    (default `tamp.geo.check.check_move`); ``domain``: ``(pddl_domain_text, binding_text)``
+    or ``(..., problem_text)`` to plan through that PDDL domain instead (`plan_pddl`)."""
+    if domain is not None:
+        return plan_pddl(scene, goal, tools, domain, config, check)
     t0 = time.perf_counter()
     config = as_ours(config)
     check = check or _check()
@@ -175,3 +179,89 @@ def _planner_stats(result, costs: GeoCosts) -> dict:
 def _done(status, moves, reason, stats, t0, plans, failures) -> GeoPlan:
     stats = {**stats, "time_s": time.perf_counter() - t0, "plans": plans, "failures": failures}
     return GeoPlan(status, tuple(moves), reason, stats)
+
+
+# ---- a pick-and-place PDDL domain (Hanoi) ------------------------------------------------------
+
+
+def pddl_problem_text(scene: Scene, goal: Goal) -> str:
+    """The Hanoi problem PDDL of ``scene`` and ``goal`` (`tamp.world.canonical.hanoi_pddl`:
+    the discs and pegs, ``smaller`` by width, the state read from the geometry)."""
+    from types import SimpleNamespace
+
+    from tamp.world.canonical import hanoi_pddl
+
+    return hanoi_pddl(SimpleNamespace(scene=scene, goal=goal))
+
+
+def plan_pddl(
+    scene: Scene,
+    goal: Goal,
+    tools,
+    domain: tuple[str, ...],
+    config=OursConfig(),
+    check: Callable | None = None,
+) -> GeoPlan:
+    """Plan through a pick-and-place PDDL domain (module docstring). ``domain``:
+    ``(domain_text, binding_text)`` (the problem written by `pddl_problem_text`, Hanoi's) or
+    ``(domain_text, binding_text, problem_text)``. The lift plans with its fallback on; each
+    paired move goes onto a disc (centred on its top) or into a region at the first of
+    `candidate_places` (``config.table_places`` of them, default 8) that the full check passes.
+    A move none passes ends planning with BUDGET (the lift gets no failure memory)."""
+    from tamp.geo.places import candidate_places
+    from task.domains.strips import problem_from_text
+    from task.symbolic import pddl_io
+    from task.symbolic.pickplace import binding as binder
+
+    t0 = time.perf_counter()
+    config = as_ours(config)
+    check = check or _check()
+    domain_text, binding_text = domain[0], domain[1]
+    problem_text = domain[2] if len(domain) > 2 else pddl_problem_text(scene, goal)
+    lifted = problem_from_text(domain_text, problem_text, scene.name)
+    bound = binder.bind_text(binding_text, pddl_io.parse_domain(domain_text, "domain"))
+    planner = replace(
+        PlannerConfig.for_domain("strips"),
+        fallback=True,
+        max_windows=config.planner.max_windows,
+        time_limit_s=config.planner.time_limit_s,
+    )
+    result = plan(lifted, planner, seed=config.seed)
+    stats = {"windows": result.stats.get("windows", 0), "plan_s": result.stats.get("time_s")}
+    if "fallback" in result.stats:
+        stats["fallback"] = result.stats["fallback"]
+    if result.status is PlanStatus.UNSOLVABLE:
+        why = f"within the PDDL problem's moves: {stats['fallback']['reason']}"
+        return _done(GeoStatus.UNSOLVABLE, (), why, stats, t0, 1, [])
+    if not result.solved:
+        why = stats.get("fallback", {}).get("reason", "the windows ran out")
+        return _done(GeoStatus.BUDGET, (), why, stats, t0, 1, [])
+    world, out = scene, []
+    objects = {o.name for o in scene.objects}
+    for move in binder.to_moves(bound, result.plan.moves):
+        if move.target in objects:
+            places = (bridge_on(world, move.entity, move.target),)
+        else:
+            n = config.table_places or 8
+            places = candidate_places(world, move.entity, move.target, n, config.seed)
+        verdict, place = None, None
+        for place in places:
+            verdict = check(world, GeoMove(move.entity, place), tools)
+            if verdict.ok:
+                break
+        if verdict is None or not verdict.ok:
+            failure = {"move": str(move), "failure": None if verdict is None else verdict.failure}
+            why = f"{move}: no place of {len(places)} passes the full check"
+            return _done(GeoStatus.BUDGET, (), why, stats, t0, 1, [failure])
+        out.append(GeoMove(move.entity, place, verdict.grasp))
+        world = moved(world, move.entity, place.pose)
+    return _done(GeoStatus.SOLVED, out, "", stats, t0, 1, [])
+
+
+def bridge_on(world: Scene, obj: str, target: str):
+    """The place of ``obj`` centred on the top of object ``target`` in ``world``."""
+    from tamp.geo.types import Place
+
+    o, y = world.object(obj), world.object(target)
+    xyz = (y.pose.xyz[0], y.pose.xyz[1], y.top + o.half[2])
+    return Place(f"on.{y.name}", y.name, xyz, y.pose.yaw)

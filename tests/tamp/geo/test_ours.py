@@ -128,3 +128,27 @@ def test_the_episode_planners_shared_config_is_accepted():
     ours = as_ours(SearchConfig(max_time_s=30.0, seed=3, choices=("top",)))
     assert ours.seed == 3 and ours.planner.time_limit_s == 30.0 and ours.costs.choices == ("top",)
     assert ours.planner.fallback is True
+
+
+def _hanoi(check, n: int = 3):
+    from tamp.world.canonical import generate
+    from task.symbolic.pickplace import hanoi
+
+    made = generate("hanoi", 0, n=n)
+    domain = (hanoi.domain_text(), hanoi.BINDING)
+    one = OursConfig(planner=replace(PLANNER, max_windows=1))  # then the lift's fallback
+    return made, plan_motion_aware(made.scene, made.goal, None, one, check, domain=domain)
+
+
+def test_hanoi_is_planned_through_its_pddl_domain_and_mapped_to_moves_onto_discs_and_pegs():
+    made, result = _hanoi(_Refuse(0), n=3)
+    assert result.status is GeoStatus.SOLVED, result.reason
+    assert len(result.moves) >= 7  # the optimum is 2^3 - 1
+    world, pegs = made.scene, {r.name for r in made.scene.regions}
+    for m in result.moves:
+        target = m.place.target
+        if target not in pegs:  # onto a disc: a wider one
+            assert 2 * world.object(target).half[0] > 2 * world.object(m.obj).half[0]
+        world = moved(world, m.obj, m.place.pose)
+    facts = read_facts(world)
+    assert made.goal.holds(facts) and not facts.unexplained and _no_overlap(world)
