@@ -3,6 +3,12 @@
 0: success (a valid plan); 1: no plan or an invalid plan (an empty plan file that does not reach
 the goal included, as in ``tamp run --plan``). Bad input raises `TampError`, which
 `tamp.cli.main` turns into one ``tamp: error:`` line and exit code 2.
+
+``tamp plan`` tells an unsolvable problem from a planner out of budget
+(`task.symbolic.proofs`): the cheap proofs run before planning, exhaustive search after the
+planner found no plan; the output is ``unsolvable: REASON`` or ``no plan found within
+BUDGET``, both exit code 1. A plan is printed (and written to ``--out``) only when it
+validates against the PDDL.
 """
 
 from __future__ import annotations
@@ -25,8 +31,11 @@ from task.instances import Instance, example, from_files
 from task.planner import plan
 from task.problem import Move, PlanResult
 from task.symbolic import pddl_io, strips
+from task.symbolic.proofs import Proof, prove_unsolvable
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
+
+PROOF_LIMIT_S = 10.0  # seconds each proof of unsolvability may take (h^2, exhaustive search)
 
 
 def _write(path: Path, text: str) -> None:
@@ -85,12 +94,17 @@ def _plan_json(
     actions: tuple,
     validation: Validation | None,
     seed: int,
+    proof: Proof | None = None,
 ) -> str:
+    """The ``--json`` report; ``status`` is "unsolvable" when ``proof`` proves it, and
+    ``proof`` says what was tried when the planner found no plan."""
+    unsolvable = proof is not None and proof.unsolvable
     return json.dumps(
         {
             "problem": result.problem.name,
-            "status": result.status.value,
+            "status": "unsolvable" if unsolvable else result.status.value,
             "valid": validation is not None and validation.valid,
+            "proof": None if proof is None else {"reason": proof.reason, "method": proof.method},
             "domain_rules": result.problem.domain,
             "moves": [_move_json(m) for m in result.plan.moves],
             "actions": [str(a).lower() for a in actions],
@@ -121,7 +135,13 @@ def _places(result: PlanResult) -> str:
     return f"table places (m, base frame): {where}\n"
 
 
-def _outcome(result: PlanResult, validation: Validation | None, instance: Instance) -> str:
+def _outcome(
+    result: PlanResult,
+    validation: Validation | None,
+    instance: Instance,
+    config: PlannerConfig,
+) -> str:
+    """The validation line of a plan, else ``no plan found within BUDGET`` (`_budget`)."""
     windows, moves = result.stats.get("windows", 0), len(result.plan)
     took = (
         f"{moves} move{'' if moves == 1 else 's'}, {windows} window{'' if windows == 1 else 's'}, "
@@ -130,9 +150,21 @@ def _outcome(result: PlanResult, validation: Validation | None, instance: Instan
     if validation is None:
         left = " ".join(strips.atom_str(a) for a in _unmet(result, instance))
         if "time_limit" in result.stats:
-            return f"NO PLAN within the limit: {result.stats['time_limit']}; unmet: {left}"
-        return f"NO PLAN: goal not reached after {took}; unmet: {left}"
+            return (
+                f"no plan found within the time limit: {result.stats['time_limit']}; unmet: {left}"
+            )
+        budget = _budget(result, config)
+        return f"no plan found within {budget}: goal not reached after {took}; unmet: {left}"
     return f"{report.validation_line(validation)} ({took})"
+
+
+def _budget(result: PlanResult, config: PlannerConfig) -> str:
+    """What the planner was allowed: its windows, and the fallback search's expansions when
+    that ran."""
+    windows = f"{config.max_windows} window{'' if config.max_windows == 1 else 's'}"
+    if "fallback" not in result.stats:
+        return windows
+    return f"{windows} and {config.fallback_nodes} fallback search expansions"
 
 
 def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
@@ -147,22 +179,71 @@ def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
     return [a for a in strips.goal_atoms(instance.pddl) if a not in holds]
 
 
+def _proved_first(args: argparse.Namespace) -> Proof:
+    """The cheap proofs (`prove_unsolvable` without search) on the PDDL files, after they
+    parse and stay within the STRIPS the planners plan (else `TampError`, exit code 2)."""
+    domain_text = pddl_io.read_text(args.domain)
+    domain = pddl_io.parse_domain(domain_text, str(args.domain))
+    pddl_io.check_strips(domain_text, str(args.domain))
+    problem_text = pddl_io.read_text(args.problem)
+    problem = pddl_io.parse_problem(problem_text, str(args.problem), domain)
+    pddl_io.check_strips(problem_text, str(args.problem))
+    return prove_unsolvable(domain, problem, time_limit_s=PROOF_LIMIT_S)
+
+
+def _proved_after(domain: Domain, instance: Instance, args: argparse.Namespace) -> Proof:
+    """Exhaustive search too, once the planner found no plan (within the time limit when
+    one is given, else `PROOF_LIMIT_S`)."""
+    limit = min(PROOF_LIMIT_S, getattr(args, "time_limit_s", None) or PROOF_LIMIT_S)
+    return prove_unsolvable(domain, instance.pddl, exhaustive=True, time_limit_s=limit)
+
+
+def _proof_json(instance_name: str, proof: Proof, seed: int) -> str:
+    return json.dumps(
+        {
+            "problem": instance_name,
+            "status": "unsolvable",
+            "valid": False,
+            "reason": proof.reason,
+            "method": proof.method,
+            "actions": [],
+            "seed": seed,
+        },
+        indent=2,
+    )
+
+
 def plan_command(args: argparse.Namespace) -> int:
-    """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line."""
+    """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line; ``unsolvable:
+    REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
     check_workcell(args, executes=False)
     out_file(args.out)
+    proof = _proved_first(args)
+    if proof.unsolvable:
+        if args.json:
+            print(_proof_json(Path(args.problem).stem, proof, args.seed))
+        else:
+            print(f"unsolvable: {proof.reason}")
+        return 1
     domain, instance = from_files(args.domain, args.problem, args.domain_rules)
-    recorded, _, result, actions, validation = _solve(domain, instance, args)
-    if args.out is not None and validation is not None:
+    recorded, config, result, actions, validation = _solve(domain, instance, args)
+    valid = validation is not None and validation.valid
+    if validation is None:
+        proof = _proved_after(domain, instance, args)
+    if args.out is not None and valid:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:
-        print(_plan_json(recorded, result, actions, validation, args.seed))
+        print(_plan_json(recorded, result, actions, validation, args.seed, proof))
+    elif proof.unsolvable:
+        print(f"unsolvable: {proof.reason}")
     else:
-        if actions:
+        if valid:
             print(pddl_io.format_plan(actions), end="")
             print(_places(result), end="")
-        print(_outcome(result, validation, instance))
-    return 0 if validation is not None and validation.valid else 1
+        print(_outcome(result, validation, instance, config))
+        if validation is None:
+            print(f"({proof.reason})")
+    return 0 if valid else 1
 
 
 def validate_command(args: argparse.Namespace) -> int:
@@ -207,7 +288,7 @@ def example_command(args: argparse.Namespace) -> int:
         f"PDDL plan ({blocksworld.PDDL_DOMAIN}):",
         pddl_io.format_plan(actions).rstrip(),
         "",
-        _outcome(result, validation, instance),
+        _outcome(result, validation, instance, config),
     ]
     print("\n".join(lines))
     if written:

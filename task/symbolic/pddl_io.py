@@ -102,38 +102,296 @@ def _parse(text: str, start: str, transformer: lark.Transformer, source: str) ->
         raise PDDLError(f"{source}: invalid {start}: {_one_line(exc)}") from None
 
 
-_TYPES = re.compile(r"\(\s*:types\b", re.IGNORECASE)
-_REQUIREMENTS = re.compile(r"\(\s*:requirements\b", re.IGNORECASE)
+# --------------------------------------------------------------- PDDL as other tools write it
+
+_KEYWORD = re.compile(
+    r"(?<![^\s()])(:[a-z][\w-]*|define|domain|problem|and|or|not|imply|either|object|forall"
+    r"|exists|when|oneof|number|increase|decrease|assign|scale-up|scale-down|maximize"
+    r"|minimize)(?![^\s()])",
+    re.IGNORECASE,
+)
+_TOKEN = re.compile(r";[^\n]*|\(|\)|[^\s();]+")
+_HEADERS = (":requirements", ":types", ":constants", ":predicates", ":functions")
+_KNOWN_REQUIREMENTS = frozenset(
+    (
+        *(":strips", ":typing", ":equality", ":non-deterministic", ":negative-preconditions"),
+        *(":disjunctive-preconditions", ":existential-preconditions", ":adl", ":fluents"),
+        *(":universal-preconditions", ":quantified-preconditions", ":derived-predicates"),
+        *(":conditional-effects", ":numeric-fluents", ":action-costs"),
+    )
+)
+_OBJECT_TYPE = re.compile(r"(?<![^\s()])-\s+object(?![^\s()])")
 
 
-def _implied_typing(text: str) -> str:
-    """Domain text with ``:typing`` added to its requirements when it declares ``(:types``
-    without it: many IPC domains (miconic, say) do, and Fast Downward and VAL accept them."""
-    body = re.sub(r";[^\n]*", " ", text)
-    if not _TYPES.search(body) or re.search(r":typing\b", body, re.IGNORECASE):
-        return text
-    if _REQUIREMENTS.search(text):
-        return _REQUIREMENTS.sub(lambda m: m.group(0) + " :typing", text, count=1)
-    return re.sub(
-        r"(\(\s*domain\s+[^\s()]+\s*\))",
-        lambda m: m.group(1) + " (:requirements :typing)",
+@dataclass(frozen=True)
+class _Word:
+    text: str
+    start: int
+    line: int
+
+
+@dataclass(frozen=True)
+class _Node:
+    """One parenthesised list of PDDL text: its span (``start`` at ``(``, ``end`` after
+    ``)``), the line it opens on and its items (words and lists), comments dropped."""
+
+    start: int
+    end: int
+    line: int
+    items: tuple
+
+    @property
+    def head(self) -> str:
+        """The first word, lowercased ("" when the list is empty or opens with a list)."""
+        first = self.items[0] if self.items else None
+        return first.text.lower() if isinstance(first, _Word) else ""
+
+
+def _read_tree(text: str) -> tuple | None:
+    """The top-level lists of ``text`` (None when its parentheses do not balance: the
+    parser says where)."""
+    stack: list[list] = [[]]
+    opened: list[tuple[int, int]] = []
+    line = 1
+    last = 0
+    for match in _TOKEN.finditer(text):
+        token, start = match.group(0), match.start()
+        line += text.count("\n", last, start)
+        last = start
+        if token.startswith(";"):
+            continue
+        if token == "(":
+            stack.append([])
+            opened.append((start, line))
+        elif token == ")":
+            if not opened:
+                return None
+            items, (begin, at) = stack.pop(), opened.pop()
+            stack[-1].append(_Node(begin, match.end(), at, tuple(items)))
+        else:
+            stack[-1].append(_Word(token, start, line))
+    return tuple(n for n in stack[0] if isinstance(n, _Node)) if not opened else None
+
+
+def _define(text: str) -> _Node | None:
+    """The ``(define ...)`` list of PDDL text (None if there is none or it does not balance)."""
+    tree = _read_tree(text)
+    found = [n for n in tree or () if n.head == "define"]
+    return found[0] if found else None
+
+
+def _blank(text: str) -> str:
+    """``text`` with every character but newlines made a space (lines and columns kept)."""
+    return re.sub(r"[^\n]", " ", text)
+
+
+def _edit(text: str, edits: list[tuple[int, int, str]]) -> str:
+    for start, end, new in sorted(edits, reverse=True):
+        text = text[:start] + new + text[end:]
+    return text
+
+
+def _lists(node: _Node):
+    """Every list inside ``node``, itself included, depth first."""
+    yield node
+    for item in node.items:
+        if isinstance(item, _Node):
+            yield from _lists(item)
+
+
+def _after(node: _Node, keyword: str) -> object | None:
+    """The item after ``keyword`` in ``node`` (an action's ``:precondition``, say)."""
+    words = [i for i, x in enumerate(node.items) if isinstance(x, _Word)]
+    for i in words:
+        if node.items[i].text.lower() == keyword and i + 1 < len(node.items):
+            return node.items[i + 1]
+    return None
+
+
+def _requirements(text: str, root: _Node) -> list[tuple[int, int, str]]:
+    """Edits that add the requirements a domain uses without declaring (``:typing`` for
+    declared types, ``:equality`` for ``=``: many IPC domains omit them, and Fast
+    Downward and VAL read them anyway) and blank the ones this parser does not know."""
+    body = " ".join(
+        text[n.start : n.end] for n in root.items[2:] if isinstance(n, _Node) and n.head
+    )
+    body = re.sub(r";[^\n]*", " ", body)
+    needs = []
+    if re.search(r"\(\s*:types\s*[^\s)]", body):
+        needs.append(":typing")
+    if re.search(r"\(\s*=\s", body):
+        needs.append(":equality")
+    section = next((n for n in root.items if isinstance(n, _Node) and n.head == _HEADERS[0]), None)
+    edits = []
+    declared = set()
+    for word in section.items[1:] if section is not None else ():
+        declared.add(word.text if isinstance(word, _Word) else "")
+        if isinstance(word, _Word) and word.text not in _KNOWN_REQUIREMENTS:
+            edits.append((word.start, word.start + len(word.text), _blank(word.text)))
+    missing = [r for r in needs if r not in declared]
+    if section is not None and len(section.items) - len(edits) > 1:
+        where = section.items[0].start + len(section.items[0].text)
+        edits.append((where, where, "".join(" " + r for r in missing)))
+    elif missing or section is not None:
+        if section is not None:
+            edits.append((section.start, section.end, _blank(text[section.start : section.end])))
+        where = root.items[1].end if len(root.items) > 1 else root.start + 1
+        if missing:
+            edits.append((where, where, f" (:requirements {' '.join(missing)})"))
+    return edits
+
+
+def _keywords(text: str) -> str:
+    """``text`` with PDDL's keywords lowercased and every ``- object`` annotation blanked
+    outside ``(:types)`` (an untyped name is an object: Tarski's writer types everything
+    ``- object``, often with no ``(:types)`` to declare it)."""
+    text = _KEYWORD.sub(lambda m: m.group(0).lower(), text)
+    root = _define(text)
+    types = [n for n in root.items if isinstance(n, _Node) and n.head == ":types"] if root else []
+    return _edit(
         text,
-        count=1,
-        flags=re.IGNORECASE,
+        [
+            (m.start(), m.end(), _blank(m.group(0)))
+            for m in _OBJECT_TYPE.finditer(text)
+            if not any(n.start < m.start() < n.end for n in types)
+        ],
     )
 
 
+def _domain_style(text: str) -> str:
+    """Domain text as the `pddl` grammar reads it, meaning unchanged: keywords lowercased
+    (PDDL is case-insensitive; the IPC's files often shout), empty header sections dropped
+    (``(:types)``, ``(:constants)``, ``(:functions)``, as Tarski's writer leaves them),
+    undeclared requirements implied (`_requirements`), ``:precondition (and)`` for an
+    action without one, and the header sections put in the order of the grammar. Lines and
+    columns are kept, so parse errors point into the file as written (except where sections
+    had to be reordered)."""
+    text = _keywords(text)
+    root = _define(text)
+    if root is None:
+        return text
+    edits = _requirements(text, root)
+    for node in root.items[2:]:
+        if not isinstance(node, _Node):
+            continue
+        if node.head in _HEADERS[1:] and len(node.items) == 1:
+            edits.append((node.start, node.end, _blank(text[node.start : node.end])))
+        if node.head == ":action" and _after(node, ":precondition") is None:
+            params = _after(node, ":parameters")
+            if isinstance(params, _Node):
+                edits.append((params.end, params.end, " :precondition (and)"))
+    text = _edit(text, edits)
+    return _in_grammar_order(text)
+
+
+def _in_grammar_order(text: str) -> str:
+    """Domain text with its header sections moved before the actions, in the grammar's order
+    (requirements, types, constants, predicates, functions); unchanged when already so."""
+    root = _define(text)
+    if root is None or len(root.items) < 3:
+        return text
+    parts = [n for n in root.items[2:] if isinstance(n, _Node)]
+    rank = [_HEADERS.index(n.head) if n.head in _HEADERS else len(_HEADERS) for n in parts]
+    if rank == sorted(rank):
+        return text
+    ordered = [n for _, n in sorted(zip(rank, parts, strict=True), key=lambda p: p[0])]
+    body = "\n  ".join(text[n.start : n.end] for n in ordered)
+    head = text[: root.items[1].end]
+    return f"{head}\n  {body})" + text[root.end :]
+
+
+def _problem_style(text: str) -> str:
+    """Problem text as the grammar reads it: keywords lowercased, an empty
+    ``(:requirements)`` dropped (lines and columns kept)."""
+    text = _keywords(text)
+    root = _define(text)
+    if root is None:
+        return text
+    edits = [
+        (n.start, n.end, _blank(text[n.start : n.end]))
+        for n in root.items[2:]
+        if isinstance(n, _Node) and n.head in (":requirements", ":objects") and len(n.items) == 1
+    ]
+    return _edit(text, edits)
+
+
+_PRECONDITION = {
+    "or": "disjunctive precondition (or)",
+    "imply": "disjunctive precondition (imply)",
+    "forall": "universal precondition (forall)",
+    "exists": "existential precondition (exists)",
+    **{op: f"numeric fluent ({op})" for op in (">", "<", ">=", "<=")},
+}
+_EFFECT = {
+    "when": "conditional effect (when)",
+    "forall": "universal effect (forall)",
+    "oneof": "non-deterministic effect (oneof)",
+    **{
+        op: f"numeric fluent ({op})"
+        for op in ("increase", "decrease", "assign", "scale-up", "scale-down")
+    },
+}
+_GOAL = {**_PRECONDITION, "not": "negative goal (not)"}
+_SUPPORTED = "STRIPS: and, atoms, not atoms in effects, = and not = in preconditions"
+
+
+def _first_beyond(node: object, features: dict[str, str], negative: str | None):
+    """The first list under ``node`` whose head is in ``features`` (or a ``not`` of anything
+    but ``=``, named ``negative``): ``(list, feature)`` or None."""
+    if not isinstance(node, _Node):
+        return None
+    for inner in _lists(node):
+        if inner.head in features:
+            return inner, features[inner.head]
+        if negative and inner.head == "not":
+            arg = inner.items[1] if len(inner.items) > 1 else None
+            if not (isinstance(arg, _Node) and arg.head == "="):
+                return inner, negative
+    return None
+
+
+def check_strips(text: str, source: str) -> None:
+    """PDDLError naming ``source``, the line and the feature of the first construct of domain
+    or problem text that the planners cannot plan with (they plan STRIPS with equality):
+    derived predicates, negative or disjunctive or quantified preconditions, conditional,
+    universal or non-deterministic effects, numeric fluents in actions (action costs
+    included), goals beyond a conjunction of atoms. Text that does not balance passes (the
+    parser says where)."""
+    root = _define(_keywords(text))
+    found = None
+    for node in root.items[2:] if root is not None else ():
+        if not isinstance(node, _Node) or found:
+            continue
+        if node.head == ":derived":
+            found = node, "derived predicate (:derived)"
+        elif node.head == ":action":
+            pre, eff = _after(node, ":precondition"), _after(node, ":effect")
+            found = _first_beyond(pre, _PRECONDITION, "negative precondition (not)")
+            found = found or _first_beyond(eff, _EFFECT, None)
+        elif node.head == ":goal":
+            found = _first_beyond(_after(node, ":goal"), _GOAL, None)
+    if found:
+        where, feature = found
+        snippet = _one_line(text[where.start : where.end])
+        snippet = snippet if len(snippet) <= 60 else snippet[:57] + "..."
+        raise PDDLError(
+            f"{source}: line {where.line}: {feature} {snippet} is not supported "
+            f"(supported: {_SUPPORTED})"
+        )
+
+
 def parse_domain(text: str, source: str = "<domain>") -> Domain:
-    """Parse domain PDDL text; ``source`` names it in error messages. A domain that declares
-    types without the ``:typing`` requirement is read as if it had it (`_implied_typing`)."""
-    return _parse(_implied_typing(text), "domain", DomainTransformer(), source)
+    """Parse domain PDDL text; ``source`` names it in error messages. Text as other tools
+    write it is read as they mean it (`_domain_style`: any case, empty sections, undeclared
+    requirements)."""
+    return _parse(_domain_style(text), "domain", DomainTransformer(), source)
 
 
 def parse_problem(
     text: str, source: str = "<problem>", domain: Domain | None = None
 ) -> PDDLProblem:
     """Parse problem PDDL text; if ``domain`` is given, its name must match ``:domain``."""
-    problem = _parse(text, "problem", ProblemTransformer(), source)
+    problem = _parse(_problem_style(text), "problem", ProblemTransformer(), source)
     if domain is not None and str(problem.domain_name).lower() != str(domain.name).lower():
         raise PDDLError(
             f"{source}: problem {problem.name} is for domain {str(problem.domain_name)!r}, "

@@ -110,7 +110,7 @@ def test_plan_without_a_plan_exits_1(capsys, files, monkeypatch):
 
     monkeypatch.setattr(commands, "plan", no_plan)
     assert main(["plan", *map(str, files)]) == 1
-    assert capsys.readouterr().out.startswith("NO PLAN: goal not reached after 0 moves")
+    assert capsys.readouterr().out.startswith("no plan found within 40 windows: goal not reached")
 
 
 def test_validate_names_the_first_failing_step(capsys, files, tmp_path):
@@ -231,6 +231,6 @@ def test_bad_run_and_motion_arguments_exit_2_with_one_line(argv, capsys):
 def test_plan_with_a_time_limit_says_how_far_it_got(capsys, files):
     assert main(["plan", *map(str, files), "--time-limit", "1e-9"]) == 1
     out = capsys.readouterr().out
-    assert out.startswith("NO PLAN within the limit: stopped at the 1e-09 s time limit")
+    assert out.startswith("no plan found within the time limit: stopped at the 1e-09 s time")
     assert main(["plan", *map(str, files), "--time-limit", "0"]) == 2
     assert "expected seconds > 0" in capsys.readouterr().err
