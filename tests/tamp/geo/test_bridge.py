@@ -1,4 +1,4 @@
-"""A scene and goal as a Blocksworld problem on places (`tamp.geo.bridge`): the problem an
+"""A scene and goal as a Blocksworld problem on places (`tamp.geo.ours.bridge`): the problem an
 inline tray scene gives, a plan of it mapped back to moves into the tray without overlap, the
 predicted worlds, what ontable and clear goals become, and the place-to-place moves the
 bridged problem allows (`task.domains.blocksworld.with_slots(hop=True)`)."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 import torch
 
-from tamp.geo.bridge import bridge
+from tamp.geo.ours.bridge import bridge
 from tamp.geo.types import moved
 from tamp.world.geometry import of_movable, penetration
 from tamp.world.goal import parse_goal

@@ -1,4 +1,4 @@
-"""The arm's prices of a bridged scene's moves (`tamp.geo.costs.GeoCosts`): the direct move of
+"""The arm's prices of a bridged scene's moves (`tamp.geo.ours.costs.GeoCosts`): the direct move of
 a hemmed-in target is IMPOSSIBLE (and the full check agrees) until a neighbour has moved, and
 the failure memory rules a move out only under the grasp and place that failed."""
 
@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import pytest
 
-from tamp.geo.bridge import bridge
 from tamp.geo.check import check_move
-from tamp.geo.costs import GeoCosts
+from tamp.geo.ours.bridge import bridge
+from tamp.geo.ours.costs import GeoCosts
 from tamp.world.goal import parse_goal
 from task.costs import IMPOSSIBLE
 from task.domains import blocksworld as bw

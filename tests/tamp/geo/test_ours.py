@@ -8,10 +8,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from tamp.geo.bridge import PACK
 from tamp.geo.check import MoveCheck
 from tamp.geo.ours import PLANNER, OursConfig, as_ours, plan_motion_aware
-from tamp.geo.pack import pack_sampled
+from tamp.geo.ours.bridge import PACK
+from tamp.geo.ours.pack import pack_sampled
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoStatus, moved
 from tamp.world.geometry import of_movable, penetration

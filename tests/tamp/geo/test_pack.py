@@ -1,4 +1,4 @@
-"""Gradient-optimised placements in a region (`tamp.geo.pack`): a region that holds five
+"""Gradient-optimised placements in a region (`tamp.geo.ours.pack`): a region that holds five
 squares only when they are placed tightly is packed from every seed, the packing loss's
 gradient matches finite differences, and the sampled baseline gives the same kind of answer."""
 
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import torch
 
-from tamp.geo.pack import PackConfig, PackError, overlap_loss, pack, pack_sampled
+from tamp.geo.ours.pack import PackConfig, PackError, overlap_loss, pack, pack_sampled
 
 TIGHT = ((0.0, 0.0), (0.17, 0.105))  # five 5 cm squares fill 70 % of it: 3 + 2 in two rows
 SQUARES = [(0.025, 0.025)] * 5

@@ -41,6 +41,7 @@ import numpy as np
 import torch
 
 from task.errors import TampError
+from task.optimize import Adam
 
 Rect = tuple[tuple[float, float], tuple[float, float]]  # ((x0, y0), (x1, y1)), m
 
@@ -179,7 +180,7 @@ def pack(
     span = torch.tensor(inner[1], dtype=torch.float64) - lo
     room = (span - 2 * half).clamp_min(0.0)  # (R, M, 2)
     u = torch.randn(r, m, 2, generator=gen, dtype=torch.float64).requires_grad_(True)
-    opt = torch.optim.Adam([u], lr=config.lr)
+    opt = Adam([{"params": [u], "lr": config.lr}])  # the planner's (no torch._dynamo import)
     fxy, fh = torch.from_numpy(fxy_np), torch.from_numpy(fh_np)
     steps = config.steps
 

@@ -1,13 +1,13 @@
 """A scene and its goal as a Blocksworld problem on capacity-one places, and back.
 
-The motion-aware planner (`tamp.geo.ours`) plans with the project's differentiable planner,
+The motion-aware planner (`tamp.geo.ours.planner`) plans with the project's differentiable planner,
 whose Blocksworld domain moves entities onto entities or onto K capacity-one places
 (`task.domains.blocksworld.with_slots`, here with ``hop``: a block may go from one place
 straight to another, e.g. from the table into a tray). `bridge` builds that problem:
 
 - entities: the scene's movable objects, in scene order;
 - places (`Site`), the K fixed targets:
-  - region cells: for each region the goal puts objects in, the cells `tamp.geo.pack.pack`
+  - region cells: for each region the goal puts objects in, the cells `tamp.geo.ours.pack.pack`
     places all of them at jointly (the region's inner rectangle, the objects already inside
     as fixed occupants, finger room for a top grasp): goal object i gets cell i,
     ``<region>.c<i>``;
@@ -28,7 +28,7 @@ And back: `Bridged.predict` gives the world after the plan reached a crisp state
 their observed poses unless moved; on a place: at its position; on an object: centred on its
 top, turned as it is), and `Bridged.geo_move` a planned move as a `GeoMove` in a world (the
 place's position, or centred on the top of the object it goes onto; grasp None: chosen when the
-move is bound, `tamp.geo.ours`).
+move is bound, `tamp.geo.ours.planner`).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tamp.geo.pack import PackConfig, PackResult, pack
+from tamp.geo.ours.pack import PackConfig, PackResult, pack
 from tamp.geo.places import TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose

@@ -1,6 +1,6 @@
 """The arm's price of every candidate move of a bridged scene, for the planner (`task.costs`).
 
-`GeoCosts` is a `task.costs.CostSource` for a `tamp.geo.bridge.Bridged` problem. For a window
+`GeoCosts` is a `task.costs.CostSource` for a `tamp.geo.ours.bridge.Bridged` problem. For a window
 starting in a crisp state it predicts the world (`Bridged.predict`: objects keep their observed
 poses unless moved; on a place: at its position; on an object: centred on its top), then
 prices each legal move x -> y of that state:
@@ -16,10 +16,10 @@ A grasp is free at a pose when the open hand (`motion.grasps.HAND_BOXES`, the pa
 fingers, as axis-aligned boxes around their turned corners) at that grasp overlaps no other
 object, obstacle, region wall or floor: the geometric half of `tamp.geo.check.quick_check`,
 without IK, for every grasp family at once. It is a proxy: the planner's moves are bound to a
-grasp by the full check (`tamp.geo.ours`), and what fails there comes back as failure memory:
-`avoid(state, move, grasp, place)` rules the move out only under the grasp (None: every grasp)
-and place that failed, so the same move keeps its price while another of its grasps is left,
-and x -> another place is priced on its own.
+grasp by the full check (`tamp.geo.ours.planner`), and what fails there comes back as failure
+memory: `avoid(state, move, grasp, place)` rules the move out only under the grasp (None:
+every grasp) and place that failed, so the same move keeps its price while another of its
+grasps is left, and x -> another place is priced on its own.
 
 Every state is priced once (cached); the IK solutions are cached by target position (to the
 mm) across states, so later windows solve only the targets they have not seen. ``stats``
@@ -38,7 +38,7 @@ import torch
 
 from motion.grasps import HAND_BOXES, Grasp, world_tcp
 from motion.ik import IKSolver, top_down_pose
-from tamp.geo.bridge import Bridged
+from tamp.geo.ours.bridge import Bridged
 from tamp.geo.places import free, supported_on
 from tamp.world.geometry import Solid, fixed_solids, of_movable
 from tamp.world.schema import Scene
@@ -112,7 +112,7 @@ class _Window:
         return []
 
     def commit(self, rows, moves) -> None:
-        """Nothing to record: the places are fixed before planning (`tamp.geo.pack`)."""
+        """Nothing to record: the places are fixed before planning (`tamp.geo.ours.pack`)."""
 
 
 class GeoCosts:

@@ -3,7 +3,8 @@
 `plan_motion_aware(scene, goal, tools, config)`:
 
 1. bridge the scene and goal to a Blocksworld problem on capacity-one places
-   (`tamp.geo.bridge`: the goal regions' cells placed jointly by gradient, `tamp.geo.pack`);
+   (`tamp.geo.ours.bridge`: the goal regions' cells placed jointly by gradient,
+   `tamp.geo.ours.pack`);
 2. plan it with `task.planner.plan` and the arm's prices in the objective (`GeoCosts`): the
    receding windows, then, when they revisit a state or run out, the planner's complete lazy
    fallback (`task.symbolic.lazy_search`) over the moves the prices allow;
@@ -30,9 +31,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
-from tamp.geo.bridge import PACK, Bridged, bridge
-from tamp.geo.costs import GeoCostConfig, GeoCosts
-from tamp.geo.pack import PackConfig
+from tamp.geo.ours.bridge import PACK, Bridged, bridge
+from tamp.geo.ours.costs import GeoCostConfig, GeoCosts
+from tamp.geo.ours.pack import PackConfig
 from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
