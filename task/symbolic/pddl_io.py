@@ -210,8 +210,10 @@ def _after(node: _Node, keyword: str) -> object | None:
 
 def _requirements(text: str, root: _Node) -> list[tuple[int, int, str]]:
     """Edits that add the requirements a domain uses without declaring (``:typing`` for
-    declared types, ``:equality`` for ``=``: many IPC domains omit them, and Fast
-    Downward and VAL read them anyway) and blank the ones this parser does not know."""
+    declared types, ``:equality`` for ``=``, ``:action-costs`` for ``(total-cost)``: many
+    IPC domains omit them, and Fast Downward and VAL read them anyway) and blank the ones
+    this parser does not know (``:durative-actions`` declared, say; a durative action
+    itself stays a parse error)."""
     body = " ".join(
         text[n.start : n.end] for n in root.items[2:] if isinstance(n, _Node) and n.head
     )
@@ -221,6 +223,8 @@ def _requirements(text: str, root: _Node) -> list[tuple[int, int, str]]:
         needs.append(":typing")
     if re.search(r"\(\s*=\s", body):
         needs.append(":equality")
+    if re.search(r"\(\s*total-cost\s*\)", body):
+        needs.append(":action-costs")
     section = next((n for n in root.items if isinstance(n, _Node) and n.head == _HEADERS[0]), None)
     edits = []
     declared = set()

@@ -93,7 +93,7 @@ def prove_unsolvable(
                 "exhaustive",
             )
         tried.append(_searched(found, max_states))
-    return Proof(False, "not proved unsolvable: " + ", ".join(tried))
+    return Proof(False, "not proved unsolvable; tried " + ", ".join(tried))
 
 
 def _searched(found: exhaust.Exhausted, max_states: int) -> str:
