@@ -14,7 +14,7 @@ are reused, not repeated.
 
 The constraints are symbolic, so the baseline is not complete over the geometric choices:
 when every symbolic plan is forbidden it ends UNSOLVABLE saying so, and BUDGET when
-``max_time_s`` (or ``max_nodes`` symbolic expansions in one search) runs out.
+``max_time_s`` (or ``symbolic_nodes`` expansions in one symbolic search) runs out.
 """
 
 from __future__ import annotations
@@ -112,11 +112,11 @@ def plan_search_then_check(
     while True:
         if time.perf_counter() - t0 > config.max_time_s:
             return end(GeoStatus.BUDGET, f"stopped after {stats['plans']} symbolic plans (time)")
-        plan, expanded = symbolic_plan(start, goal, targets, forbidden, config.max_nodes)
+        plan, expanded = symbolic_plan(start, goal, targets, forbidden, config.symbolic_nodes)
         stats["plans"] += 1
         stats["nodes"] += expanded
         if plan is None:
-            if expanded >= config.max_nodes:
+            if expanded >= config.symbolic_nodes:
                 return end(GeoStatus.BUDGET, f"symbolic search stopped at {expanded} expansions")
             return end(
                 GeoStatus.UNSOLVABLE,

@@ -117,7 +117,7 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
     t0 = time.perf_counter()
     start = tuple(read_facts(scene).supports)
     targets = (*(r.name for r in scene.regions), TABLE)
-    plan, expanded = symbolic_plan(start, goal, targets, set(), config.max_nodes)
+    plan, expanded = symbolic_plan(start, goal, targets, set(), config.symbolic_nodes)
     stats = {"nodes": expanded, "checks": 0, "failures": 0}
     if plan is None:
         stats["time_s"] = time.perf_counter() - t0

@@ -64,7 +64,8 @@ class SearchConfig:
 
     ``places``: candidate places per target (`candidate_places`' ``n``); ``choices``: the grasp
     families (`motion.grasps.grasps`); ``max_nodes``: states expanded; ``max_time_s``: wall
-    clock; ``seed``: the places' samples; ``weight``: 1 is A*, above 1 weighted A*."""
+    clock; ``seed``: the places' samples; ``weight``: 1 is A*, above 1 weighted A*;
+    ``symbolic_nodes``: expansions of one symbolic search (`tamp.geo.baseline`)."""
 
     max_nodes: int = 500
     max_time_s: float = 120.0
@@ -72,6 +73,7 @@ class SearchConfig:
     choices: tuple[str, ...] = ("top", "side", "tilt")
     seed: int = 0
     weight: float = 1.0
+    symbolic_nodes: int = 200_000  # the baseline's and soft's symbolic searches, per plan
 
 
 DEFAULT = SearchConfig()
