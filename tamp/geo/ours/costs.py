@@ -74,6 +74,18 @@ def hand_boxes(grasp: Grasp, xyz, yaw: float, margin: float = 0.0) -> np.ndarray
     return np.asarray(out)
 
 
+def hand_corners(grasps: Sequence[Grasp], margin: float = 0.0) -> np.ndarray:
+    """(G, 3, 8, 3) the corners (m) of the open hand's palm and finger boxes (grown by
+    ``margin``) at each grasp, in the frame of the object held (its centre, unturned)."""
+    out = np.zeros((len(grasps), len(HAND_BOXES), 8, 3))
+    for i, g in enumerate(grasps):
+        m = g.matrix  # (4, 4) TCP in the object frame
+        for k, (centre, half) in enumerate(HAND_BOXES):
+            pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
+            out[i, k] = pts @ m[:3, :3].T + m[:3, 3]
+    return out
+
+
 def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
     """(S, 2, 3) axis-aligned bounds (m) of upright solids (turned ones: their bounding box)."""
     out = []
@@ -84,17 +96,6 @@ def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
         half = np.array([hx, hy, s.half[2]]) if not s.cylinder else np.array(s.half)
         out.append((np.asarray(s.centre) - half, np.asarray(s.centre) + half))
     return np.asarray(out).reshape(-1, 2, 3)
-
-
-def hits(hand: np.ndarray, boxes: np.ndarray) -> bool:
-    """Whether any of the hand's boxes (H, 2, 3) overlaps any of ``boxes`` (S, 2, 3) deeper
-    than `TOUCH` along every axis."""
-    if not len(boxes):
-        return False
-    depth = np.minimum(hand[:, None, 1], boxes[None, :, 1]) - np.maximum(
-        hand[:, None, 0], boxes[None, :, 0]
-    )  # (H, S, 3)
-    return bool((depth > TOUCH).all(-1).any())
 
 
 class _Window:
@@ -137,6 +138,7 @@ class GeoCosts:
         self.grasps: dict[str, tuple[Grasp, ...]] = dict(grasps)
         self._base: dict[State, tuple[np.ndarray, dict]] = {}
         self._ik: dict[tuple[int, int, int], tuple[np.ndarray, bool]] = {}
+        self._hands: dict[str, np.ndarray] = {}  # object -> `hand_corners` of its grasps
         self.failed: dict[tuple[State, Move, str], set] = {}
         self.stats = {"states": 0, "price_s": 0.0, "ik_targets": 0}
 
@@ -230,11 +232,22 @@ class GeoCosts:
 
     def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, fixed, bodies) -> set[str]:
         """Names of x's grasps whose open hand, x centred at ``xyz`` turned ``yaw``, overlaps
-        nothing but x (the other objects where ``world`` has them, the fixed solids)."""
+        nothing but x (the other objects where ``world`` has them, the fixed solids); all of
+        x's grasps at once."""
         others = [bodies[o.name] for o in world.objects if o.name != x]
-        boxes = np.concatenate([fixed, *others]) if others else fixed
-        m = self.config.margin
-        return {g.name for g in self.grasps[x] if not hits(hand_boxes(g, xyz, yaw, m), boxes)}
+        boxes = np.concatenate([fixed, *others]) if others else fixed  # (S, 2, 3)
+        if x not in self._hands:
+            self._hands[x] = hand_corners(self.grasps[x], self.config.margin)
+        corners = self._hands[x]  # (G, 3, 8, 3) in x's frame
+        if not len(corners) or not len(boxes):
+            return {g.name for g in self.grasps[x]}
+        c, s = np.cos(yaw), np.sin(yaw)
+        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        pts = corners @ turn.T + np.asarray(xyz)  # (G, 3, 8, 3) in the world
+        lo, hi = pts.min(2), pts.max(2)  # (G, 3, 3)
+        depth = np.minimum(hi[:, :, None], boxes[:, 1]) - np.maximum(lo[:, :, None], boxes[:, 0])
+        hit = (depth > TOUCH).all(-1).any((1, 2))  # (G,)
+        return {g.name for g, h in zip(self.grasps[x], hit, strict=True) if not h}
 
     def _solve(self, points: list) -> tuple[np.ndarray, np.ndarray]:
         """Top-down IK (yaw 0) of every point (m), cached to the mm: (M, J), (M,)."""

@@ -4,11 +4,13 @@ the failure memory rules a move out only under the grasp and place that failed."
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
+from motion.grasps import grasps
 from tamp.geo.check import check_move
 from tamp.geo.ours.bridge import bridge
-from tamp.geo.ours.costs import GeoCosts
+from tamp.geo.ours.costs import GeoCosts, hand_boxes, hand_corners
 from tamp.world.goal import parse_goal
 from task.costs import IMPOSSIBLE
 from task.domains import blocksworld as bw
@@ -62,3 +64,15 @@ def test_a_failure_rules_a_move_out_only_under_its_grasp_and_place(priced):
     assert _price(costs, after, other) < IMPOSSIBLE  # t may still go to another place
     costs.avoid(after, other, None, "spot_n")  # every grasp at that place failed
     assert _price(costs, after, other) >= IMPOSSIBLE
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.4])
+def test_the_batched_hand_boxes_are_those_of_each_grasp_alone(yaw):
+    made = grasps("cuboid", (0.02, 0.03, 0.025))
+    corners = hand_corners(made, 0.004)  # (G, 3, 8, 3)
+    xyz = np.array([0.5, 0.1, 0.025])
+    turn = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
+    pts = corners @ turn.T + xyz
+    for i, g in enumerate(made):
+        one = hand_boxes(g, xyz, yaw, 0.004)  # (3, 2, 3)
+        assert np.allclose(one[:, 0], pts[i].min(1)) and np.allclose(one[:, 1], pts[i].max(1))
