@@ -120,7 +120,6 @@ _KNOWN_REQUIREMENTS = frozenset(
         *(":conditional-effects", ":numeric-fluents", ":action-costs"),
     )
 )
-_OBJECT_TYPE = re.compile(r"(?<![^\s()])-\s+object(?![^\s()])")
 
 
 @dataclass(frozen=True)
@@ -246,20 +245,25 @@ def _requirements(text: str, root: _Node) -> list[tuple[int, int, str]]:
 
 
 def _keywords(text: str) -> str:
-    """``text`` with PDDL's keywords lowercased and every ``- object`` annotation blanked
-    outside ``(:types)`` (an untyped name is an object: Tarski's writer types everything
-    ``- object``, often with no ``(:types)`` to declare it)."""
+    """``text`` with PDDL's keywords lowercased and the ``- object`` annotations that end a
+    typed list blanked outside ``(:types)``: an untyped name is an object (Tarski's writer
+    types everything ``- object``, often with no ``(:types)`` to declare it). A ``- object``
+    before another type stays: blanking it would give its names that type."""
     text = _KEYWORD.sub(lambda m: m.group(0).lower(), text)
-    root = _define(text)
-    types = [n for n in root.items if isinstance(n, _Node) and n.head == ":types"] if root else []
-    return _edit(
-        text,
-        [
-            (m.start(), m.end(), _blank(m.group(0)))
-            for m in _OBJECT_TYPE.finditer(text)
-            if not any(n.start < m.start() < n.end for n in types)
-        ],
-    )
+    edits = []
+    for top in _read_tree(text) or ():
+        for node in _lists(top):
+            if node.head == ":types":
+                continue
+            items = node.items
+            seps = [k for k, w in enumerate(items) if isinstance(w, _Word) and w.text == "-"]
+            for k in reversed(seps):
+                after = items[k + 1] if k + 1 < len(items) else None
+                if not (isinstance(after, _Word) and after.text == "object"):
+                    break  # a real type (or an either): the names before it keep theirs
+                start, end = items[k].start, after.start + len("object")
+                edits.append((start, end, _blank(text[start:end])))
+    return _edit(text, edits)
 
 
 def _domain_style(text: str) -> str:

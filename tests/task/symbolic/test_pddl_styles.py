@@ -169,3 +169,28 @@ def test_tamp_plan_refuses_an_unsupported_feature_in_one_line(capsys, tmp_path):
     problem.write_text("(define (problem x) (:domain d) (:objects o) (:init (p o)) (:goal (q o)))")
     assert main(["plan", str(domain), str(problem)]) == 2
     assert f"{domain}: line 8: conditional effect (when)" in one_line_error(capsys)
+
+
+def test_object_annotations_keep_every_name_its_type():
+    """``- object`` that ends a typed list is dropped (an untyped name is an object); the
+    names before another type keep that type."""
+    domain = pddl_io.parse_domain(
+        "(define (domain d) (:requirements :typing) (:types block)"
+        " (:predicates (p ?y - block ?x - object))"
+        " (:action a :parameters (?y - block ?x ?z - object) :precondition (p ?y ?x)"
+        " :effect (not (p ?y ?z))))",
+        "d",
+    )
+    params = {str(p.name): set(p.type_tags) for p in next(iter(domain.actions)).parameters}
+    assert params == {"y": {"block"}, "x": set(), "z": set()}
+    problem = pddl_io.parse_problem(
+        "(define (problem x) (:domain d) (:objects b - block a c - object)"
+        " (:init (p b a)) (:goal (and (p b c))))",
+        "x",
+        domain,
+    )
+    assert {str(o.name): set(o.type_tags) for o in problem.objects} == {
+        "b": {"block"},
+        "a": set(),
+        "c": set(),
+    }
