@@ -17,6 +17,10 @@ The loop is a few public steps, which `run` (through `play`) and
 `tamp.loop.given.GivenPlanEpisode` both drive: `start` a tally, `step` (plan when nothing is
 queued, then the next move), `execute` one move with its faults and its score, `check` what
 the robot observes after it, `observe`, `close`, and `report`.
+
+A ``recorder`` (`tamp.rerun_log.RerunRecorder`, an observer) is told of each plan, observation,
+phase, move, message and frame; while it records, the simulator calls back at the recorder's
+frame period and ``on_frame`` (a video) keeps the period the simulator had when `run` began.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ import time
 from collections import Counter
 from collections.abc import Callable, Mapping
 from contextlib import contextmanager
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,6 +52,9 @@ from tamp.slots import plan_on_places
 from task.domains import get_domain
 from task.planner import plan
 from task.problem import Move, Problem
+
+if TYPE_CHECKING:
+    from tamp.rerun_log import RerunRecorder
 
 # what the arm could not do (not a fault of the world): motion-aware planning prices the move out
 ARM_FAILURES = frozenset(
@@ -74,12 +82,16 @@ class Episode:
         on_event: Callable[[str], None] | None = None,
         solver: IKSolver | None = None,
         poses: Mapping[str, Pose] | None = None,
+        recorder: RerunRecorder | None = None,
     ) -> None:
         self.problem, self.config, self.seed = problem, config, seed
         self.domain = get_domain(problem.domain)
         self.rng = np.random.default_rng(seed)
         self.on_frame = on_frame
+        self.recorder = recorder
         self.say = on_event or (lambda text: None)
+        if recorder is not None:
+            self.say = self._recorded_say(self.say)
         self.solver = solver or IKSolver()
         if poses is None:  # laid out from the problem's initial state
             poses = layout(problem.entities, problem.init, config.scene, seed)
@@ -109,15 +121,29 @@ class Episode:
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
         if self.collision is not None:
             self.eyes.home_guard = self._home_guard
+        self._shown = (self.sim.frame_period, 0.0)  # on_frame's (period, next time) when recording
+        if recorder is not None:
+            recorder.begin(problem, self.sim, self.solver)
 
     def belief_lines(self) -> list[str]:
         """The last perceived soft state, one line per block (see `Observer.belief_lines`)."""
         return self.eyes.belief_lines()
 
     def run(self) -> EpisodeReport:
-        """Run the episode to the goal or a stop (`play`); closes the simulator."""
-        with _torch_threads(1):  # one small problem: thread hand-offs cost more than they give
-            return self.play()
+        """Run the episode to the goal or a stop (`play`); closes the simulator (and the
+        recorder's file)."""
+        if self.recorder is None:
+            with _torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+                return self.play()
+        self._shown = (self.sim.frame_period, 0.0)  # on_frame keeps the period set by now
+        self.sim.frame_period = self.recorder.period
+        report = None
+        try:
+            with _torch_threads(1):
+                report = self.play()
+        finally:
+            self.recorder.close(report)
+        return report
 
     def play(self) -> EpisodeReport:
         """The closed loop: `start`, then `step` until the goal or a stop; scores the goal on
@@ -194,6 +220,8 @@ class Episode:
         result = self._plan_window(basis, self.seed + len(p.plans))
         p.plan_time += time.perf_counter() - t0
         p.plans.append(tuple(str(m) for m in result.plan))
+        if self.recorder is not None:
+            self.recorder.planned(self.sim, len(p.plans), result)
         if len(p.plans) == 1:
             p.first_solved, p.first_plan = result.solved, result.plan.moves
         window = self.config.observe == "camera" and len(result.plan) > 0
@@ -310,7 +338,7 @@ class Episode:
         self.status_text = label
         cfg = self.config
         self._acts += 1
-        return execute_move(
+        done = execute_move(
             self.sim,
             self.solver,
             move,
@@ -318,20 +346,52 @@ class Episode:
             cfg.execution,
             cfg.scene,
             drop_at,
-            self.on_frame,
+            self._frames(),
             self.collision,
             self.seed * 1000 + self._acts,
+            on_phase=None if self.recorder is None else self.recorder.phase,
         )
+        if self.recorder is not None:
+            self.recorder.moved(self.sim, label, done)
+        return done
 
     def _settle(self) -> None:
-        self.eyes.settle(self.on_frame)
+        self.eyes.settle(self._frames())
 
     def _poses(self) -> dict[str, Pose]:
-        return self.eyes.poses(self.on_frame, self._show)
+        return self.eyes.poses(self._frames(), self._show)
 
     def observe(self) -> Reading:
         """The symbolic state the robot observes now (`Observer.read`)."""
-        return self.eyes.read(self.on_frame, self._show)
+        reading = self.eyes.read(self._frames(), self._show)
+        if self.recorder is not None:
+            image = self.eyes.image
+            support = None if reading.state is None else self.eyes.perceived  # not a stale one
+            self.recorder.observed(self.sim, reading, self.target.targets, image, support)
+        return reading
+
+    # --- the recorder ----------------------------------------------------------------------
+    def _frames(self) -> Callable[[Simulator], None] | None:
+        """What the simulator calls back each frame: ``on_frame``, or with a recorder
+        `_recorded_frame`."""
+        return self.on_frame if self.recorder is None else self._recorded_frame
+
+    def _recorded_frame(self, sim: Simulator) -> None:
+        """The recorder's frame, and ``on_frame`` on its own clock (`_shown`)."""
+        self.recorder.frame(sim)
+        period, due = self._shown
+        if self.on_frame is not None and sim.time >= due:
+            self.on_frame(sim)
+            self._shown = (period, max(due + period, sim.time))
+
+    def _recorded_say(self, say: Callable[[str], None]) -> Callable[[str], None]:
+        """``say``, and the message on the recording's time line."""
+
+        def both(text: str) -> None:
+            self.recorder.event(self.sim.time, text)
+            say(text)
+
+        return both
 
     def _show(self, text: str) -> None:
         self.status_text = text

@@ -230,12 +230,14 @@ def execute_move(
     on_frame: Callable[[Simulator], None] | None = None,
     collision: CollisionModel | None = None,
     seed: int = 0,
+    on_phase: Callable[[Simulator, Phase], None] | None = None,
 ) -> ExecutionResult:
     """Pick ``move.entity`` where it is observed and place it on ``move.target``.
 
     ``drop_at`` in [0, 1] opens the gripper at that fraction of the transit (fault injection).
     ``collision``: the arm's collision model (`robots.collision.PandaCollision`), which checks
     the planned phases unless ``config.collision`` is "off"; ``seed`` seeds the motion planner.
+    ``on_phase(sim, phase)`` is called as each planned phase starts (a recording, `tamp.rerun_log`).
     """
     wall0, sim0 = time.perf_counter(), sim.time
 
@@ -279,6 +281,8 @@ def execute_move(
         q = phase.trajectory.positions  # (S, J)
         times[2] += float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum())
         expected = _expected(phase.name, move.entity, supports)
+        if on_phase is not None:
+            on_phase(sim, phase)
         worst = max(worst, sim.run(phase.trajectory, phase.gripper, release, on_frame, expected))
         if worst > config.max_tracking:
             _back_off(sim, phases, on_frame, handling)

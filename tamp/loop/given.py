@@ -220,6 +220,8 @@ class GivenPlanEpisode(Episode):
         wall0 = time.perf_counter()
         p = Progress(self.problem.init, False)
         p.plans.append(tuple(s.label for s in self.steps))
+        if self.recorder is not None:
+            self.recorder.given(self.sim, p.plans[0])
         try:
             handed = self._given(p)
             while handed and not self.finished(p):
