@@ -35,7 +35,8 @@ from task.symbolic.proofs import Proof, prove_unsolvable
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
 
-PROOF_LIMIT_S = 10.0  # seconds each proof of unsolvability may take (h^2, exhaustive search)
+PROOF_FIRST_S = 3.0  # seconds the proofs before planning may take (h^2; grounding is unbounded)
+PROOF_AFTER_S = 10.0  # seconds the proofs after a failed plan may take (h^2, exhaustive search)
 
 
 def _write(path: Path, text: str) -> None:
@@ -179,29 +180,31 @@ def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
     return [a for a in strips.goal_atoms(instance.pddl) if a not in holds]
 
 
-def _proved_first(args: argparse.Namespace) -> Proof:
-    """The cheap proofs (`prove_unsolvable` without search) on the PDDL files, after they
-    parse and stay within the STRIPS the planners plan (else `TampError`, exit code 2)."""
+def _proved_first(args: argparse.Namespace) -> tuple[str, Proof]:
+    """The problem's name and the cheap proofs (`prove_unsolvable` without search) on the
+    PDDL files, after they parse and stay within the STRIPS the planners plan (else
+    `TampError`, exit code 2)."""
     domain_text = pddl_io.read_text(args.domain)
     domain = pddl_io.parse_domain(domain_text, str(args.domain))
     pddl_io.check_strips(domain_text, str(args.domain))
     problem_text = pddl_io.read_text(args.problem)
     problem = pddl_io.parse_problem(problem_text, str(args.problem), domain)
     pddl_io.check_strips(problem_text, str(args.problem))
-    return prove_unsolvable(domain, problem, time_limit_s=PROOF_LIMIT_S)
+    return str(problem.name), prove_unsolvable(domain, problem, time_limit_s=PROOF_FIRST_S)
 
 
 def _proved_after(domain: Domain, instance: Instance, args: argparse.Namespace) -> Proof:
     """Exhaustive search too, once the planner found no plan (within the time limit when
-    one is given, else `PROOF_LIMIT_S`)."""
-    limit = min(PROOF_LIMIT_S, getattr(args, "time_limit_s", None) or PROOF_LIMIT_S)
+    one is given, else `PROOF_AFTER_S`)."""
+    limit = min(PROOF_AFTER_S, getattr(args, "time_limit_s", None) or PROOF_AFTER_S)
     return prove_unsolvable(domain, instance.pddl, exhaustive=True, time_limit_s=limit)
 
 
-def _proof_json(instance_name: str, proof: Proof, seed: int) -> str:
+def _proof_json(name: str, proof: Proof, seed: int) -> str:
+    """The ``--json`` report of a problem proved unsolvable before planning."""
     return json.dumps(
         {
-            "problem": instance_name,
+            "problem": name,
             "status": "unsolvable",
             "valid": False,
             "reason": proof.reason,
@@ -218,31 +221,30 @@ def plan_command(args: argparse.Namespace) -> int:
     REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
     check_workcell(args, executes=False)
     out_file(args.out)
-    proof = _proved_first(args)
+    name, proof = _proved_first(args)
     if proof.unsolvable:
         if args.json:
-            print(_proof_json(Path(args.problem).stem, proof, args.seed))
+            print(_proof_json(name, proof, args.seed))
         else:
             print(f"unsolvable: {proof.reason}")
         return 1
     domain, instance = from_files(args.domain, args.problem, args.domain_rules)
     recorded, config, result, actions, validation = _solve(domain, instance, args)
     valid = validation is not None and validation.valid
-    if validation is None:
-        proof = _proved_after(domain, instance, args)
+    after = None if validation is not None else _proved_after(domain, instance, args)
     if args.out is not None and valid:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:
-        print(_plan_json(recorded, result, actions, validation, args.seed, proof))
-    elif proof.unsolvable:
-        print(f"unsolvable: {proof.reason}")
+        print(_plan_json(recorded, result, actions, validation, args.seed, after))
+    elif after is not None and after.unsolvable:
+        print(f"unsolvable: {after.reason}")
     else:
         if valid:
             print(pddl_io.format_plan(actions), end="")
             print(_places(result), end="")
         print(_outcome(result, validation, instance, config))
-        if validation is None:
-            print(f"({proof.reason})")
+        if after is not None:
+            print(f"({after.reason})")
     return 0 if valid else 1
 
 
