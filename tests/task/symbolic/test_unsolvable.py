@@ -175,6 +175,15 @@ def test_exhaustive_search_is_what_proves_three_in_two():
     )
 
 
+def test_a_partial_h2_fixpoint_proves_nothing():
+    """Out of time, h^2 stops before its fixpoint, where every unreached pair would look
+    like a mutex: it must say it ran out of time, not call the problem unsolvable."""
+    cycle = _blocks("(on a b) (on b c) (on c a)")
+    proof = _prove(BLOCKS, cycle, time_limit_s=0.0)
+    assert not proof.unsolvable and "h^2 ran out of time" in proof.reason
+    assert "h^2 skipped" in _prove(BLOCKS, cycle, max_atoms=3).reason
+
+
 def test_a_cycle_of_a_relation_that_may_loop_is_not_called_unsolvable():
     """``edge`` gains edges out of any free node, so the acyclicity invariant does not hold."""
     assert not _prove(LINKS, LINKS_PROBLEM).unsolvable
