@@ -270,7 +270,7 @@ def example_command(args: argparse.Namespace) -> int:
         for name in (data.DOMAIN_FILE, data.EXAMPLE_FILE):
             _write(out / name, data.read_text(name))
             written.append(name)
-        if validation is not None:
+        if validation is not None and validation.valid:
             _write(out / "example-5.plan", pddl_io.format_plan(actions))
             written.append("example-5.plan")
     if args.json:
@@ -288,7 +288,7 @@ def example_command(args: argparse.Namespace) -> int:
         *(f"  {k}. {m}" for k, m in enumerate(result.plan.moves, start=1)),
         "",
         f"PDDL plan ({blocksworld.PDDL_DOMAIN}):",
-        pddl_io.format_plan(actions).rstrip(),
+        pddl_io.format_plan(actions).rstrip() if validation and validation.valid else "(none)",
         "",
         _outcome(result, validation, instance, config),
     ]
