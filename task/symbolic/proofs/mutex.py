@@ -44,23 +44,33 @@ def _columns(task, atoms) -> np.ndarray:
 
 def h2(task, deadline: float | None = None) -> Pairs | None:
     """The h^2 fixpoint of ``task`` from its initial state; None when ``deadline``
-    (``time.perf_counter()`` seconds) passes first (a partial fixpoint proves nothing)."""
+    (``time.perf_counter()`` seconds) passes first (a partial fixpoint proves nothing).
+
+    An action is looked at again only when a row of ``pairs`` it reads (one per
+    precondition; the diagonal when it has none) changed since it last was: what it adds
+    depends on nothing else."""
     n = len(task.atoms)
     pre = [_columns(task, e.pre_pos) for e in task.effects]
     add = [_columns(task, e.add) for e in task.effects]
     delete = [_columns(task, e.delete - e.add) for e in task.effects]
     pairs = np.zeros((n, n), dtype=bool)  # (P, P)
     init = _columns(task, task.init)
-    pairs[np.ix_(init, init)] = True
+    for row in init:
+        pairs[row, init] = True
     applicable = np.zeros(len(task.effects), dtype=bool)  # (G,)
-    changed = True
+    stamp = np.ones(n + 1, dtype=np.int64)  # (P + 1,) when each row changed; [n]: the diagonal
+    seen = np.zeros(len(task.effects), dtype=np.int64)  # (G,) when each action was looked at
+    clock, changed = 1, True
     while changed:
         changed = False
         if deadline is not None and time.perf_counter() > deadline:
             return None
         for j, p in enumerate(pre):
+            if (stamp[p].max() if p.size else stamp[n]) <= seen[j]:
+                continue
+            seen[j] = clock
             if not applicable[j]:
-                if not pairs[np.ix_(p, p)].all():
+                if not pairs[p][:, p].all():
                     continue  # (the diagonal: each precondition reached)
                 applicable[j] = True
             a = add[j]
@@ -70,9 +80,16 @@ def h2(task, deadline: float | None = None) -> Pairs | None:
             others[delete[j]] = False
             others[a] = True
             q = np.flatnonzero(others)
-            if not pairs[np.ix_(a, q)].all():
-                pairs[np.ix_(a, q)] = True
-                pairs[np.ix_(q, a)] = True
+            new = ~pairs[a][:, q]  # (|a|, |q|)
+            if new.any():
+                clock += 1
+                for row in a:
+                    pairs[row, q] = True
+                    pairs[q, row] = True
+                stamp[a[new.any(axis=1)]] = clock
+                stamp[q[new.any(axis=0)]] = clock
+                if (np.diag(new[:, np.searchsorted(q, a)]) if a.size else new[:0]).any():
+                    stamp[n] = clock
                 changed = True
     return Pairs(pairs, applicable)
 

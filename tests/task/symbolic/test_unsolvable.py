@@ -19,8 +19,9 @@ from tamp.cli import main
 from tamp.cli import plan as commands
 from task import data
 from task.problem import Move, Plan, PlanResult, PlanStatus
-from task.symbolic import pddl_io
-from task.symbolic.proofs import Proof, prove_unsolvable
+from task.symbolic import ground, pddl_io, strips
+from task.symbolic.proofs import Proof, mutex, prove_unsolvable
+from task.symbolic.strips_task import StripsTask
 
 BLOCKS = data.read_text("blocksworld-4ops.pddl")
 LOGISTICS = data.read_text("logistics-strips.pddl")
@@ -173,6 +174,52 @@ def test_exhaustive_search_is_what_proves_three_in_two():
     assert (
         "stopped at 5 states" in _prove(HOLES, HOLES_PROBLEM, exhaustive=True, max_states=5).reason
     )
+
+
+def _naive_h2(task) -> set[frozenset]:
+    """h^2 by its definition, over sets of atoms (the reference for `mutex.h2`)."""
+    pairs = {frozenset((p, q)) for p in task.init for q in task.init}
+    changed = True
+    while changed:
+        changed = False
+        for e in task.effects:
+            if not all(frozenset((p, q)) in pairs for p in e.pre_pos for q in e.pre_pos):
+                continue
+            for p in e.add:
+                for q in task.atoms:
+                    kept = q not in e.delete and frozenset((q, q)) in pairs
+                    kept = kept and all(frozenset((q, r)) in pairs for r in e.pre_pos)
+                    if (q in e.add or kept) and frozenset((p, q)) not in pairs:
+                        pairs.add(frozenset((p, q)))
+                        changed = True
+    return pairs
+
+
+@pytest.mark.parametrize(
+    ("domain", "problem"),
+    [
+        (BLOCKS, _blocks("(on a b)", 4)),
+        (LOGISTICS, _logistics("(at p1 l2)", truck_in_city2=True)),
+        (SOKOBAN, _sokoban("f1-2f", "f2-2f", size=3)),
+        (GRIPPER, _gripper("(at ball1 roomb)")),
+        (HOLES, HOLES_PROBLEM),
+    ],
+    ids=["blocksworld", "logistics", "sokoban", "gripper", "holes"],
+)
+def test_h2_matches_its_definition(domain, problem):
+    parsed = pddl_io.parse_domain(domain, "d")
+    pddl_problem = pddl_io.parse_problem(problem, "p", parsed)
+    grounding = ground.reachable(parsed, pddl_problem)
+    task = StripsTask.build(
+        grounding.actions, strips.goal_atoms(pddl_problem), parsed, pddl_problem
+    )
+    found = mutex.h2(task)
+    ours = {
+        frozenset((task.atoms[i], task.atoms[j]))
+        for i, j in zip(*found.pairs.nonzero(), strict=True)
+    }
+    assert ours == _naive_h2(task)
+    assert (found.pairs == found.pairs.T).all()
 
 
 def test_a_partial_h2_fixpoint_proves_nothing():
