@@ -8,7 +8,9 @@
 - ``validate``: a plan checked step by step against the PDDL (the official check);
 - ``search``: optimal plans by breadth-first search and A* (for optimal lengths);
 - ``generate``: seeded random blocksworld problems;
-- ``signature``: what recognises a parsed PDDL domain.
+- ``signature``: what recognises a parsed PDDL domain;
+- ``proofs/``: proofs that a problem has no plan (relaxed reachability, h^2, invariants,
+  exhaustive search), told apart from a planner out of budget.
 
 Nothing here imports torch or a domain (`task.domains` builds on this side, never the other
 way round; tests/test_layout.py keeps it so). Reading a PDDL problem into a domain's

@@ -1,8 +1,10 @@
 """PDDL as other tools write it: Tarski's writer, pyperplan's benchmark folder, the IPC's files.
 
-The fixtures (tests/task/fixtures/pddl_styles/) are small files written for these tests in each
-tool's layout, not copied from it. Each parses, and `tamp plan` plans it to a plan that
-validates; what the planners cannot plan stays a one-line error naming the feature and the line.
+The fixtures (tests/task/fixtures/pddl_styles/) are small files in each tool's layout: the
+Tarski and IPC-logistics pairs and every problem file are written for these tests; the two
+pyperplan domain files are the IPC's own (each file's header says where it comes from). Each
+parses, and `tamp plan` plans it to a plan that validates; what the planners cannot plan stays a
+one-line error naming the feature and the line.
 """
 
 from __future__ import annotations
