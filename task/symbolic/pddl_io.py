@@ -9,6 +9,13 @@ format with ``;`` comments, optional step numbers (``0: (pick-up a)``, LPG and L
 ``[duration]`` suffixes, or relational moves (``move(a -> b)``, the form `task.problem.Move`
 prints, or ``move(a, b)`` or ``a -> b``), one kind per plan.
 
+PDDL as other tools write it is read as they mean it before the library's grammar sees it
+(`_domain_style`, `_problem_style`): keywords in any case, empty sections (Tarski's writer
+leaves ``(:types)``, ``(:constants)``, ``(:functions)`` empty), requirements used but not
+declared or declared but unknown here, ``- object`` annotations, header sections out of order,
+actions without a precondition; lines and columns are kept for parse errors. `check_strips`
+names the line and the feature of the first construct the planners cannot plan.
+
 The `pddl` library compiles its grammar on every ``pddl.parse_*`` call (about 60 ms); here the
 compiled grammar is built once per start symbol and a fresh transformer is used per file, so
 the library's per-parser state never leaks from one file into the next.
