@@ -22,8 +22,8 @@ into the failure memory and the search runs again (the cheap verdicts cached), s
 check has the final word. The memory records what failed where it failed:
 
 - a grasp that failed on the pick side (reaching or closing on the object) is ruled out for
-  that object in that neighbourhood (its pose and those of the objects within `NEAR`), for
-  every place, when what it hit is in that neighbourhood (else in that state only);
+  that object at that pose, for every place, while what the hand hit stands where it stood (a
+  fixed box, the table or no IK solution: always; an object: until it moves);
 - a grasp whose place pose has no IK solution is ruled out for that place in every state (the
   place pose's IK does not depend on where the other objects are);
 - any other failure rules out (state, object, grasp, place) only: the same object may still go
@@ -156,17 +156,21 @@ class _Memory:
 
     def __init__(self, scene: Scene) -> None:
         self.fixed = {s.name for s in fixed_solids(scene)} | {"table"}
-        self.pick: set[tuple] = set()  # (neighbourhood, obj, grasp)
+        # (obj, its pose, grasp) -> culprits: "fixed" (IK, or a fixed box or the table hit:
+        # whatever the other objects do) or (object, its pose) hit
+        self.pick: dict[tuple, set] = {}
         self.place: set[tuple] = set()  # (obj, grasp, place name)
         self.move: set[tuple] = set()  # (state key, obj, grasp, place name)
         self.ruled_out = 0  # grasps skipped because the memory ruled them out
 
     def open(self, scene: Scene, key: tuple, move: GeoMove, grasps) -> tuple:
-        hood = _neighbourhood(scene, move.obj)
+        here = _pose_key(scene.object(move.obj))
+        poses = {o.name: _pose_key(o) for o in scene.objects}
         out = []
         for g in grasps:
+            culprits = self.pick.get((move.obj, here, g.name), ())
             if (
-                (hood, move.obj, g.name) in self.pick
+                any(c == "fixed" or poses.get(c[0]) == c[1] for c in culprits)
                 or (key, move.obj, g.name, move.place.name) in self.move
                 or (move.obj, g.name, move.place.name) in self.place
             ):
@@ -176,17 +180,24 @@ class _Memory:
         return tuple(out)
 
     def record(self, scene: Scene, key: tuple, move: GeoMove, check: MoveCheck) -> None:
-        hood = _neighbourhood(scene, move.obj)
-        local = {h[0] for h in hood} | self.fixed
+        here = _pose_key(scene.object(move.obj))
+        names = {o.name for o in scene.objects}
         for t in check.tried:
             if t.failure is None:
                 continue
-            if t.side == "pick" and (t.failure == "ik_infeasible" or t.other in local):
-                self.pick.add((hood, move.obj, t.grasp))
+            if t.side == "pick" and (t.failure == "ik_infeasible" or t.other in self.fixed):
+                self.pick.setdefault((move.obj, here, t.grasp), set()).add("fixed")
+            elif t.side == "pick" and t.other in names:
+                culprit = (t.other, _pose_key(scene.object(t.other)))
+                self.pick.setdefault((move.obj, here, t.grasp), set()).add(culprit)
             elif t.failure == "ik_infeasible" and t.where == "place":
                 self.place.add((move.obj, t.grasp, move.place.name))
             else:
                 self.move.add((key, move.obj, t.grasp, move.place.name))
+
+
+def _pose_key(o) -> tuple:
+    return (*(round(v, 3) for v in o.pose.xyz), round(o.pose.yaw % (2 * math.pi), 2))
 
 
 def _without_others(scene: Scene, obj: str) -> Scene:
