@@ -1,0 +1,534 @@
+"""A batched, conservative collision checker of the Panda against boxes over a sphere model.
+
+`SphereCollision` has the interface of `robots.collision.PandaCollision` (``set_boxes``,
+``hold``, ``valid``, ``contacts``, ``check_path``, ``margin``, ``self_margin``) plus
+``valid_batch(q (B, J)) -> (B,) bool``, which checks B configurations at once in numpy: forward
+kinematics of the 7 revolute joints (the URDF's fixed joint origins, parsed once), the centres of
+the G spheres of `robots.panda_spheres` (cuRobo's SPHERES plus the COVER rows), and against them
+
+- every box (a block or an obstacle, turned by ``yaw`` about z): the exact box signed distance
+  of the sphere centre, minus the radius;
+- the table, a plane at z = 0 (panda_link0, which stands on it, is not modelled);
+- the other links (self-collision), skipping `robots.collision.DISABLED_PAIRS` as the mesh
+  model does, with ``self_margin``;
+- the held box (`hold`): riding in the TCP frame, tested against the boxes with the separating
+  axis theorem (its half extents grown by the margin), against the table through its lowest
+  corner, and against the links other than the hand and fingers through the spheres' signed
+  distances in its frame.
+
+Conservative. Every point of a link's collision hull lies within ``COVER_GAP`` (1.5 cm) of one
+of its spheres, so each sphere is grown by COVER_GAP (``2 COVER_GAP`` between two links): when
+the meshes come within ``margin`` of a box, a grown sphere does too. The model therefore says
+"collision" a little earlier than the mesh model, never later (tests/motion/test_sphere_check.py
+compares the two on configurations near boxes); it never says why in mesh terms, so the mesh
+model stays the final word where a contact's exact distance matters.
+
+Speed. A bounding sphere per link (L = 10) is tested first, (B, L, O); only the (configuration,
+link, box) triples it flags are tested sphere by sphere, each link's spheres padded to the same
+count with a far-away dummy.
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from collections.abc import Collection, Sequence
+from itertools import combinations
+
+import numpy as np
+
+from motion.errors import MotionError
+from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck
+from robots.panda import PANDA, PandaSpec, data_dir, urdf_path
+from robots.panda_spheres import COVER, COVER_GAP, FINGER_ORIGIN, FINGERS, SPHERES
+
+Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in PandaCollision
+_ARM = tuple(f"panda_link{i}" for i in range(1, 8))
+_HAND = "panda_hand"
+PARTS = ("panda_link0", *_ARM, _HAND, *FINGERS)  # (L,) the links, as PandaCollision.parts
+# Link pairs whose collision meshes stay at least APART_CLEARANCE apart while joint j's angle is
+# at least the given one (rad; -inf: always), within the datasheet limits and for any finger
+# opening: measured with PyBullet's closest points on a grid (tests/motion/test_sphere_check.py
+# re-derives them), less the most a point can move between grid points. They are skipped there
+# while self_margin < APART_CLEARANCE. The wrist's links are closer to each other than the
+# spheres' cover gap, so checking them with spheres would refuse most configurations.
+APART = (
+    ("panda_link0", "panda_link2", 0, -math.inf),  # >= 12 cm on a 0.03 rad grid of (q1, q2)
+    ("panda_link1", "panda_link3", 0, -math.inf),  # >= 12 cm, grid of (q2, q3)
+    ("panda_link2", "panda_link4", 0, -math.inf),  # >= 45 mm, grid of (q3, q4)
+    ("panda_link3", "panda_link5", 0, -math.inf),  # >= 48 mm, grid of (q4, q5)
+    ("panda_link5", "panda_link7", 5, 0.9),  # >= 9.8 mm for q6 >= 0.9, grid of (q6, q7)
+    ("panda_link5", "panda_hand", 5, 0.9),  # >= 12 mm for q6 >= 0.9, grid of (q6, q7)
+    ("panda_link6", "panda_hand", 0, -math.inf),  # >= 28 mm, grid of q7
+    ("panda_link6", FINGERS[0], 0, -math.inf),  # >= 10 cm, grid of q7
+    ("panda_link6", FINGERS[1], 0, -math.inf),
+    ("panda_link7", FINGERS[0], 0, -math.inf),  # >= 57 mm, fingers at 0 and 0.04 m
+    ("panda_link7", FINGERS[1], 0, -math.inf),
+)
+APART_CLEARANCE = 0.005  # m
+
+
+def _rpy(rpy: Sequence[float]) -> np.ndarray:
+    """URDF roll-pitch-yaw as a rotation (3, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
+    r, p, y = rpy
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _chain(spec: PandaSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The joint origins of the URDF: revolute (J, 3, 3) rotations and (J, 3) offsets from link
+    i-1 to link i (before the joint's turn about z), and panda_link7 -> panda_hand, and
+    panda_hand -> TCP as (4, 4) transforms."""
+    joints = {}
+    for joint in ET.parse(urdf_path(spec)).getroot().iter("joint"):
+        origin = joint.find("origin")
+        xyz = [float(v) for v in origin.get("xyz", "0 0 0").split()]
+        rpy = [float(v) for v in origin.get("rpy", "0 0 0").split()]
+        child = joint.find("child").get("link")
+        transform = np.eye(4)
+        transform[:3, :3], transform[:3, 3] = _rpy(rpy), xyz
+        joints[child] = (joint.find("parent").get("link"), transform, joint.get("type"))
+
+    def path(frm: str, to: str) -> np.ndarray:
+        out = np.eye(4)
+        while to != frm:
+            parent, transform, _ = joints[to]
+            out, to = transform @ out, parent
+        return out
+
+    arm = [joints[link][1] for link in _ARM]
+    if any(joints[link][2] != "revolute" for link in _ARM):
+        raise MotionError(f"expected revolute joints into {_ARM} in {urdf_path(spec)}")
+    rot = np.stack([t[:3, :3] for t in arm])  # (J, 3, 3)
+    off = np.stack([t[:3, 3] for t in arm])  # (J, 3)
+    return rot, off, path(_ARM[-1], _HAND), path(_HAND, spec.tcp_link)
+
+
+def _link_spheres():
+    """Per link: sphere centres (S_l, 3) in its frame and radii (S_l,), fingers in their own."""
+    rows = (*SPHERES, *COVER)
+    out = {}
+    for link in PARTS:
+        centres = np.array([a for name, a, _ in rows if name == link], dtype=float)
+        radii = np.array([r for name, _, r in rows if name == link], dtype=float)
+        out[link] = (centres.reshape(-1, 3), radii)
+    return out
+
+
+_MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
+    _HAND: "hand.obj",
+    FINGERS[0]: "finger.obj",
+    FINGERS[1]: "finger.obj",
+}
+
+
+def _directions() -> np.ndarray:
+    """The 26 unit directions of a 26-DOP (26, 3): faces, edges and corners of a cube."""
+    grid = np.stack(np.meshgrid(*[(-1.0, 0.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    grid = grid[np.abs(grid).sum(1) > 0]
+    return grid / np.linalg.norm(grid, axis=1, keepdims=True)
+
+
+def _dops() -> tuple[np.ndarray, np.ndarray]:
+    """Per link, the support offsets (L, 26) of its collision mesh's vertices along
+    `_directions` (the 26-DOP holding its convex hull, in its frame; fingers in their own)."""
+    directions = _directions()
+    out = np.zeros((len(PARTS), len(directions)))
+    for k, link in enumerate(PARTS):
+        path = data_dir() / "franka_panda" / "meshes" / "collision" / _MESHES[link]
+        rows = [line.split()[1:4] for line in path.read_text().splitlines() if line[:2] == "v "]
+        v = np.array(rows, dtype=float)  # (V, 3)
+        if link == FINGERS[1]:  # the URDF turns the right finger's mesh by pi about z
+            v = v * np.array([-1.0, -1.0, 1.0])
+        out[k] = (v @ directions.T).max(0)
+    return directions, out
+
+
+def _bound(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
+    """A sphere (centre (3,), radius) holding all the given spheres: around their box's middle."""
+    mid = (np.min(centres - radii[:, None], 0) + np.max(centres + radii[:, None], 0)) / 2
+    return mid, float((np.linalg.norm(centres - mid, axis=1) + radii).max())
+
+
+def _turn(yaw: np.ndarray) -> np.ndarray:
+    """Rotations (..., 3, 3) about z by ``yaw`` (...)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    z, o = np.zeros_like(yaw), np.ones_like(yaw)
+    return np.stack([c, -s, z, s, c, z, z, z, o], -1).reshape(*yaw.shape, 3, 3)
+
+
+def _box_sdf(points: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Signed distances (...) of points (..., 3) in a box's frame to it, half extents (..., 3)."""
+    d = np.abs(points) - half
+    outside = np.sqrt(np.square(np.maximum(d, 0.0)).sum(-1))
+    return outside + np.minimum(d.max(-1), 0.0)
+
+
+class SphereCollision:
+    """The Panda's sphere model, its held box and a set of boxes; see the module docstring.
+
+    ``margin``: a contact counts when a mesh would come closer than this to a box, the table or
+    the held box (m); ``self_margin`` the same between two links (default 0, as the mesh
+    model). Both may be changed between calls (the guard widens ``margin`` while it plans).
+    """
+
+    def __init__(self, margin: float = 0.01, spec: PandaSpec = PANDA, self_margin: float = 0.0):
+        if not (math.isfinite(margin) and math.isfinite(self_margin)):
+            raise MotionError(f"margins must be finite and >= 0, got {margin}, {self_margin}")
+        if margin < 0 or self_margin < 0:
+            raise MotionError(f"margins must be finite and >= 0, got {margin}, {self_margin}")
+        self.margin, self.self_margin, self.spec = float(margin), float(self_margin), spec
+        self.gap = COVER_GAP
+        self.parts = (*PARTS, HELD)  # (P,) = L links + the held box, as PandaCollision.parts
+        self._rot, self._off, self._hand, self._tcp = _chain(spec)
+        spheres = _link_spheres()
+        # the G spheres, link by link: centres (G, 3) in their link's frame, radii (G,)
+        self._local = np.concatenate([spheres[link][0] for link in PARTS])
+        self._radii = np.concatenate([spheres[link][1] for link in PARTS])
+        self._count = np.array([len(spheres[link][1]) for link in PARTS])  # (L,)
+        self._start = np.cumsum(self._count) - self._count  # (L,) first sphere of each link
+        bounds = [_bound(*spheres[link]) for link in PARTS]
+        self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
+        self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
+        index = {name: k for k, name in enumerate(self.parts)}
+        self._index = index
+        self._groups = {n: [k] for n, k in index.items()} | {
+            "robot": list(range(len(PARTS))),
+            "hand": [index[n] for n in HAND],
+        }
+        pairs = [
+            (a, b)
+            for a, b in combinations(range(len(PARTS)), 2)
+            if frozenset((PARTS[a], PARTS[b])) not in DISABLED_PAIRS
+        ]
+        self._pairs = np.array(pairs)  # (K, 2) link pairs checked for self-collision
+        # (K,) the joint whose angle, when at least (K,), keeps the pair apart (see APART)
+        apart = {frozenset((a, b)): (j, lowest) for a, b, j, lowest in APART}
+        rule = [apart.get(frozenset((PARTS[a], PARTS[b])), (0, math.inf)) for a, b in pairs]
+        self._apart_joint = np.array([j for j, _ in rule])
+        self._apart_from = np.array([lowest for _, lowest in rule])
+        self._directions, self._dop = _dops()  # (26, 3), (L, 26)
+        self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
+        self._arm_vs_held = np.array([k for k, n in enumerate(PARTS) if n not in HAND])
+        self._names: list[str] = [TABLE]  # (O + 1,) the table, then the boxes
+        self._box_c = np.zeros((0, 3))  # (O, 3)
+        self._halves = np.ones((0, 3))  # (O, 3)
+        self._yaws = np.zeros(0)  # (O,)
+        self._held_half: np.ndarray | None = None  # (3,)
+        self._held_pose = np.eye(4)  # in the TCP frame
+        self._masks: dict[frozenset, tuple[np.ndarray, np.ndarray]] = {}
+
+    # ---- the scene ---------------------------------------------------------------------------
+
+    def set_boxes(self, boxes: Sequence[Box]) -> None:
+        """Replace all boxes (blocks and obstacles). Names must be unique and not a part name."""
+        seen, reserved = set(), {*self._groups, TABLE, ""}
+        rows = []
+        for box in boxes:
+            name = getattr(box, "name", None)
+            if not isinstance(name, str) or name in seen | reserved:
+                raise MotionError(f"box name {name!r} is empty, repeated, 'table' or a robot part")
+            try:
+                row = np.array([*box.centre, *box.half, box.yaw], dtype=float)
+            except (TypeError, ValueError):
+                row = np.full(1, np.nan)
+            if row.shape != (7,) or not np.isfinite(row).all() or (row[3:6] <= 0).any():
+                raise MotionError(
+                    f"box {name!r}: centre (3,), half (3,) > 0 and yaw must be finite"
+                )
+            seen.add(name)
+            rows.append(row)
+        table = np.array(rows).reshape(-1, 7)  # (O, 7)
+        self._box_c, self._halves, self._yaws = table[:, :3], table[:, 3:6], table[:, 6]
+        self._turns = _turn(self._yaws)
+        self._names = [TABLE, *(b.name for b in boxes)]
+        self._masks = {}
+
+    def hold(self, size: float | None = None, half=None, pose=None) -> None:
+        """Hold a box in the hand (as `PandaCollision.hold`); nothing when ``size`` and
+        ``half`` are both None. ``pose``: (4, 4) the box's pose in the TCP frame; None: centred
+        at the TCP, turned with the hand."""
+        if size is not None and half is not None:
+            raise MotionError(f"hold a cube edge or half extents, not both (size {size}, {half})")
+        extents = None
+        if size is not None or half is not None:
+            extents = np.asarray((size / 2,) * 3 if size is not None else half, dtype=float)
+            if extents.shape != (3,) or not np.isfinite(extents).all() or (extents <= 0).any():
+                raise MotionError(f"held box must have a finite size or half extents > 0 m: {half}")
+        relative = np.eye(4) if pose is None else np.asarray(pose, dtype=float)
+        if relative.shape != (4, 4) or not np.isfinite(relative).all():
+            raise MotionError(f"held pose must be a finite (4, 4) transform, got {relative.shape}")
+        r = relative[:3, :3]
+        if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
+            raise MotionError("held pose's rotation block is not a rotation (tolerance 1e-6)")
+        self._held_half, self._held_pose = extents, relative
+
+    def _mask(self, ignore: Ignore) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs to check, cached per ignore set: (P, O + 1) part vs table and boxes, (K,) link
+        pairs, (L,) links vs the held box."""
+        try:
+            key = ignore if isinstance(ignore, frozenset) else frozenset(ignore)
+        except TypeError:
+            raise MotionError(f"ignore must hold (part, other) tuples, got {ignore!r}") from None
+        if key in self._masks:
+            return self._masks[key]
+        scene = np.ones((len(self.parts), len(self._names)), dtype=bool)  # (P, O + 1)
+        scene[self._index[self.spec.base_link], 0] = False  # link0 stands on the table
+        own = np.ones(len(self._pairs), dtype=bool)  # (K,)
+        held_arm = np.ones(len(PARTS), dtype=bool)  # (L,) held box vs link
+        for pair in key:
+            part, other = pair if isinstance(pair, tuple) and len(pair) == 2 else ("", "")
+            rows, col = self._groups.get(part), self._index.get(other)
+            if rows is None or (col is None and other not in self._names):
+                raise MotionError(
+                    f"ignore {pair!r} is not (link|held|hand|robot, box|table|link); boxes: "
+                    f"{', '.join(self._names[1:]) or 'none'}"
+                )
+            if col is None:
+                scene[rows, self._names.index(other)] = False
+                continue
+            for k, (a, b) in enumerate(self._pairs):
+                own[k] &= not ((a in rows and b == col) or (b in rows and a == col))
+            held = self._index[HELD]
+            if held in rows and col < len(PARTS):
+                held_arm[col] = False
+            if part != HELD and other == HELD:
+                held_arm[[r for r in rows if r < len(PARTS)]] = False
+        self._masks[key] = (scene, own, held_arm)
+        return self._masks[key]
+
+    def _other(self, other, k: int) -> str:
+        """The name of what a part hit: ``other`` itself (a name), or entry k of an index
+        array into the table and boxes (>= 0) or into the links (~link < 0)."""
+        if isinstance(other, str):
+            return other
+        return self._names[other[k]] if other[k] >= 0 else self.parts[~other[k]]
+
+    # ---- kinematics --------------------------------------------------------------------------
+
+    def _links(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
+        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3) of the frames of
+        `PARTS` (fingers at ``fingers`` m each), then of the TCP."""
+        n = q.shape[0]
+        rot, pos = np.empty((n, len(PARTS) + 1, 3, 3)), np.empty((n, len(PARTS) + 1, 3))
+        r, t = np.broadcast_to(np.eye(3), (n, 3, 3)), np.zeros((n, 3))
+        rot[:, 0], pos[:, 0] = r, t  # panda_link0 is the base frame
+        c, s = np.cos(q), np.sin(q)  # (B, J)
+        for j in range(7):
+            t = t + r @ self._off[j]  # (B, 3)
+            r = r @ self._rot[j]  # (B, 3, 3) before the turn about z
+            x, y = r[:, :, 0], r[:, :, 1]
+            cj, sj = c[:, j, None], s[:, j, None]
+            r = np.stack([x * cj + y * sj, y * cj - x * sj, r[:, :, 2]], -1)
+            rot[:, j + 1], pos[:, j + 1] = r, t
+        hand = len(_ARM) + 1
+        rot[:, hand] = r @ self._hand[:3, :3]
+        pos[:, hand] = t + r @ self._hand[:3, 3]
+        for k, sign in ((hand + 1, 1.0), (hand + 2, -1.0)):  # the fingers slide along hand y
+            rot[:, k] = rot[:, hand]
+            pos[:, k] = pos[:, hand] + rot[:, hand] @ np.array([0.0, sign * fingers, FINGER_ORIGIN])
+        rot[:, -1] = rot[:, hand] @ self._tcp[:3, :3]
+        pos[:, -1] = pos[:, hand] + rot[:, hand] @ self._tcp[:3, 3]
+        return rot, pos
+
+    def _spheres(self, rot, pos, b: np.ndarray, link: np.ndarray):
+        """Every sphere of the (configuration, link) pairs ``b``, ``link`` (M,) each: the pair
+        it belongs to (N,), its world centre (N, 3) and grown radius (N,), and where each
+        pair's spheres start (M,) (they are consecutive)."""
+        count = self._count[link]  # (M,)
+        first = np.cumsum(count) - count  # (M,)
+        pair = np.repeat(np.arange(len(link)), count)  # (N,)
+        sphere = self._start[link][pair] + np.arange(pair.size) - first[pair]  # (N,)
+        rows, frames = b[pair], link[pair]
+        centres = np.einsum("nij,nj->ni", rot[rows, frames], self._local[sphere])
+        return pair, centres + pos[rows, frames], self._radii[sphere] + self.gap, first
+
+    # ---- queries -----------------------------------------------------------------------------
+
+    def valid_batch(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()):
+        """(B,) bool: True where configuration q (B, J) rad has no contact below the margins."""
+        return self._clearance(self._configs(q), fingers, ignore, detail=False)
+
+    def valid(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()) -> bool:
+        """True when ``q`` (J,) has no contact below the margins."""
+        return bool(self._clearance(self._configs(q, single=True), fingers, ignore, False)[0])
+
+    def contacts(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()) -> list[Contact]:
+        """The contacts below the margins at ``q`` (J,), deepest first; a distance is the
+        grown spheres' clearance (m, at most the meshes' distance)."""
+        found = self._clearance(self._configs(q, single=True), fingers, ignore, detail=True)
+        return sorted(found, key=lambda c: c.distance)
+
+    def check_path(
+        self, path, fingers=PANDA.finger_open, ignore: Ignore = (), max_step: float = 0.02
+    ) -> PathCheck:
+        """Check a joint path (S, J), densified so no joint moves more than ``max_step`` rad
+        (as `PandaCollision.check_path`), one batch per finger opening."""
+        path = np.asarray(path, dtype=float)
+        n_j = len(self.spec.arm_joints)
+        if path.ndim != 2 or path.shape[1] != n_j or not len(path) or not np.isfinite(path).all():
+            raise MotionError(f"path must be finite (S, {n_j}) joint angles, got {path.shape}")
+        if not (math.isfinite(max_step) and max_step > 0):
+            raise MotionError(f"max_step must be a finite angle > 0 rad, got {max_step}")
+        try:
+            fs = np.broadcast_to(np.asarray(fingers, dtype=float), (len(path),))  # (S,)
+        except ValueError:
+            raise MotionError(f"fingers: one opening or {len(path)}, one per waypoint") from None
+        n = np.ceil(np.abs(np.diff(path, axis=0)).max(-1) / max_step - 1e-9)  # (S-1,)
+        n = np.maximum(n, 1).astype(int)
+        seg = np.concatenate([[0], np.repeat(np.arange(1, len(path)), n)])  # (N,) waypoint
+        t = np.concatenate([[1.0], *(np.arange(1, k + 1) / k for k in n)])  # (N,)
+        prev = np.maximum(seg - 1, 0)
+        qs = path[prev] + t[:, None] * (path[seg] - path[prev])  # (N, J)
+        f = fs[prev] + t * (fs[seg] - fs[prev])  # (N,)
+        ok = np.ones(len(qs), dtype=bool)
+        for opening in np.unique(f):
+            rows = f == opening
+            ok[rows] = self.valid_batch(qs[rows], float(opening), ignore)
+        if ok.all():
+            return PathCheck(True, None, None, None, len(qs))
+        k = int(np.argmin(ok))
+        hit = self.contacts(qs[k], f[k], ignore)[0]
+        why = f"{hit.part} hits {hit.other} (d = {hit.distance:+.4f} m)"
+        why += f" on the way to waypoint {seg[k]}"
+        return PathCheck(False, int(seg[k]), tuple(qs[k].tolist()), hit, k + 1, why)
+
+    def _configs(self, q, single: bool = False) -> np.ndarray:
+        """``q`` as float64 (B, J), from (J,) when ``single``, else from (B, J)."""
+        n_j = len(self.spec.arm_joints)
+        try:
+            a = np.asarray(q, dtype=float)
+        except (TypeError, ValueError):
+            raise MotionError(f"q must be numeric joint angles, got {q!r}") from None
+        if a.ndim != (1 if single else 2) or a.shape[-1] != n_j:
+            want = f"({n_j},)" if single else f"(B, {n_j})"
+            raise MotionError(f"q must have shape {want}, got {a.shape}")
+        if not np.isfinite(a).all():
+            raise MotionError("q contains NaN or inf")
+        return a[None] if single else a
+
+    # ---- the checks --------------------------------------------------------------------------
+
+    def _clearance(self, q: np.ndarray, fingers: float, ignore: Ignore, detail: bool):
+        """(B,) bool validity, or (detail, B = 1) the list of contacts."""
+        scene, own, held_arm = self._mask(ignore)
+        n, links = q.shape[0], len(PARTS)
+        rot, pos = self._links(q, float(fingers))  # (B, L + 1, 3, 3), (B, L + 1, 3)
+        mid = np.einsum("blij,lj->bli", rot[:, :links], self._bounds) + pos[:, :links]  # (B, L, 3)
+        reach = self._reach + self.gap  # (L,)
+        hit = np.zeros(n, dtype=bool)
+        found: list[Contact] = []
+
+        def record(b, part, other, clearance, limit: float, pair=None, first=None) -> None:
+            """Mark the rows b (M,) whose clearance is under ``limit``: (M,), or per sphere
+            (N,) of the pairs ``pair`` (N,) starting at ``first`` (M,); ``part`` a name or link
+            indices (M,), ``other`` a name or indices (see `_other`)."""
+            bad = clearance < limit
+            hit[b[bad] if pair is None else b[pair[bad]]] = True
+            if detail and bad.any():
+                if pair is not None:
+                    clearance = np.minimum.reduceat(clearance, first)  # (M,)
+                for k in np.flatnonzero(clearance < limit):
+                    name = part if isinstance(part, str) else self.parts[part[k]]
+                    found.append(Contact(name, self._other(other, k), float(clearance[k])))
+
+        m = self.margin
+        # the table: a plane at z = 0
+        near_b, near_l = np.nonzero((mid[..., 2] - reach < m) & scene[None, :links, 0])
+        if near_b.size:
+            pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
+            record(near_b, near_l, np.zeros_like(near_b), x[:, 2] - r, m, pair, first)
+        # the boxes, each in its own frame
+        if len(self._names) > 1:
+            between = mid[:, :, None] - self._box_c  # (B, L, O, 3)
+            inner = np.einsum("oji,bloj->bloi", self._turns, between)
+            gap = _box_sdf(inner, self._halves) - reach[:, None]  # (B, L, O)
+            near_b, near_l, near_o = np.nonzero((gap < m) & scene[None, :links, 1:])
+            if near_b.size:
+                pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
+                box = near_o[pair]  # (N,)
+                inner = np.einsum("nji,nj->ni", self._turns[box], x - self._box_c[box])
+                sdf = _box_sdf(inner, self._halves[box]) - r  # (N,)
+                record(near_b, near_l, near_o + 1, sdf, m, pair, first)
+        # the links against each other: the distal link's spheres against the other's 26-DOP
+        a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
+        apart = np.linalg.norm(mid[:, a] - mid[:, c], axis=-1) - reach[a] - reach[c]  # (B, K')
+        close = apart < self.self_margin
+        if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at these angles
+            close &= q[:, self._apart_joint[own]] < self._apart_from[own]
+        near_b, near_k = np.nonzero(close)
+        if near_b.size:
+            la, lc = a[near_k], c[near_k]
+            pair, x, r, first = self._spheres(rot, pos, near_b, la)
+            rows, frames = near_b[pair], lc[pair]
+            inner = np.einsum("nji,nj->ni", rot[rows, frames], x - pos[rows, frames])
+            dop = (inner @ self._directions.T - self._dop[frames]).max(-1)  # (N,)
+            record(near_b, la, ~lc, dop - r, self.self_margin, pair, first)
+        if self._held_half is not None:
+            self._check_held(rot, pos, mid, scene, held_arm, record)
+        return found if detail else ~hit
+
+    def _check_held(self, rot, pos, mid, scene, held_arm, record) -> None:
+        """The held box at the TCP against the table, the boxes and the arm's links."""
+        m, held = self.margin, self._index[HELD]
+        half = self._held_half  # (3,)
+        r_tcp, t_tcp = rot[:, -1], pos[:, -1]  # (B, 3, 3), (B, 3)
+        r_box = r_tcp @ self._held_pose[:3, :3]  # (B, 3, 3) held box -> world
+        t_box = t_tcp + r_tcp @ self._held_pose[:3, 3]  # (B, 3)
+        every = np.arange(len(t_box))
+        if scene[held, 0]:
+            low = t_box[:, 2] - np.abs(r_box[:, 2, :]) @ half  # (B,) lowest corner's z
+            record(every, HELD, TABLE, low, m)
+        columns = np.flatnonzero(scene[held, 1:])
+        if columns.size:
+            gap = _obb_gap(r_box, t_box, half + m, self._turns[columns])
+            gap = gap(self._box_c[columns], self._halves[columns])  # (B, O')
+            near_b, near_o = np.nonzero(gap < 0.0)
+            record(near_b, HELD, columns[near_o] + 1, gap[near_b, near_o] + m, m)
+        links = self._arm_vs_held[held_arm[self._arm_vs_held]]
+        if links.size:
+            reach = self._reach + self.gap
+            # (B, L', 3) link bounds in the held box's frame
+            inner = np.einsum("bji,blj->bli", r_box, mid[:, links] - t_box[:, None])
+            gap = _box_sdf(inner, half) - reach[links]  # (B, L')
+            near_b, near_l = np.nonzero(gap < m)
+            if near_b.size:
+                link = links[near_l]
+                pair, x, r, first = self._spheres(rot, pos, near_b, link)
+                rows = near_b[pair]
+                inner = np.einsum("nji,nj->ni", r_box[rows], x - t_box[rows])
+                sdf = _box_sdf(inner, half) - r  # (N,)
+                record(near_b, HELD, ~link, sdf, m, pair, first)
+
+
+def _obb_gap(r_a: np.ndarray, t_a: np.ndarray, half_a: np.ndarray, r_b: np.ndarray):
+    """Separating-axis test of boxes A (B of them: rotations (B, 3, 3), centres (B, 3), half
+    extents (3,)) against boxes B (O: rotations (O, 3, 3)); returns f(centres (O, 3), half
+    (O, 3)) -> (B, O): the largest separation over the 15 axes (< 0: the boxes overlap)."""
+
+    def gap(c_b: np.ndarray, h_b: np.ndarray) -> np.ndarray:
+        a_axes = np.swapaxes(r_a, 1, 2)[:, None]  # (B, 1, 3, 3) rows are A's axes
+        b_axes = np.swapaxes(r_b, 1, 2)[None]  # (1, O, 3, 3)
+        a_axes, b_axes = np.broadcast_arrays(a_axes, b_axes)  # (B, O, 3, 3)
+        cross = np.cross(a_axes[:, :, :, None], b_axes[:, :, None, :]).reshape(
+            *a_axes.shape[:2], 9, 3
+        )
+        norm = np.linalg.norm(cross, axis=-1, keepdims=True)
+        cross = np.where(norm > 1e-9, cross / np.maximum(norm, 1e-9), 0.0)
+        axes = np.concatenate([a_axes, b_axes, cross], axis=2)  # (B, O, 15, 3)
+        between = c_b[None] - t_a[:, None]  # (B, O, 3)
+        along = np.abs(np.einsum("boki,boi->bok", axes, between))  # (B, O, 15)
+        rad_a = np.abs(np.einsum("boki,boji->bokj", axes, a_axes)) @ half_a  # (B, O, 15)
+        rad_b = (np.abs(np.einsum("boki,boji->bokj", axes, b_axes)) * h_b[None, :, None]).sum(-1)
+        sep = along - rad_a - rad_b  # (B, O, 15); a zero axis never separates
+        sep = np.where(np.linalg.norm(axes, axis=-1) > 0.5, sep, -np.inf)
+        return sep.max(-1)
+
+    return gap
