@@ -44,6 +44,12 @@ def blocked() -> Scene:
     )
 
 
+def hemmed() -> Scene:
+    """Target ``t`` with ``w`` on its -x side and ``n`` on its +y side, 1 cm apart: every
+    top-down grasp of t has a finger on w or n until one of them moves."""
+    return scene(cube("t", 0.5, 0.0), cube("w", 0.44, 0.0), cube("n", 0.5, 0.06))
+
+
 @functools.cache
 def tools():
     """One `tamp.geo.check.Tools` for the whole test process, closed at exit (torch on one

@@ -9,7 +9,7 @@ from tamp.geo.baseline import apply_symbolic, plan_search_then_check, symbolic_m
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoStatus
 from tamp.world.goal import parse_goal
-from tests.tamp.geo.geo_scenes import blocked, cube, scene, tools
+from tests.tamp.geo.geo_scenes import blocked, cube, hemmed, scene, tools
 
 SMALL = SearchConfig(choices=("top",), places=4, max_time_s=60.0)
 
@@ -27,8 +27,8 @@ def test_the_symbolic_search_ignores_geometry_and_honours_constraints():
 
 
 @pytest.mark.sim
-def test_the_baseline_solves_blocked_with_more_checks_and_failures_than_the_search():
-    s = blocked()
+def test_the_baseline_solves_a_hemmed_target_with_more_checks_and_failures_than_the_search():
+    s = hemmed()
     goal = parse_goal("(in t goal)", s)
     base = plan_search_then_check(s, goal, tools(), SMALL)
     ours = plan_search(s, goal, tools(), SMALL)

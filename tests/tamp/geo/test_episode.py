@@ -10,15 +10,9 @@ from tamp.geo.episode import PLANNERS, planner_by_name, run_geo_episode
 from tamp.geo.search import SearchConfig
 from tamp.world.goal import parse_goal
 from task.errors import TampError
-from tests.tamp.geo.geo_scenes import cube, scene, tools
+from tests.tamp.geo.geo_scenes import hemmed, tools
 
 SMALL = SearchConfig(choices=("top",), places=4, max_time_s=60.0)
-
-
-def hemmed():
-    """Target t with w on its -x side and n on its +y side, 1 cm apart: every top-down grasp
-    of t has a finger on w or n until one of them moves."""
-    return scene(cube("t", 0.5, 0.0), cube("w", 0.44, 0.0), cube("n", 0.5, 0.06))
 
 
 @pytest.mark.sim
