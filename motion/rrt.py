@@ -3,7 +3,10 @@
 ``plan_path(start, goal, valid)`` searches the datasheet joint box with OMPL (the only module of
 this repository that imports ``ompl``) against the caller's ``valid(q)`` collision check, then
 shortens the path with our own seeded shortcutting and re-checks every returned segment with
-``valid`` at the checking resolution. ``path_trajectory`` times the polyline with ruckig, one
+``valid`` at the checking resolution. With a batched check (``valid_batch``, e.g. the sphere
+model of `motion.sphere_check`) it first tries the straight segment and seeded one-via-point
+detours, whole segments per call, and verifies what it finds with ``valid``; OMPL runs only when
+that finds nothing. ``path_trajectory`` times the polyline with ruckig, one
 rest-to-rest straight segment per piece (an RRT path has sharp corners).
 
 Determinism. OMPL 2.0.1 seeds every ``RNG`` object from one process-global seed generator, and
@@ -53,6 +56,11 @@ class PathPlannerConfig:
     simplify: bool = True  # seeded shortcutting and vertex reduction
     simplify_time: float = 1.0  # s, a cap only: the attempts bound the work
     shortcut_attempts: int = 50  # random partial shortcuts tried (OMPL's shortcutPath, seeded)
+    # with a batched check (``plan_path(..., valid_batch=...)``): via points tried per round,
+    # their spread about the midpoint per round (rad), and whether ``valid`` verifies the path
+    vias: int = 16
+    via_spreads: tuple[float, ...] = (0.3, 0.6, 1.0, 1.5)
+    verify: bool = True
 
     def __post_init__(self):
         if self.planner not in PLANNERS:
@@ -64,6 +72,8 @@ class PathPlannerConfig:
             "range": self.range >= 0.0,
             "simplify_time": self.simplify_time >= 0.0,
             "shortcut_attempts": self.shortcut_attempts >= 0,
+            "vias": self.vias >= 1,
+            "via_spreads": all(s > 0.0 for s in self.via_spreads),
         }
         for name, ok in checks.items():
             if not ok:
@@ -211,23 +221,158 @@ def _dedupe(path: np.ndarray) -> np.ndarray:
     return out
 
 
+class _Batch:
+    """The caller's ``valid_batch`` (B, J) -> (B,) with a count of configurations checked."""
+
+    def __init__(self, valid_batch: Callable[[np.ndarray], np.ndarray], step: float):
+        self.valid_batch, self.step, self.configs, self.calls = valid_batch, step, 0, 0
+
+    def __call__(self, q: np.ndarray) -> np.ndarray:
+        self.configs, self.calls = self.configs + len(q), self.calls + 1
+        ok = np.asarray(self.valid_batch(np.ascontiguousarray(q, dtype=np.float64)), dtype=bool)
+        if ok.shape != (len(q),):
+            raise MotionError(f"valid_batch returned shape {ok.shape} for {len(q)} configurations")
+        return ok
+
+    def segments(self, a: np.ndarray, b: np.ndarray, stride: int = 8) -> np.ndarray:
+        """(P,) bool: whether each segment a[p] -> b[p] ((P, J) each) is valid at the points
+        ``a + k/n (b - a)``, 0 <= k <= n = ceil(|b - a| / step) (the ends included), in two
+        batched calls: every ``stride``-th point of every segment, then the rest of those
+        still valid."""
+        n = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / self.step)).astype(int)  # (P,)
+        seg = np.repeat(np.arange(len(n)), n + 1)  # (N,) the segment of each point
+        k = np.arange(seg.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)  # (N,) 0..n
+        t = (k / n[seg])[:, None]
+        points = a[seg] + t * (b[seg] - a[seg])  # (N, J)
+        alive = np.ones(len(n), dtype=bool)
+        coarse = (k % stride == 0) | (k == n[seg])
+        for part in (coarse, ~coarse):
+            rows = np.flatnonzero(part & alive[seg])
+            if rows.size:
+                bad = rows[~self(points[rows])]
+                alive[seg[bad]] = False
+        return alive
+
+
+def _via_search(start, goal, batch: _Batch, lo, hi, config: PathPlannerConfig):
+    """A path (K <= 3, J) start -> goal straight or through one via point, each segment valid
+    under ``batch``, or None. Rounds of ``config.vias`` seeded via points, Gaussian about the
+    midpoint with the round's spread; the shortest valid one is pulled towards the midpoint
+    while its segments stay valid."""
+    if batch.segments(start[None], goal[None])[0]:
+        return np.stack([start, goal])
+    rng = np.random.default_rng(config.seed)
+    mid = (start + goal) / 2.0
+    for spread in config.via_spreads:
+        vias = np.clip(mid + rng.normal(0.0, spread, (config.vias, start.size)), lo, hi)  # (V, J)
+        ends = np.broadcast_to(start, vias.shape), np.broadcast_to(goal, vias.shape)
+        ok = batch.segments(np.concatenate([ends[0], vias]), np.concatenate([vias, ends[1]]))
+        ok = ok[: len(vias)] & ok[len(vias) :]  # (V,) both halves valid
+        if not ok.any():
+            continue
+        lengths = np.linalg.norm(vias - start, axis=1) + np.linalg.norm(goal - vias, axis=1)
+        via = vias[np.flatnonzero(ok)[lengths[ok].argmin()]]
+        pulled = mid + np.array([0.25, 0.5, 0.75])[:, None] * (via - mid)  # (3, J) shorter first
+        ends = np.broadcast_to(start, pulled.shape), np.broadcast_to(goal, pulled.shape)
+        good = batch.segments(np.concatenate([ends[0], pulled]), np.concatenate([pulled, ends[1]]))
+        good = good[:3] & good[3:]
+        if good.any():
+            via = pulled[int(np.argmax(good))]
+        return np.stack([start, via, goal])
+    return None
+
+
+def _prefix(batch: _Batch, a: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """The farthest point of a -> b ((J,) each) up to which every checked point is valid (one
+    batched call over the whole line), or None when the first step is already blocked."""
+    n = max(1, math.ceil(float(np.linalg.norm(b - a)) / batch.step))
+    points = a + (np.arange(1, n + 1) / n)[:, None] * (b - a)  # (n, J)
+    ok = batch(points)
+    stop = n if ok.all() else int(np.argmin(ok))  # points[:stop] are valid
+    return None if stop == 0 else points[stop - 1]
+
+
+def _batched_connect(start, goal, batch: _Batch, lo, hi, config: PathPlannerConfig, deadline):
+    """RRT-Connect (Kuffner and LaValle, 2000) with whole-edge batched checks: each EXTEND
+    checks its edge (at most ``reach`` rad) in one call, each CONNECT the whole line to the
+    other tree's new node in one call and keeps its valid prefix. The (K, J) path or None."""
+    rng = np.random.default_rng(config.seed + 1)
+    reach = config.range if config.range > 0 else 1.0
+    trees = [([start], [-1]), ([goal], [-1])]  # (nodes, parents) grown from start, from goal
+    while time.perf_counter() < deadline:
+        nodes, parents = trees[0]
+        target = rng.uniform(lo, hi)
+        near = int(np.argmin(np.linalg.norm(np.array(nodes) - target, axis=1)))
+        step = target - nodes[near]
+        step *= min(1.0, reach / max(float(np.linalg.norm(step)), 1e-12))
+        new = _prefix(batch, nodes[near], nodes[near] + step)
+        if new is not None:
+            nodes.append(new)
+            parents.append(near)
+            others, other_parents = trees[1]
+            near = int(np.argmin(np.linalg.norm(np.array(others) - new, axis=1)))
+            reached = _prefix(batch, others[near], new)
+            if reached is not None:
+                others.append(reached)
+                other_parents.append(near)
+                if np.array_equal(reached, new):
+                    first, second = sorted(trees, key=lambda tree: tree[0][0] is not start)
+                    # start ... the meeting node, then on from it to the goal
+                    return np.array([*_branch(*first)[::-1], *_branch(*second)[1:]])
+        trees.reverse()
+    return None
+
+
+def _branch(nodes: list, parents: list) -> list:
+    """The nodes from the last one back to its tree's root."""
+    out, k = [], len(nodes) - 1
+    while k >= 0:
+        out.append(nodes[k])
+        k = parents[k]
+    return out
+
+
+def _batched_reduce(path: np.ndarray, batch: _Batch) -> np.ndarray:
+    """From each kept vertex, jump to the farthest later vertex it sees (one call each)."""
+    keep, i = [path[0]], 0
+    while i < len(path) - 1:
+        later = np.arange(i + 1, len(path))
+        ok = batch.segments(np.broadcast_to(path[i], (later.size, path.shape[1])), path[later])
+        i = int(later[np.flatnonzero(ok)].max()) if ok.any() else i + 1
+        keep.append(path[i])
+    return np.array(keep)
+
+
 def plan_path(
     start,
     goal,
     valid: Callable[[np.ndarray], bool],
     spec: PandaSpec = PANDA,
     config: PathPlannerConfig = PathPlannerConfig(),
+    valid_batch: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> PathResult:
     """A collision-free joint path ``start -> goal`` (each (J,)) inside spec's joint limits.
 
     ``valid(q)`` gets a fresh (J,) float64 array and says whether q is collision-free. Every
     segment of the returned path is checked with it every ``resolution x diagonal`` rad (and at
-    its ends). Misuse (shapes, NaN, start or goal outside the limits) raises MotionError; an
+    its ends).
+
+    ``valid_batch(q (B, J)) -> (B,) bool``, optional: a fast batched check that is at least as
+    strict as ``valid`` (e.g. `motion.sphere_check.SphereCollision.valid_batch` beside the mesh
+    model). It is tried first: the straight segment, then rounds of seeded via points, every
+    segment's points checked in one call or two; the path it finds is verified with ``valid``
+    (``config.verify``) and returned when it passes (evidence "search": "via"). Otherwise, or
+    when ``valid_batch`` finds nothing, OMPL searches with ``valid`` as without it.
+
+    Misuse (shapes, NaN, start or goal outside the limits) raises MotionError; an
     invalid start or goal and a search that runs out of time are failures in the result.
     """
     start, goal = _joint_vector("start", start, spec), _joint_vector("goal", goal, spec)
     if not callable(valid):
         raise MotionError(f"valid must be a callable q -> bool, got {type(valid).__name__}")
+    if valid_batch is not None and not callable(valid_batch):
+        kind = type(valid_batch).__name__
+        raise MotionError(f"valid_batch must be None or a callable (B, J) -> (B,), got {kind}")
     t0 = time.perf_counter()
     lo, hi = np.array(spec.q_min) - _BOUND_TOL, np.array(spec.q_max) + _BOUND_TOL
     checker = _Checker(valid, config.resolution * float(np.linalg.norm(hi - lo)))
@@ -240,6 +385,23 @@ def plan_path(
         dt = time.perf_counter() - t0
         return PathResult(failure is None, path, failure, info, dt, checker.calls)
 
+    if valid_batch is not None:
+        batch = _Batch(valid_batch, checker.step)
+        path = _via_search(start, goal, batch, lo, hi, config)
+        if path is None:
+            deadline = t0 + config.time_limit
+            path = _batched_connect(start, goal, batch, lo, hi, config, deadline)
+            if path is not None:
+                path = _dedupe(_batched_reduce(path, batch))
+        evidence |= {"batch_configs": batch.configs, "batch_calls": batch.calls}
+        evidence |= {"batch_s": time.perf_counter() - t0}
+        if path is not None and (
+            not config.verify or all(checker.segment(a, b, ends=True) for a, b in pairwise(path))
+        ):
+            search = "via" if len(path) <= 3 else "connect"
+            info = {"search": search, "waypoints": len(path), "length": _length(path)}
+            return result(path, None, **info, verified=config.verify)
+        evidence["search"] = "batched_failed" if path is None else "batched_refused"
     for name, q in (("start", start), ("goal", goal)):
         if not checker(q):
             return result(None, f"invalid_{name}", **{name: q.tolist()})
