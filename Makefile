@@ -27,7 +27,7 @@ $(PY):
 
 $(STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install -q torch==2.13.0
-	$(PY) -m pip install -q -e '.[dev,ray,docs]'  # ray: sweep tests; docs: mkdocs; no CUDA packages
+	$(PY) -m pip install -q -e '.[dev,ray,docs,rerun]'  # ray: sweep tests; docs: mkdocs; rerun: recordings; no CUDA
 	touch $(STAMP)
 
 # the embedded 5-block example from camera images: perception, planning and the simulated Panda

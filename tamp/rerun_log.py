@@ -84,6 +84,14 @@ def episode_file(folder: str | Path, sim: str, name: str) -> Path:
     return Path(folder) / "recordings" / f"{sim}-{safe}{SUFFIX}"
 
 
+def recorder_for(folder: str | Path | None, sim: str, name: str) -> RerunRecorder | None:
+    """A benchmark episode's recorder (`episode_file` under ``folder``), or None without a
+    folder."""
+    if folder is None:
+        return None
+    return RerunRecorder(episode_file(folder, sim, name), name)
+
+
 def _rgba(rgb: Sequence[float]) -> tuple[int, int, int, int]:
     return (*(round(255 * float(v)) for v in rgb), 255)
 

@@ -24,6 +24,7 @@ from robots.panda import PANDA
 from tamp.bench.suites import Suite
 from tamp.loop import LoopConfig
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
+from tamp.rerun_log import recorder_for
 from tamp.scene import layout
 from tamp.slots import plan_on_places
 from tamp.sweep import process_solver, run_items
@@ -172,13 +173,15 @@ def run_given(
     progress: Callable | None = None,
     workers: int = 1,
     ray_address: str | None = None,
+    record: str | None = None,
 ) -> list:
     """`PlanRow` of every source's plan of every instance in each simulator. Instance ``k`` uses
     episode seed ``seed * 100_003 + k`` (its layout) for every source; a plan met before on the
     same instance and simulator (the same steps, table places included) is run once (the rows
     share its outcome, time included): the distinct runs are the sweep's items. ``ours``: our
     planner's row (`our_plans`, with ``base``'s scene and placements). ``progress(sim, row)``
-    as each row is done."""
+    as each row is done. ``record``: a folder, each run a Rerun recording under it named by
+    the instance and the first source that has the plan (`tamp.rerun_log.recorder_for`)."""
     mine = {} if ours is None else our_plans(suite, ours, seed, base)
     plans: dict[str, Mapping] = {**sources, **({OURS: mine} if ours is not None else {})}
     checked = {}
@@ -199,7 +202,8 @@ def run_given(
                     unrun.append(len(specs))
                 else:
                     key = (sim, k, tuple((s.label, getattr(s.move, "at", None)) for s in steps))
-                    runs.setdefault(key, (inst.problem, steps, config, seed * 100_003 + k))
+                    named = (record, f"{inst.name}-{src}")
+                    runs.setdefault(key, (inst.problem, steps, config, seed * 100_003 + k, named))
                     waiting.setdefault(key, []).append(len(specs))
                 specs.append((src, sim, inst.name, task, verdict, error))
     rows, keys = [None] * len(specs), list(runs)
@@ -223,8 +227,11 @@ def run_given(
 
 
 def _given(item: tuple) -> tuple:
-    """`run_given`'s run ``(problem, steps, config, seed)``: its row's outcome columns."""
-    r = GivenPlanEpisode(*item, solver=process_solver()).run()
+    """`run_given`'s run ``(problem, steps, config, seed, (record, name))``: its row's outcome
+    columns."""
+    *episode, (record, name) = item
+    recorder = recorder_for(record, episode[2].sim, name)
+    r = GivenPlanEpisode(*episode, solver=process_solver(), recorder=recorder).run()
     return (
         r.reached_goal,
         *first_failure(r.steps, r.reached_goal),

@@ -27,6 +27,7 @@ from motion.ik import IKSolver, top_down_pose
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
+from tamp.rerun_log import recorder_for
 from tamp.sweep import process_solver, run_items
 from task.instances import Instance
 
@@ -128,13 +129,15 @@ def run(
     progress: Callable[[str, EpisodeReport], None] | None = None,
     workers: int = 1,
     ray_address: str | None = None,
+    record: str | None = None,
 ) -> MotionBench:
     """One closed-loop episode per instance in each simulator; ``progress(sim, report)`` as
     each ends. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
-    reproducible from ``seed`` whatever ``workers``/``ray_address`` (`tamp.sweep.run_items`)."""
+    reproducible from ``seed`` whatever ``workers``/``ray_address`` (`tamp.sweep.run_items`).
+    ``record``: a folder, each episode a Rerun recording under it (`tamp.rerun_log`)."""
     ik = time_ik(process_solver())
     items = [
-        (inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name)
+        (inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name, record)
         for name in sims
         for k, inst in enumerate(suite.instances)
     ]
@@ -150,9 +153,11 @@ def run(
 
 
 def _episode(item: tuple) -> EpisodeReport:
-    """`run`'s episode ``(problem, config, seed, name)``, in the process that runs it."""
-    report = run_episode(*item[:3], solver=process_solver())
-    return dataclasses.replace(report, problem=item[3])
+    """`run`'s episode ``(problem, config, seed, name, record)``, in the process that runs it."""
+    problem, config, seed, name, record = item
+    recorder = recorder_for(record, config.sim, name)
+    report = run_episode(problem, config, seed, solver=process_solver(), recorder=recorder)
+    return dataclasses.replace(report, problem=name)
 
 
 def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:

@@ -360,6 +360,27 @@ def episode_options(
         "state (an oracle) (perceived)",
     )
     scene_options(p, scene_files)
+    record_option(p, "SIM-INSTANCE" if multi_sim else None)
+
+
+def record_option(p: argparse.ArgumentParser, episodes: str | None = None) -> None:
+    """``--record``: a Rerun recording of the episode (``FILE.rrd``), or with ``episodes`` (a
+    benchmark's file names, e.g. ``SIM-INSTANCE``) a flag for one recording per episode under
+    ``--out`` (`tamp.rerun_log`)."""
+    extra = "needs the rerun extra: pip install 'soft-tamp[rerun]'"
+    if episodes is not None:
+        p.add_argument(
+            "--record",
+            action="store_true",
+            help=f"write a Rerun recording of every episode to OUT/recordings/{episodes}.rrd "
+            f"(needs --out; {extra})",
+        )
+        return
+    p.add_argument(
+        "--record",
+        metavar="FILE.rrd",
+        help=f"write a Rerun recording of the episode to FILE.rrd ({extra})",
+    )
 
 
 def scene_options(p: argparse.ArgumentParser, files: bool = False) -> None:
@@ -558,6 +579,7 @@ def executability_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=seed, default=0, help="scene layout and planner seed (0)")
     p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
     scene_options(p)
+    record_option(p, "SIM-INSTANCE-SOURCE")  # a plan run once for several sources: the first
     progress_option(p)
     output_options(p, "write results.json and plans.csv into this folder")
 

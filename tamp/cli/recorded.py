@@ -21,6 +21,7 @@ from pathlib import Path
 from perception import CHECKPOINT
 from tamp.bench.official import default_data
 from tamp.cli.options import SCENES, check_workcell, planner_config, sim_list
+from tamp.rerun_log import check_record_path
 from task.errors import TampError
 
 # options that change where or how the output is shown, never what is computed: checked by
@@ -165,6 +166,7 @@ def run_config(args: argparse.Namespace) -> dict:
         "replan": args.replan,
         "stop_at_invalid": args.stop_at_invalid,
         "video": None if args.no_video or args.out is None else args.video_format,
+        "record": None if args.record is None else str(check_record_path(args.record)),
     }
 
 
@@ -211,6 +213,7 @@ _PLANNER_FLAGS = (
 def executability_config(args: argparse.Namespace) -> dict:
     """``bench executability``."""
     config = given_config(args)
+    _records_under_out(args)
     return {
         "plans": str(args.plans),
         "sims": list(sim_list(args.sim)),
@@ -227,7 +230,14 @@ def executability_config(args: argparse.Namespace) -> dict:
         "threads": args.threads,
         "workers": args.workers,
         "ray": args.ray,
+        "record": args.record,
     }
+
+
+def _records_under_out(args: argparse.Namespace) -> None:
+    """A benchmark's ``--record`` writes OUT/recordings/: refused without ``--out``."""
+    if args.record and not args.out:
+        raise TampError("--record writes OUT/recordings/SIM-INSTANCE.rrd; give --out DIR")
 
 
 def tamp_bench_config(args: argparse.Namespace) -> dict:
@@ -250,6 +260,7 @@ def motion_config(args: argparse.Namespace) -> dict:
     """``bench motion``."""
     if args.blocks and args.data != str(default_data("blocksworld")):
         raise TampError("--data with --blocks: random problems read no data; drop one")
+    _records_under_out(args)
     config = loop_config(args)
     body = _loop_dict(config)
     del body["sim"]
@@ -262,6 +273,7 @@ def motion_config(args: argparse.Namespace) -> dict:
         "blocks": list(args.blocks) if args.blocks else None,
         "workers": args.workers,
         "ray": args.ray,
+        "record": args.record,
     }
 
 

@@ -19,9 +19,17 @@ import sys
 import time
 from pathlib import Path
 
-from tamp.cli.recorded import checkpoint, loop_config, out_folder, run_config, scene_run
+from tamp.cli.recorded import (
+    checkpoint,
+    loop_config,
+    out_file,
+    out_folder,
+    run_config,
+    scene_run,
+)
 from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
+from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.video import EpisodeVideo
 from task import data
 from task.errors import TampError
@@ -81,6 +89,9 @@ def _given_steps(path: str | None, problem: Problem):
 def run_command(args: argparse.Namespace) -> int:
     recorded = run_config(args)  # refused combinations: before any work
     out_folder(args.out)
+    out_file(args.record, "--record")
+    if args.record is not None:
+        require_rerun()  # the optional extra: a one-line error naming it
     task = scene_run(args)
     problem = load_problem(args.problem, args.domain) if task is None else task.problem
     config = loop_config(args)
@@ -102,12 +113,20 @@ def run_command(args: argparse.Namespace) -> int:
         if not quiet:
             print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
+    recorder = None if args.record is None else RerunRecorder(args.record, problem.name)
     if steps is None:
         poses = None if task is None else dict(task.poses)  # a scene file's: where it puts them
-        episode = Episode(problem, config, args.seed, on_event=say, poses=poses)
+        episode = Episode(problem, config, args.seed, on_event=say, poses=poses, recorder=recorder)
     else:
         episode = GivenPlanEpisode(
-            problem, steps, config, args.seed, args.replan, args.stop_at_invalid, on_event=say
+            problem,
+            steps,
+            config,
+            args.seed,
+            args.replan,
+            args.stop_at_invalid,
+            on_event=say,
+            recorder=recorder,
         )
     if video is not None:
 
@@ -148,4 +167,8 @@ def run_command(args: argparse.Namespace) -> int:
         print("\n".join(summary_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
+        if recorder is not None:
+            print(
+                f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
+            )
     return 0 if report.reached_goal else 1

@@ -24,6 +24,7 @@ from tamp.cli.recorded import (
     motion_config,
 )
 from tamp.cli.recorded import out_folder as output_folder
+from tamp.rerun_log import require_rerun
 from task.errors import TampError
 
 DEFAULT_N = 20  # bench executability: instances when --n is not given (fewer if fewer named)
@@ -37,6 +38,8 @@ def motion_command(args: argparse.Namespace) -> int:
 
     recorded = motion_config(args)  # refused combinations: before any work
     output_folder(args.out)
+    if args.record:
+        require_rerun()  # the optional extra: a one-line error naming it
     if args.observe == "camera":
         checkpoint(args.checkpoint)
     sims, base = sim_list(args.sim), loop_config(args)
@@ -60,7 +63,10 @@ def motion_command(args: argparse.Namespace) -> int:
             bar.update(1)
 
         try:
-            result = motion.run(suite, base, sims, args.seed, progress, args.workers, args.ray)
+            record = args.out if args.record else None  # OUT/recordings/SIM-INSTANCE.rrd
+            result = motion.run(
+                suite, base, sims, args.seed, progress, args.workers, args.ray, record
+            )
         except KeyboardInterrupt:
             if args.out:
                 _motion_partial(args.out, recorded, suite, done, sims, base, total)
@@ -95,7 +101,8 @@ def motion_command(args: argparse.Namespace) -> int:
         f"({ik['converged']}/{ik['n']} converged)"
     )
     if args.out:
-        print(f"wrote results.json, episodes.csv to {args.out}")
+        also = ", recordings/" if args.record else ""
+        print(f"wrote results.json, episodes.csv{also} to {args.out}")
     return 0
 
 
@@ -131,6 +138,8 @@ def executability_command(args: argparse.Namespace) -> int:
 
     recorded = executability_config(args)  # refused combinations: before any work
     output_folder(args.out)
+    if args.record:
+        require_rerun()  # the optional extra: a one-line error naming it
     sims, sources = sim_list(args.sim), bench.read_sources(args.plans)
     names = bench.named(sources)
     if args.n is not None and args.n > len(names):
@@ -155,8 +164,18 @@ def executability_command(args: argparse.Namespace) -> int:
             bar.update(1)
 
         try:
+            record = args.out if args.record else None  # OUT/recordings/SIM-INSTANCE-SOURCE.rrd
             rows = bench.run_given(
-                suite, sources, base, sims, args.seed, ours, progress, args.workers, args.ray
+                suite,
+                sources,
+                base,
+                sims,
+                args.seed,
+                ours,
+                progress,
+                args.workers,
+                args.ray,
+                record,
             )
         except KeyboardInterrupt:
             if args.out:
@@ -191,5 +210,6 @@ def executability_command(args: argparse.Namespace) -> int:
         sep="\n",
     )
     if args.out:
-        print(f"wrote results.json, plans.csv to {args.out}")
+        also = ", recordings/" if args.record else ""
+        print(f"wrote results.json, plans.csv{also} to {args.out}")
     return 0

@@ -189,12 +189,12 @@ def test_motion_aware_and_placements_plan_our_row_on_the_table_and_are_recorded(
     config = json.loads((out / "results.json").read_text())["config"]
     assert (config["lambda_motion"], config["placements"]) == (0.05, 0.02)
     assert config["planner"]["lambda_motion"] == 0.05
-    ours = [steps for _, steps, loop, _ in items if any(getattr(s.move, "at", None) for s in steps)]
+    ours = [steps for _, steps, *_ in items if any(getattr(s.move, "at", None) for s in steps)]
     assert len(ours) == 1  # the CSV's plan names no places; ours does
     (placed,) = [s.move for s in ours[0] if s.move.target == "table"]
     assert placed.entity == "b" and len(placed.at) == 2
-    assert all(loop.placements == 0.02 for _, _, loop, _ in items)
+    assert all(loop.placements == 0.02 for _, _, loop, *_ in items)
     items.clear()
     assert main(_argv(root, plans, out, "--n", "1", "--restarts", "4", "--iters", "30")) == 0
-    assert not any(getattr(s.move, "at", None) for _, steps, _, _ in items for s in steps)
+    assert not any(getattr(s.move, "at", None) for _, steps, *_ in items for s in steps)
     capsys.readouterr()

@@ -63,6 +63,7 @@ SAMPLES = {
     "--goal": "(on b c)",
     "--problems": "blocked,tall",
     "--planner": "search",
+    "--record": "episode.rrd",  # run and demo: a file (the benchmarks: a flag)
 }
 # what an option needs to take effect, per command where it differs; tried in order
 NEEDS = {
@@ -76,6 +77,7 @@ NEEDS = {
     "--video-format": [["--out", "folder"]],
     "--video": [["--out", "folder"]],
     "--no-video": [["--out", "folder"]],
+    "--record": [["--out", "folder"]],  # the benchmarks: OUT/recordings/
     "--domain": [["problem.pddl"]],
     "--min-blocks": [["--max-blocks", "9"]],
     "--data": [["--blocks", "4"]],
