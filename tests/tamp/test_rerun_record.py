@@ -77,6 +77,32 @@ def test_tamp_run_record_writes_a_recording_rerun_reads_back(tmp_path, capsys):
 
 
 @pytest.mark.sim
+@pytest.mark.slow  # perception, rendering and an episode
+def test_a_camera_episode_records_its_images_and_soft_supports(tmp_path):
+    pytest.importorskip("rerun")
+    from rerun.chunk import RrdReader
+
+    from tamp.rerun_log import RerunRecorder
+
+    problem = Problem("two", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    rrd = tmp_path / "camera.rrd"
+    config = LoopConfig(observe="camera")
+    report = Episode(problem, config, 0, recorder=RerunRecorder(rrd, "two")).run()
+    rows, timelines = _entities(rrd)
+    assert TIMELINE in timelines["/camera/image"] and TIMELINE in timelines["/belief/support"]
+    observations = rows["/camera/image"]
+    assert observations >= 1 + len(report.moves)  # the first image, and one after each move
+    assert rows["/belief/support"] == observations  # every image was readable here
+    shapes = set()
+    for chunk in RrdReader(rrd).stream():
+        if chunk.entity_path == "/belief/support":
+            batch = chunk.to_record_batch()
+            shape = next(c for c in batch.schema.names if c.endswith("Tensor:data"))
+            shapes |= {tuple(t[0]["shape"]) for t in batch[shape].to_pylist()}
+    assert shapes == {(2, 3)}  # (N, N + 1): the blocks, onto a block or the table
+
+
+@pytest.mark.sim
 @pytest.mark.slow  # two episodes
 def test_a_recording_changes_nothing_the_episode_does(tmp_path):
     pytest.importorskip("rerun")
