@@ -56,6 +56,7 @@ ON_SPOT = 0.01  # m, an object this near a table spot stands on it
 FINGERS = 0.07
 SIDE = 0.033
 PACK = PackConfig(fingers=FINGERS, side=SIDE)
+PACK_TRIES = 4  # packings tried (seeds) before a region counts as too small
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,11 @@ class Bridged:
         return GeoMove(o.name, Place(f"on.{y.name}", y.name, xyz, y.pose.yaw))
 
 
+def own_footprint(o: Movable) -> tuple[float, float]:
+    """Half extents (x, y) of ``o``'s footprint in its own frame (m): the packer turns it."""
+    return o.half[0], o.half[1]
+
+
 def footprint(o: Movable) -> tuple[float, float]:
     """Half extents (x, y) of ``o``'s axis-aligned bounding footprint (m)."""
     c, s = abs(math.cos(o.pose.yaw)), abs(math.sin(o.pose.yaw))
@@ -188,14 +194,18 @@ def bridge(
         if not movers:
             continue
         fixed = [scene.object(x) for x in inside]
-        result = pack(
-            r.inner(),
-            [footprint(scene.object(x)) for x in movers],
-            [o.pose.xyz[:2] for o in fixed],
-            [footprint(o) for o in fixed],
-            config,
-            seed,
-        )
+        for attempt in range(PACK_TRIES):  # a few seeds: each is R restart rows already
+            result = pack(
+                r.inner(),
+                [own_footprint(scene.object(x)) for x in movers],
+                [o.pose.xyz[:2] for o in fixed],
+                [footprint(o) for o in fixed],
+                config,
+                seed + attempt,
+                walled=r.wall_height > 0,
+            )
+            if result.ok:
+                break
         packs.append((r.name, result))
         for i, x in enumerate(movers):
             xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))

@@ -12,8 +12,9 @@ prices each legal move x -> y of that state:
 - else the joint distance (rad) between the top-down grasp and release configurations, as
   `tamp.arm_costs` prices Blocksworld moves (`motion.cost`'s c(x, y) without its sphere terms).
 
-A grasp is free at a pose when the open hand (`motion.grasps.HAND_BOXES`, the palm and both
-fingers, as axis-aligned boxes around their turned corners) at that grasp overlaps no other
+A grasp is free at a pose when the hand (`motion.grasps.HAND_BOXES`, the palm and both fingers,
+each finger swept from open to closed on the object, as axis-aligned boxes around their turned
+corners; `hand_shape`) at that grasp overlaps no other
 object, obstacle, region wall or floor: the geometric half of `tamp.geo.check.quick_check`,
 without IK, for every grasp family at once. It is a proxy: the planner's moves are bound to a
 grasp by the full check (`tamp.geo.ours.planner`), and what fails there comes back as failure
@@ -61,13 +62,27 @@ class GeoCostConfig:
     margin: float = 0.004  # m, the open hand's boxes grown by this (the collision margin)
 
 
+def hand_shape(grasp: Grasp) -> tuple:
+    """The open hand's boxes (centre, half extents) in the TCP frame at ``grasp``
+    (`motion.grasps.HAND_BOXES`), each finger swept in to where it closes on the object (the
+    object's width apart): the room the fingers take while they open, close, carry and let go."""
+    (palm, *fingers) = HAND_BOXES
+    out = [palm]
+    for (cx, cy, cz), (hx, hy, hz) in fingers:
+        outer = abs(cy) + hy
+        inner = min(abs(cy) - hy, grasp.width / 2)
+        side = 1.0 if cy > 0 else -1.0
+        out.append(((cx, side * (outer + inner) / 2, cz), (hx, (outer - inner) / 2, hz)))
+    return tuple(out)
+
+
 def hand_boxes(grasp: Grasp, xyz, yaw: float, margin: float = 0.0) -> np.ndarray:
-    """(3, 2, 3) lower and upper corners (m) of the axis-aligned boxes around the open hand's
-    palm and fingers (grown by ``margin``, m) holding an object at centre ``xyz``, turned
-    ``yaw``."""
+    """(3, 2, 3) lower and upper corners (m) of the axis-aligned boxes around the hand's palm
+    and fingers (`hand_shape`, grown by ``margin``, m) holding an object at centre ``xyz``,
+    turned ``yaw``."""
     tcp = world_tcp(grasp, xyz, yaw)  # (4, 4)
     out = []
-    for centre, half in HAND_BOXES:
+    for centre, half in hand_shape(grasp):
         pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
         world = pts @ tcp[:3, :3].T + tcp[:3, 3]  # (8, 3)
         out.append((world.min(0), world.max(0)))
@@ -75,12 +90,12 @@ def hand_boxes(grasp: Grasp, xyz, yaw: float, margin: float = 0.0) -> np.ndarray
 
 
 def hand_corners(grasps: Sequence[Grasp], margin: float = 0.0) -> np.ndarray:
-    """(G, 3, 8, 3) the corners (m) of the open hand's palm and finger boxes (grown by
+    """(G, 3, 8, 3) the corners (m) of the hand's palm and finger boxes (`hand_shape`, grown by
     ``margin``) at each grasp, in the frame of the object held (its centre, unturned)."""
     out = np.zeros((len(grasps), len(HAND_BOXES), 8, 3))
     for i, g in enumerate(grasps):
         m = g.matrix  # (4, 4) TCP in the object frame
-        for k, (centre, half) in enumerate(HAND_BOXES):
+        for k, (centre, half) in enumerate(hand_shape(g)):
             pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
             out[i, k] = pts @ m[:3, :3].T + m[:3, 3]
     return out

@@ -22,12 +22,17 @@ region's edges (its walls), and the
 closing axis of each object (x or y) is drawn per restart row, as is each footprint's yaw
 (0 or pi/2: a cuboid turned a quarter turn swaps its half extents). Yaws are thus chosen among
 {0, pi/2} across restarts, not optimised; footprints are axis-aligned (a cylinder's is its
-bounding square). A packing is ``ok`` when no two grown footprints interpenetrate more than
-`PackConfig.tol` and every one lies inside.
+bounding square). The hand needs its room only when its object is placed, among the objects
+placed before: with `PackConfig.ordered` (the default) a pair counts the lesser of its two
+directions (whichever goes second needs the room), and the packing must admit a placing order
+(`placing_order`; the planner finds its own with the arm's prices). A packing is ``ok`` when no
+pair interpenetrates more than `PackConfig.tol`, every footprint lies inside and (ordered) an
+order exists.
 
 `pack_sampled` is the baseline a greedy TAMP system uses: objects in order, each at a uniform
-random position inside until one is free (rejection sampling), starting over from the first
-object when one finds no position in its share of tries, until the budget of samples is spent.
+random position inside until one is free of those placed before (its hand too; rejection
+sampling), starting over from the first object when one finds no position in its share of
+tries, until the budget of samples is spent.
 """
 
 from __future__ import annotations
@@ -64,7 +69,11 @@ class PackConfig:
     fingers: float = 0.0  # m, the hand's reach from the object's centre along the closing axis
     # (open finger pads, with the collision model's margin); 0: no finger room
     side: float = 0.0  # m, the hand's reach from the centre across the closing axis
+    stroke: float = 0.08  # m, the widest the fingers open: a side wider than this is never
+    # the closing axis
     tol: float = 1e-4  # m, interpenetration still counted as free
+    ordered: bool = True  # finger room against the objects placed before only: a pair is free
+    # when either's hand clears the other's body, and some placing order must exist (`order`)
 
 
 @dataclass(frozen=True)
@@ -72,7 +81,8 @@ class PackResult:
     """The best packing: ``positions`` (M, 2) centres, ``yaws`` (M,) in {0, pi/2}, ``axes``
     (M,) each object's closing axis (0: x, 1: y, in the world frame), ``ok`` when free and
     inside, ``overlap`` the deepest interpenetration left (m), ``time`` (s), ``tries`` (Adam
-    rows or samples spent)."""
+    row-steps or samples spent), ``order`` an order of placing them in which each object's
+    hand clears those placed before (empty when none exists)."""
 
     positions: np.ndarray
     yaws: np.ndarray
@@ -81,6 +91,7 @@ class PackResult:
     overlap: float
     time: float
     tries: int
+    order: tuple[int, ...] = ()
 
 
 def _check(inner: Rect, half, fixed_xy, fixed_half) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -121,15 +132,19 @@ def overlap_loss(
     beta: float,
     eps: float,
     gap: float,
+    ordered: bool = False,
 ) -> torch.Tensor:
     """(R,) the packing loss of each row (module docstring). ``xy`` (R, M, 2) centres, ``half``
     (R, M, 2) grown half extents (finger room), ``body`` (R, M, 2) the bodies' own; fixed
     occupants ``fixed_xy`` / ``fixed_half`` (F, 2). A grown footprint must clear the other
-    bodies: pairs count both ways (i's fingers against j's body and j's against i's)."""
+    bodies: pairs count both ways (i's fingers against j's body and j's against i's), or with
+    ``ordered`` the lesser of the two (whichever is placed second needs the room)."""
     m = xy.shape[1]
     d = xy[:, :, None] - xy[:, None]  # (R, M, M, 2)
     reach = half[:, :, None] + body[:, None] + gap  # (R, M, M, 2): i grown, j body
     pair = _soft_area(d, reach, beta, eps)  # (R, M, M)
+    if ordered:
+        pair = torch.minimum(pair, pair.transpose(1, 2))  # (R, M, M), symmetric
     off = ~torch.eye(m, dtype=torch.bool)
     loss = torch.where(off, pair, 0.0).sum((-1, -2))  # (R,)
     if fixed_xy.shape[0]:
@@ -138,10 +153,13 @@ def overlap_loss(
     return loss
 
 
-def _depths(xy, half, body, fxy, fh, gap: float) -> np.ndarray:
-    """(R,) the deepest exact interpenetration (m) of each row's grown footprints, with gap."""
+def _depths(xy, half, body, fxy, fh, gap: float, ordered: bool = False) -> np.ndarray:
+    """(R,) the deepest exact interpenetration (m) of each row's grown footprints, with gap
+    (``ordered``: of each pair, the lesser of its two directions)."""
     d = np.abs(xy[:, :, None] - xy[:, None])  # (R, M, M, 2)
-    pen = (half[:, :, None] + body[:, None] + gap - d).min(-1)  # (R, M, M)
+    pen = (half[:, :, None] + body[:, None] + gap - d).min(-1)  # (R, M, M): i's hand, j's body
+    if ordered:
+        pen = np.minimum(pen, pen.transpose(0, 2, 1))
     m = xy.shape[1]
     pen[:, np.arange(m), np.arange(m)] = -np.inf
     worst = pen.reshape(len(xy), -1).max(-1) if m > 1 else np.full(len(xy), -np.inf)
@@ -149,6 +167,23 @@ def _depths(xy, half, body, fxy, fh, gap: float) -> np.ndarray:
         pf = (half[:, :, None] + fh + gap - np.abs(xy[:, :, None] - fxy)).min(-1)  # (R, M, F)
         worst = np.maximum(worst, pf.reshape(len(xy), -1).max(-1))
     return worst
+
+
+def placing_order(xy, half, body, gap: float, tol: float) -> tuple[int, ...]:
+    """An order of placing M footprints at ``xy`` (M, 2) in which each one's hand (``half``,
+    (M, 2) grown) clears the bodies (``body``) placed before it, found backwards (the last
+    placed clears every other); () when there is none."""
+    d = np.abs(xy[:, None] - xy[None])  # (M, M, 2)
+    hits = (half[:, None] + body[None] + gap - d).min(-1) > tol  # (M, M): i's hand on j's body
+    np.fill_diagonal(hits, False)
+    left, backwards = list(range(len(xy))), []
+    while left:
+        last = next((i for i in left if not hits[i, left].any()), None)
+        if last is None:
+            return ()
+        backwards.append(last)
+        left.remove(last)
+    return tuple(reversed(backwards))
 
 
 def pack(
@@ -159,11 +194,13 @@ def pack(
     config: PackConfig = PackConfig(),
     seed: int = 0,
     turnable: Sequence[bool] | None = None,
+    walled: bool = True,
 ) -> PackResult:
     """Place the M ``footprints`` (half extents (M, 2), m) inside ``inner`` free of each other
     and of the fixed occupants (centres (F, 2), half extents (F, 2)); see the module docstring.
     ``turnable[m]``: whether footprint m may turn a quarter turn (default: when it is not
-    square)."""
+    square); ``walled``: the hand must stay inside the region too (walls stand on its edges;
+    a marked area lets the fingers reach beyond it)."""
     t0 = time.perf_counter()
     half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
     m, r = len(half_np), config.restarts
@@ -175,39 +212,50 @@ def pack(
     may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
     turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
     axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
+    h = torch.where(turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np))
+    wide = 2 * h.gather(-1, axis[..., None])[..., 0] > config.stroke  # (R, M): not between
+    axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
     body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
     lo = torch.tensor(inner[0], dtype=torch.float64)
     span = torch.tensor(inner[1], dtype=torch.float64) - lo
-    room = (span - 2 * half).clamp_min(0.0)  # (R, M, 2)
+    edge = half if walled else body  # what must stay inside: the hand too where walls stand
+    room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
     u = torch.randn(r, m, 2, generator=gen, dtype=torch.float64).requires_grad_(True)
     opt = Adam([{"params": [u], "lr": config.lr}])  # the planner's (no torch._dynamo import)
     fxy, fh = torch.from_numpy(fxy_np), torch.from_numpy(fh_np)
     steps = config.steps
 
     def centres() -> torch.Tensor:
-        return lo + half + room * torch.sigmoid(u)  # (R, M, 2)
+        return lo + edge + room * torch.sigmoid(u)  # (R, M, 2)
 
     for k in range(steps):
         beta = config.beta * (config.beta_end / config.beta) ** (k / max(steps - 1, 1))
-        loss = overlap_loss(centres(), half, body, fxy, fh, beta, config.eps, config.gap)
+        loss = overlap_loss(
+            centres(), half, body, fxy, fh, beta, config.eps, config.gap, config.ordered
+        )
         opt.zero_grad()
         loss.sum().backward()
         opt.step()
     with torch.no_grad():
         xy = centres().numpy()  # (R, M, 2)
     fits = (room > 0).all(-1).all(-1).numpy()  # (R,) every grown footprint fits the region
-    worst = _depths(xy, half.numpy(), body.numpy(), fxy_np, fh_np, config.gap)  # (R,)
+    grown_np, body_np = half.numpy(), body.numpy()
+    worst = _depths(xy, grown_np, body_np, fxy_np, fh_np, config.gap, config.ordered)  # (R,)
     worst = np.where(fits, worst, np.inf)
     best = int(np.argmin(worst))
+    order = tuple(range(m))
+    if config.ordered:
+        order = placing_order(xy[best], grown_np[best], body_np[best], config.gap, config.tol)
     yaws = np.where(turn[best].numpy(), math.pi / 2, 0.0)
     return PackResult(
         positions=xy[best],
         yaws=yaws,
         axes=axis[best].numpy(),
-        ok=bool(worst[best] <= config.tol),
+        ok=bool(worst[best] <= config.tol) and len(order) == m,
         overlap=float(worst[best]),
         time=time.perf_counter() - t0,
         tries=r * steps,
+        order=order,
     )
 
 
@@ -220,11 +268,12 @@ def pack_sampled(
     seed: int = 0,
     config: PackConfig = PackConfig(),
     per_object: int = 50,
+    walled: bool = True,
 ) -> PackResult:
     """The sampled baseline (module docstring): at most ``budget`` position samples in all,
     ``per_object`` tries per object before starting over; each object's yaw (for a cuboid)
-    and closing axis drawn at random per attempt. Same result value as `pack` (``tries``:
-    samples spent)."""
+    and closing axis drawn at random per attempt; ``walled`` as in `pack`. Same result value
+    as `pack` (``tries``: samples spent)."""
     t0 = time.perf_counter()
     half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
     m = len(half_np)
@@ -240,16 +289,19 @@ def pack_sampled(
             turn = not np.isclose(*half_np[i]) and rng.random() < 0.5
             axes[i] = rng.integers(2)
             bodies[i] = half_np[i][::-1] if turn else half_np[i]
+            if 2 * bodies[i, axes[i]] > config.stroke:
+                axes[i] = 1 - axes[i]  # the fingers close across the other side
             grown[i] = np.maximum(bodies[i], config.side)
             grown[i, axes[i]] = max(bodies[i, axes[i]], config.fingers)
             yaws[i] = math.pi / 2 if turn else 0.0
-            if np.any(hi - lo < 2 * grown[i]):
+            edge = grown[i] if walled else bodies[i]
+            if np.any(hi - lo < 2 * edge):
                 break
             for _ in range(per_object):
                 if spent >= budget:
                     break
                 spent += 1
-                p = lo + grown[i] + rng.random(2) * (hi - lo - 2 * grown[i])
+                p = lo + edge + rng.random(2) * (hi - lo - 2 * edge)
                 if _free(
                     p, grown[i], bodies[i], xy[:i], grown[:i], bodies[:i], fxy_np, fh_np, config
                 ):
@@ -259,7 +311,8 @@ def pack_sampled(
             if placed <= i:
                 break
         if placed == m:
-            return PackResult(xy, yaws, axes, True, -math.inf, time.perf_counter() - t0, spent)
+            took = time.perf_counter() - t0
+            return PackResult(xy, yaws, axes, True, -math.inf, took, spent, tuple(range(m)))
         if best is None or placed > len(best.positions):
             best = PackResult(xy[:placed], yaws[:placed], axes[:placed], False, math.inf, 0.0, 0)
     if best is None:
@@ -274,8 +327,8 @@ def _free(p, grown, body, xy, others_grown, others_body, fxy, fh, config: PackCo
     g, tol = config.gap, config.tol
     if len(xy):
         d = np.abs(xy - p)  # (k, 2)
-        mine = (grown + others_body + g - d).min(-1)  # my fingers against their bodies
-        theirs = (others_grown + body + g - d).min(-1)
-        if max(mine.max(), theirs.max()) > tol:
+        mine = (grown + others_body + g - d).min(-1)  # my hand against their bodies
+        theirs = (others_grown + body + g - d).min(-1)  # theirs against mine (placed before me)
+        if mine.max() > tol or (not config.ordered and theirs.max() > tol):
             return False
     return not (len(fxy) and (grown + fh + g - np.abs(fxy - p)).min(-1).max() > tol)

@@ -11,8 +11,11 @@
 3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
    full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
    no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
-   at that place, under the grasps that failed) and the problem is planned again, at most
-   `OursConfig.replans` times.
+   at that place, under the grasps that failed) and the problem is planned on from the state
+   the moves bound so far reached, at most `OursConfig.replans` times. A window prices all
+   its moves in its start state, so a later move of it may be priced out in its own state
+   (the hand no longer fits once a neighbour is placed): binding stops there too and planning
+   goes on from that state (`OursConfig.cuts`).
 
 The status is SOLVED with the bound moves; UNSOLVABLE only when the planner's fallback proved
 that no plan exists within the discretised places and the moves the prices allow; BUDGET
@@ -38,7 +41,9 @@ from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 from task.config import PlannerConfig
+from task.costs import IMPOSSIBLE
 from task.domains.blocksworld import apply_move
+from task.domains.blocksworld import check_move as legal
 from task.planner import plan
 from task.problem import PlanStatus
 
@@ -54,6 +59,7 @@ class OursConfig:
     costs: GeoCostConfig = field(default_factory=GeoCostConfig)
     table_places: int | None = None  # table spots (None: objects + 2)
     replans: int = 4  # plans again after a move no grasp passes, at most this often
+    cuts: int = 8  # plans on after a move priced out in its own state, at most this often
     seed: int = 0
 
 
@@ -109,34 +115,86 @@ def plan_motion_aware(
         return GeoPlan(GeoStatus.BUDGET, reason=why, stats=stats)
     solver, q = getattr(tools, "solver", None), getattr(tools, "q", None)
     costs = GeoCosts(bridged, solver, q, config.costs)
-    failures, plans = [], 0
-    for attempt in range(config.replans + 1):
+    failures, plans, cuts = [], 0, 0
+    state, world, bound = bridged.problem.init, bridged.scene, []
+    while len(failures) <= config.replans and cuts <= config.cuts:
         plans += 1
-        result = plan(bridged.problem, config.planner, seed=config.seed + attempt, costs=costs)
+        now = replace(bridged.problem, init=state)
+        result = plan(now, config.planner, seed=config.seed + plans - 1, costs=costs)
         stats.update(_planner_stats(result, costs))
-        if result.status is PlanStatus.UNSOLVABLE:
+        if result.status is PlanStatus.UNSOLVABLE and state == bridged.problem.init:
             why = result.stats.get("fallback", {}).get("reason", "no plan")
             why = f"within the discretised places: {why}"
             return _done(GeoStatus.UNSOLVABLE, (), why, stats, t0, plans, failures)
         if not result.solved:
             why = result.stats.get("fallback", {}).get("reason", "the windows ran out")
+            if state != bridged.problem.init:
+                why = f"after {len(bound)} bound moves: {why}"
             return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
-        bound, failed = _bind(bridged, result.plan.moves, tools, costs, check)
+        state, world, more, failed = _bind(
+            bridged, state, world, result.plan.moves, tools, costs, check
+        )
+        bound += more
         if failed is None:
-            return _done(GeoStatus.SOLVED, bound, "", stats, t0, plans, failures)
-        failures.append(failed)
+            return _done(GeoStatus.SOLVED, tuple(bound), "", stats, t0, plans, failures)
+        if failed.get("failure") == "priced":
+            cuts += 1  # a window's later move its own state prices out: plan on from there
+        else:
+            failures.append(failed)
     why = f"{len(failures)} planned moves failed the full check; the replan budget is spent"
     return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
 
 
-def _bind(bridged: Bridged, moves, tools, costs: GeoCosts, check) -> tuple[tuple, dict | None]:
-    """Each planned move as a `GeoMove` with the grasp the full check passes, in the world the
-    moves before it leave. Returns the bound moves and None, or the moves bound so far and the
-    failure (recorded in ``costs``)."""
+def reorder(bridged: Bridged, costs: GeoCosts, state, moves, budget: int = 200):
+    """``moves`` in an order in which each is legal and not priced out in its own state
+    (`GeoCosts.price`), the moves of each object kept in their order (so the plan ends in the
+    same state), the planned order tried first; None when no such order is found within
+    ``budget`` states. A window prices all its moves in its start state: placing o5 then o4
+    may look free there though o4's hand no longer fits beside o5; this repairs the order."""
+    p = bridged.problem
+    dead: set[frozenset] = set()
+    seen = 0
+
+    def search(state, left: tuple[int, ...]) -> list[int] | None:
+        nonlocal seen
+        if not left:
+            return []
+        key = frozenset(left)
+        if key in dead or seen >= budget:
+            return None
+        seen += 1
+        prices = costs.price(state)
+        for k, i in enumerate(left):
+            move = moves[i]
+            if any(moves[j].entity == move.entity for j in left[:k]):
+                continue  # an earlier move of the same object comes first
+            if legal(p, state, move) is not None:
+                continue
+            if prices[p.entities.index(move.entity), p.index(move.target)] >= IMPOSSIBLE:
+                continue
+            rest = search(apply_move(p, state, move), left[:k] + left[k + 1 :])
+            if rest is not None:
+                return [i, *rest]
+        dead.add(key)
+        return None
+
+    order = search(tuple(state), tuple(range(len(moves))))
+    return None if order is None else tuple(moves[i] for i in order)
+
+
+def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
+    """Each planned move, from crisp ``state`` and ``world``, as a `GeoMove` with the grasp the
+    full check passes, in the world the moves before it leave. Returns the state and world
+    after the bound moves, those moves, and None or why the next one was not bound: priced out
+    in its own state (a window prices all its moves in its start state), or refused by the full
+    check (recorded in ``costs``)."""
     from tamp.geo.check import candidate_grasps
 
-    state, world, bound = bridged.problem.init, bridged.scene, []
+    p, bound = bridged.problem, []
     for move in moves:
+        price = costs.price(state)[p.entities.index(move.entity), p.index(move.target)]
+        if price >= IMPOSSIBLE:
+            return state, world, tuple(bound), {"move": str(move), "failure": "priced"}
         geo = bridged.geo_move(world, move)
         o = world.object(move.entity)
         first = costs.grasps_left(state, move)
@@ -151,11 +209,11 @@ def _bind(bridged: Bridged, moves, tools, costs: GeoCosts, check) -> tuple[tuple
             if not tried:  # failed before any grasp: the move, at that place, in that state
                 costs.avoid(state, move, None, geo.place.name)
             failure = {"move": str(move), "place": geo.place.name, "failure": verdict.failure}
-            return tuple(bound), failure
+            return state, world, tuple(bound), failure
         bound.append(GeoMove(geo.obj, geo.place, verdict.grasp))
         world = moved(world, geo.obj, geo.place.pose)
-        state = apply_move(bridged.problem, state, move)
-    return tuple(bound), None
+        state = apply_move(p, state, move)
+    return state, world, tuple(bound), None
 
 
 def _packs(bridged: Bridged) -> dict:

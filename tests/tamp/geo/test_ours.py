@@ -1,8 +1,8 @@
 """Motion-aware planning of scene-file problems (`tamp.geo.ours.plan_motion_aware`): a
-hemmed-in target is reached by moving a neighbour first, four cubes go into a tray that holds
-them only when packed (the sampled packer's cells fail at the same budget), a move the full
-check refuses is fed back and planned around, and UNSOLVABLE means the planner's fallback
-proved it within the discretised places."""
+hemmed-in target is reached by moving a neighbour first, the canonical packed boxes go into a
+tray that holds them only when packed (the sampled packer's cells fail at the same budget), a
+move the full check refuses is fed back and planned around, and UNSOLVABLE means the
+planner's fallback proved it within the discretised places."""
 
 from __future__ import annotations
 
@@ -18,9 +18,6 @@ from tamp.world.geometry import of_movable, penetration
 from tamp.world.goal import parse_goal
 from tamp.world.relations import read_facts
 from tests.tamp.geo.geo_scenes import blocked, cube, scene, tools
-
-# walled tray, inner 0.17 x 0.24 m: four 5 cm cubes fit with the hand's room only when packed
-TIGHT = {"name": "tray", "min": [0.44, 0.12], "max": [0.63, 0.38], "wall_height": 0.03}
 
 
 def _replay(world, moves):
@@ -47,24 +44,22 @@ def test_a_hemmed_in_target_is_reached_by_moving_a_neighbour_first():
     assert result.stats["ms_per_state"] > 0 and result.stats["failures"] == []
 
 
-def test_four_cubes_go_into_a_tray_that_holds_them_only_when_packed():
-    s = scene(
-        cube("a", 0.40, -0.25),
-        cube("b", 0.50, -0.25),
-        cube("c", 0.60, -0.25),
-        cube("d", 0.45, -0.10),
-        regions=[TIGHT],
-    )
-    goal = parse_goal("(and (in a tray) (in b tray) (in c tray) (in d tray))", s)
+def test_the_canonical_packed_boxes_go_into_the_tray_the_sampled_packer_cannot_fill():
+    from tamp.world.canonical import generate
+
+    made = generate("packed", 1)  # five boxes that fit only in two columns with a finger lane
+    s, goal = made.scene, made.goal
     result = plan_motion_aware(s, goal, tools())
     assert result.status is GeoStatus.SOLVED, result.reason
-    assert len(result.moves) == 4 and {m.place.target for m in result.moves} == {"tray"}
+    assert len(result.moves) == 5 and {m.place.target for m in result.moves} == {"tray"}
+    assert all(m.grasp is not None for m in result.moves)
     end = _replay(s, result.moves)
     assert goal.holds(read_facts(end)) and _no_overlap(end)
     # the sampled packer, at the gradient packer's budget (R rows x steps), finds no cells
     budget = PACK.restarts * PACK.steps
-    half = [(0.025, 0.025)] * 4
-    sampled = pack_sampled(s.region("tray").inner(), half, budget=budget, seed=0, config=PACK)
+    half = [s.object(a[1]).half[:2] for a in goal.atoms]
+    inner = s.region("tray").inner()
+    sampled = pack_sampled(inner, half, budget=budget, seed=0, config=PACK, walled=False)
     assert not sampled.ok
     print(
         f"packed: gradient {result.stats['packs']['tray']}, sampled ok={sampled.ok} "
