@@ -1,6 +1,6 @@
 """Episodes you can scrub through: an episode written as a Rerun recording (``.rrd``).
 
-`RerunRecorder` is an observer an `tamp.loop.Episode` is given (``recorder=``): the episode
+`RerunRecorder` is an observer that a `tamp.loop.Episode` is given (``recorder=``): the episode
 calls it at its steps, and it logs what happened on one time line, ``sim``, the simulated time
 in seconds. Open a recording with ``rerun FILE.rrd`` (the viewer ships with the extra). Entities:
 
@@ -25,7 +25,9 @@ in seconds. Open a recording with ``rerun FILE.rrd`` (the viewer ships with the 
 - ``/gripper/width`` (m) and ``/gripper/force`` (N, left and right finger) every frame;
 - ``/checks/moves``: each move's outcome (ok, or the failure kind and its evidence, with the
   collision checks' time, the phases rerouted and the motion-planner runs), WARN level when it
-  failed; ``/checks/contacts``: the unexpected contact steps counted so far (contact scoring);
+  failed; ``/checks/failures``: the failed moves so far; ``/checks/contacts``: the unexpected
+  contact steps counted so far (contact scoring: the arm or the held block touching what its
+  phase does not expect);
 - ``/events``: the episode's messages (plans, replans, step lines); ``/episode``: its outcome.
 
 Frames are buffered and sent in columns at each move's end (one batched forward-kinematics call
@@ -225,8 +227,10 @@ class RerunRecorder:
         its planned joints at their own times, and its planned TCP path."""
         rr, rec = self._rr, self.rec
         traj = phase.trajectory
-        every = max(1, round(TRAJECTORY_STEP / max(float(np.diff(traj.times[:2]).sum()), 1e-9)))
-        keep = np.unique(np.r_[np.arange(0, len(traj.times), every), len(traj.times) - 1])
+        steps = len(traj.times)
+        dt = float(traj.times[1] - traj.times[0]) if steps > 1 else TRAJECTORY_STEP
+        every = max(1, round(TRAJECTORY_STEP / dt))  # keep every this many samples, and the last
+        keep = np.unique(np.r_[np.arange(0, steps, every), steps - 1])
         times = sim.time + np.asarray(traj.times)[keep]  # (S,)
         q = np.asarray(traj.positions)[keep]  # (S, J)
         rec.send_columns(
