@@ -46,12 +46,13 @@ Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in Panda
 _ARM = tuple(f"panda_link{i}" for i in range(1, 8))
 _HAND = "panda_hand"
 PARTS = ("panda_link0", *_ARM, _HAND, *FINGERS)  # (L,) the links, as PandaCollision.parts
-# Link pairs whose collision meshes stay at least APART_CLEARANCE apart while joint j's angle is
-# at least the given one (rad; -inf: always), within the datasheet limits and for any finger
-# opening: measured with PyBullet's closest points on a grid (tests/motion/test_sphere_check.py
-# re-derives them), less the most a point can move between grid points. They are skipped there
-# while self_margin < APART_CLEARANCE. The wrist's links are closer to each other than the
-# spheres' cover gap, so checking them with spheres would refuse most configurations.
+# Link pairs whose collision meshes stay at least APART_CLEARANCE apart while q[j] (0-based: 5
+# is panda_joint6) is at least the given angle (rad; -inf: always), within the datasheet limits
+# and for any finger opening: the least distance on a 0.02-0.03 rad grid of the two joints
+# between the links (PyBullet's closest points), less the most a point can move between grid
+# points (tests/motion/test_sphere_check.py re-derives them). They are skipped there while
+# self_margin < APART_CLEARANCE. The wrist's links are closer to each other than the spheres'
+# cover gap, so checking them with spheres would refuse most configurations.
 APART = (
     ("panda_link0", "panda_link2", 0, -math.inf),  # >= 12 cm on a 0.03 rad grid of (q1, q2)
     ("panda_link1", "panda_link3", 0, -math.inf),  # >= 12 cm, grid of (q2, q3)
@@ -65,7 +66,7 @@ APART = (
     ("panda_link7", FINGERS[0], 0, -math.inf),  # >= 57 mm, fingers at 0 and 0.04 m
     ("panda_link7", FINGERS[1], 0, -math.inf),
 )
-APART_CLEARANCE = 0.005  # m
+APART_CLEARANCE = 0.003  # m
 
 
 def _rpy(rpy: Sequence[float]) -> np.ndarray:
