@@ -257,8 +257,9 @@ def test_the_pairs_left_out_stay_apart_on_a_coarse_grid(pair):
 @pytest.mark.slow
 @pytest.mark.parametrize("pair", APART, ids=lambda pair: f"{pair[0]}-{pair[1]}")
 def test_the_pairs_left_out_stay_apart_between_the_grid_points(pair):
-    """APART re-derived on a 0.03 rad grid (the default run samples every 0.1 rad only): the least distance, less the most a point within
-    0.3 m of both joint axes moves to the nearest grid point, stays above APART_CLEARANCE."""
+    """APART re-derived on a 0.03 rad grid (the default run samples every 0.1 rad only): the
+    least distance, less the most a point within 0.3 m of both joint axes moves to the nearest
+    grid point, stays above APART_CLEARANCE."""
     step = 0.03
     assert _closest_on_grid(pair, step) - 0.3 * step * math.sqrt(2) / 2 > APART_CLEARANCE, pair
 
