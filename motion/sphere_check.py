@@ -46,6 +46,7 @@ Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in Panda
 _ARM = tuple(f"panda_link{i}" for i in range(1, 8))
 _HAND = "panda_hand"
 PARTS = ("panda_link0", *_ARM, _HAND, *FINGERS)  # (L,) the links, as PandaCollision.parts
+_FLOAT = np.float32  # the checks' precision: 0.1 um at 1 m, against the 1.5 cm cover gap
 # Link pairs whose collision meshes stay at least APART_CLEARANCE apart while q[j] (0-based: 5
 # is panda_joint6) is at least the given angle (rad; -inf: always), within the datasheet limits
 # and for any finger opening: the least distance on a 0.02-0.03 rad grid of the two joints
@@ -217,6 +218,7 @@ class SphereCollision:
         self._apart_from = np.array([lowest for _, lowest in rule])
         self._directions, self._dop = _dops()  # (26, 3), (L, 26)
         self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
+        self._cos, self._sin = np.zeros(0, _FLOAT), np.zeros(0, _FLOAT)  # (O,) of the yaws
         self._arm_vs_held = np.array([k for k, n in enumerate(PARTS) if n not in HAND])
         self._names: list[str] = [TABLE]  # (O + 1,) the table, then the boxes
         self._box_c = np.zeros((0, 3))  # (O, 3)
@@ -225,6 +227,14 @@ class SphereCollision:
         self._held_half: np.ndarray | None = None  # (3,)
         self._held_pose = np.eye(4)  # in the TCP frame
         self._masks: dict[frozenset, tuple[np.ndarray, np.ndarray]] = {}
+        for name in ("_rot", "_off", "_hand", "_tcp", "_local", "_radii", "_bounds", "_reach"):
+            setattr(self, name, getattr(self, name).astype(_FLOAT))
+        self._directions, self._dop = self._directions.astype(_FLOAT), self._dop.astype(_FLOAT)
+        # the 26-DOP's first test: its axis-aligned box, centre (L, 3) and half extents (L, 3)
+        axes = [np.flatnonzero((self._directions == e).all(1))[0] for e in np.eye(3, dtype=_FLOAT)]
+        minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
+        high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
+        self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
 
     # ---- the scene ---------------------------------------------------------------------------
 
@@ -246,9 +256,10 @@ class SphereCollision:
                 )
             seen.add(name)
             rows.append(row)
-        table = np.array(rows).reshape(-1, 7)  # (O, 7)
+        table = np.array(rows, dtype=_FLOAT).reshape(-1, 7)  # (O, 7)
         self._box_c, self._halves, self._yaws = table[:, :3], table[:, 3:6], table[:, 6]
-        self._turns = _turn(self._yaws)
+        self._turns = _turn(self._yaws).astype(_FLOAT)
+        self._cos, self._sin = np.cos(self._yaws), np.sin(self._yaws)  # (O,) each
         self._names = [TABLE, *(b.name for b in boxes)]
         self._masks = {}
 
@@ -269,7 +280,8 @@ class SphereCollision:
         r = relative[:3, :3]
         if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
             raise MotionError("held pose's rotation block is not a rotation (tolerance 1e-6)")
-        self._held_half, self._held_pose = extents, relative
+        self._held_half = None if extents is None else extents.astype(_FLOAT)
+        self._held_pose = relative.astype(_FLOAT)
 
     def _mask(self, ignore: Ignore) -> tuple[np.ndarray, np.ndarray]:
         """Pairs to check, cached per ignore set: (P, O + 1) part vs table and boxes, (K,) link
@@ -318,10 +330,11 @@ class SphereCollision:
         """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3) of the frames of
         `PARTS` (fingers at ``fingers`` m each), then of the TCP."""
         n = q.shape[0]
-        rot, pos = np.empty((n, len(PARTS) + 1, 3, 3)), np.empty((n, len(PARTS) + 1, 3))
-        r, t = np.broadcast_to(np.eye(3), (n, 3, 3)), np.zeros((n, 3))
+        rot = np.empty((n, len(PARTS) + 1, 3, 3), dtype=_FLOAT)
+        pos = np.empty((n, len(PARTS) + 1, 3), dtype=_FLOAT)
+        r, t = np.broadcast_to(np.eye(3, dtype=_FLOAT), (n, 3, 3)), np.zeros((n, 3), _FLOAT)
         rot[:, 0], pos[:, 0] = r, t  # panda_link0 is the base frame
-        c, s = np.cos(q), np.sin(q)  # (B, J)
+        c, s = np.cos(q).astype(_FLOAT), np.sin(q).astype(_FLOAT)  # (B, J)
         for j in range(7):
             t = t + r @ self._off[j]  # (B, 3)
             r = r @ self._rot[j]  # (B, 3, 3) before the turn about z
@@ -334,7 +347,8 @@ class SphereCollision:
         pos[:, hand] = t + r @ self._hand[:3, 3]
         for k, sign in ((hand + 1, 1.0), (hand + 2, -1.0)):  # the fingers slide along hand y
             rot[:, k] = rot[:, hand]
-            pos[:, k] = pos[:, hand] + rot[:, hand] @ np.array([0.0, sign * fingers, FINGER_ORIGIN])
+            slide = np.array([0.0, sign * fingers, FINGER_ORIGIN], dtype=_FLOAT)
+            pos[:, k] = pos[:, hand] + rot[:, hand] @ slide
         rot[:, -1] = rot[:, hand] @ self._tcp[:3, :3]
         pos[:, -1] = pos[:, hand] + rot[:, hand] @ self._tcp[:3, 3]
         return rot, pos
@@ -413,7 +427,7 @@ class SphereCollision:
             raise MotionError(f"q must have shape {want}, got {a.shape}")
         if not np.isfinite(a).all():
             raise MotionError("q contains NaN or inf")
-        return a[None] if single else a
+        return (a[None] if single else a).astype(_FLOAT)
 
     # ---- the checks --------------------------------------------------------------------------
 
@@ -446,18 +460,14 @@ class SphereCollision:
         if near_b.size:
             pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
             record(near_b, near_l, np.zeros_like(near_b), x[:, 2] - r, m, pair, first)
-        # the boxes, each in its own frame
+        # the boxes, each in its own frame (turned about z only)
         if len(self._names) > 1:
-            between = mid[:, :, None] - self._box_c  # (B, L, O, 3)
-            inner = np.einsum("oji,bloj->bloi", self._turns, between)
-            gap = _box_sdf(inner, self._halves) - reach[:, None]  # (B, L, O)
-            near_b, near_l, near_o = np.nonzero((gap < m) & scene[None, :links, 1:])
+            gap = self._box_gap(mid[:, :, None], slice(None), reach[:, None] + m, detail)
+            near_b, near_l, near_o = np.nonzero((gap < 0.0) & scene[None, :links, 1:])
             if near_b.size:
                 pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
-                box = near_o[pair]  # (N,)
-                inner = np.einsum("nji,nj->ni", self._turns[box], x - self._box_c[box])
-                sdf = _box_sdf(inner, self._halves[box]) - r  # (N,)
-                record(near_b, near_l, near_o + 1, sdf, m, pair, first)
+                gap = self._box_gap(x, near_o[pair], r + m, detail)  # (N,)
+                record(near_b, near_l, near_o + 1, gap + m, m, pair, first)
         # the links against each other: the distal link's spheres against the other's 26-DOP
         a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
         apart = np.linalg.norm(mid[:, a] - mid[:, c], axis=-1) - reach[a] - reach[c]  # (B, K')
@@ -465,16 +475,45 @@ class SphereCollision:
         if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at these angles
             close &= q[:, self._apart_joint[own]] < self._apart_from[own]
         near_b, near_k = np.nonzero(close)
+        la, lc = a[near_k], c[near_k]
+        if near_b.size:  # link a's bounding sphere against link c's box, in c's frame
+            centre = np.einsum("mji,mj->mi", rot[near_b, lc], mid[near_b, la] - pos[near_b, lc])
+            gap = _box_sdf(centre - self._aabb_c[lc], self._aabb_h[lc]) - reach[la]  # (M,)
+            keep = gap < self.self_margin
+            near_b, la, lc = near_b[keep], la[keep], lc[keep]
         if near_b.size:
-            la, lc = a[near_k], c[near_k]
             pair, x, r, first = self._spheres(rot, pos, near_b, la)
             rows, frames = near_b[pair], lc[pair]
             inner = np.einsum("nji,nj->ni", rot[rows, frames], x - pos[rows, frames])
-            dop = (inner @ self._directions.T - self._dop[frames]).max(-1)  # (N,)
-            record(near_b, la, ~lc, dop - r, self.self_margin, pair, first)
+            # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
+            gap = _box_sdf(inner - self._aabb_c[frames], self._aabb_h[frames]) - r  # (N,)
+            near = np.flatnonzero(gap < self.self_margin)
+            f = frames[near]
+            dop = np.einsum("nk,jk->nj", inner[near], self._directions) - self._dop[f]
+            gap[near] = dop.max(-1) - r[near]  # (N',) the 26-DOP's lower bound
+            record(near_b, la, ~lc, gap, self.self_margin, pair, first)
         if self._held_half is not None:
             self._check_held(rot, pos, mid, scene, held_arm, record)
         return found if detail else ~hit
+
+    def _box_gap(self, points: np.ndarray, box, reach, exact: bool) -> np.ndarray:
+        """Clearance of points (..., 3) to the boxes ``box`` (indices broadcasting with the
+        points' leading axes, or a slice) less ``reach`` (...): < 0 where a ball of radius
+        ``reach`` there meets the box. ``exact``: the signed distance less ``reach``; else
+        only its sign is right (the squared distance outside the box less ``reach``^2, which
+        skips the square root)."""
+        d = points - self._box_c[box]  # (..., 3)
+        cos, sin, half = self._cos[box], self._sin[box], self._halves[box]
+        u = np.abs(cos * d[..., 0] + sin * d[..., 1]) - half[..., 0]
+        v = np.abs(cos * d[..., 1] - sin * d[..., 0]) - half[..., 1]
+        w = np.abs(d[..., 2]) - half[..., 2]
+        outside = np.square(np.maximum(u, 0.0))
+        outside += np.square(np.maximum(v, 0.0))
+        outside += np.square(np.maximum(w, 0.0))
+        if not exact:
+            return outside - np.square(reach)
+        inside = np.minimum(np.maximum(np.maximum(u, v), w), 0.0)
+        return np.sqrt(outside) + inside - reach
 
     def _check_held(self, rot, pos, mid, scene, held_arm, record) -> None:
         """The held box at the TCP against the table, the boxes and the arm's links."""
