@@ -234,11 +234,11 @@ class _Batch:
             raise MotionError(f"valid_batch returned shape {ok.shape} for {len(q)} configurations")
         return ok
 
-    def segments(self, a: np.ndarray, b: np.ndarray, stride: int = 8) -> np.ndarray:
+    def segments(self, a: np.ndarray, b: np.ndarray, stride: int = 8, full: bool = True):
         """(P,) bool: whether each segment a[p] -> b[p] ((P, J) each) is valid at the points
         ``a + k/n (b - a)``, 0 <= k <= n = ceil(|b - a| / step) (the ends included), in two
         batched calls: every ``stride``-th point of every segment, then the rest of those
-        still valid."""
+        still valid (``full``; else only the first call: a necessary condition)."""
         n = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / self.step)).astype(int)  # (P,)
         seg = np.repeat(np.arange(len(n)), n + 1)  # (N,) the segment of each point
         k = np.arange(seg.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)  # (N,) 0..n
@@ -246,12 +246,34 @@ class _Batch:
         points = a[seg] + t * (b[seg] - a[seg])  # (N, J)
         alive = np.ones(len(n), dtype=bool)
         coarse = (k % stride == 0) | (k == n[seg])
-        for part in (coarse, ~coarse):
+        for part in (coarse, ~coarse) if full else (coarse,):
             rows = np.flatnonzero(part & alive[seg])
             if rows.size:
                 bad = rows[~self(points[rows])]
                 alive[seg[bad]] = False
         return alive
+
+
+def _through(start, goal, vias: np.ndarray, batch: _Batch, full: bool) -> np.ndarray:
+    """(V,) bool: start -> via -> goal valid for each via (V, J) (``full``: at every point;
+    else at every 8th, a necessary condition)."""
+    ends = np.broadcast_to(start, vias.shape), np.broadcast_to(goal, vias.shape)
+    ok = batch.segments(np.concatenate([ends[0], vias]), np.concatenate([vias, ends[1]]), full=full)
+    return ok[: len(vias)] & ok[len(vias) :]  # (V,) both halves valid
+
+
+def _shortest_via(start, goal, vias: np.ndarray, batch: _Batch) -> np.ndarray | None:
+    """The via point (J,) of the shortest valid start -> via -> goal, or None: all vias at every
+    8th point in one call, then the survivors in order of length, two at a time, in full."""
+    lengths = np.linalg.norm(vias - start, axis=1) + np.linalg.norm(goal - vias, axis=1)
+    alive = np.flatnonzero(_through(start, goal, vias, batch, full=False))
+    alive = alive[np.argsort(lengths[alive], kind="stable")]
+    for k in range(0, alive.size, 2):
+        chunk = vias[alive[k : k + 2]]
+        ok = _through(start, goal, chunk, batch, full=True)
+        if ok.any():
+            return chunk[int(np.argmax(ok))]
+    return None
 
 
 def _via_search(start, goal, batch: _Batch, lo, hi, config: PathPlannerConfig):
@@ -265,20 +287,12 @@ def _via_search(start, goal, batch: _Batch, lo, hi, config: PathPlannerConfig):
     mid = (start + goal) / 2.0
     for spread in config.via_spreads:
         vias = np.clip(mid + rng.normal(0.0, spread, (config.vias, start.size)), lo, hi)  # (V, J)
-        ends = np.broadcast_to(start, vias.shape), np.broadcast_to(goal, vias.shape)
-        ok = batch.segments(np.concatenate([ends[0], vias]), np.concatenate([vias, ends[1]]))
-        ok = ok[: len(vias)] & ok[len(vias) :]  # (V,) both halves valid
-        if not ok.any():
+        via = _shortest_via(start, goal, vias, batch)
+        if via is None:
             continue
-        lengths = np.linalg.norm(vias - start, axis=1) + np.linalg.norm(goal - vias, axis=1)
-        via = vias[np.flatnonzero(ok)[lengths[ok].argmin()]]
         pulled = mid + np.array([0.25, 0.5, 0.75])[:, None] * (via - mid)  # (3, J) shorter first
-        ends = np.broadcast_to(start, pulled.shape), np.broadcast_to(goal, pulled.shape)
-        good = batch.segments(np.concatenate([ends[0], pulled]), np.concatenate([pulled, ends[1]]))
-        good = good[:3] & good[3:]
-        if good.any():
-            via = pulled[int(np.argmax(good))]
-        return np.stack([start, via, goal])
+        shorter = _shortest_via(start, goal, pulled, batch)
+        return np.stack([start, via if shorter is None else shorter, goal])
     return None
 
 

@@ -70,6 +70,13 @@ APART = (
 APART_CLEARANCE = 0.003  # m
 
 
+def _onehot(rows: np.ndarray) -> np.ndarray:
+    """(3, 3) with a 1 in row rows[a] of each column a."""
+    out = np.zeros((3, 3))
+    out[rows, np.arange(3)] = 1.0
+    return out
+
+
 def _rpy(rpy: Sequence[float]) -> np.ndarray:
     """URDF roll-pitch-yaw as a rotation (3, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
     r, p, y = rpy
@@ -190,6 +197,14 @@ class SphereCollision:
         self.gap = COVER_GAP
         self.parts = (*PARTS, HELD)  # (P,) = L links + the held box, as PandaCollision.parts
         self._rot, self._off, self._hand, self._tcp = _chain(spec)
+        # each joint origin's rotation as (source axis, sign) per axis; the URDF's are all
+        # quarter turns
+        self._swaps = []
+        for turn in self._rot:
+            k = np.abs(turn).argmax(0)  # (3,) the parent axis each new axis is
+            if not np.allclose(np.abs(turn), _onehot(k), atol=1e-9):
+                raise MotionError(f"joint origin rotations must be quarter turns, got {turn}")
+            self._swaps.append([(int(k[a]), float(np.sign(turn[k[a], a]))) for a in range(3)])
         spheres = _link_spheres()
         # the G spheres, link by link: centres (G, 3) in their link's frame, radii (G,)
         self._local = np.concatenate([spheres[link][0] for link in PARTS])
@@ -335,13 +350,20 @@ class SphereCollision:
         r, t = np.broadcast_to(np.eye(3, dtype=_FLOAT), (n, 3, 3)), np.zeros((n, 3), _FLOAT)
         rot[:, 0], pos[:, 0] = r, t  # panda_link0 is the base frame
         c, s = np.cos(q).astype(_FLOAT), np.sin(q).astype(_FLOAT)  # (B, J)
+        cols = [r[:, :, 0], r[:, :, 1], r[:, :, 2]]  # (B, 3) each: the frame's axes
         for j in range(7):
-            t = t + r @ self._off[j]  # (B, 3)
-            r = r @ self._rot[j]  # (B, 3, 3) before the turn about z
-            x, y = r[:, :, 0], r[:, :, 1]
+            for axis, v in enumerate(self._off[j]):  # the joint's origin, in the parent frame
+                if v:
+                    t = t + v * cols[axis]  # (B, 3)
+            # the origin's rotation is a signed permutation: it only reorders the axes
+            cols = [cols[k] if sign > 0 else -cols[k] for k, sign in self._swaps[j]]
             cj, sj = c[:, j, None], s[:, j, None]
-            r = np.stack([x * cj + y * sj, y * cj - x * sj, r[:, :, 2]], -1)
-            rot[:, j + 1], pos[:, j + 1] = r, t
+            x, y = cols[0], cols[1]
+            cols = [x * cj + y * sj, y * cj - x * sj, cols[2]]  # the turn about z
+            for axis in range(3):
+                rot[:, j + 1, :, axis] = cols[axis]
+            pos[:, j + 1] = t
+        r = rot[:, len(_ARM)]
         hand = len(_ARM) + 1
         rot[:, hand] = r @ self._hand[:3, :3]
         pos[:, hand] = t + r @ self._hand[:3, 3]
@@ -527,11 +549,15 @@ class SphereCollision:
             low = t_box[:, 2] - np.abs(r_box[:, 2, :]) @ half  # (B,) lowest corner's z
             record(every, HELD, TABLE, low, m)
         columns = np.flatnonzero(scene[held, 1:])
-        if columns.size:
-            gap = _obb_gap(r_box, t_box, half + m, self._turns[columns])
-            gap = gap(self._box_c[columns], self._halves[columns])  # (B, O')
+        if columns.size:  # the held box's bounding sphere first, then the separating axes
+            ball = float(np.linalg.norm(half)) + m
+            gap = self._box_gap(t_box[:, None], columns, ball, exact=False)  # (B, O')
             near_b, near_o = np.nonzero(gap < 0.0)
-            record(near_b, HELD, columns[near_o] + 1, gap[near_b, near_o] + m, m)
+            if near_b.size:
+                box = columns[near_o]  # (M,)
+                turns, centres, halves = self._turns[box], self._box_c[box], self._halves[box]
+                sep = _obb_gap(r_box[near_b], t_box[near_b], half + m, turns, centres, halves)
+                record(near_b, HELD, box + 1, sep + m, m)
         links = self._arm_vs_held[held_arm[self._arm_vs_held]]
         if links.size:
             reach = self._reach + self.gap
@@ -548,30 +574,21 @@ class SphereCollision:
                 record(near_b, HELD, ~link, sdf, m, pair, first)
 
 
-def _obb_gap(r_a: np.ndarray, t_a: np.ndarray, half_a: np.ndarray, r_b: np.ndarray):
-    """Separating-axis test of boxes A (B of them: rotations (B, 3, 3), centres (B, 3), half
-    extents (3,)) against boxes B (O: rotations (O, 3, 3)); returns f(centres (O, 3), half
-    (O, 3)) -> (B, O): the largest separation over the 15 axes (< 0: the boxes overlap)."""
-
-    def gap(c_b: np.ndarray, h_b: np.ndarray) -> np.ndarray:
-        a_axes = np.swapaxes(r_a, 1, 2)[:, None]  # (B, 1, 3, 3) rows are A's axes
-        b_axes = np.swapaxes(r_b, 1, 2)[None]  # (1, O, 3, 3)
-        a_axes, b_axes = np.broadcast_arrays(a_axes, b_axes)  # (B, O, 3, 3)
-        cross = np.cross(a_axes[:, :, :, None], b_axes[:, :, None, :]).reshape(
-            *a_axes.shape[:2], 9, 3
-        )
-        norm = np.linalg.norm(cross, axis=-1, keepdims=True)
-        cross = np.where(norm > 1e-9, cross / np.maximum(norm, 1e-9), 0.0)
-        axes = np.concatenate([a_axes, b_axes, cross], axis=2)  # (B, O, 15, 3)
-        between = c_b[None] - t_a[:, None]  # (B, O, 3)
-        along = np.abs(np.einsum("boki,boi->bok", axes, between))  # (B, O, 15)
-        rad_a = np.abs(np.einsum("boki,boji->bokj", axes, a_axes)) @ half_a  # (B, O, 15)
-        rad_b = (np.abs(np.einsum("boki,boji->bokj", axes, b_axes)) * h_b[None, :, None]).sum(-1)
-        sep = along - rad_a - rad_b  # (B, O, 15); a zero axis never separates
-        sep = np.where(np.linalg.norm(axes, axis=-1) > 0.5, sep, -np.inf)
-        return sep.max(-1)
-
-    return gap
+def _obb_gap(r_a, t_a, half_a, r_b, c_b, h_b) -> np.ndarray:
+    """Separating-axis test of M pairs of boxes: A (rotations (M, 3, 3), centres (M, 3), half
+    extents (3,)) against B (rotations (M, 3, 3), centres (M, 3), half extents (M, 3)); the
+    largest separation (M,) over the 15 axes (< 0: the boxes overlap)."""
+    a_axes, b_axes = np.swapaxes(r_a, 1, 2), np.swapaxes(r_b, 1, 2)  # (M, 3, 3): rows are axes
+    cross = np.cross(a_axes[:, :, None], b_axes[:, None, :]).reshape(-1, 9, 3)  # (M, 9, 3)
+    norm = np.linalg.norm(cross, axis=-1, keepdims=True)
+    cross = np.where(norm > 1e-6, cross / np.maximum(norm, 1e-6), 0.0)
+    axes = np.concatenate([a_axes, b_axes, cross], axis=1)  # (M, 15, 3)
+    along = np.abs(np.einsum("mki,mi->mk", axes, c_b - t_a))  # (M, 15)
+    rad_a = np.abs(np.einsum("mki,mji->mkj", axes, a_axes)) @ half_a  # (M, 15)
+    rad_b = (np.abs(np.einsum("mki,mji->mkj", axes, b_axes)) * h_b[:, None]).sum(-1)
+    sep = along - rad_a - rad_b  # (M, 15); a zero axis never separates
+    sep = np.where(np.linalg.norm(axes, axis=-1) > 0.5, sep, -np.inf)
+    return sep.max(-1)
 
 
 class Screened:
