@@ -166,3 +166,56 @@ def test_trajectory_edge_cases():
         path_trajectory(START[None])
     with pytest.raises(MotionError, match="NaN"):
         path_trajectory(np.stack([START, np.full(7, np.inf)]))
+
+
+# ---- with a batched check (motion.sphere_check's valid_batch, here the wall in joint space) --
+
+
+def wall_batch(q: np.ndarray, margin: float = 0.0) -> np.ndarray:
+    """`wall` for (B, J) configurations at once."""
+    return ~((np.abs(q[:, 0]) < 0.3 + margin) & (q[:, 1] < 0.5 + margin))
+
+
+def padded_batch(q: np.ndarray) -> np.ndarray:
+    return wall_batch(q, margin=0.55 * STEP)
+
+
+def test_a_batched_check_finds_a_path_that_valid_verifies():
+    r = plan_path(START, GOAL, wall, config=FAST, valid_batch=padded_batch)
+    assert r.ok and r.evidence["search"] in ("via", "connect"), r.evidence
+    assert r.evidence["verified"] and "plan_s" not in r.evidence  # OMPL never ran
+    assert r.evidence["batch_configs"] > 0 and r.evidence["batch_calls"] > 0
+    assert dense_ok(r.path, wall, step=r.evidence["step_rad"])
+    np.testing.assert_array_equal(r.path[[0, -1]], np.stack([START, GOAL]))
+    again = plan_path(START, GOAL, wall, config=FAST, valid_batch=padded_batch)
+    np.testing.assert_array_equal(again.path, r.path)  # seeded: the same path
+
+
+def test_a_free_straight_line_is_one_segment():
+    r = plan_path(START, GOAL, lambda q: True, valid_batch=lambda q: np.ones(len(q), bool))
+    assert r.ok and r.path.shape == (2, 7) and r.evidence["search"] == "via"
+
+
+def test_a_wall_one_via_point_cannot_pass_needs_the_batched_rrt_connect():
+    # vias drawn only 0.01 rad about the midpoint: never over the wall
+    config = replace(FAST, via_spreads=(0.01,))
+    r = plan_path(START, GOAL, wall, config=config, valid_batch=padded_batch)
+    assert r.ok and r.evidence["search"] == "connect", r.evidence
+    assert dense_ok(r.path, wall, step=r.evidence["step_rad"])
+
+
+def test_a_path_valid_refuses_falls_back_to_ompl_with_valid():
+    """A batched check laxer than ``valid`` (it sees no wall): its straight line fails the
+    verification, and OMPL plans with ``valid`` as without a batched check."""
+    r = plan_path(START, GOAL, padded, config=FAST, valid_batch=lambda q: np.ones(len(q), bool))
+    assert r.ok and r.evidence["search"] == "batched_refused" and "plan_s" in r.evidence
+    assert dense_ok(r.path, wall)
+
+
+def test_a_bad_batched_check_raises():
+    with pytest.raises(MotionError, match="valid_batch must be None or a callable"):
+        plan_path(START, GOAL, wall, valid_batch=3)
+    with pytest.raises(MotionError, match=r"valid_batch returned shape \(1,\)"):
+        plan_path(START, GOAL, wall, valid_batch=lambda q: np.ones(1, bool))
+    with pytest.raises(MotionError, match="vias"):
+        PathPlannerConfig(vias=0)

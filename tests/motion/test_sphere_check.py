@@ -289,3 +289,26 @@ def test_screened_sends_the_scene_to_both_and_answers_batches_with_spheres():
     assert mesh.margin == model.spheres.margin == 0.03
     assert model.valid(HOME) == "mesh"
     assert model.valid_batch(HOME[None], 0.025).tolist() == [True]
+
+
+@pytest.mark.sim
+def test_the_planner_routes_around_a_box_with_spheres_and_the_mesh_model_agrees(spheres):
+    """plan_path with the spheres' valid_batch: a detour around a board in the hand's way,
+    found without OMPL and valid under the mesh model at the checking resolution."""
+    from motion.rrt import plan_path
+    from robots.collision import PandaCollision
+
+    board = [Box("board", (0.3, 0.0, 0.55), (0.05, 0.01, 0.1))]
+    start, goal = (
+        HOME + np.array([-0.8, 0, 0, 0, 0, 0, 0]),
+        HOME + np.array([0.8, 0, 0, 0, 0, 0, 0]),
+    )
+    spheres.set_boxes(board)
+    spheres.hold(None)
+    with PandaCollision(margin=0.01) as mesh:
+        mesh.set_boxes(board)
+        r = plan_path(start, goal, mesh.valid, valid_batch=spheres.valid_batch)
+        assert r.ok and r.evidence["search"] in ("via", "connect"), r.evidence
+        assert not mesh.check_path(np.stack([start, goal])).ok
+        assert mesh.check_path(r.path, max_step=0.01).ok
+    spheres.set_boxes([])
