@@ -61,6 +61,7 @@ class PathPlannerConfig:
     vias: int = 16
     via_spreads: tuple[float, ...] = (0.3, 0.6, 1.0, 1.5)
     verify: bool = True
+    batch_time_limit: float = 0.5  # s for the batched RRT-Connect before OMPL takes over
 
     def __post_init__(self):
         if self.planner not in PLANNERS:
@@ -74,6 +75,7 @@ class PathPlannerConfig:
             "shortcut_attempts": self.shortcut_attempts >= 0,
             "vias": self.vias >= 1,
             "via_spreads": all(s > 0.0 for s in self.via_spreads),
+            "batch_time_limit": self.batch_time_limit >= 0.0,
         }
         for name, ok in checks.items():
             if not ok:
@@ -373,10 +375,12 @@ def plan_path(
 
     ``valid_batch(q (B, J)) -> (B,) bool``, optional: a fast batched check that is at least as
     strict as ``valid`` (e.g. `motion.sphere_check.SphereCollision.valid_batch` beside the mesh
-    model). It is tried first: the straight segment, then rounds of seeded via points, every
-    segment's points checked in one call or two; the path it finds is verified with ``valid``
-    (``config.verify``) and returned when it passes (evidence "search": "via"). Otherwise, or
-    when ``valid_batch`` finds nothing, OMPL searches with ``valid`` as without it.
+    model). It is tried first when it accepts start and goal: the straight segment, then
+    rounds of seeded via points, every segment's points checked in one call or two, then an
+    RRT-Connect with whole-edge batched checks for at most ``config.batch_time_limit``; the
+    path it finds is verified with ``valid`` (``config.verify``) and returned when it passes
+    (evidence "search": "via" or "connect"). Otherwise ("batched_failed", "batched_refused")
+    OMPL searches with ``valid`` as without it.
 
     Misuse (shapes, NaN, start or goal outside the limits) raises MotionError; an
     invalid start or goal and a search that runs out of time are failures in the result.
@@ -401,12 +405,14 @@ def plan_path(
 
     if valid_batch is not None:
         batch = _Batch(valid_batch, checker.step)
-        path = _via_search(start, goal, batch, lo, hi, config)
-        if path is None:
-            deadline = t0 + config.time_limit
-            path = _batched_connect(start, goal, batch, lo, hi, config, deadline)
-            if path is not None:
-                path = _dedupe(_batched_reduce(path, batch))
+        path = None
+        if batch(np.stack([start, goal])).all():  # else the stricter check refuses an end
+            path = _via_search(start, goal, batch, lo, hi, config)
+            if path is None:
+                deadline = time.perf_counter() + min(config.batch_time_limit, config.time_limit)
+                path = _batched_connect(start, goal, batch, lo, hi, config, deadline)
+                if path is not None:
+                    path = _dedupe(_batched_reduce(path, batch))
         evidence |= {"batch_configs": batch.configs, "batch_calls": batch.calls}
         evidence |= {"batch_s": time.perf_counter() - t0}
         if path is not None and (

@@ -219,3 +219,13 @@ def test_a_bad_batched_check_raises():
         plan_path(START, GOAL, wall, valid_batch=lambda q: np.ones(1, bool))
     with pytest.raises(MotionError, match="vias"):
         PathPlannerConfig(vias=0)
+
+
+def test_a_batched_check_that_refuses_an_end_hands_over_to_ompl_at_once():
+    def strict(q: np.ndarray) -> np.ndarray:  # stricter than padded: refuses the start
+        return padded_batch(q) & (np.abs(q - START).max(axis=1) > 1e-9)
+
+    r = plan_path(START, GOAL, padded, config=FAST, valid_batch=strict)
+    assert r.ok and r.evidence["search"] == "batched_failed", r.evidence
+    assert r.evidence["batch_calls"] == 1 and "plan_s" in r.evidence
+    assert dense_ok(r.path, wall)
