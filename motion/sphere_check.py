@@ -439,7 +439,8 @@ class SphereCollision:
         if ok.all():
             return PathCheck(True, None, None, None, len(qs))
         k = int(np.argmin(ok))
-        hit = self.contacts(qs[k], f[k], ignore)[0]
+        hits = self.contacts(qs[k], f[k], ignore)  # empty only when rounding tips the sign
+        hit = hits[0] if hits else Contact("robot", "unknown", 0.0)
         why = f"{hit.part} hits {hit.other} (d = {hit.distance:+.4f} m)"
         why += f" on the way to waypoint {seg[k]}"
         return PathCheck(False, int(seg[k]), tuple(qs[k].tolist()), hit, k + 1, why)
