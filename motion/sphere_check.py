@@ -639,3 +639,15 @@ class Screened:
 
     def valid_batch(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()):
         return self.spheres.valid_batch(q, fingers, ignore)
+
+    def __getattr__(self, name: str):
+        """Anything else (``parts``, ``spec``, ``close``, ...) is the mesh model's."""
+        if name in ("mesh", "spheres"):  # not set yet: no recursion through the mesh
+            raise AttributeError(name)
+        return getattr(self.mesh, name)
+
+    def __enter__(self) -> Screened:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.mesh.close()

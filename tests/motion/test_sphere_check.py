@@ -289,6 +289,10 @@ def test_screened_sends_the_scene_to_both_and_answers_batches_with_spheres():
     assert mesh.margin == model.spheres.margin == 0.03
     assert model.valid(HOME) == "mesh"
     assert model.valid_batch(HOME[None], 0.025).tolist() == [True]
+    mesh.close = lambda: mesh.calls.append(("close",))
+    with model as same:
+        assert same is model and same.self_margin == 0.0  # the mesh model's
+    assert mesh.calls[-1] == ("close",)
 
 
 @pytest.mark.sim
