@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -96,9 +97,11 @@ def _plan_json(
     validation: Validation | None,
     seed: int,
     proof: Proof | None = None,
+    note: str = "",
 ) -> str:
     """The ``--json`` report; ``status`` is "unsolvable" when ``proof`` proves it, and
-    ``proof`` says what was tried when the planner found no plan."""
+    ``proof`` says what was tried when the planner found no plan; ``note``: why a domain that
+    nearly matches a hand-written one is planned by the generic lift ("" otherwise)."""
     unsolvable = proof is not None and proof.unsolvable
     return json.dumps(
         {
@@ -107,6 +110,7 @@ def _plan_json(
             "valid": validation is not None and validation.valid,
             "proof": None if proof is None else {"reason": proof.reason, "method": proof.method},
             "domain_rules": result.problem.domain,
+            "note": note,
             "moves": [_move_json(m) for m in result.plan.moves],
             "actions": [str(a).lower() for a in actions],
             "validation": None if validation is None else report.validation_dict(validation),
@@ -229,13 +233,15 @@ def plan_command(args: argparse.Namespace) -> int:
             print(f"unsolvable: {proof.reason}")
         return 1
     domain, instance = from_files(args.domain, args.problem, args.domain_rules)
+    if instance.note and not args.json:  # a near miss of a hand-written domain: the lift plans
+        print(f"note: {instance.note}", file=sys.stderr)
     recorded, config, result, actions, validation = _solve(domain, instance, args)
     valid = validation is not None and validation.valid
     after = None if validation is not None else _proved_after(domain, instance, args)
     if args.out is not None and valid:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:
-        print(_plan_json(recorded, result, actions, validation, args.seed, after))
+        print(_plan_json(recorded, result, actions, validation, args.seed, after, instance.note))
     elif after is not None and after.unsolvable:
         print(f"unsolvable: {after.reason}")
     else:

@@ -180,3 +180,16 @@ def test_unrelated_domains_match_nothing():
     from task.domains.strips import GRIPPER
 
     assert match_domain(pddl_io.parse_domain(GRIPPER)) is None
+
+
+def test_tamp_plan_says_why_a_near_miss_is_planned_by_the_lift(tmp_path, capsys):
+    from tamp.cli import main
+
+    renamed = rename(NEAR_MISS, (blocksworld_pddl(random_problem(2, 1)),), seed=4)
+    domain, problem = tmp_path / "d.pddl", tmp_path / "p.pddl"
+    domain.write_text(renamed.domain)
+    problem.write_text(renamed.problems[0])
+    reason = match_domain(pddl_io.parse_domain(renamed.domain)).reason
+    main(["plan", str(domain), str(problem), "--time-limit", "2"])
+    err = capsys.readouterr().err
+    assert f"note: {reason}" in err
