@@ -125,9 +125,11 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
     assert _uses("_block_poses", "tamp") <= sims
     assert _uses("_snapshot", "tamp") <= sims
     assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py"}
-    # a snapshot (the true block poses) is read by the video alone, inside its recording grant
-    assert _uses("snapshot", "tamp") <= {"tamp/sim/truth.py", "tamp/video.py"}
+    # a snapshot (the true block poses) is read by the video and the Rerun recording alone,
+    # inside their recording grant
+    assert _uses("snapshot", "tamp") <= {"tamp/sim/truth.py", "tamp/video.py", "tamp/rerun_log.py"}
     assert _granted(ROOT / "tamp/video.py", "snapshot") == []
+    assert _granted(ROOT / "tamp/rerun_log.py", "snapshot") == []
     # in the loop: the scorer, the nudge (experimenter), the state-mode mocap oracle and the
     # per-step verdicts of a given plan (scoring: what the report says, never what the robot does)
     assert _uses("truth", "tamp/loop") <= {
