@@ -17,9 +17,15 @@
    (the hand no longer fits once a neighbour is placed): binding stops there too and planning
    goes on from that state (`OursConfig.cuts`).
 
-The status is SOLVED with the bound moves; UNSOLVABLE only when the planner's fallback proved
-that no plan exists within the discretised places and the moves the prices allow; BUDGET
-otherwise (windows, fallback nodes, replans or time ran out).
+4. when that ends without a plan (the windows, the fallback's nodes, the replans or half the
+   time ran out, or the prices, a proxy of the full check, allowed no plan at all), the
+   complete geometric search (`tamp.geo.search.plan_search`, `OursConfig.search`) goes on
+   from the world the bound moves reached, with what is left of the time.
+
+The status is SOLVED with the moves; UNSOLVABLE only when the complete search proved that no
+plan exists within the discretised grasps and places (or, with the search off, when the
+planner's fallback proved it within the places and the moves the prices allow); BUDGET
+otherwise. ``stats["first"]`` says how the differentiable planner's attempt ended.
 
 `plan_pddl` does the same for a problem named by a PDDL domain instead of Blocksworld (Tower of
 Hanoi): the generic STRIPS lift plans it (its fallback on), the declared binding
@@ -37,6 +43,7 @@ from dataclasses import dataclass, field, replace
 from tamp.geo.ours.bridge import PACK, Bridged, bridge
 from tamp.geo.ours.costs import GeoCostConfig, GeoCosts
 from tamp.geo.ours.pack import PackConfig
+from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
@@ -61,6 +68,10 @@ class OursConfig:
     replans: int = 4  # plans again after a move no grasp passes, at most this often
     cuts: int = 8  # plans on after a move priced out in its own state, at most this often
     seed: int = 0
+    # when the differentiable planner ends without a plan, the complete geometric search
+    # (`tamp.geo.search.plan_search`, every move under the full check) goes on from the world
+    # its bound moves reached, with these budgets (None: no fallback)
+    search: SearchConfig | None = field(default_factory=SearchConfig)
 
 
 def _check():
@@ -75,13 +86,19 @@ def as_ours(config) -> OursConfig:
     which bounds the differentiable planner's windows and fallback)."""
     if isinstance(config, OursConfig):
         return config
+    if isinstance(config, SearchConfig):
+        search = config
+    else:
+        search = SearchConfig(seed=getattr(config, "seed", 0))
     limit = getattr(config, "max_time_s", None)
-    planner = replace(PLANNER, time_limit_s=limit) if limit else PLANNER
+    # the differentiable planner gets half the wall clock; the complete search what is left
+    planner = replace(PLANNER, time_limit_s=limit / 2) if limit else PLANNER
     choices = getattr(config, "choices", GeoCostConfig().choices)
     return OursConfig(
         planner=planner,
         costs=GeoCostConfig(choices=tuple(choices)),
         seed=getattr(config, "seed", 0),
+        search=search,
     )
 
 
@@ -103,6 +120,42 @@ def plan_motion_aware(
     t0 = time.perf_counter()
     config = as_ours(config)
     check = check or _check()
+    first = _plan_soft(scene, goal, tools, config, check, t0)
+    bound = first.stats.pop("bound", ())
+    if first.solved or config.search is None:
+        return first
+    return _complete(scene, goal, tools, config, first, bound, t0)
+
+
+def _complete(scene, goal, tools, config: OursConfig, first: GeoPlan, bound: tuple, t0: float):
+    """The complete geometric search from the world the first attempt's ``bound`` moves
+    reached, within what is left of the time budget; its status is the answer (UNSOLVABLE from
+    it is exhaustive over the discretised grasps and places under the full check), the bound
+    moves first."""
+    from tamp.geo.search import plan_search
+
+    world = scene
+    for move in bound:
+        world = moved(world, move.obj, move.place.pose)
+    left = config.search.max_time_s - (time.perf_counter() - t0)
+    if left <= 0:
+        return first
+    found = plan_search(world, goal, tools, replace(config.search, max_time_s=left))
+    stats = {
+        **first.stats,
+        "first": {"status": first.status.value, "reason": first.reason, "bound": len(bound)},
+        "search": found.stats,
+        "time_s": time.perf_counter() - t0,
+    }
+    reason = found.reason
+    if not found.solved:
+        reason = f"{found.reason} (after the differentiable planner: {first.reason})"
+    return GeoPlan(found.status, (*bound, *found.moves), reason, stats)
+
+
+def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: float) -> GeoPlan:
+    """The differentiable planner's attempt (steps 1-3 of the module docstring); a plan that
+    ends unsolved carries the moves it bound in ``stats["bound"]``."""
     try:
         bridged = bridge(scene, goal, config.table_places, config.pack, config.seed)
     except SceneFileError as exc:
@@ -130,6 +183,7 @@ def plan_motion_aware(
             why = result.stats.get("fallback", {}).get("reason", "the windows ran out")
             if state != bridged.problem.init:
                 why = f"after {len(bound)} bound moves: {why}"
+            stats["bound"] = tuple(bound)
             return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
         state, world, more, failed = _bind(
             bridged, state, world, result.plan.moves, tools, costs, check
@@ -142,6 +196,7 @@ def plan_motion_aware(
         else:
             failures.append(failed)
     why = f"{len(failures)} planned moves failed the full check; the replan budget is spent"
+    stats["bound"] = tuple(bound)
     return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
 
 

@@ -80,7 +80,10 @@ class _Refuse:
         return MoveCheck(ok=True, grasp=grasps[0] if grasps else None)
 
 
-FAST = OursConfig(planner=replace(PLANNER, max_windows=4, restarts=4, iters=30), replans=2)
+# the differentiable planner's attempt alone (no complete search after it)
+FAST = OursConfig(
+    planner=replace(PLANNER, max_windows=4, restarts=4, iters=30), replans=2, search=None
+)
 
 
 def test_a_move_the_full_check_refuses_is_planned_around_and_the_replans_are_bounded():
@@ -119,9 +122,40 @@ def test_unsolvable_only_when_the_fallback_proves_it_within_the_places():
     assert result.stats["fallback"]["status"] == "unsolvable"
 
 
+def test_when_the_first_attempt_gives_up_the_complete_search_goes_on_from_its_moves():
+    s = scene(cube("a", 0.45, 0.2), cube("b", 0.55, 0.2))
+    goal = parse_goal("(in a goal)", s)
+    # the first attempt's check refuses everything (its replans run out); the complete
+    # search's own full check finds the move
+    config = replace(FAST, search=SearchConfig(max_time_s=60.0))
+    result = plan_motion_aware(s, goal, tools(), config, check=_Refuse(10**6))
+    assert result.status is GeoStatus.SOLVED, result.reason
+    assert result.stats["first"]["status"] == "budget" and "search" in result.stats
+    assert goal.holds(read_facts(_replay(s, result.moves)))
+
+
+def test_unsolvable_from_the_complete_search_is_said_with_the_first_attempts_reason():
+    posts = [
+        {"name": f"post{i}", "centre": [0.5 + dx, dy, 0.04], "half": [hx, hy, 0.04]}
+        for i, (dx, dy, hx, hy) in enumerate(
+            [(0.045, 0.0, 0.01, 0.05), (-0.045, 0.0, 0.01, 0.05), (0.0, 0.045, 0.03, 0.01)]
+        )
+    ]
+    posts.append({"name": "post3", "centre": [0.5, -0.045, 0.04], "half": [0.03, 0.01, 0.04]})
+    s = scene(cube("t", 0.5, 0.0), obstacles=posts)
+    goal = parse_goal("(in t goal)", s)
+    config = replace(FAST, search=SearchConfig(max_time_s=60.0))
+    result = plan_motion_aware(s, goal, tools(), config)
+    assert result.status is GeoStatus.UNSOLVABLE, result.reason
+    assert "after the differentiable planner" in result.reason
+    assert result.stats["first"]["status"] == "unsolvable"
+
+
 def test_the_episode_planners_shared_config_is_accepted():
     ours = as_ours(SearchConfig(max_time_s=30.0, seed=3, choices=("top",)))
-    assert ours.seed == 3 and ours.planner.time_limit_s == 30.0 and ours.costs.choices == ("top",)
+    assert ours.seed == 3 and ours.costs.choices == ("top",)
+    # half the wall clock for the differentiable planner, the complete search the rest
+    assert ours.planner.time_limit_s == 15.0 and ours.search.max_time_s == 30.0
     assert ours.planner.fallback is True
 
 
