@@ -193,3 +193,22 @@ def test_tamp_plan_says_why_a_near_miss_is_planned_by_the_lift(tmp_path, capsys)
     main(["plan", str(domain), str(problem), "--time-limit", "2"])
     err = capsys.readouterr().err
     assert f"note: {reason}" in err
+
+
+def test_a_benchmark_folder_is_renamed_file_for_file(tmp_path):
+    from task.domains.match import rename_folder
+
+    src = tmp_path / "set"
+    (src / "instances" / "sub").mkdir(parents=True)
+    (src / "domain.pddl").write_text(BLOCKSWORLD)
+    (src / "instances" / "sub" / "instance-1.pddl").write_text(EXAMPLE)
+    (src / "manifest.csv").write_text("name\ninstance-1\n")
+    made = rename_folder(src, tmp_path / "out", seed=3)
+    out = tmp_path / "out"
+    assert (out / "manifest.csv").read_text() == "name\ninstance-1\n"
+    domain = pddl_io.parse_domain((out / "domain.pddl").read_text())
+    assert isinstance(match_domain(domain), Match)
+    assert (out / "instances" / "sub" / "instance-1.pddl").read_text() == made.problems[0]
+    assert "on" not in {p.name for p in domain.predicates}
+    with pytest.raises(PDDLError, match=r"no domain\.pddl"):
+        rename_folder(tmp_path / "nothing", out)

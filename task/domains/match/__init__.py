@@ -17,7 +17,7 @@ add and delete lists as sets of atom shapes over parameter positions.
 
 from task.domains.match.problem import to_reference
 from task.domains.match.recognise import Match, NearMiss, match_domain
-from task.domains.match.rename import RenamedFiles, rename
+from task.domains.match.rename import RenamedFiles, rename, rename_folder
 from task.domains.match.renaming import Renamed, Renaming
 
 __all__ = [
@@ -28,5 +28,6 @@ __all__ = [
     "Renaming",
     "match_domain",
     "rename",
+    "rename_folder",
     "to_reference",
 ]

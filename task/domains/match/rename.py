@@ -14,9 +14,11 @@ renamed) and the object names, to map plans back.
 from __future__ import annotations
 
 import random
+import shutil
 import string
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 from task.domains.match.renaming import Renamed, Renaming
 from task.domains.match.schema import OBJECT, Schema, Shape, shape
@@ -199,3 +201,35 @@ def rename(
         tuple(sorted(consts.items())),
     )
     return RenamedFiles(text, problems, renaming, tuple(sorted(objects.items())))
+
+
+def rename_folder(source: str | Path, out: str | Path, seed: int = 0) -> RenamedFiles:
+    """A renamed copy of a benchmark folder: ``source/domain.pddl`` and every
+    ``source/instances/**/*.pddl`` renamed by one seeded `rename`, written under ``out`` with
+    the same file names (``manifest.csv`` and ``info.json`` copied as they are), so
+    ``tamp bench planbench --data OUT`` runs the renamed set. Run as
+    ``python -m task.domains.match.rename SOURCE OUT [SEED]``."""
+    src, dst = Path(source), Path(out)
+    if not (src / "domain.pddl").is_file():
+        raise PDDLError(f"{src}: no domain.pddl (a benchmark folder: domain.pddl, instances/)")
+    paths = sorted(src.glob("instances/**/*.pddl"))
+    renamed = rename((src / "domain.pddl").read_text(), [p.read_text() for p in paths], seed)
+    dst.mkdir(parents=True, exist_ok=True)
+    (dst / "domain.pddl").write_text(renamed.domain)
+    for path, text in zip(paths, renamed.problems, strict=True):
+        target = dst / path.relative_to(src)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text)
+    for name in ("manifest.csv", "info.json"):
+        if (src / name).is_file():
+            shutil.copy(src / name, dst / name)
+    return renamed
+
+
+if __name__ == "__main__":
+    import sys
+
+    if len(sys.argv) not in (3, 4):
+        sys.exit("usage: python -m task.domains.match.rename SOURCE OUT [SEED]")
+    made = rename_folder(sys.argv[1], sys.argv[2], int(sys.argv[3]) if len(sys.argv) == 4 else 0)
+    print(f"{len(made.problems)} problems renamed into {sys.argv[2]}")
