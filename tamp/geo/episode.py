@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -37,6 +36,7 @@ from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.loop.episode import torch_threads
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
 from tamp.world.geometry import Tolerances
@@ -193,7 +193,7 @@ def run_geo_episode(
     path, first_len, replans, failures = 0.0, 0, 0, 0
     status, reason = "not_reached", ""
     try:
-        with _torch_threads(1):
+        with torch_threads(1):
             _settle(sim, on_frame)
             world = observe(sim, scene)
             while True:
@@ -309,16 +309,3 @@ def _recorder(video: str | Path | None):
         recorder.write(sim)
 
     return recorder, on_frame
-
-
-@contextmanager
-def _torch_threads(n: int):
-    """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
-    import torch
-
-    before = torch.get_num_threads()
-    torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(before)

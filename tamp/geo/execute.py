@@ -25,6 +25,7 @@ from motion.pick_place import Phase
 from motion.trajectory import JointTrajectory
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
+from tamp.loop.execute import holding
 from tamp.sim.base import Expected, Simulator
 
 
@@ -101,14 +102,14 @@ def run_move(
             _back_off(sim, check.motion, on_frame, handling)
             return done("tracking_error", phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
-            missed = _holding(sim, width, config, fresh=True)
+            missed = holding(sim, width, config, fresh=True)
             if missed is None and sim.grasp == "weld" and not sim.attach():
                 missed = {"weld": "no object between the fingers"}
             if missed is not None:
                 _back_off(sim, check.motion, on_frame, handling)
                 return done("missed_grasp", **missed)
         elif phase.name in ("lift", "transit"):
-            gone = _holding(sim, width, config, fresh=False)
+            gone = holding(sim, width, config, fresh=False)
             if gone is not None:
                 sim.detach()
                 hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
@@ -120,23 +121,6 @@ def run_move(
 def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:
     """(what the object leaves, what it goes onto) as the simulator names the bodies."""
     return support_box(scene, support), support_box(scene, move.place.target)
-
-
-def _holding(sim: Simulator, width: float, config: RunConfig, fresh: bool) -> dict | None:
-    """None when the fingers hold an object ``width`` wide (pushing on both sides when
-    ``fresh``), else the evidence that they do not."""
-    r = sim.gripper()
-    wide = abs(r.width - width) <= config.width_tol
-    floor = config.min_force if fresh else 0.0
-    both = r.left_force > floor and r.right_force > floor
-    if wide and (both or (sim.grasp == "weld" and not fresh)):
-        return None
-    return {
-        "finger_width": round(r.width, 4),
-        "grasp_width": round(width, 4),
-        "left_force": round(r.left_force, 3),
-        "right_force": round(r.right_force, 3),
-    }
 
 
 def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:

@@ -133,13 +133,13 @@ class Episode:
         """Run the episode to the goal or a stop (`play`); closes the simulator (and the
         recorder's file)."""
         if self.recorder is None:
-            with _torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+            with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
                 return self.play()
         self._shown = (self.sim.frame_period, 0.0)  # on_frame keeps the period set by now
         self.sim.frame_period = self.recorder.period
         report = None
         try:
-            with _torch_threads(1):
+            with torch_threads(1):
                 report = self.play()
         finally:
             self.recorder.close(report)
@@ -398,7 +398,7 @@ class Episode:
 
 
 @contextmanager
-def _torch_threads(n: int):
+def torch_threads(n: int):
     """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
     import torch
 

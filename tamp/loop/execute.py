@@ -98,19 +98,20 @@ class ExecutionResult:
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
 
 
-def _holding(sim: Simulator, config: ExecConfig, fresh: bool) -> dict | None:
-    """None when the fingers hold a block: opened to the block width and, on a fresh grasp,
-    both pushing; otherwise the evidence that they do not."""
+def holding(sim: Simulator, width: float, config, fresh: bool) -> dict | None:
+    """None when the fingers hold an object ``width`` (m) wide: opened to that width within
+    ``config.width_tol`` and, on a fresh grasp, both pushing at least ``config.min_force``
+    (a weld grasp holds once made); otherwise the evidence that they do not. ``config``: an
+    `ExecConfig` or anything with those two fields (`tamp.geo.execute.RunConfig`)."""
     r = sim.gripper()
-    size = config.motion.block_size
-    wide = abs(r.width - size) <= config.width_tol
+    wide = abs(r.width - width) <= config.width_tol
     floor = config.min_force if fresh else 0.0
     both = r.left_force > floor and r.right_force > floor
     if wide and (both or (sim.grasp == "weld" and not fresh)):
         return None
     return {
         "finger_width": round(r.width, 4),
-        "block_width": size,
+        "grasp_width": round(width, 4),
         "left_force": round(r.left_force, 3),
         "right_force": round(r.right_force, 3),
     }
@@ -288,7 +289,7 @@ def execute_move(
             _back_off(sim, phases, on_frame, handling)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
         if phase.name == "close":
-            missed = _holding(sim, config, fresh=True)
+            missed = holding(sim, config.motion.block_size, config, fresh=True)
             if missed is None and sim.grasp == "weld" and not sim.attach():
                 r = sim.gripper()  # block-wide, but no one block touches both fingers
                 missed = {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
@@ -296,7 +297,7 @@ def execute_move(
                 _back_off(sim, phases, on_frame, handling)
                 return result(Failure.GRASP_MISSED, ik, **missed)
         elif phase.name in ("lift", "transit"):
-            gone = _holding(sim, config, fresh=False)
+            gone = holding(sim, config.motion.block_size, config, fresh=False)
             if gone is not None:
                 sim.detach()
                 hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
