@@ -12,28 +12,30 @@ from perception import CHECKPOINT
 from tamp.bench.official import DEFAULT_DATA
 from tamp.cli.options import (
     IMAGE_SCENES,
-    MAX_BLOCKS,
     Parser,
-    block_counts,
-    bounded,
     data_option,
     episode_options,
     executability_options,
-    nonnegative,
     output_options,
     perception_bench_options,
     planner_options,
-    positive,
     progress_option,
-    radius,
     rules_option,
     run_options,
-    seed,
     suite_options,
     sweep_options,
     tamp_bench_options,
-    threads,
     workcell_options,
+)
+from tamp.cli.types import (
+    MAX_BLOCKS,
+    block_counts,
+    bounded,
+    nonnegative,
+    positive,
+    radius,
+    seed,
+    threads,
 )
 from tamp.sim.base import SIMULATORS
 

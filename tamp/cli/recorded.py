@@ -20,7 +20,8 @@ from pathlib import Path
 
 from perception import CHECKPOINT
 from tamp.bench.official import default_data
-from tamp.cli.options import SCENES, check_workcell, planner_config, sim_list
+from tamp.cli.options import SCENES, check_workcell, planner_config
+from tamp.cli.types import sim_list
 from tamp.rerun_log import check_record_path
 from task.errors import TampError
 

@@ -15,7 +15,6 @@ from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
 from tamp.cli.bench import interrupted
-from tamp.cli.options import sim_list
 from tamp.cli.recorded import (
     checkpoint,
     executability_config,
@@ -24,6 +23,7 @@ from tamp.cli.recorded import (
     motion_config,
 )
 from tamp.cli.recorded import out_folder as output_folder
+from tamp.cli.types import sim_list
 from tamp.rerun_log import require_rerun
 from task.errors import TampError
 

@@ -11,8 +11,8 @@ from tqdm import tqdm
 
 from tamp.bench import results, tables
 from tamp.cli.bench import interrupted
-from tamp.cli.options import sim_list
 from tamp.cli.recorded import out_folder, tamp_bench_config
+from tamp.cli.types import sim_list
 
 
 def tamp_command(args: argparse.Namespace) -> int:

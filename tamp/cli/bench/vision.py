@@ -13,7 +13,7 @@ from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
 from tamp.cli.bench import bar, interrupted
-from tamp.cli.options import planner_config, sim_list
+from tamp.cli.options import planner_config
 from tamp.cli.recorded import (
     checkpoint,
     latplan_config,
@@ -22,6 +22,7 @@ from tamp.cli.recorded import (
     segmentation_config,
 )
 from tamp.cli.recorded import out_folder as output_folder
+from tamp.cli.types import sim_list
 
 
 def perception_command(args: argparse.Namespace) -> int:
