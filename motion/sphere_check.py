@@ -38,22 +38,18 @@ box, then its 26 planes. Without square roots where only the sign of a clearance
 from __future__ import annotations
 
 import math
-import xml.etree.ElementTree as ET
 from collections.abc import Collection, Sequence
 from itertools import combinations
 
 import numpy as np
 
 from motion.errors import MotionError
-from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck
-from robots.panda import PANDA, PandaSpec, data_dir, urdf_path
-from robots.panda_spheres import COVER, COVER_GAP, FINGER_ORIGIN, FINGERS, SPHERES
+from motion.sphere_fk import _FLOAT, _HAND, PARTS, _chain, _link_spheres, _links, _onehot
+from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck, densify
+from robots.panda import PANDA, PandaSpec, data_dir
+from robots.panda_spheres import COVER_GAP, FINGERS
 
 Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in PandaCollision
-_ARM = tuple(f"panda_link{i}" for i in range(1, 8))
-_HAND = "panda_hand"
-PARTS = ("panda_link0", *_ARM, _HAND, *FINGERS)  # (L,) the links, as PandaCollision.parts
-_FLOAT = np.float32  # the checks' precision: 0.1 um at 1 m, against the 1.5 cm cover gap
 # Link pairs whose collision meshes stay at least APART_CLEARANCE apart while q[j] (0-based: 5
 # is panda_joint6) is at least the given angle (rad; -inf: always), within the datasheet limits
 # and for any finger opening: the least distance on a 0.02-0.03 rad grid of the two joints
@@ -75,67 +71,6 @@ APART = (
     ("panda_link7", FINGERS[1], 0, -math.inf),
 )
 APART_CLEARANCE = 0.003  # m
-
-
-def _onehot(rows: np.ndarray) -> np.ndarray:
-    """(3, 3) with a 1 in row rows[a] of each column a."""
-    out = np.zeros((3, 3))
-    out[rows, np.arange(3)] = 1.0
-    return out
-
-
-def _rpy(rpy: Sequence[float]) -> np.ndarray:
-    """URDF roll-pitch-yaw as a rotation (3, 3): Rz(yaw) Ry(pitch) Rx(roll)."""
-    r, p, y = rpy
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
-    cy, sy = math.cos(y), math.sin(y)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
-def _chain(spec: PandaSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The joint origins of the URDF: revolute (J, 3, 3) rotations and (J, 3) offsets from link
-    i-1 to link i (before the joint's turn about z), and panda_link7 -> panda_hand, and
-    panda_hand -> TCP as (4, 4) transforms."""
-    joints = {}
-    for joint in ET.parse(urdf_path(spec)).getroot().iter("joint"):
-        origin = joint.find("origin")
-        xyz = [float(v) for v in origin.get("xyz", "0 0 0").split()]
-        rpy = [float(v) for v in origin.get("rpy", "0 0 0").split()]
-        child = joint.find("child").get("link")
-        transform = np.eye(4)
-        transform[:3, :3], transform[:3, 3] = _rpy(rpy), xyz
-        joints[child] = (joint.find("parent").get("link"), transform, joint.get("type"))
-
-    def path(frm: str, to: str) -> np.ndarray:
-        out = np.eye(4)
-        while to != frm:
-            parent, transform, _ = joints[to]
-            out, to = transform @ out, parent
-        return out
-
-    arm = [joints[link][1] for link in _ARM]
-    if any(joints[link][2] != "revolute" for link in _ARM):
-        raise MotionError(f"expected revolute joints into {_ARM} in {urdf_path(spec)}")
-    rot = np.stack([t[:3, :3] for t in arm])  # (J, 3, 3)
-    off = np.stack([t[:3, 3] for t in arm])  # (J, 3)
-    return rot, off, path(_ARM[-1], _HAND), path(_HAND, spec.tcp_link)
-
-
-def _link_spheres():
-    """Per link: sphere centres (S_l, 3) in its frame and radii (S_l,), fingers in their own."""
-    rows = (*SPHERES, *COVER)
-    out = {}
-    for link in PARTS:
-        centres = np.array([a for name, a, _ in rows if name == link], dtype=float)
-        radii = np.array([r for name, _, r in rows if name == link], dtype=float)
-        out[link] = (centres.reshape(-1, 3), radii)
-    return out
 
 
 _MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
@@ -349,38 +284,8 @@ class SphereCollision:
     # ---- kinematics --------------------------------------------------------------------------
 
     def _links(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
-        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3) of the frames of
-        `PARTS` (fingers at ``fingers`` m each), then of the TCP."""
-        n = q.shape[0]
-        rot = np.empty((n, len(PARTS) + 1, 3, 3), dtype=_FLOAT)
-        pos = np.empty((n, len(PARTS) + 1, 3), dtype=_FLOAT)
-        r, t = np.broadcast_to(np.eye(3, dtype=_FLOAT), (n, 3, 3)), np.zeros((n, 3), _FLOAT)
-        rot[:, 0], pos[:, 0] = r, t  # panda_link0 is the base frame
-        c, s = np.cos(q).astype(_FLOAT), np.sin(q).astype(_FLOAT)  # (B, J)
-        cols = [r[:, :, 0], r[:, :, 1], r[:, :, 2]]  # (B, 3) each: the frame's axes
-        for j in range(7):
-            for axis, v in enumerate(self._off[j]):  # the joint's origin, in the parent frame
-                if v:
-                    t = t + v * cols[axis]  # (B, 3)
-            # the origin's rotation is a signed permutation: it only reorders the axes
-            cols = [cols[k] if sign > 0 else -cols[k] for k, sign in self._swaps[j]]
-            cj, sj = c[:, j, None], s[:, j, None]
-            x, y = cols[0], cols[1]
-            cols = [x * cj + y * sj, y * cj - x * sj, cols[2]]  # the turn about z
-            for axis in range(3):
-                rot[:, j + 1, :, axis] = cols[axis]
-            pos[:, j + 1] = t
-        r = rot[:, len(_ARM)]
-        hand = len(_ARM) + 1
-        rot[:, hand] = r @ self._hand[:3, :3]
-        pos[:, hand] = t + r @ self._hand[:3, 3]
-        for k, sign in ((hand + 1, 1.0), (hand + 2, -1.0)):  # the fingers slide along hand y
-            rot[:, k] = rot[:, hand]
-            slide = np.array([0.0, sign * fingers, FINGER_ORIGIN], dtype=_FLOAT)
-            pos[:, k] = pos[:, hand] + rot[:, hand] @ slide
-        rot[:, -1] = rot[:, hand] @ self._tcp[:3, :3]
-        pos[:, -1] = pos[:, hand] + rot[:, hand] @ self._tcp[:3, 3]
-        return rot, pos
+        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk._links`."""
+        return _links(q, fingers, self._off, self._swaps, self._hand, self._tcp)
 
     def _spheres(self, rot, pos, b: np.ndarray, link: np.ndarray):
         """Every sphere of the (configuration, link) pairs ``b``, ``link`` (M,) each: the pair
@@ -425,13 +330,7 @@ class SphereCollision:
             fs = np.broadcast_to(np.asarray(fingers, dtype=float), (len(path),))  # (S,)
         except ValueError:
             raise MotionError(f"fingers: one opening or {len(path)}, one per waypoint") from None
-        n = np.ceil(np.abs(np.diff(path, axis=0)).max(-1) / max_step - 1e-9)  # (S-1,)
-        n = np.maximum(n, 1).astype(int)
-        seg = np.concatenate([[0], np.repeat(np.arange(1, len(path)), n)])  # (N,) waypoint
-        t = np.concatenate([[1.0], *(np.arange(1, k + 1) / k for k in n)])  # (N,)
-        prev = np.maximum(seg - 1, 0)
-        qs = path[prev] + t[:, None] * (path[seg] - path[prev])  # (N, J)
-        f = fs[prev] + t * (fs[seg] - fs[prev])  # (N,)
+        seg, qs, f = densify(path, fs, max_step)
         ok = np.ones(len(qs), dtype=bool)
         for opening in np.unique(f):
             rows = f == opening

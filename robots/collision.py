@@ -56,6 +56,19 @@ _TABLE_HALF = (3.0, 3.0, 0.5)  # m; its top face is z = 0
 Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip
 
 
+def densify(path: np.ndarray, fs: np.ndarray, max_step: float):
+    """A joint path (S, J) and its finger openings (S,) densified so no joint moves more than
+    ``max_step`` rad: the waypoint each point leads to (N,), the points (N, J), openings (N,)."""
+    n = np.ceil(np.abs(np.diff(path, axis=0)).max(-1) / max_step - 1e-9)  # (S-1,)
+    n = np.maximum(n, 1).astype(int)
+    seg = np.concatenate([[0], np.repeat(np.arange(1, len(path)), n)])  # (N,) waypoint
+    t = np.concatenate([[1.0], *(np.arange(1, k + 1) / k for k in n)])  # (N,)
+    prev = np.maximum(seg - 1, 0)
+    qs = path[prev] + t[:, None] * (path[seg] - path[prev])  # (N, J)
+    f = fs[prev] + t * (fs[seg] - fs[prev])  # (N,)
+    return seg, qs, f
+
+
 @dataclass(frozen=True)
 class Box:
     """A box in the world (a block or an obstacle), turned by ``yaw`` about world z."""
@@ -255,13 +268,7 @@ class PandaCollision:
             fs = np.broadcast_to(np.asarray(fingers, dtype=float), (len(path),))  # (S,)
         except ValueError:
             raise RobotError(f"fingers: one opening or {len(path)}, one per waypoint") from None
-        n = np.ceil(np.abs(np.diff(path, axis=0)).max(-1) / max_step - 1e-9)  # (S-1,)
-        n = np.maximum(n, 1).astype(int)
-        seg = np.concatenate([[0], np.repeat(np.arange(1, len(path)), n)])  # (N,) waypoint
-        t = np.concatenate([[1.0], *(np.arange(1, k + 1) / k for k in n)])  # (N,)
-        prev = np.maximum(seg - 1, 0)
-        qs = path[prev] + t[:, None] * (path[seg] - path[prev])  # (N, J)
-        f = fs[prev] + t * (fs[seg] - fs[prev])  # (N,)
+        seg, qs, f = densify(path, fs, max_step)
         for k in range(len(qs)):
             if next(self._hits(qs[k], f[k], ignore), None) is not None:
                 hit = self.contacts(qs[k], f[k], ignore)[0]
