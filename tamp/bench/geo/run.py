@@ -16,6 +16,7 @@ failure, plan length (median over solved), planning time p50/p90, execution time
 from __future__ import annotations
 
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -157,14 +158,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
                 "arm_path_rad": _median([r["arm_path_rad"] for r in solved]),
                 "collided": sum(r["collisions"] > 0 for r in mine),
                 "collisions": sum(r["collisions"] for r in mine),
-                "statuses": _count(r["status"] for r in mine),
+                "statuses": dict(Counter(r["status"] for r in mine)),
             }
         )
-    return out
-
-
-def _count(values) -> dict[str, int]:
-    out: dict[str, int] = {}
-    for v in values:
-        out[v] = out.get(v, 0) + 1
     return out
