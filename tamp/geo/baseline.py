@@ -24,9 +24,9 @@ import itertools
 import time
 
 from tamp.geo.check import MoveCheck, Tools, candidate_grasps, check_move, grasp_order
-from tamp.geo.places import candidate_places
+from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import DEFAULT, SearchConfig, _holds, heuristic, state_key
-from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
 from tamp.world.schema import Scene
@@ -88,7 +88,7 @@ def plan_search_then_check(
     checks, failures, constraints, time_s, check_time_s."""
     t0 = time.perf_counter()
     stats = {"plans": 0, "nodes": 0, "checks": 0, "failures": 0, "check_time_s": 0.0}
-    targets = (*(r.name for r in scene.regions), TABLE)
+    targets = fixed_targets(scene)
     start: Supports = tuple(read_facts(scene).supports)
     forbidden: set[tuple[Supports, SymMove]] = set()
     cache: dict[tuple, MoveCheck] = {}

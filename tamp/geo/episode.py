@@ -28,12 +28,13 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from functools import partial
 from pathlib import Path
 
 from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.execute import RunConfig, rests_of, run_move
-from tamp.geo.places import candidate_places
+from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.loop.episode import torch_threads
@@ -116,7 +117,7 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
     place of the predicted scene, nothing checked, no grasp chosen."""
     t0 = time.perf_counter()
     start = tuple(read_facts(scene).supports)
-    targets = (*(r.name for r in scene.regions), TABLE)
+    targets = fixed_targets(scene)
     plan, expanded = symbolic_plan(start, goal, targets, set(), config.symbolic_nodes)
     stats = {"nodes": expanded, "checks": 0, "failures": 0}
     if plan is None:
@@ -159,14 +160,23 @@ def run_geo_episode(
     inject: dict | None = None,
     tools: Tools | None = None,
     grasp: str = "friction",
+    domain: tuple[str, ...] | None = None,
 ) -> GeoReport:
     """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
     `SearchConfig` with ``seed``); ``video``: a file path to record the episode to (.mp4 or
     .gif); ``inject``: fault injection, ``{"drop": [k, ...]}`` opens the gripper mid-transit
     on those move indices; ``tools``: reuse an IK solver and collision model (else built and
-    closed here)."""
+    closed here); ``domain``: ``(pddl_domain_text, binding_text)`` the motion-aware planner
+    plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules); refused for the
+    other planners, which plan over the moves the geometry allows."""
     plan_fn = planner_by_name(planner)
+    if domain is not None:
+        if planner != "motion-aware":
+            raise TampError(
+                f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
+            )
+        plan_fn = partial(plan_fn, domain=domain)
     config = planner_config or SearchConfig(seed=seed)
     inject = inject or {}
     drops = set(inject.get("drop", ()))

@@ -67,12 +67,13 @@ def candidate_places(
     or `task.problem.TABLE`) in ``scene`` as it stands, in the order a planner should try them
     (see the module docstring). ``samples``: seeded region positions added after the grid
     (default ``n``). An unknown name is a `SceneFileError` listing the valid ones; a target
-    nothing fits on gives ``()``."""
+    nothing fits on gives ``()``, as does the table in a scene without parking
+    (`Scene.parking`)."""
     o = scene.object(obj)
     objects = {x.name for x in scene.objects}
     regions = {r.name for r in scene.regions}
     if target == TABLE:
-        pool = _on_table(scene, o, seed)
+        pool = _on_table(scene, o, seed) if scene.parking else []
     elif target in regions:
         pool = _in_region(scene, o, scene.region(target), seed, n if samples is None else samples)
     elif target in objects:
@@ -90,6 +91,12 @@ def candidate_places(
         if free(scene, obj, place, clearance):
             out.append(place)
     return tuple(out)
+
+
+def fixed_targets(scene: Scene) -> tuple[str, ...]:
+    """What an object may be set on besides the other objects: the regions and, where the
+    scene allows parking (`Scene.parking`), the table."""
+    return (*(r.name for r in scene.regions), *((TABLE,) if scene.parking else ()))
 
 
 def free(scene: Scene, obj: str, place: Place, clearance: float = 0.0) -> bool:

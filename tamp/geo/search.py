@@ -42,13 +42,14 @@ import heapq
 import itertools
 import math
 import time
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from motion.grasps import world_tcp
 from tamp.geo.check import MoveCheck, Tools, candidate_grasps, check_move, grasp_order
-from tamp.geo.places import apart, candidate_places, supported_on
+from tamp.geo.places import apart, candidate_places, free, supported_on
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, Place, moved
 from tamp.world.geometry import fixed_solids, footprint_gap, of_movable
 from tamp.world.goal import Goal
@@ -234,10 +235,18 @@ def dead_goal(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> s
     return ""
 
 
-def plan_search(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig = DEFAULT) -> GeoPlan:
-    """Plan moves from ``scene`` to ``goal`` (see the module docstring). ``stats``: nodes
-    (expanded, all rounds), generated, checks (`check_move` calls: quick and full),
-    full_checks, failures (checks that failed), restarts (plans a full check refused),
+def plan_search(
+    scene: Scene,
+    goal: Goal,
+    tools: Tools,
+    config: SearchConfig = DEFAULT,
+    hints: Mapping[tuple[str, str], Sequence[Place]] | None = None,
+) -> GeoPlan:
+    """Plan moves from ``scene`` to ``goal`` (see the module docstring). ``hints``: places
+    to try first, per (object, target), before `candidate_places` (e.g. a joint packing of a
+    region, `tamp.geo.ours`): each offered where it is free (`tamp.geo.places.free`).
+    ``stats``: nodes (expanded, all rounds), generated, checks (`check_move` calls: quick and
+    full), full_checks, failures (checks that failed), restarts (plans a full check refused),
     ruled_out (grasps the failure memory skipped), time_s, check_time_s."""
     t0 = time.perf_counter()
     stats = {
@@ -263,7 +272,7 @@ def plan_search(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig = D
         return end(GeoStatus.UNSOLVABLE, f"no plan: {dead}")
     cache: dict[tuple, MoveCheck] = {}  # (state key, object, place name) -> quick verdict
     while True:
-        found = _search(scene, goal, tools, config, memory, cache, stats, t0)
+        found = _search(scene, goal, tools, config, memory, cache, stats, t0, hints or {})
         if isinstance(found, tuple):  # (status, reason): no plan this round
             return end(*found)
         verified = _verify(scene, found, tools, config, memory, cache, stats)
@@ -301,7 +310,7 @@ def _count(stats: dict, check: MoveCheck, full: bool) -> None:
     stats["check_time_s"] += check.time_s
 
 
-def _search(scene, goal, tools, config, memory, cache, stats, t0):
+def _search(scene, goal, tools, config, memory, cache, stats, t0, hints):
     """One round of the best-first search with quick checks: the moves of a plan, or
     (status, reason) when the round ends without one."""
     start = _Node(scene, dict(read_facts(scene).supports), 0, None, None)
@@ -310,7 +319,7 @@ def _search(scene, goal, tools, config, memory, cache, stats, t0):
     guide = _Guide(goal)
     tie = itertools.count()
     queue: list = []
-    _expand(0, nodes, goal, config, queue, tie, guide, stats)
+    _expand(0, nodes, goal, config, queue, tie, guide, stats, hints)
     while queue:
         if time.perf_counter() - t0 > config.max_time_s:
             return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (time)"
@@ -346,7 +355,7 @@ def _search(scene, goal, tools, config, memory, cache, stats, t0):
             return _path(nodes, len(nodes) - 1)
         if stats["nodes"] >= config.max_nodes:
             return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (nodes)"
-        _expand(len(nodes) - 1, nodes, goal, config, queue, tie, guide, stats)
+        _expand(len(nodes) - 1, nodes, goal, config, queue, tie, guide, stats, hints)
     return (
         GeoStatus.UNSOLVABLE,
         f"no plan within the discretised choices: {config.places} places per target, grasps "
@@ -420,11 +429,12 @@ class _Guide:
         return out
 
 
-def _expand(i, nodes, goal, config, queue, tie, guide, stats) -> None:
-    """Queue every successor of node ``i`` unchecked, keyed (f, -g, place rank, distance of
-    the moved object to the goal's objects, insertion); f = g + weight (h + blockers) plus a
-    penalty of 1 for moving an object no goal atom plausibly involves and 1 for moving the
-    object the last move moved (orderings only: nothing is pruned); h is `_Guide.estimate`."""
+def _expand(i, nodes, goal, config, queue, tie, guide, stats, hints) -> None:
+    """Queue every successor of node ``i`` unchecked, keyed (f, -g, place rank, insertion);
+    f = g + weight (h + blockers) plus a penalty of 1 for moving an object no goal atom
+    plausibly involves and 1 for moving the object the last move moved (orderings only:
+    nothing is pruned); h is `_Guide.estimate`. The ``hints`` places of (object, target)
+    where they are free rank before `candidate_places`'."""
     node = nodes[i]
     stats["nodes"] += 1
     scene, supports = node.scene, node.supports
@@ -439,9 +449,9 @@ def _expand(i, nodes, goal, config, queue, tie, guide, stats) -> None:
         for target in targets:
             if target == x or (target == supports[x] and target not in (TABLE, *_regions(scene))):
                 continue
-            for rank, place in enumerate(
-                candidate_places(scene, x, target, config.places, config.seed)
-            ):
+            hinted = [p for p in hints.get((x, target), ()) if free(scene, x, p)]
+            places = candidate_places(scene, x, target, config.places, config.seed)
+            for rank, place in enumerate([*hinted, *places]):
                 if _same_spot(scene, x, place):
                     continue
                 after = dict(supports)

@@ -13,7 +13,9 @@ world (the Panda at the origin facing +x, the table top at z = 0, metres and rad
   colour's zone;
 - ``tall``: a tower of 8-10 cubes built or taken down at the edge of the arm's reach;
 - ``hanoi``: Tower of Hanoi, 3-5 square discs on three pegs (marked regions that hold one
-  tower each); `hanoi_pddl` writes the problem for ``task/data/hanoi.pddl`` from the geometry.
+  tower each), played by its rules: nothing is parked on the bare table (`NO_PARKING`); a
+  disc stands only on a wider one, as the geometry says; `hanoi_pddl` writes the problem for
+  ``task/data/hanoi.pddl`` from the geometry.
 
 `generate(problem, seed, **size)` draws a variant from ``numpy.random.default_rng(seed)``
 (positions, yaws, colours, counts); every variant passes `tamp.world.load.load_scene`'s checks
@@ -124,7 +126,9 @@ class CanonicalProblem:
 
     ``witness``: for ``packed``, poses (name, pose) of every object in the tray that meet the
     goal, each with a free top-down grasp among the others: the goal is reachable. Empty for
-    the other problems.
+    the other problems. ``domain``: for a problem defined by a PDDL domain (``hanoi``), the
+    domain's text and its binding to the motion layer (`task.symbolic.pickplace.binding`),
+    for a planner that plans through it; None for the others.
     """
 
     name: str
@@ -133,6 +137,7 @@ class CanonicalProblem:
     goal: Goal
     note: str
     witness: tuple[tuple[str, Pose], ...] = ()
+    domain: tuple[str, str] | None = None
 
     def goal_text(self) -> str:
         """The goal as a goal file: a comment with the note, then the formula, one atom a line."""
@@ -300,6 +305,11 @@ def in_view(points, eye, target, camera: Camera = Camera(), margin: float = 1.0)
     )
 
 
+# problems played by their rules: Tower of Hanoi's discs rest only on pegs and discs, never
+# parked on the bare table (`tamp.world.schema.Scene.parking`)
+NO_PARKING = frozenset({"hanoi"})
+
+
 def _finish(name, seed, objects, regions, obstacles, atoms, note, witness) -> CanonicalProblem:
     """The variant as a checked scene: round-tripped through the file format and the loader's
     checks (a failure here is a generator bug), its goal parsed and unmet."""
@@ -311,10 +321,16 @@ def _finish(name, seed, objects, regions, obstacles, atoms, note, witness) -> Ca
         tuple(objects),
         None,
         _camera(objects, regions),
+        parking=name not in NO_PARKING,
     )
     scene = load_scene(scene_dict(scene))
     text = "(and " + " ".join(f"({' '.join(a)})" for a in atoms) + ")"
     goal = parse_goal(text, scene, source=f"{name} goal")
     if goal.holds(read_facts(scene)):
         raise ProblemError(f"{name}: seed {seed} draws a scene that already meets its goal")
-    return CanonicalProblem(name, seed, scene, goal, note, tuple(witness))
+    domain = None
+    if name == "hanoi":
+        from task.symbolic.pickplace import hanoi
+
+        domain = (hanoi.domain_text(), hanoi.BINDING)
+    return CanonicalProblem(name, seed, scene, goal, note, tuple(witness), domain)

@@ -53,7 +53,7 @@ SCENES_DIR = Path(__file__).resolve().parent / "scenes"
 NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
 
 TOP = {"schema", "name", "table"}
-TOP_OPTIONAL = {"slots", "regions", "obstacles", "objects", "camera"}
+TOP_OPTIONAL = {"slots", "regions", "obstacles", "objects", "camera", "parking"}
 REGION = {"name", "min", "max"}
 REGION_OPTIONAL = {"on", "floor", "wall_height", "wall_thickness", "colour"}
 OBSTACLE = {"name", "centre", "half"}
@@ -217,7 +217,10 @@ def _parse(data) -> Scene:
     )
     objects = tuple(_object(o, f"objects[{i}]") for i, o in enumerate(_list(data, "objects")))
     camera = _camera(data["camera"]) if "camera" in data else None
-    return Scene(data["name"], table, regions, obstacles, objects, slots, camera)
+    parking = data.get("parking", True)
+    if not isinstance(parking, bool):
+        raise _Fault(f"parking: expected true or false, got {parking!r}")
+    return Scene(data["name"], table, regions, obstacles, objects, slots, camera, parking)
 
 
 def _coordinates(value, where: str) -> tuple[float, ...]:
@@ -435,6 +438,8 @@ def scene_dict(scene: Scene) -> dict:
             "width": c.width,
             "height": c.height,
         }
+    if not scene.parking:
+        out["parking"] = False
     return out
 
 

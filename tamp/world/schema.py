@@ -42,7 +42,10 @@ Schema version 1::
       ],
       "camera": {"eye": [x, y, z], "target": [x, y, z],    # optional (`tamp.sim.base.Camera`);
                  "up": [0, 0, 1], "fovy": 40.0,            #   every key but eye and target is
-                 "width": 320, "height": 240}              #   optional, fovy in degrees
+                 "width": 320, "height": 240},             #   optional, fovy in degrees
+      "parking": true                    # optional: whether an object may be set down on the
+                                         #   bare table (default true); false: only in the
+                                         #   regions and on objects (Tower of Hanoi's pegs)
     }
 
 `tamp.world.load` checks a file against this schema and against geometry (nothing overlaps,
@@ -186,6 +189,7 @@ class Scene:
     objects: tuple[Movable, ...] = ()
     slots: Slots | None = None
     camera: Camera | None = None
+    parking: bool = True  # an object may be set down on the bare table (else: regions, objects)
 
     def object(self, name: str) -> Movable:
         """The object named ``name``; SceneFileError listing the objects when there is none."""

@@ -26,6 +26,9 @@ import numpy as np
 from tamp.sweep import run_items
 
 PLANNERS = ("soft", "motion-aware", "search-then-check")  # the issue's three, side by side
+# every episode's limits (`run_geo_episode`): moves run (Tower of Hanoi with 5 discs takes 31
+# at best), plans after the first, and each planner call's wall clock (`SearchConfig`)
+LIMITS = {"max_moves": 40, "max_replans": 3, "planning_s": 120.0}
 ROW_COLUMNS = (
     "problem",
     "variant",
@@ -86,12 +89,24 @@ def items(
 def play(item: Item) -> dict:
     """One episode's row (`ROW_COLUMNS`), in the process that runs it."""
     from tamp.geo.episode import run_geo_episode
+    from tamp.geo.search import SearchConfig
     from tamp.world.canonical import generate
 
     made = generate(item.problem, item.variant)
     t0 = time.perf_counter()
+    # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
+    domain = made.domain if item.planner == "motion-aware" else None
     report = run_geo_episode(
-        made.scene, made.goal, item.planner, item.sim, seed=item.seed, video=item.video
+        made.scene,
+        made.goal,
+        item.planner,
+        item.sim,
+        seed=item.seed,
+        planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS["planning_s"]),
+        video=item.video,
+        max_moves=LIMITS["max_moves"],
+        max_replans=LIMITS["max_replans"],
+        domain=domain,
     )
     return {
         "problem": item.problem,

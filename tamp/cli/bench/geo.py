@@ -21,6 +21,7 @@ def tamp_command(args: argparse.Namespace) -> int:
     from tamp.bench.geo import run as bench
 
     recorded = tamp_bench_config(args)  # refused combinations: before any work
+    recorded["limits"] = dict(bench.LIMITS)
     out_folder(args.out)
     sims = sim_list(args.sim)
     videos = None

@@ -8,11 +8,14 @@ straight to another, e.g. from the table into a tray). `bridge` builds that prob
 - entities: the scene's movable objects, in scene order;
 - places (`Site`), the K fixed targets:
   - region cells: for each region the goal puts objects in, the cells `tamp.geo.ours.pack.pack`
-    places all of them at jointly (the region's inner rectangle, the objects already inside
-    as fixed occupants, finger room for a top grasp): goal object i gets cell i,
+    places all of them at jointly (the region's inner rectangle, kept `PACK_MARGIN` inside
+    it where that fits, the objects already inside as fixed occupants, finger room for a top
+    grasp): goal object i gets cell i,
     ``<region>.c<i>``;
   - table spots: `tamp.geo.places.candidate_places` of the largest object on the table (the
-    scene's slot grid first), ``table.s<i>`` / ``table.g<i>``;
+    scene's slot grid first), ``table.s<i>`` / ``table.g<i>``; none in a scene without
+    parking (`Scene.parking`), where each empty region without cells offers its centre,
+    ``<region>.centre``;
   - the place each object standing on the table or in a region stands on now: a table spot
     when it stands on one (within `ON_SPOT`), else its own, ``spot_<object>`` (as
     `tamp.slots` does with ``spot_<base>``);
@@ -39,7 +42,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from tamp.geo.ours.pack import PackConfig, PackResult, pack
-from tamp.geo.places import TABLE_CLEARANCE, candidate_places, placed_solid
+from tamp.geo.places import PACK_MARGIN, TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose
 from tamp.world.geometry import footprint_gap, of_movable
@@ -194,13 +197,16 @@ def bridge(
         if not movers:
             continue
         fixed = [scene.object(x) for x in inside]
-        for attempt in range(PACK_TRIES):  # a few seeds: each is R restart rows already
+        # a few seeds (each R restart rows already), first with the footprints kept
+        # `PACK_MARGIN` inside the rectangle, then flush with it where nothing else fits
+        tries = [(m, attempt) for m in (PACK_MARGIN, 0.0) for attempt in range(PACK_TRIES)]
+        for margin, attempt in tries:
             result = pack(
                 r.inner(),
                 [own_footprint(scene.object(x)) for x in movers],
                 [o.pose.xyz[:2] for o in fixed],
                 [footprint(o) for o in fixed],
-                config,
+                replace(config, margin=margin),
                 seed + attempt,
                 walled=r.wall_height > 0,
             )
@@ -211,8 +217,16 @@ def bridge(
             xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))
             sites.append(Site(f"{r.name}.c{i}", r.name, xy, r.surface, float(result.yaws[i])))
             cells.append((x, sites[-1].name))
+    if not scene.parking:  # no table spots: each region that has no cell offers its centre
+        taken = {s.target for s in sites}
+        for r in scene.regions:
+            if r.name not in taken and not any(support.get(x) == r.name for x in names):
+                (x0, y0), (x1, y1) = r.inner()
+                centre = ((x0 + x1) / 2, (y0 + y1) / 2)
+                sites.append(Site(f"{r.name}.centre", r.name, centre, r.surface))
     probe = max(scene.objects, key=lambda o: max(footprint(o)))
     n_table = len(names) + 2 if table_places is None else table_places
+    n_table = n_table if scene.parking else 0
     spots = candidate_places(scene, probe.name, TABLE, 3 * n_table, seed)
     me = of_movable(probe)  # the probe ignores itself: keep spots off its footprint too
     spots = [

@@ -74,6 +74,9 @@ class PackConfig:
     tol: float = 1e-4  # m, interpenetration still counted as free
     ordered: bool = True  # finger room against the objects placed before only: a pair is free
     # when either's hand clears the other's body, and some placing order must exist (`order`)
+    margin: float = 0.0  # m, the footprints keep this far inside the region's rectangle (a
+    # placed object settles a millimetre or two from where it was released: a footprint
+    # flush with a marked area's edge may be read as standing outside it)
 
 
 @dataclass(frozen=True)
@@ -202,6 +205,8 @@ def pack(
     square); ``walled``: the hand must stay inside the region too (walls stand on its edges;
     a marked area lets the fingers reach beyond it)."""
     t0 = time.perf_counter()
+    (x0, y0), (x1, y1) = inner
+    inner = ((x0 + config.margin, y0 + config.margin), (x1 - config.margin, y1 - config.margin))
     half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
     m, r = len(half_np), config.restarts
     if m == 0:
@@ -275,6 +280,8 @@ def pack_sampled(
     and closing axis drawn at random per attempt; ``walled`` as in `pack`. Same result value
     as `pack` (``tries``: samples spent)."""
     t0 = time.perf_counter()
+    (x0, y0), (x1, y1) = inner
+    inner = ((x0 + config.margin, y0 + config.margin), (x1 - config.margin, y1 - config.margin))
     half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
     m = len(half_np)
     rng = np.random.default_rng(seed)

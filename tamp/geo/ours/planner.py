@@ -17,10 +17,12 @@
    (the hand no longer fits once a neighbour is placed): binding stops there too and planning
    goes on from that state (`OursConfig.cuts`).
 
-4. when that ends without a plan (the windows, the fallback's nodes, the replans or half the
-   time ran out, or the prices, a proxy of the full check, allowed no plan at all), the
-   complete geometric search (`tamp.geo.search.plan_search`, `OursConfig.search`) goes on
-   from the world the bound moves reached, with what is left of the time.
+4. when that ends without a plan (the windows, the fallback's nodes, the replans or its
+   share of the time, `OursConfig.soft_time_s`, ran out, or the prices, a proxy of the full
+   check, allowed no plan at all), the complete geometric search
+   (`tamp.geo.search.plan_search`, `OursConfig.search`) goes on from the world the bound
+   moves reached, with what is left of the time, the bridged problem's places offered first
+   (`cell_hints`: the packer's cells, each object's starting place).
 
 The status is SOLVED with the moves; UNSOLVABLE only when the complete search proved that no
 plan exists within the discretised grasps and places (or, with the search off, when the
@@ -54,6 +56,7 @@ from task.domains.blocksworld import check_move as legal
 from task.planner import plan
 from task.problem import PlanStatus
 
+SOFT_SHARE = 4  # the differentiable planner's share of the wall clock: 1 / SOFT_SHARE
 PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True)
 
 
@@ -72,6 +75,9 @@ class OursConfig:
     # (`tamp.geo.search.plan_search`, every move under the full check) goes on from the world
     # its bound moves reached, with these budgets (None: no fallback)
     search: SearchConfig | None = field(default_factory=SearchConfig)
+    # wall clock (s) of the differentiable planner's attempt, all its plans and bindings
+    # together (None: only ``planner.time_limit_s`` per plan)
+    soft_time_s: float | None = None
 
 
 def _check():
@@ -91,14 +97,17 @@ def as_ours(config) -> OursConfig:
     else:
         search = SearchConfig(seed=getattr(config, "seed", 0))
     limit = getattr(config, "max_time_s", None)
-    # the differentiable planner gets half the wall clock; the complete search what is left
-    planner = replace(PLANNER, time_limit_s=limit / 2) if limit else PLANNER
+    # the differentiable planner gets a quarter of the wall clock; the complete search what
+    # is left
+    soft = limit / SOFT_SHARE if limit else None
+    planner = replace(PLANNER, time_limit_s=soft) if limit else PLANNER
     choices = getattr(config, "choices", GeoCostConfig().choices)
     return OursConfig(
         planner=planner,
         costs=GeoCostConfig(choices=tuple(choices)),
         seed=getattr(config, "seed", 0),
         search=search,
+        soft_time_s=soft,
     )
 
 
@@ -122,16 +131,33 @@ def plan_motion_aware(
     check = check or _check()
     first = _plan_soft(scene, goal, tools, config, check, t0)
     bound = first.stats.pop("bound", ())
+    bridged = first.stats.pop("bridged", None)
     if first.solved or config.search is None:
         return first
-    return _complete(scene, goal, tools, config, first, bound, t0)
+    return _complete(scene, goal, tools, config, first, bound, t0, cell_hints(bridged))
 
 
-def _complete(scene, goal, tools, config: OursConfig, first: GeoPlan, bound: tuple, t0: float):
+def cell_hints(bridged: Bridged | None) -> dict:
+    """The bridged problem's places as `plan_search` hints, (object, target) -> places: the
+    packer's cell of each goal object in its region, and the place each object stood on at
+    the start (where it goes back to when it must move out of the way and return)."""
+    if bridged is None:
+        return {}
+    p, out = bridged.problem, {}
+    starts = [(x, s) for x, s in zip(p.entities, p.init, strict=True) if s in p.fixed]
+    for x, name in (*bridged.cells, *starts):
+        site = bridged.site(name)
+        out.setdefault((x, site.target), []).append(site.place(bridged.scene.object(x)))
+    return {k: tuple(v) for k, v in out.items()}
+
+
+def _complete(
+    scene, goal, tools, config: OursConfig, first: GeoPlan, bound: tuple, t0: float, hints: dict
+):
     """The complete geometric search from the world the first attempt's ``bound`` moves
-    reached, within what is left of the time budget; its status is the answer (UNSOLVABLE from
-    it is exhaustive over the discretised grasps and places under the full check), the bound
-    moves first."""
+    reached, within what is left of the time budget, the packer's cells (``hints``) offered
+    first in their regions; its status is the answer (UNSOLVABLE from it is exhaustive over
+    the discretised grasps and places under the full check), the bound moves first."""
     from tamp.geo.search import plan_search
 
     world = scene
@@ -140,7 +166,7 @@ def _complete(scene, goal, tools, config: OursConfig, first: GeoPlan, bound: tup
     left = config.search.max_time_s - (time.perf_counter() - t0)
     if left <= 0:
         return first
-    found = plan_search(world, goal, tools, replace(config.search, max_time_s=left))
+    found = plan_search(world, goal, tools, replace(config.search, max_time_s=left), hints)
     stats = {
         **first.stats,
         "first": {"status": first.status.value, "reason": first.reason, "bound": len(bound)},
@@ -160,7 +186,7 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
         bridged = bridge(scene, goal, config.table_places, config.pack, config.seed)
     except SceneFileError as exc:
         return GeoPlan(GeoStatus.FAILED, reason=str(exc), stats={"time_s": 0.0})
-    stats: dict = {"places": len(bridged.sites), "packs": _packs(bridged)}
+    stats: dict = {"places": len(bridged.sites), "packs": _packs(bridged), "bridged": bridged}
     unpacked = [r for r, p in bridged.packs if not p.ok]
     if unpacked:
         stats["time_s"] = time.perf_counter() - t0
@@ -171,9 +197,18 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     failures, plans, cuts = [], 0, 0
     state, world, bound = bridged.problem.init, bridged.scene, []
     while len(failures) <= config.replans and cuts <= config.cuts:
+        planner = config.planner
+        if config.soft_time_s is not None:
+            left = config.soft_time_s - (time.perf_counter() - t0)
+            if left <= 0:
+                stats["bound"] = tuple(bound)
+                why = f"the differentiable planner's {config.soft_time_s:g} s ran out"
+                return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+            limit = planner.time_limit_s
+            planner = replace(planner, time_limit_s=left if limit is None else min(limit, left))
         plans += 1
         now = replace(bridged.problem, init=state)
-        result = plan(now, config.planner, seed=config.seed + plans - 1, costs=costs)
+        result = plan(now, planner, seed=config.seed + plans - 1, costs=costs)
         stats.update(_planner_stats(result, costs))
         if result.status is PlanStatus.UNSOLVABLE and state == bridged.problem.init:
             why = result.stats.get("fallback", {}).get("reason", "no plan")

@@ -58,6 +58,18 @@ def test_region_places_pack_against_walls_and_objects_then_grid_then_samples():
     assert [far(p) for p in grid] == sorted(far(p) for p in grid)
 
 
+def test_without_parking_the_table_is_no_place_and_regions_are_the_fixed_targets():
+    from dataclasses import replace
+
+    from tamp.geo.places import fixed_targets
+
+    s = scene(cube("a", 0.5, 0.2), cube("b", 0.4, -0.1), regions=[TRAY])
+    assert candidate_places(s, "b", TABLE, n=4) and fixed_targets(s) == ("tray", TABLE)
+    kept = replace(s, parking=False)
+    assert candidate_places(kept, "b", TABLE, n=4) == ()
+    assert candidate_places(kept, "b", "tray", n=4) and fixed_targets(kept) == ("tray",)
+
+
 def test_a_region_too_small_for_the_object_has_no_place():
     small = {"name": "small", "min": [0.5, 0.2], "max": [0.54, 0.24]}
     s = scene(cube("a", 0.4, -0.1), regions=[small])

@@ -91,8 +91,9 @@ def test_a_scene_with_every_field_round_trips(tmp_path):
     )
     data["camera"] = {"eye": [1.2, -0.4, 0.8], "target": [0.5, 0.0, 0.1], "fovy": 50.0}
     data["slots"] = {"xs": [0.4], "ys": [-0.3, 0.0]}
+    data["parking"] = False
     s = load_scene(data)
-    assert s.camera.fovy == 50.0 and s.camera.width == 320
+    assert s.camera.fovy == 50.0 and s.camera.width == 320 and s.parking is False
     assert s.region("plate").surface == pytest.approx(0.01)
     assert load_scene(scene_dict(s)) == s
     assert load_scene(save_scene(s, tmp_path / "s.json")) == s
@@ -151,6 +152,7 @@ def _with(path, value):
         (("regions", 0, "on"), "shelf", r"regions\[0\] \(tray\)\.on: unknown obstacle 'shelf'"),
         (("regions", 0, "wall_thickness"), 0.2, r"wall_thickness: 0.2 m walls leave no room"),
         (("camera",), {"eye": [1, 0, 1]}, r"camera\.target: missing"),
+        (("parking",), "no", r"^scene: parking: expected true or false, got 'no'"),
     ],
 )
 def test_bad_fields_get_one_line_naming_the_field(path, value, expected):
