@@ -7,6 +7,7 @@ from dataclasses import dataclass
 # moves per window (horizon, lookahead): far beyond any plan the windows decode, and the window's
 # (B, T, N, A) logits and T-step rollout graph grow with it (1_000_000 hung before planning)
 MAX_HORIZON = 1000
+FALLBACK_SEARCHES = ("astar", "greedy")  # `PlannerConfig.fallback_search`
 
 
 @dataclass(frozen=True)
@@ -44,6 +45,12 @@ class PlannerConfig:
     # None: only with a cost source (motion-aware planning); never with beliefs (perception)
     fallback_nodes: int = 5_000  # state expansions the fallback may spend per problem (each
     # expanded state is priced once by the cost source when one of its moves is checked)
+    shorten: bool = False  # cut cycles and redundant moves out of a plan that reaches the goal
+    # (`task.symbolic.shorten`); only without beliefs and a cost source (their windows are
+    # committed move by move)
+    fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans);
+    # "greedy": lazy greedy best-first on its `estimate` and `helpful` moves (far larger
+    # problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
 
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:
@@ -70,6 +77,13 @@ class PlannerConfig:
                 raise TampError(
                     f"PlannerConfig.{name} must be in 1..{MAX_HORIZON}, got {getattr(self, name)}"
                 )
+        if self.fallback_search not in FALLBACK_SEARCHES:
+            from task.errors import one_of
+
+            raise TampError(
+                f"unknown PlannerConfig.fallback_search "
+                f"{one_of(self.fallback_search, FALLBACK_SEARCHES)}"
+            )
         if not 0.0 < self.threshold <= 1.0:
             raise TampError(f"PlannerConfig.threshold must be in (0, 1], got {self.threshold}")
         if not 0.0 <= self.lookahead_share <= 1.0:

@@ -33,7 +33,8 @@ from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 from task.rollout import OutOfTime, check_deadline
-from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first
+from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first, lazy_greedy
+from task.symbolic.shorten import shorten
 
 
 def _window(
@@ -181,15 +182,19 @@ def _fall_back(
     to the cost source move by move (restart row 0 of a one-row window priced in the state
     the move starts from). When no plan exists from ``state`` but ``state`` is not the initial
     state, the initial state is searched too: UNSOLVABLE only when neither has a plan within
-    these choices (the windows may have led into a dead end)."""
+    these choices (the windows may have led into a dead end). ``config.fallback_search``
+    picks the search: A* on the lower bound, or greedy on the domain's ``estimate``."""
     feasible, windows = (
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
-    found = lazy_best_first(domain, problem, state, feasible, config.fallback_nodes, deadline)
+    search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
+    if search is lazy_greedy and getattr(domain, "estimate", None) is None:
+        raise TampError(f"PlannerConfig.fallback_search='greedy': {domain.name} has no estimate")
+    found = search(domain, problem, state, feasible, config.fallback_nodes, deadline)
     start = domain.initial_state(problem)
     if found.status is SearchStatus.UNSOLVABLE and state != start:
         left = max(1, config.fallback_nodes - found.expanded)
-        again = lazy_best_first(domain, problem, start, feasible, left, deadline)
+        again = search(domain, problem, start, feasible, left, deadline)
         if again.status is not SearchStatus.UNSOLVABLE:
             why = (
                 "the windows reached a state from which no plan exists within these choices, "
@@ -330,6 +335,10 @@ def _run(
             searched[i] = _fall_back(domain, p, states[i], costs, indices, i, config, deadline)
             moves[i].extend(searched[i].moves)
             solved[i] = searched[i].status is SearchStatus.SOLVED
+    if config.shorten and source is None and costs is None:
+        for i, p in enumerate(problems):
+            if solved[i] and illegal[i] is None:
+                moves[i] = list(shorten(domain, p, moves[i]))
     on_done(len(active))
     elapsed = time.perf_counter() - start
     results = []

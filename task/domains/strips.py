@@ -25,6 +25,7 @@ from __future__ import annotations
 import contextlib
 import random
 from collections.abc import Iterator, Sequence
+from types import MappingProxyType
 
 from pddl.core import Domain as PDDLDomain
 from pddl.core import Problem as PDDLProblem
@@ -188,13 +189,34 @@ def lower_bound(problem: Problem, state: State) -> float:
     return task.bounds[key]
 
 
-def estimate(problem: Problem, state: State) -> float:
-    """h_FF (`task.symbolic.relaxed.ff`), not admissible: what the decoder ranks restarts by
-    (moves + estimate); LM-cut still marks dead ends. Memoised with the bounds."""
+def _relaxed(problem: Problem, state: State) -> tuple[float, tuple[int, ...]]:
+    """h_FF of ``state`` and its helpful action columns (`task.symbolic.relaxed`), memoised
+    with the bounds (0 and none at a goal; INF and none at a dead end)."""
     task, key = _task(problem), ("ff", frozenset(state))
     if key not in task.bounds:
-        task.bounds[key] = relaxed.ff(task, key[1]) if not is_goal(problem, state) else 0.0
+        if is_goal(problem, state):
+            task.bounds[key] = (0.0, ())
+        else:
+            chosen = relaxed.relaxed_plan(task, key[1])
+            if chosen is None:
+                task.bounds[key] = (relaxed.INF, ())
+            else:
+                task.bounds[key] = (float(len(chosen)), relaxed.helpful(task, key[1], chosen))
     return task.bounds[key]
+
+
+def estimate(problem: Problem, state: State) -> float:
+    """h_FF (`task.symbolic.relaxed.ff`), not admissible: what the decoder ranks restarts by
+    (moves + estimate) and the greedy fallback search (`task.symbolic.lazy_search.lazy_greedy`)
+    is guided by; LM-cut still marks dead ends. Memoised with the bounds."""
+    return _relaxed(problem, state)[0]
+
+
+def helpful(problem: Problem, state: State) -> frozenset[Action]:
+    """The helpful actions of ``state`` (`task.symbolic.relaxed.helpful`): the moves of its
+    relaxed plan that apply in ``state``, which the greedy fallback search tries first."""
+    actions = _task(problem).actions
+    return frozenset(actions[j] for j in _relaxed(problem, state)[1])
 
 
 # ---------------------------------------------------------------------------------- samples
@@ -269,12 +291,19 @@ class Strips:
     is_goal = staticmethod(is_goal)
     lower_bound = staticmethod(lower_bound)
     estimate = staticmethod(estimate)
+    helpful = staticmethod(helpful)
     from_pddl = staticmethod(from_pddl)
     to_actions = staticmethod(to_actions)
     to_atoms = staticmethod(to_atoms)
     to_pddl = staticmethod(to_pddl)
     pddl_domain_text = staticmethod(pddl_domain_text)
     samples = staticmethod(samples)
+    # when the windows revisit a state or run out, a complete greedy search on h_FF and the
+    # helpful actions takes over (`PlannerConfig.fallback`; `lazy_search.lazy_greedy`); plans
+    # leave with their cycles and redundant moves cut (`task.symbolic.shorten`)
+    planner_defaults = MappingProxyType(
+        {"fallback": True, "fallback_search": "greedy", "fallback_nodes": 50_000, "shorten": True}
+    )
 
     @staticmethod
     def matches(domain: PDDLDomain) -> bool:

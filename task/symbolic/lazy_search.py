@@ -165,3 +165,95 @@ def lazy_best_first(
         f"no plan exists within these choices: {len(parent)} reachable states expanded, "
         f"{ruled} moves ruled out",
     )
+
+
+class GuidedDomain(CrispDomain, Protocol):
+    """A crisp domain with an inadmissible cost-to-go ``estimate`` (INF at a dead end); an
+    optional ``helpful(problem, state)`` gives the moves worth trying first."""
+
+    def estimate(self, problem: Problem, state: Hashable) -> float: ...
+
+
+BOOST = 1000  # preferred-queue pops granted on each new best estimate (Fast Downward's boost)
+
+
+def lazy_greedy(
+    domain: GuidedDomain,
+    problem: Problem,
+    start: Hashable,
+    feasible: Feasible | None = None,
+    max_nodes: int = 20_000,
+    deadline: float | None = None,
+) -> LazyResult:
+    """Greedy best-first search on ``domain.estimate`` with deferred evaluation and preferred
+    operators, as Fast Downward's lazy GBFS (Richter & Helmert 2009): a queue entry is a
+    (state, move) pair ranked by its parent's estimate; the successor is made, and its estimate
+    computed, only when the entry pops, and the move's feasibility is checked then (as in
+    `lazy_best_first`). The domain's optional ``helpful`` moves also enter a second queue; the
+    two alternate, and every new best estimate grants the preferred queue ``BOOST`` pops.
+
+    Complete over the same choices as `lazy_best_first` (every reachable state is closed once;
+    states the estimate calls dead ends, INF, are cut), but the plan need not be shortest.
+    Ends SOLVED, UNSOLVABLE or BUDGET (``max_nodes`` expansions or ``deadline``)."""
+    t0 = time.perf_counter()
+    allowed: dict[tuple[Hashable, Move], bool] = {}
+    checked = 0
+    helpful = getattr(domain, "helpful", None)
+
+    def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
+        ruled = sum(not v for v in allowed.values())
+        elapsed = time.perf_counter() - t0
+        return LazyResult(status, moves, expanded, checked, ruled, elapsed, reason)
+
+    parent: dict[Hashable, tuple[Hashable, Move] | None] = {start: None}  # closed states
+    queues: tuple[list, list] = ([], [])  # every successor; the preferred ones
+    credit = [0, 0]  # pops taken from each queue, less the boosts: the lower one pops next
+    tie = itertools.count()
+    expanded, best = 0, math.inf
+    state, h = start, domain.estimate(problem, start)
+    while True:
+        if domain.is_goal(problem, state):
+            path = []
+            while parent[state] is not None:
+                state, move = parent[state]
+                path.append(move)
+            path.reverse()
+            return done(SearchStatus.SOLVED, tuple(path), f"a plan of {len(path)} moves")
+        if not math.isinf(h):
+            if h < best:
+                best = h
+                credit[1] -= BOOST
+            late = deadline is not None and time.perf_counter() > deadline
+            if expanded >= max_nodes or late:
+                why = "time" if late else "budget"
+                return done(SearchStatus.BUDGET, (), f"stopped after {expanded} expansions ({why})")
+            expanded += 1
+            preferred = helpful(problem, state) if helpful is not None else ()
+            for move in domain.legal_moves(problem, state):
+                entry = (h, next(tie), state, move)
+                heapq.heappush(queues[0], entry)
+                if move in preferred:
+                    heapq.heappush(queues[1], entry)
+        state = None
+        while state is None and (queues[0] or queues[1]):
+            k = min((k for k in (0, 1) if queues[k]), key=lambda k: credit[k])
+            credit[k] += 1
+            _, _, before, move = heapq.heappop(queues[k])
+            nxt = domain.apply_move(problem, before, move)
+            if nxt in parent:
+                continue
+            key = (before, move)
+            if key not in allowed:
+                checked += 1
+                allowed[key] = True if feasible is None else bool(feasible(before, move))
+            if allowed[key]:
+                parent[nxt], state = key, nxt
+        if state is None:
+            ruled = sum(not v for v in allowed.values())
+            return done(
+                SearchStatus.UNSOLVABLE,
+                (),
+                f"no plan exists within these choices: {len(parent)} reachable states closed, "
+                f"{ruled} moves ruled out",
+            )
+        h = domain.estimate(problem, state)

@@ -1,5 +1,6 @@
-"""Crisp delete relaxations of a grounded STRIPS task: h_max, LM-cut (admissible) and h_FF
-(an inadmissible estimate that ranks restarts), vectorised over the task's padded arrays.
+"""Crisp delete relaxations of a grounded STRIPS task: h_max, LM-cut (admissible), h_FF
+(an inadmissible estimate that ranks restarts and guides the greedy fallback search) and its
+helpful actions, vectorised over the task's padded arrays.
 
 ``task`` is a `task.symbolic.strips_task.StripsTask` (or any object with its arrays): ``pre``
 (G, kp) precondition columns padded with P (column P is constant-true, P + 1 constant-false),
@@ -90,14 +91,14 @@ def hadd(task, state: frozenset) -> tuple[np.ndarray, np.ndarray]:
         h[targets] = best
 
 
-def ff(task, state: frozenset) -> float:
-    """h_FF (Hoffmann & Nebel 2001): the size of a relaxed plan from ``state`` that reaches
-    every goal atom through each atom's cheapest achiever by h_add; INF when the relaxation
-    cannot reach the goal. Not admissible: the decoder ranks restarts by it."""
+def relaxed_plan(task, state: frozenset) -> tuple[int, ...] | None:
+    """The actions of a relaxed plan from ``state`` (Hoffmann & Nebel 2001): every goal atom
+    reached through each atom's cheapest achiever by h_add, backwards through their
+    preconditions; None when the relaxation cannot reach the goal. -> action columns, sorted"""
     h, price = hadd(task, state)
     goal = [task.column[a] for a in task.goal]
     if any(math.isinf(h[g]) for g in goal):
-        return INF
+        return None
     actions, targets, starts = task.pairs
     where = {int(t): k for k, t in enumerate(targets)}
     ends = np.append(starts[1:], len(actions))
@@ -113,4 +114,24 @@ def ff(task, state: frozenset) -> float:
         if best not in chosen:
             chosen.add(best)
             todo.extend(int(p) for p in task.pre[best] if p < n and h[p] > 0)
-    return float(len(chosen))
+    return tuple(sorted(chosen))
+
+
+def ff(task, state: frozenset) -> float:
+    """h_FF (Hoffmann & Nebel 2001): the size of the `relaxed_plan` from ``state``; INF when
+    the relaxation cannot reach the goal. Not admissible: the decoder ranks restarts by it."""
+    chosen = relaxed_plan(task, state)
+    return INF if chosen is None else float(len(chosen))
+
+
+def helpful(task, state: frozenset, chosen: tuple[int, ...] | None = None) -> tuple[int, ...]:
+    """The *helpful actions* of ``state`` (Hoffmann & Nebel 2001, as FF's and Fast Downward's
+    preferred operators): the actions of its `relaxed_plan` (``chosen``, computed when None)
+    that apply in ``state`` itself, i.e. whose preconditions all hold there. Empty at a dead
+    end. -> action columns, sorted"""
+    chosen = relaxed_plan(task, state) if chosen is None else chosen
+    if not chosen:
+        return ()
+    false = np.ones(len(task.atoms) + 2, dtype=bool)  # (P + 2,) the atoms that do not hold
+    false[[len(task.atoms), *(task.column[a] for a in state if a in task.column)]] = False
+    return tuple(j for j in chosen if not false[task.pre[j]].any())
