@@ -13,9 +13,10 @@ prices each legal move x -> y of that state:
   `tamp.arm_costs` prices Blocksworld moves (`motion.cost`'s c(x, y) without its sphere terms).
 
 A grasp is free at a pose when the hand (`motion.grasps.HAND_BOXES`, the palm and both fingers,
-each finger swept from open to closed on the object, as axis-aligned boxes around their turned
-corners; `hand_shape`) at that grasp overlaps no other
-object, obstacle, region wall or floor: the geometric half of `tamp.geo.check.quick_check`,
+each finger swept from open to closed on the object, as oriented boxes; `hand_shape`,
+`hand_obbs`) at that grasp overlaps no other object, obstacle, region wall or floor (the
+separating axis test of oriented boxes, `obb_overlap`; an upright solid as its turned box, a
+cylinder as its bounding square): the geometric half of `tamp.geo.check.quick_check`,
 without IK, for every grasp family at once. It is a proxy: the planner's moves are bound to a
 grasp by the full check (`tamp.geo.ours.planner`), and what fails there comes back as failure
 memory: `avoid(state, move, grasp, place)` rules the move out only under the grasp (None:
@@ -99,6 +100,63 @@ def hand_corners(grasps: Sequence[Grasp], margin: float = 0.0) -> np.ndarray:
             pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
             out[i, k] = pts @ m[:3, :3].T + m[:3, 3]
     return out
+
+
+def hand_obbs(grasps: Sequence[Grasp], margin: float = 0.0):
+    """The hand's palm and finger boxes (`hand_shape`, grown by ``margin``) at each grasp as
+    oriented boxes in the frame of the object held: centres (G, 3, 3), axes (G, 3, 3, 3) (each
+    box's rotation: its axes as columns), half extents (G, 3, 3), m."""
+    g = len(grasps)
+    centres, axes, halves = np.zeros((g, 3, 3)), np.zeros((g, 3, 3, 3)), np.zeros((g, 3, 3))
+    for i, grasp in enumerate(grasps):
+        m = grasp.matrix  # (4, 4) TCP in the object frame
+        for k, (centre, half) in enumerate(hand_shape(grasp)):
+            centres[i, k] = m[:3, :3] @ np.asarray(centre) + m[:3, 3]
+            axes[i, k] = m[:3, :3]
+            halves[i, k] = np.asarray(half) + margin
+    return centres, axes, halves
+
+
+def solid_obbs(solids: Sequence[Solid]):
+    """Upright solids as oriented boxes: centres (S, 3), axes (S, 3, 3), half extents (S, 3);
+    a cylinder as its bounding square."""
+    centres = np.array([s.centre for s in solids], dtype=np.float64).reshape(-1, 3)
+    halves = np.array([s.half for s in solids], dtype=np.float64).reshape(-1, 3)
+    yaws = np.array([0.0 if s.cylinder else s.yaw for s in solids], dtype=np.float64)
+    return centres, _turn(yaws), halves
+
+
+def _turn(yaws: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotations about z by ``yaws`` (...,)."""
+    c, s = np.cos(yaws), np.sin(yaws)
+    out = np.zeros((*np.shape(yaws), 3, 3))
+    out[..., 0, 0], out[..., 0, 1], out[..., 1, 0], out[..., 1, 1] = c, -s, s, c
+    out[..., 2, 2] = 1.0
+    return out
+
+
+def obb_overlap(a, b, touch: float = TOUCH) -> np.ndarray:
+    """(A, B) True where oriented box a_i and b_j interpenetrate more than ``touch`` (m) on
+    every one of the 15 separating axes (the separating axis theorem: two convex boxes are
+    apart when their projections on some face normal or edge cross product are). ``a``, ``b``:
+    (centres (N, 3), axes (N, 3, 3), half extents (N, 3)) as `hand_obbs` and `solid_obbs`."""
+    (ca, ra, ha), (cb, rb, hb) = a, b
+    ua, ub = np.swapaxes(ra, -1, -2), np.swapaxes(rb, -1, -2)  # (N, 3 axes, 3)
+    n, m = len(ca), len(cb)
+    cross = np.cross(ua[:, None, :, None, :], ub[None, :, None, :, :]).reshape(n, m, 9, 3)
+    axes = np.concatenate(
+        [
+            np.broadcast_to(ua[:, None], (n, m, 3, 3)),
+            np.broadcast_to(ub[None], (n, m, 3, 3)),
+            cross,
+        ],
+        axis=2,
+    )  # (A, B, 15, 3)
+    reach_a = (np.abs(np.einsum("abkd,aid->abki", axes, ua)) * ha[:, None, None]).sum(-1)
+    reach_b = (np.abs(np.einsum("abkd,bid->abki", axes, ub)) * hb[None, :, None]).sum(-1)
+    gap = np.abs(np.einsum("abkd,abd->abk", axes, cb[None] - ca[:, None]))  # (A, B, 15)
+    length = np.linalg.norm(axes, axis=-1)  # 0 for parallel edges: never separating
+    return ~(gap > reach_a + reach_b - touch * length).any(-1)
 
 
 def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
@@ -209,8 +267,8 @@ class GeoCosts:
         n, y = problem.n, len(problem.targets)
         out = np.zeros((n, y))
         allowed: dict[Move, tuple[str, ...]] = {}
-        fixed = solid_boxes(fixed_solids(world))
-        bodies = {o.name: solid_boxes([of_movable(o)]) for o in world.objects}
+        fixed = solid_obbs(fixed_solids(world))
+        bodies = {o.name: solid_obbs([of_movable(o)]) for o in world.objects}
         picks = {
             o.name: self._free_grasps(world, o.name, o.pose.xyz, o.pose.yaw, fixed, bodies)
             for o in world.objects
@@ -247,21 +305,23 @@ class GeoCosts:
 
     def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, fixed, bodies) -> set[str]:
         """Names of x's grasps whose open hand, x centred at ``xyz`` turned ``yaw``, overlaps
-        nothing but x (the other objects where ``world`` has them, the fixed solids); all of
-        x's grasps at once."""
+        nothing but x (the other objects where ``world`` has them, the fixed solids: oriented
+        boxes, `solid_obbs`); all of x's grasps at once (`obb_overlap`)."""
         others = [bodies[o.name] for o in world.objects if o.name != x]
-        boxes = np.concatenate([fixed, *others]) if others else fixed  # (S, 2, 3)
+        solids = tuple(np.concatenate(parts) for parts in zip(fixed, *others, strict=True))
         if x not in self._hands:
-            self._hands[x] = hand_corners(self.grasps[x], self.config.margin)
-        corners = self._hands[x]  # (G, 3, 8, 3) in x's frame
-        if not len(corners) or not len(boxes):
+            self._hands[x] = hand_obbs(self.grasps[x], self.config.margin)
+        centres, axes, halves = self._hands[x]  # (G, 3, ...) in x's frame
+        g = len(centres)
+        if not g or not len(solids[0]):
             return {g.name for g in self.grasps[x]}
-        c, s = np.cos(yaw), np.sin(yaw)
-        turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        pts = corners @ turn.T + np.asarray(xyz)  # (G, 3, 8, 3) in the world
-        lo, hi = pts.min(2), pts.max(2)  # (G, 3, 3)
-        depth = np.minimum(hi[:, :, None], boxes[:, 1]) - np.maximum(lo[:, :, None], boxes[:, 0])
-        hit = (depth > TOUCH).all(-1).any((1, 2))  # (G,)
+        turn = _turn(np.asarray(yaw))  # (3, 3)
+        hand = (
+            (centres @ turn.T + np.asarray(xyz)).reshape(-1, 3),
+            (turn @ axes).reshape(-1, 3, 3),
+            halves.reshape(-1, 3),
+        )  # the hand's 3 G boxes in the world
+        hit = obb_overlap(hand, solids).reshape(g, -1).any(-1)  # (G,)
         return {g.name for g, h in zip(self.grasps[x], hit, strict=True) if not h}
 
     def _solve(self, points: list) -> tuple[np.ndarray, np.ndarray]:

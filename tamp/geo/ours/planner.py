@@ -14,8 +14,10 @@
    at that place, under the grasps that failed) and the problem is planned on from the state
    the moves bound so far reached, at most `OursConfig.replans` times. A window prices all
    its moves in its start state, so a later move of it may be priced out in its own state
-   (the hand no longer fits once a neighbour is placed): binding stops there too and planning
-   goes on from that state (`OursConfig.cuts`).
+   (the hand no longer fits once a neighbour is placed): the plan's moves are first put in
+   an order each move's own state allows (`reorder`, each object's moves kept in their
+   order), and where none is found binding stops at that move and planning goes on from
+   that state (`OursConfig.cuts`).
 
 4. when that ends without a plan (the windows, the fallback's nodes, the replans or its
    share of the time, `OursConfig.soft_time_s`, ran out, or the prices, a proxy of the full
@@ -220,9 +222,10 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
                 why = f"after {len(bound)} bound moves: {why}"
             stats["bound"] = tuple(bound)
             return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
-        state, world, more, failed = _bind(
-            bridged, state, world, result.plan.moves, tools, costs, check
-        )
+        # a window prices its moves in its start state: put them in an order each move's own
+        # state allows first, where one exists
+        moves = reorder(bridged, costs, state, result.plan.moves) or result.plan.moves
+        state, world, more, failed = _bind(bridged, state, world, moves, tools, costs, check)
         bound += more
         if failed is None:
             return _done(GeoStatus.SOLVED, tuple(bound), "", stats, t0, plans, failures)

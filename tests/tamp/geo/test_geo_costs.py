@@ -76,3 +76,32 @@ def test_the_batched_hand_boxes_are_those_of_each_grasp_alone(yaw):
     for i, g in enumerate(made):
         one = hand_boxes(g, xyz, yaw, 0.004)  # (3, 2, 3)
         assert np.allclose(one[:, 0], pts[i].min(1)) and np.allclose(one[:, 1], pts[i].max(1))
+
+
+def test_oriented_boxes_overlap_only_where_they_truly_interpenetrate():
+    from tamp.geo.ours.costs import obb_overlap, solid_obbs
+    from tamp.world.geometry import Solid
+
+    def box(x, y, yaw, half=(0.02, 0.02, 0.02)):
+        return solid_obbs([Solid("b", False, (x, y, 0.02), half, yaw)])
+
+    def both(*boxes):
+        return tuple(np.concatenate(parts) for parts in zip(*boxes, strict=True))
+
+    quarter = np.pi / 4
+    # a diamond and a square off its side: their bounding boxes overlap, they are 8 mm apart
+    assert not obb_overlap(box(0.0, 0.0, quarter), box(0.04, 0.04, 0.0))[0, 0]
+    # a diamond's corner 3.3 mm inside a square
+    assert obb_overlap(box(0.0, 0.0, quarter), box(0.045, 0.0, 0.0))[0, 0]
+    # touching faces are contact, not overlap; stacked boxes overlap in no height
+    assert not obb_overlap(box(0.0, 0.0, 0.0), box(0.0399, 0.0, 0.0))[0, 0]
+    high = solid_obbs([Solid("h", False, (0.0, 0.0, 0.07), (0.02, 0.02, 0.02), 0.3)])
+    assert not obb_overlap(box(0.0, 0.0, 0.0), high)[0, 0]
+    # batched: every pair at once, as each pair alone
+    many = both(box(0.0, 0.0, 0.0), box(0.1, 0.0, 0.2), box(0.03, 0.01, 1.0))
+    table = obb_overlap(many, many)
+    for i in range(3):
+        for j in range(3):
+            one = obb_overlap(*(tuple(p[k : k + 1] for p in many) for k in (i, j)))
+            assert table[i, j] == one[0, 0]
+    assert table[0, 2] and not table[0, 1]
