@@ -138,25 +138,26 @@ def _turn(yaws: np.ndarray) -> np.ndarray:
 def obb_overlap(a, b, touch: float = TOUCH) -> np.ndarray:
     """(A, B) True where oriented box a_i and b_j interpenetrate more than ``touch`` (m) on
     every one of the 15 separating axes (the separating axis theorem: two convex boxes are
-    apart when their projections on some face normal or edge cross product are). ``a``, ``b``:
-    (centres (N, 3), axes (N, 3, 3), half extents (N, 3)) as `hand_obbs` and `solid_obbs`."""
+    apart when their projections on some face normal or edge cross product are); pairs whose
+    axis-aligned bounds are apart are not tested further. ``a``, ``b``: (centres (N, 3), axes
+    (N, 3, 3), half extents (N, 3)) as `hand_obbs` and `solid_obbs`."""
     (ca, ra, ha), (cb, rb, hb) = a, b
-    ua, ub = np.swapaxes(ra, -1, -2), np.swapaxes(rb, -1, -2)  # (N, 3 axes, 3)
-    n, m = len(ca), len(cb)
-    cross = np.cross(ua[:, None, :, None, :], ub[None, :, None, :, :]).reshape(n, m, 9, 3)
-    axes = np.concatenate(
-        [
-            np.broadcast_to(ua[:, None], (n, m, 3, 3)),
-            np.broadcast_to(ub[None], (n, m, 3, 3)),
-            cross,
-        ],
-        axis=2,
-    )  # (A, B, 15, 3)
-    reach_a = (np.abs(np.einsum("abkd,aid->abki", axes, ua)) * ha[:, None, None]).sum(-1)
-    reach_b = (np.abs(np.einsum("abkd,bid->abki", axes, ub)) * hb[None, :, None]).sum(-1)
-    gap = np.abs(np.einsum("abkd,abd->abk", axes, cb[None] - ca[:, None]))  # (A, B, 15)
+    bound_a = np.einsum("aij,aj->ai", np.abs(ra), ha)  # (A, 3) axis-aligned half extents
+    bound_b = np.einsum("bij,bj->bi", np.abs(rb), hb)  # (B, 3)
+    near = (np.abs(cb[None] - ca[:, None]) < bound_a[:, None] + bound_b[None] - touch).all(-1)
+    out = np.zeros((len(ca), len(cb)), dtype=bool)
+    ia, ib = np.nonzero(near)  # (K,) the pairs left
+    if not len(ia):
+        return out
+    ua, ub = np.swapaxes(ra[ia], -1, -2), np.swapaxes(rb[ib], -1, -2)  # (K, 3 axes, 3)
+    cross = np.cross(ua[:, :, None, :], ub[:, None, :, :]).reshape(-1, 9, 3)
+    axes = np.concatenate([ua, ub, cross], axis=1)  # (K, 15, 3)
+    reach_a = (np.abs(np.einsum("kld,kid->kli", axes, ua)) * ha[ia][:, None]).sum(-1)
+    reach_b = (np.abs(np.einsum("kld,kid->kli", axes, ub)) * hb[ib][:, None]).sum(-1)
+    gap = np.abs(np.einsum("kld,kd->kl", axes, cb[ib] - ca[ia]))  # (K, 15)
     length = np.linalg.norm(axes, axis=-1)  # 0 for parallel edges: never separating
-    return ~(gap > reach_a + reach_b - touch * length).any(-1)
+    out[ia, ib] = ~(gap > reach_a + reach_b - touch * length).any(-1)
+    return out
 
 
 def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
