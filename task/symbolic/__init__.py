@@ -7,6 +7,9 @@
 - ``relaxed``: delete relaxations over those arrays (h_max, LM-cut, h_FF);
 - ``validate``: a plan checked step by step against the PDDL (the official check);
 - ``search``: optimal plans by breadth-first search and A* (for optimal lengths);
+- ``lazy_search``: the planner's complete fallback: A* with lazily checked moves, and a lazy
+  greedy best-first search on an estimate with helpful actions (the generic lift's);
+- ``shorten``: plans with cycles and redundant moves taken out (greedy action elimination);
 - ``generate``: seeded random blocksworld problems;
 - ``signature``: what recognises a parsed PDDL domain;
 - ``proofs/``: proofs that a problem has no plan (relaxed reachability, h^2, invariants,

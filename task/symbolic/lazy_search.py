@@ -16,6 +16,12 @@ rules out, states the lower bound calls dead ends cut): it ends ``SOLVED`` with 
 ``UNSOLVABLE`` when the reachable feasible space is exhausted without a goal (no plan exists
 within these choices), or ``BUDGET`` when ``max_nodes`` expansions or the deadline run out.
 With ``weight`` 1 a plan is a shortest one among the feasible moves.
+
+`lazy_greedy` is the same search made greedy, for problems far beyond A*'s reach (the generic
+STRIPS lift's fallback, `PlannerConfig.fallback_search`): Fast Downward's lazy greedy
+best-first search on the domain's inadmissible ``estimate`` (h_FF for the lift), with deferred
+evaluation and the domain's ``helpful`` moves as preferred operators. Equally complete, same
+statuses; its plans are not shortest (`task.symbolic.shorten` takes detours out).
 """
 
 from __future__ import annotations
