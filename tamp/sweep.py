@@ -16,6 +16,9 @@ Determinism lives in the items: each carries its own seed (episode ``k`` of a be
 Ray workers compute on one thread each: the processes are the parallelism (Ray's workers run
 with ``OMP_NUM_THREADS=1`` too).
 
+`torch_threads(n)`: a block run with ``n`` torch intra-op threads (one small problem: thread
+hand-offs cost more than they give, and on a busy machine they wait for cores).
+
 `process_solver()`: the one `motion.ik.IKSolver` of the process that calls it, built on first
 use, so a worker builds it once for all its episodes (it keeps no state between solves, so
 sharing it changes no result).
@@ -28,6 +31,7 @@ import os
 import sys
 from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from contextlib import contextmanager
 from typing import Any
 
 from task.errors import TampError
@@ -35,6 +39,19 @@ from task.errors import TampError
 RAY_MISSING = "--ray needs Ray: pip install 'soft-tamp[ray]'"
 
 _SOLVERS: dict[int, Any] = {}  # os.getpid() -> that process's IKSolver (a forked child: its own)
+
+
+@contextmanager
+def torch_threads(n: int):
+    """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
+    import torch
+
+    before = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def process_solver():

@@ -40,6 +40,10 @@ from tamp.cli.types import (
 from tamp.sim.base import SIMULATORS
 
 EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
+PLAN_THREADS = (
+    "torch threads while planning (1: one problem's tensors are small, and more threads wait "
+    "for cores on a busy machine)"
+)
 
 
 def version() -> str:
@@ -94,6 +98,7 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
         default=0,
         help="planner seed (0) and, with --motion-aware, the scene layout's",
     )
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     workcell_options(p)
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
@@ -118,6 +123,7 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
         help="plan the embedded 5-block example and show every stage (no robot)",
     )
     p.add_argument("--seed", type=seed, default=0, help="planner seed (0)")
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     output_options(p, "write the example's domain, problem and plan files into this folder")
     p.set_defaults(
         func=_lazy("tamp.cli.plan", "example_command"),

@@ -51,12 +51,15 @@ def _write(path: Path, text: str) -> None:
 def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan);
     ``(recorded config, config, result, actions, validation)``."""
+    from tamp.sweep import torch_threads
+
     recorded = plan_config(args, instance.problem.domain)
     config = planner_config(args, instance.problem.domain)
-    if getattr(args, "lambda_motion", None):
-        result = _plan_on_table(instance.problem, config, args)
-    else:
-        result = plan(instance.problem, config, args.seed)
+    with torch_threads(args.threads):
+        if getattr(args, "lambda_motion", None):
+            result = _plan_on_table(instance.problem, config, args)
+        else:
+            result = plan(instance.problem, config, args.seed)
     actions: tuple = ()
     validation = None
     if result.solved:

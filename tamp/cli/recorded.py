@@ -38,7 +38,7 @@ def plan_config(args: argparse.Namespace, domain: str | None = None) -> dict:
     """``plan`` and ``example``: the planner config, seed, rules, and the table planned on."""
     if hasattr(args, "scene"):
         check_workcell(args, executes=False)
-    body = {**_planner(args, domain), "seed": args.seed}
+    body = {**_planner(args, domain), "seed": args.seed, "threads": args.threads}
     if hasattr(args, "scene"):
         body |= {"scene": args.scene, "placements": args.placements}
         body["domain_rules"] = args.domain_rules

@@ -37,9 +37,9 @@ from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
-from tamp.loop.episode import torch_threads
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
+from tamp.sweep import torch_threads
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts

@@ -49,11 +49,16 @@ def test_plan_generated_problem_writes_a_valid_plan_file(capsys, files, tmp_path
 
 
 def test_plan_json_parses(capsys, files):
-    assert main(["plan", *map(str, files), *FAST, "--horizon", "2", "--json"]) == 0
+    import torch
+
+    before = torch.get_num_threads()
+    argv = ["plan", *map(str, files), *FAST, "--horizon", "2", "--threads", "2", "--json"]
+    assert main(argv) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["status"] == "solved" and report["valid"]
     assert len(report["actions"]) == 2 * len(report["moves"]) == report["validation"]["length"]
     assert report["config"]["horizon"] == 2 and report["config"]["restarts"] == 8
+    assert report["config"]["threads"] == 2 and torch.get_num_threads() == before  # restored
 
 
 def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(
