@@ -8,7 +8,9 @@ allowed: the open fingers around the object they pick (descend, retreat), the he
 what it leaves (lift) and on what it is placed onto (lower). A blocked free-space phase
 (``approach`` or ``transit``) is replanned with `motion.rrt.plan_path` and timed along the new
 path with ruckig; a blocked vertical phase, or a free-space phase the planner cannot route, is a
-``collision`` failure with the contact as evidence.
+``collision`` failure with the contact as evidence. A detour starts and ends at rest, so the
+vertical phases next to it, which may have been timed to pass into the free-space phase
+without stopping (`motion.pick_place`), are re-timed along the same path to stop there.
 
 The collision model is anything with `robots.collision.PandaCollision`'s ``set_boxes``,
 ``hold``, ``valid`` and ``check_path``; this module never imports a simulator.
@@ -25,7 +27,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from motion.pick_place import Phase
-from motion.trajectory import SpeedLimits
+from motion.trajectory import TRANSIT, SpeedLimits, polyline_segment
 
 if TYPE_CHECKING:
     from motion.grasps import Grasp
@@ -53,7 +55,7 @@ class GuardConfig:
 
     plan: bool = True
     max_step: float = 0.02
-    speed: SpeedLimits = SpeedLimits(velocity=0.5, acceleration=0.3, jerk=0.1)
+    speed: SpeedLimits = TRANSIT  # a detour's speed limits (the free-space phases')
     rrt: PathPlannerConfig | None = None  # None: motion.rrt's defaults
     open_width: float = 0.04  # m per finger, open
     plan_pad: float = 0.01  # m added to the model's margin while the motion planner searches
@@ -194,7 +196,29 @@ def _guard_phase(
     if not again.ok:  # the planner checks at its own resolution; this is the final word
         evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
         return None, evidence, t_check, found_path.time_s
-    return Phase(phase.name, trajectory, phase.gripper), {}, t_check, found_path.time_s
+    return (
+        Phase(phase.name, trajectory, phase.gripper, config.speed),
+        {},
+        t_check,
+        found_path.time_s,
+    )
+
+
+def at_rest(phase: Phase, step: float = 0.002) -> Phase:
+    """``phase`` re-timed rest to rest along the same path (its samples ``step`` rad apart as
+    knots), with the limits it was timed with (`motion.trajectory.APPROACH` when unknown); the
+    phase itself when it already starts and ends at rest."""
+    from motion.trajectory import APPROACH
+
+    trajectory = phase.trajectory
+    if not np.abs(trajectory.velocities[[0, -1]]).any():
+        return phase
+    limits = phase.limits or APPROACH
+    knots = thin(trajectory.positions, step)  # (K, J)
+    if len(knots) < 2:
+        return phase
+    dt = float(trajectory.times[1] - trajectory.times[0])
+    return replace(phase, trajectory=polyline_segment(knots, dt, limits=limits))
 
 
 def guard_pick_place(
@@ -222,6 +246,11 @@ def guard_pick_place(
         out.append(run)
         if run is not phase:
             rerouted.append(phase.name)
+    for k, phase in enumerate(out):  # a detour stops at its ends: so must its neighbours
+        if phase.name in rerouted:
+            for n in (k - 1, k + 1):
+                if 0 <= n < len(out) and out[n].name not in ("close", "open"):
+                    out[n] = at_rest(out[n])
     return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan, runs)
 
 

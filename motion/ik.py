@@ -1,10 +1,15 @@
 """Batched inverse kinematics for the Panda's TCP with pytorch_kinematics, plus pose helpers.
 
 `IKSolver` builds the serial chain ``base_link -> tcp_link`` once (float64) and solves batches of
-4x4 targets given in the base frame with ``PseudoInverseIK``, seeded with the current
-configuration, the home pose and a few Gaussian perturbations of the current configuration
-(early stopping once any seed converges). A row is ``ok`` when it converged and lies inside the
-datasheet limits; non-convergence is a returned status, never an exception.
+4x4 targets given in the base frame by damped Gauss-Newton (Levenberg-Marquardt) steps on the
+chain's geometric Jacobian, all rows of a batch in one numpy array, clamped to the datasheet limits.
+Each target is seeded with the current configuration (the warm start: the nearest IK branch,
+a few iterations), the home pose and a few Gaussian perturbations of the current configuration,
+all in one batch; rows stop iterating as they converge, and the batch stops once every target
+has a converged seed (the valid solution closest to the current configuration is kept). A row
+is ``ok`` when it converged and lies inside the datasheet limits; non-convergence is a returned
+status, never an exception. pytorch_kinematics supplies the chain for `fk`, `fk_tensor` and
+`ik_refine`; the iterations run on a numpy float64 copy of the same URDF chain.
 
 `ik_refine` is the differentiable hook for joint task-motion optimisation: one Gauss-Newton step
 at the detached solution, so ``d q / d target = pinv(J)`` by the implicit-function theorem.
@@ -26,18 +31,24 @@ from motion.errors import MotionError
 from robots.panda import PANDA, PandaSpec, urdf_path
 
 log = logging.getLogger(__name__)
+POLISH = 1e-3  # Gauss-Newton iterates until the errors are this share of the tolerances
+EDGE = 1e-3  # rad: a solution this close to a joint limit counts as pinned there
+NEAR = 1e-2  # |pose error| (m and rad together) below which the null-space pull stops
 
 
 @dataclass(frozen=True)
 class IKConfig:
-    """PseudoInverseIK settings (motion-research notes, section 2)."""
+    """Damped Gauss-Newton settings (motion-research notes, section 2)."""
 
-    max_iterations: int = 60  # Levenberg-Marquardt steps per solve
+    max_iterations: int = 60  # Levenberg-Marquardt steps per stage (warm start, then retries)
     pos_tolerance: float = 1e-4  # m
     rot_tolerance: float = 1e-3  # rad
     perturbed_seeds: int = 4  # Gaussian perturbations of q_current, besides q_current and q_home
     seed_std: float = 0.3  # rad, std of those perturbations
     seed: int = 0  # seeds the perturbations' torch.Generator (fresh per solve: deterministic)
+    damping: float = 1e-6  # Levenberg-Marquardt lambda^2 added to J J^T (m^2, rad^2)
+    max_step: float = 0.5  # rad, the largest joint change of one step (a trust region)
+    null_gain: float = 0.5  # share of the way back to the seed per step, in the null space
 
 
 @dataclass(frozen=True, eq=False)
@@ -108,6 +119,7 @@ class IKSolver:
         self.chain.high = torch.tensor(spec.q_max, dtype=torch.float64)
         self.q_min = np.array(spec.q_min)
         self.q_max = np.array(spec.q_max)
+        self._kin = _kinematics(spec)  # the same chain for numpy FK and Jacobians
 
     @property
     def dof(self) -> int:
@@ -123,8 +135,15 @@ class IKSolver:
         with torch.no_grad():
             return self.fk_tensor(torch.from_numpy(qa)).numpy()
 
+    def tcp_positions(self, q) -> np.ndarray:
+        """TCP positions (B, 3) in the base frame of ``q`` (B, J) by the numpy kinematics of the
+        solver's own iterations (no torch; within 1e-6 m of `fk`)."""
+        qa = _as_float64(q, (self.dof,), "q")  # (B, J)
+        return _fk_jacobian(qa, *self._kin)[0][:, :3, 3]
+
     def _seeds(self, q_current: np.ndarray) -> torch.Tensor:
-        """(M, J) retry configurations: q_current, q_home, Gaussian perturbations of q_current."""
+        """(M - 1, J) more seeds besides q_current: q_home, Gaussian perturbations of
+        q_current (float64 tensor)."""
         gen = torch.Generator().manual_seed(self.config.seed)
         q0 = torch.from_numpy(q_current)
         noise = torch.randn(
@@ -132,12 +151,82 @@ class IKSolver:
         )
         seeds = torch.cat(
             [
-                q0[None],
                 torch.tensor(self.spec.q_home, dtype=torch.float64)[None],
                 q0 + self.config.seed_std * noise,
             ]
-        )  # (M, J)
+        )  # (M - 1, J)
         return torch.clamp(seeds, self.chain.low, self.chain.high)
+
+    def _iterate(
+        self,
+        q: np.ndarray,
+        h: np.ndarray,
+        iterations: int,
+        clamp: bool = True,
+        groups: np.ndarray | None = None,
+    ):
+        """Levenberg-Marquardt from ``q`` (R, J) towards ``h`` (R, 4, 4), every row stopping
+        once within POLISH x the tolerances: (q (R, J), pos_err (R,), rot_err (R,),
+        converged (R,) within the tolerances). A step that does not lower a row's error is
+        taken back and that row's damping raised tenfold; one that does lowers it tenfold.
+        ``groups`` (R,) sorted ints: the rows of a group are seeds of one target, the first
+        one the warm start; all rows stop once every group has a converged row and every warm
+        start has converged or got stuck. Numpy float64 on `_fk_jacobian`."""
+        cfg = self.config
+        q, seed = q.copy(), q.copy()
+        rows = q.shape[0]
+        pos, rot = np.full(rows, np.inf), np.full(rows, np.inf)
+        err = np.full(rows, np.inf)  # (R,) |e| at q
+        lam = np.full(rows, cfg.damping)  # (R,) per-row damping
+        jac_at = np.zeros((rows, 6, q.shape[1]))  # (R, 6, J) at q
+        e_at = np.zeros((rows, 6))  # (R, 6) at q
+        trial = q.copy()  # (R, J) the configurations to evaluate
+        active = np.arange(rows)
+        eye = np.eye(6)
+        for step in range(iterations + 1):
+            m, jac = _fk_jacobian(trial[active], *self._kin)  # (A, 4, 4), (A, 6, J)
+            e = _pose_error(h[active], m)  # (A, 6)
+            norm = np.linalg.norm(e, axis=-1)  # (A,)
+            better = norm < err[active]
+            lam[active] = np.where(better, np.maximum(lam[active] * 0.1, 1e-12), lam[active] * 10)
+            keep = active[better]
+            q[keep], err[keep] = trial[keep], norm[better]
+            jac_at[keep], e_at[keep] = jac[better], e[better]
+            pos[keep] = np.linalg.norm(e[better, :3], axis=-1)
+            rot[keep] = np.linalg.norm(e[better, 3:], axis=-1)
+            # polish to POLISH x the tolerances: one more step at a quadratic rate
+            moving = (pos[active] >= POLISH * cfg.pos_tolerance) | (
+                rot[active] >= POLISH * cfg.rot_tolerance
+            )
+            active = active[moving & (lam[active] < 1e6)]  # a row stuck at a minimum stops
+            if step == iterations or not len(active):
+                break
+            if groups is not None:
+                done = (pos < POLISH * cfg.pos_tolerance) & (rot < POLISH * cfg.rot_tolerance)
+                first = np.flatnonzero(np.diff(groups, prepend=-1))  # each group's first row
+                if np.isin(groups, groups[done]).all() and not np.isin(first, active).any():
+                    break  # every target solved, and every warm start converged or stuck
+            jac, e, now = jac_at[active], e_at[active], q[active]
+            damp = lam[active, None, None] * eye  # (A, 6, 6)
+            # back toward the row's seed while far from the target; pure Gauss-Newton near it
+            far = err[active, None] > NEAR
+            pull = np.where(far, cfg.null_gain * (seed[active] - now), 0.0)  # (A, J)
+            dq = _lm_step(jac, e, damp, pull)  # (A, J)
+            if clamp:  # a joint at a limit that the step pushes out of it drops out of the step
+                out = ((now <= self.q_min + 1e-9) & (dq < 0)) | (
+                    (now >= self.q_max - 1e-9) & (dq > 0)
+                )
+                if out.any():
+                    dq = _lm_step(jac * ~out[:, None, :], e, damp, pull * ~out)
+            scale = np.minimum(1.0, cfg.max_step / np.maximum(np.abs(dq).max(-1), 1e-12))
+            step_q = q[active] + scale[:, None] * dq  # (A, J)
+            trial[active] = np.clip(step_q, self.q_min, self.q_max) if clamp else step_q
+        converged = (pos < cfg.pos_tolerance) & (rot < cfg.rot_tolerance)
+        return q, pos, rot, converged
+
+    def _inside(self, q: np.ndarray) -> np.ndarray:
+        """(...,) whether each configuration (..., J) lies inside the datasheet limits."""
+        return ((q >= self.q_min - 1e-9) & (q <= self.q_max + 1e-9)).all(-1)
 
     def solve(self, targets, q_current) -> IKResult:
         """Solve IK for ``targets`` (B, 4, 4) in the base frame from ``q_current`` (J,)."""
@@ -148,35 +237,26 @@ class IKSolver:
         qc = np.array(q_current, dtype=np.float64)  # a writable copy for torch.from_numpy
         if qc.shape != (self.dof,) or not np.isfinite(qc).all():
             raise MotionError(f"q_current has shape {qc.shape}; expected finite ({self.dof},)")
-        cfg = self.config
-        ik = self._pk.PseudoInverseIK(
-            self.chain,
-            retry_configs=self._seeds(qc),
-            max_iterations=cfg.max_iterations,
-            pos_tolerance=cfg.pos_tolerance,
-            rot_tolerance=cfg.rot_tolerance,
-            early_stopping_any_converged=True,
-        )
-        goal = self._pk.Transform3d(matrix=torch.from_numpy(h), dtype=torch.float64)
-        sol = ik.solve(goal)
-        q = sol.solutions.numpy()  # (B, M, J)
-        pos_err = sol.err_pos.numpy()  # (B, M)
-        rot_err = sol.err_rot.numpy()  # (B, M)
-        inside = ((q >= self.q_min - 1e-9) & (q <= self.q_max + 1e-9)).all(-1)  # (B, M)
-        valid = sol.converged.numpy() & inside  # (B, M)
-        dist = np.linalg.norm(q - qc, axis=-1)  # (B, M)
-        score = pos_err + rot_err  # (B, M), ranks the attempts of rows without a valid solution
-        score = np.where(np.isfinite(score) & inside, score, np.inf)
-        best = np.where(
-            valid.any(1), np.where(valid, dist, np.inf).argmin(1), score.argmin(1)
-        )  # (B,)
-        rows = np.arange(h.shape[0])
-        out = IKResult(
-            ok=valid.any(1),
-            q=q[rows, best],
-            pos_err=pos_err[rows, best],
-            rot_err=rot_err[rows, best],
-        )
+        cfg, b = self.config, h.shape[0]
+        seeds = np.concatenate([np.clip(qc, self.q_min, self.q_max)[None], self._seeds(qc)])
+        m = seeds.shape[0]  # (M, J): q_current first, then the retries
+        rows = np.repeat(np.arange(b), m)  # (B * M,) the target of each row
+        q, pos_err, rot_err, conv = (
+            x.reshape(b, m, *x.shape[1:])
+            for x in self._iterate(np.tile(seeds, (b, 1)), h[rows], cfg.max_iterations, True, rows)
+        )  # (B, M, J), (B, M), (B, M), (B, M): every seed of every target in one batch
+        valid = conv & self._inside(q)  # (B, M)
+        # a solution pinned at a joint limit (where the clamp stopped it) leaves that joint no
+        # room for the next move: it ranks after every interior one
+        pinned = ((q <= self.q_min + EDGE) | (q >= self.q_max - EDGE)).any(-1)  # (B, M)
+        dist = np.linalg.norm(q - qc, axis=-1) + np.where(pinned, 100.0, 0.0)  # (B, M)
+        dist = np.where(valid, dist, np.inf)
+        score = np.where(np.isfinite(pos_err + rot_err), pos_err + rot_err, np.inf)
+        best = np.where(valid.any(1), dist.argmin(1), score.argmin(1))  # (B,)
+        pick = np.arange(b)
+        ok, q = valid.any(1), q[pick, best]
+        pos_err, rot_err = pos_err[pick, best], rot_err[pick, best]
+        out = IKResult(ok=ok, q=q, pos_err=pos_err, rot_err=rot_err)
         for a in (out.ok, out.q, out.pos_err, out.rot_err):
             a.flags.writeable = False
         return out
@@ -187,23 +267,16 @@ class IKSolver:
         For dense targets along a short path (a few cm apart, near q_seed's pose): every row
         converges to the solution on q_seed's IK branch, with no retries or clamping, so it is
         an order of magnitude cheaper than ``solve``. ``ok`` also requires the datasheet limits.
+        At most ``iterations`` steps; rows stop as they converge.
         """
-        h = torch.from_numpy(_as_float64(targets, (4, 4), "targets"))  # (B, 4, 4)
+        h = _as_float64(targets, (4, 4), "targets")  # (B, 4, 4)
         qs = np.asarray(q_seed, dtype=np.float64)
         if qs.shape != (self.dof,) or not np.isfinite(qs).all():
             raise MotionError(f"q_seed has shape {qs.shape}; expected finite ({self.dof},)")
-        q = torch.tensor(qs).repeat(h.shape[0], 1)  # (B, J)
-        with torch.no_grad():
-            for _ in range(iterations):
-                q = ik_refine(self, q, h)
-            m = self.fk_tensor(q)  # (B, 4, 4)
-            pos_err = torch.linalg.norm(h[:, :3, 3] - m[:, :3, 3], dim=-1).numpy()  # (B,)
-            rot = _rotation_log(h[:, :3, :3] @ m[:, :3, :3].transpose(1, 2))  # (B, 3)
-            rot_err = torch.linalg.norm(rot, dim=-1).numpy()  # (B,)
-        qn = q.numpy()
-        inside = ((qn >= self.q_min - 1e-9) & (qn <= self.q_max + 1e-9)).all(-1)
-        ok = (pos_err < self.config.pos_tolerance) & (rot_err < self.config.rot_tolerance) & inside
-        return IKResult(ok=ok, q=qn, pos_err=pos_err, rot_err=rot_err)
+        q0 = np.tile(qs, (h.shape[0], 1))  # (B, J)
+        q, pos_err, rot_err, conv = self._iterate(q0, h, iterations)
+        ok = conv & self._inside(q)
+        return IKResult(ok=ok, q=q, pos_err=pos_err, rot_err=rot_err)
 
 
 def top_down_pose(xyz, yaw: float) -> np.ndarray:
@@ -234,6 +307,91 @@ def grasp_yaw(block_yaw: float, hand_yaw: float) -> float:
     quarter = math.pi / 2
     base = (block_yaw + quarter / 2) % quarter - quarter / 2  # in [-pi/4, pi/4)
     return min((base, base + quarter), key=lambda c: abs(math.remainder(c - hand_yaw, 2 * math.pi)))
+
+
+def _kinematics(spec: PandaSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The URDF chain for `_fk_jacobian`: joint-origin rotations (J, 3, 3) and offsets (J, 3)
+    from link i-1 to link i, and panda_link7 -> TCP (4, 4) (`motion.sphere_fk._chain`)."""
+    from motion.sphere_fk import _chain
+
+    rot, off, hand, tcp = _chain(spec)
+    return rot, off, hand @ tcp
+
+
+def _fk_jacobian(q: np.ndarray, rot: np.ndarray, off: np.ndarray, tail: np.ndarray):
+    """TCP poses (B, 4, 4) and geometric Jacobians (B, 6, J) in the base frame (rows: linear,
+    then angular velocity) of ``q`` (B, J), float64, on `_kinematics`' chain. The frame is
+    carried as its three axis columns (B, 3) each: a few small array operations per joint."""
+    n, joints = q.shape
+    cols = [np.zeros((n, 3)) for _ in range(3)]
+    for a in range(3):
+        cols[a][:, a] = 1.0
+    t = np.zeros((n, 3))
+    axes, origins = np.empty((n, joints, 3)), np.empty((n, joints, 3))
+    c, s = np.cos(q), np.sin(q)  # (B, J)
+    for j in range(joints):
+        for k in np.flatnonzero(off[j]):  # the joint's origin, in the parent frame
+            t = t + off[j, k] * cols[k]  # (B, 3)
+        turned = []
+        for a in range(3):  # the origin's rotation: new axis a = sum_k rot[k, a] old axis k
+            nz = np.flatnonzero(rot[j][:, a])
+            col = rot[j][nz[0], a] * cols[nz[0]]
+            for k in nz[1:]:
+                col = col + rot[j][k, a] * cols[k]
+            turned.append(col)
+        x, y, z = turned
+        axes[:, j], origins[:, j] = z, t
+        cj, sj = c[:, j, None], s[:, j, None]
+        cols = [x * cj + y * sj, y * cj - x * sj, z]  # the turn about z
+    r = np.stack(cols, axis=-1)  # (B, 3, 3)
+    m = np.zeros((n, 4, 4))
+    m[:, :3, :3] = r @ tail[:3, :3]
+    m[:, :3, 3] = t + r @ tail[:3, 3]
+    m[:, 3, 3] = 1.0
+    d = m[:, None, :3, 3] - origins  # (B, J, 3) joint origin -> TCP
+    linear = np.stack(
+        [
+            axes[..., 1] * d[..., 2] - axes[..., 2] * d[..., 1],
+            axes[..., 2] * d[..., 0] - axes[..., 0] * d[..., 2],
+            axes[..., 0] * d[..., 1] - axes[..., 1] * d[..., 0],
+        ],
+        axis=-1,
+    )  # (B, J, 3) = axis x d
+    return m, np.concatenate([linear, axes], axis=-1).transpose(0, 2, 1)  # (B, 6, J)
+
+
+def _lm_step(jac: np.ndarray, e: np.ndarray, damp: np.ndarray, pull: np.ndarray) -> np.ndarray:
+    """Joint steps (A, J): the damped least-squares step J^+ e towards the pose error ``e``
+    (A, 6), J^+ = J^T (J J^T + ``damp``)^-1 with ``jac`` (A, 6, J), plus ``pull`` (A, J)
+    projected onto the null space (I - J^+ J): the redundant seventh joint drifts back toward
+    the seed, so a solution stays near where it started on the arm's self-motion manifold."""
+    jt = jac.transpose(0, 2, 1)  # (A, J, 6)
+    pinv = jt @ np.linalg.inv(jac @ jt + damp)  # (A, J, 6)
+    task = (pinv @ e[:, :, None])[:, :, 0]  # (A, J)
+    null = pull - (pinv @ (jac @ pull[:, :, None]))[:, :, 0]  # (A, J)
+    return task + null
+
+
+def _pose_error(h: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """(B, 6): the position error h - m and the axis-angle of R_h R_m^T, for poses (B, 4, 4)."""
+    r = h[:, :3, :3] @ m[:, :3, :3].transpose(0, 2, 1)  # (B, 3, 3)
+    w = 0.5 * np.stack(
+        [r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=-1
+    )  # (B, 3) = sin(theta) axis
+    c = np.clip(0.5 * (np.trace(r, axis1=1, axis2=2) - 1.0), -1.0, 1.0)  # (B,) cos(theta)
+    sin = np.linalg.norm(w, axis=-1)  # (B,)
+    theta = np.arctan2(sin, c)
+    factor = np.where(sin > 1e-9, theta / np.maximum(sin, 1e-12), 1.0)
+    rotvec = factor[:, None] * w  # (B, 3)
+    flip = c < -0.99  # near a half turn sin(theta) loses the axis: read it from (R + I) / 2
+    if flip.any():
+        b = 0.5 * (r[flip] + np.eye(3))  # (F, 3, 3) = a a^T at theta = pi
+        k = np.argmax(np.diagonal(b, axis1=1, axis2=2), axis=-1)  # (F,)
+        axis = b[np.arange(len(k)), :, k]  # (F, 3) a column with the largest diagonal
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        sign = np.where((axis * w[flip]).sum(-1) < 0, -1.0, 1.0)
+        rotvec[flip] = sign[:, None] * theta[flip, None] * axis
+    return np.concatenate([h[:, :3, 3] - m[:, :3, 3], rotvec], axis=-1)
 
 
 def _rotation_log(r: torch.Tensor) -> torch.Tensor:

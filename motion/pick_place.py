@@ -5,9 +5,14 @@ Six TCP waypoints (pre-grasp, grasp, lift, pre-place, place, retreat) are solved
 IK call. Consecutive solutions must be close in joint space (a wrist flip between two
 waypoints a few centimetres apart is a bug), so a waypoint whose solution jumps more than
 ``max_joint_jump`` from the previous one is re-solved seeded with that previous solution, and the
-closer valid answer is kept. Each arm phase is a rest-to-rest straight joint segment
-(`motion.trajectory.straight_segment`); the gripper phases are standstills. An unreachable
-waypoint is a returned failure (``ik_infeasible``) with evidence, never an exception.
+closer valid answer is kept. The vertical phases (descend, lift, lower, retreat) follow the
+Cartesian line through IK knots (`motion.trajectory.polyline_segment`); the free-space phases
+(approach, transit) are straight joint segments, or, with ``PickPlaceConfig.blend``,
+`motion.trajectory.transition` curves that pass into and out of the vertical phases at a
+fraction of their speed instead of stopping at the corners (pre-grasp, lift, pre-place). The
+arm is at rest where the gripper acts (close, open) and at both ends of the move. The gripper
+phases are standstills. An unreachable waypoint is a returned failure (``ik_infeasible``) with
+evidence, never an exception.
 
 Two ways to say how the hand holds the object (`PickPlaceRequest`):
 
@@ -39,7 +44,17 @@ import numpy as np
 from motion.errors import MotionError
 from motion.grasps import Grasp, back_out, grasps, world_tcp
 from motion.ik import IKSolver, grasp_yaw, pose_yaw, top_down_pose
-from motion.trajectory import JointTrajectory, SpeedLimits, polyline_segment, straight_segment
+from motion.trajectory import (
+    APPROACH,
+    TRANSIT,
+    JointTrajectory,
+    SpeedLimits,
+    direction_at,
+    pass_speed,
+    polyline_segment,
+    straight_segment,
+    transition,
+)
 
 WAYPOINTS = ("pre_grasp", "grasp", "lift", "pre_place", "place", "retreat")
 PHASES = ("approach", "descend", "close", "lift", "transit", "lower", "open", "retreat")
@@ -53,10 +68,13 @@ class PickPlaceConfig:
     # both also hover lift_clearance above the highest stack top)
     lift_clearance: float = 0.06  # m, the held block's bottom clears the highest top by >= this
     place_gap: float = 0.003  # m, release height of the block above its support
-    close_time: float = 0.5  # s, standstill while the gripper closes
-    open_time: float = 0.3  # s, standstill while the gripper opens
-    transit: SpeedLimits = SpeedLimits(velocity=0.5, acceleration=0.3, jerk=0.1)
-    approach: SpeedLimits = SpeedLimits(velocity=0.2, acceleration=0.1, jerk=0.1)
+    close_time: float = 0.25  # s, standstill while the gripper closes
+    open_time: float = 0.15  # s, standstill while the gripper opens
+    # fractions of the datasheet limits (motion.trajectory: TRANSIT 80%, APPROACH 50%)
+    transit: SpeedLimits = TRANSIT  # free space: approach, transit
+    approach: SpeedLimits = APPROACH  # near contact: descend, lift, lower, retreat
+    blend: bool = True  # pass through pre-grasp, lift and pre-place without stopping
+    pass_share: float = 0.6  # the speed there, as a share of what the vertical phase allows
     dt: float = 0.002  # s, trajectory sampling period
     block_size: float = 0.05  # m, cube edge
     max_joint_jump: float = 0.5  # rad, per-joint change between waypoints that triggers a re-solve
@@ -83,11 +101,13 @@ class PickPlaceRequest:
 
 @dataclass(frozen=True)
 class Phase:
-    """One segment of a move: ``name`` in PHASES, gripper command "open" or "closed" held."""
+    """One segment of a move: ``name`` in PHASES, gripper command "open" or "closed" held;
+    ``limits``: the speed limits it was timed with (None: a standstill, or unknown)."""
 
     name: str
     trajectory: JointTrajectory
     gripper: str
+    limits: SpeedLimits | None = None
 
 
 @dataclass(frozen=True)
@@ -266,6 +286,123 @@ def _vertical_path(
     return path
 
 
+def _dip(solver: IKSolver, positions: np.ndarray) -> float:
+    """How far (m) the TCP of a joint path ``positions`` (S, J) passes below the lower of its
+    two ends (0 when it never does), sampled every fifth configuration."""
+    z = solver.tcp_positions(np.vstack([positions[::5], positions[-1:]]))[:, 2]  # (S',)
+    return max(0.0, float(min(z[0], z[-1]) - z.min()))
+
+
+def _kept_up(solver: IKSolver, q0, q1, config: PickPlaceConfig) -> JointTrajectory:
+    """The straight joint segment q0 -> q1 at transit speed, or, where the TCP would sag
+    more than 1 mm below its lower end on the way (the hover and transit heights keep the hand
+    and the held object above every stack), two segments through the sagging configuration's
+    IK solution raised by the sag (rest at the via point)."""
+    spec, dt = solver.spec, config.dt
+    line = straight_segment(q0, q1, dt, spec, config.transit)
+    sag = _dip(solver, line.positions)
+    if sag <= 1e-3:
+        return line
+    z = solver.tcp_positions(line.positions)[:, 2]  # (S,)
+    low = line.positions[int(np.argmin(z))]  # (J,)
+    pose = solver.fk(low)[0]
+    pose[2, 3] += sag
+    via = solver.follow(pose[None], low, iterations=20)
+    if not via.ok[0]:
+        return line
+    first = straight_segment(q0, via.q[0], dt, spec, config.transit)
+    second = straight_segment(via.q[0], q1, dt, spec, config.transit)
+    both = np.vstack([first.positions, second.positions[1:]])
+    if _dip(solver, both) >= sag:
+        return line
+    return JointTrajectory(
+        np.concatenate([first.times, first.duration + second.times[1:]]),
+        both,
+        np.vstack([first.velocities, second.velocities[1:]]),
+        np.vstack([first.accelerations, second.accelerations[1:]]),
+    )
+
+
+def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> tuple[Phase, ...]:
+    """The eight phases through the waypoint solutions ``w`` (name -> (J,), "now" included;
+    updated where a vertical phase ends on another IK solution) and poses ``pose`` (name ->
+    (4, 4)). The vertical paths come first, so the free-space phases can pass into them."""
+    spec, dt = solver.spec, config.dt
+    paths = {}
+    for src, dst in (("pre_grasp", "grasp"), ("grasp", "lift"), ("pre_place", "place")):
+        paths[dst] = _vertical_path(
+            solver, pose[src], pose[dst], w[src], w[dst], config.vertical_step
+        )
+        w[dst] = paths[dst][-1]  # later phases start where this one ends
+    paths["retreat"] = _vertical_path(
+        solver, pose["place"], pose["retreat"], w["place"], w["retreat"], config.vertical_step
+    )
+    w["retreat"] = paths["retreat"][-1]
+    share = config.pass_share if config.blend else 0.0
+    # arclength speeds where descend starts, lift ends and lower starts
+    down = pass_speed(paths["grasp"], share, spec, config.approach)
+    up = pass_speed(paths["lift"], share, spec, config.approach)
+    low = pass_speed(paths["place"], share, spec, config.approach)
+
+    def free(src: str, dst: str, qd0, qd1):
+        """The free-space phase src -> dst passing through at joint velocities qd0, qd1, and
+        whether it stops at both ends instead: when ruckig finds no curve in the joint limits,
+        or the curve takes the hand more than 1 mm below the lower of its two ends (the
+        hover and transit heights keep the hand and the held object above every stack)."""
+        line = _kept_up(solver, w[src], w[dst], config)
+        if not (qd0.any() or qd1.any()):
+            return line, True
+        try:
+            curve = transition(w[src], qd0, w[dst], qd1, dt, spec, config.transit)
+        except MotionError:
+            return line, True
+        if _dip(solver, curve.positions) > 1e-3:
+            return line, True
+        return curve, False
+
+    zero = np.zeros(solver.dof)
+    approach, still = free("now", "pre_grasp", zero, down * direction_at(paths["grasp"], 0))
+    down = 0.0 if still else down
+    transit, still = free(
+        "lift",
+        "pre_place",
+        up * direction_at(paths["lift"], -1),
+        low * direction_at(paths["place"], 0),
+    )
+    up, low = (0.0, 0.0) if still else (up, low)
+    grasp, place = w["grasp"], w["place"]
+    return (
+        Phase("approach", approach, "open", config.transit),
+        Phase(
+            "descend",
+            polyline_segment(paths["grasp"], dt, spec, config.approach, down),
+            "open",
+            config.approach,
+        ),
+        Phase("close", JointTrajectory.hold(grasp, config.close_time, dt), "closed"),
+        Phase(
+            "lift",
+            polyline_segment(paths["lift"], dt, spec, config.approach, 0.0, up),
+            "closed",
+            config.approach,
+        ),
+        Phase("transit", transit, "closed", config.transit),
+        Phase(
+            "lower",
+            polyline_segment(paths["place"], dt, spec, config.approach, low),
+            "closed",
+            config.approach,
+        ),
+        Phase("open", JointTrajectory.hold(place, config.open_time, dt), "open"),
+        Phase(
+            "retreat",
+            polyline_segment(paths["retreat"], dt, spec, config.approach),
+            "open",
+            config.approach,
+        ),
+    )
+
+
 def plan_pick_place(
     solver: IKSolver,
     q_now,
@@ -307,29 +444,8 @@ def plan_pick_place(
         return MotionResult(False, (), "ik_infeasible", evidence, ik_time, grasp)
 
     w = {"now": q_now, **dict(zip(WAYPOINTS, q, strict=True))}  # name -> (J,)
-    plan = (  # phase, from, to (None: standstill), SpeedLimits or standstill seconds, gripper
-        ("approach", "now", "pre_grasp", config.transit, "open"),
-        ("descend", "pre_grasp", "grasp", config.approach, "open"),
-        ("close", "grasp", None, config.close_time, "closed"),
-        ("lift", "grasp", "lift", config.approach, "closed"),
-        ("transit", "lift", "pre_place", config.transit, "closed"),
-        ("lower", "pre_place", "place", config.approach, "closed"),
-        ("open", "place", None, config.open_time, "open"),
-        ("retreat", "place", "retreat", config.approach, "open"),
-    )
-    pose = dict(zip(WAYPOINTS, targets, strict=True))  # name -> (4, 4)
     start = time.perf_counter()
-
-    def motion(src: str, dst: str | None, how) -> JointTrajectory:
-        if dst is None:
-            return JointTrajectory.hold(w[src], how, config.dt)
-        if src == "now" or dst == "pre_place":  # free-space moves: one straight joint segment
-            return straight_segment(w[src], w[dst], config.dt, solver.spec, how)
-        path = _vertical_path(solver, pose[src], pose[dst], w[src], w[dst], config.vertical_step)
-        w[dst] = path[-1]  # later phases start where this one ends (phases are built in order)
-        return polyline_segment(path, config.dt, solver.spec, how)
-
-    phases = tuple(Phase(name, motion(src, dst, how), grip) for name, src, dst, how, grip in plan)
+    phases = _phases(solver, w, dict(zip(WAYPOINTS, targets, strict=True)), config)
     ik_time += time.perf_counter() - start
     final = np.stack([w[n] for n in WAYPOINTS])  # (6, J), after the vertical re-solves
     steps = np.abs(np.diff(np.vstack([q_now[None], final]), axis=0)).max(1)  # (6,) rad

@@ -1,4 +1,5 @@
-"""Jerk-limited joint trajectories: exactly straight, rest-to-rest segments timed by ruckig.
+"""Jerk-limited joint trajectories: exactly straight segments timed by ruckig, and free-space
+transitions between moving states.
 
 A segment ``q0 -> q1`` is parameterised by its arclength s in joint space, ``q(t) = q0 + s(t) u``
 with ``u = (q1 - q0) / L``, and s is timed by an offline 1-DoF ruckig problem ``0 -> L`` with the
@@ -7,6 +8,22 @@ limit and the path stays exactly on the line (a 7-DoF ruckig with phase synchron
 to time synchronisation for the Panda's unequal limits and leaves the line by about 1e-2 rad).
 Ruckig's intermediate waypoints are never used: the Community build computes them on a remote
 server. Everything here runs locally.
+
+A straight segment may start or end moving along its line (``v_start``, ``v_end``: arclength
+speeds), so that a free-space `transition` (a 7-DoF ruckig problem between two moving states, which
+leaves the straight line: free space only) can pass into it without stopping at the corner.
+
+Speed limits (`SpeedLimits`) are fractions of the Franka Panda datasheet limits in
+`robots.panda.PandaSpec` (velocity 2.175 rad/s for joints 1-4 and 2.61 for 5-7, the URDF's
+``<limit velocity>``; acceleration 15, 7.5, 10, 12.5, 15, 20, 20 rad/s^2; jerk 7500, 3750, 5000,
+6250, 7500, 10000, 10000 rad/s^3). `TRANSIT` (the free-space phases) uses 80% of the velocity and
+acceleration limits: a 20% reserve for tracking the trajectory with the simulators' position
+controllers; `APPROACH` (the phases near contact: the open hand around a block, a block lifted
+off or lowered onto a stack) uses 50%; both use 5% of the jerk limit, which still reaches the
+acceleration limit within 32 ms (joint 2) and keeps every ramp smooth at the 2 ms control period.
+MoveIt's ``panda_moveit_config`` uses about 25% of the accelerations on a real arm, whose
+tracking is worse than a simulator's; the friction grasp holds at these values in both
+simulators (`tests/tamp/loop`).
 """
 
 from __future__ import annotations
@@ -42,6 +59,10 @@ class SpeedLimits:
             self.acceleration * np.array(spec.a_max),
             self.jerk * np.array(spec.j_max),
         )
+
+
+TRANSIT = SpeedLimits(velocity=0.8, acceleration=0.8, jerk=0.05)  # free space: approach, transit
+APPROACH = SpeedLimits(velocity=0.5, acceleration=0.5, jerk=0.05)  # descend, lift, lower, retreat
 
 
 def _frozen(a) -> np.ndarray:
@@ -100,16 +121,66 @@ class JointTrajectory:
         return cls(dt * np.arange(n + 1), np.tile(q, (n + 1, 1)), zeros, zeros)
 
 
-def _ruckig_rest_to_rest(length: float, v: float, a: float, j: float):
-    """Offline 1-DoF ruckig trajectory from rest at 0 to rest at ``length``."""
+def _ruckig_1dof(length: float, v: float, a: float, j: float, v0: float = 0.0, v1: float = 0.0):
+    """Offline 1-DoF ruckig trajectory from 0 at speed ``v0`` to ``length`` at speed ``v1``
+    (both at zero acceleration); MotionError when it would leave [0, length] (a boundary
+    speed too high to stop or start within the segment)."""
     inp = InputParameter(1)
     inp.current_position, inp.target_position = [0.0], [length]
+    inp.current_velocity, inp.target_velocity = [v0], [v1]
     inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
     traj = Trajectory(1)
     result = Ruckig(1).calculate(inp, traj)
     if result not in (Result.Working, Result.Finished):
         raise MotionError(f"ruckig failed on a segment of length {length:.4g}: {result}")
+    extrema = traj.position_extrema[0]
+    if extrema.min < -1e-9 or extrema.max > length + 1e-9:
+        raise MotionError(
+            f"boundary speeds {v0:.3g}, {v1:.3g} rad/s overshoot a segment of {length:.4g} rad"
+        )
     return traj
+
+
+def arc_limits(path, spec: PandaSpec = PANDA, limits: SpeedLimits = SpeedLimits()):
+    """(length, v, a, j) of the joint-space polyline ``path`` (K >= 2, J): its arclength (rad)
+    and the arclength limits min over pieces and joints of ``limit / |direction cosine|``."""
+    d = np.diff(as_path(path, spec), axis=0)  # (K-1, J)
+    seg = np.linalg.norm(d, axis=1)  # (K-1,)
+    keep = seg > 1e-12
+    if not keep.any():
+        return 0.0, 0.0, 0.0, 0.0
+    u = np.abs(d[keep] / seg[keep, None]).max(axis=0)  # (J,) largest direction cosine per joint
+    moving = u > 0.0
+    v, a, j = (float(np.min(lim[moving] / u[moving])) for lim in limits.scaled(spec))
+    return float(seg.sum()), v, a, j
+
+
+def pass_speed(path, share: float, spec: PandaSpec = PANDA, limits: SpeedLimits = SpeedLimits()):
+    """An arclength speed (rad/s) at which a move along ``path`` (K, J) can start or end and
+    still stop (or start) within it: ``share`` of the least of the arclength velocity limit and
+    the speed that braking at half the acceleration limit stops in half the length, less what
+    the jerk ramp adds. 0 for a zero-length path."""
+    length, v, a, j = arc_limits(path, spec, limits)
+    if length == 0.0:
+        return 0.0
+    # braking distance from speed w: about w^2 / (2 a) + w a / (2 j); keep it under L / 2
+    w = min(v, math.sqrt(0.5 * a * length))
+    while w > 1e-6 and w * w / a + w * a / j > 0.5 * length:
+        w *= 0.8
+    return share * w
+
+
+def direction_at(path, end: int) -> np.ndarray:
+    """The unit direction (J,) of ``path`` (K, J) as it leaves its first point (``end`` 0) or
+    arrives at its last (``end`` -1); zeros for a path of zero length."""
+    path = np.asarray(path, dtype=np.float64)
+    d = np.diff(path, axis=0)  # (K-1, J)
+    seg = np.linalg.norm(d, axis=1)
+    moving = np.flatnonzero(seg > 1e-12)
+    if not len(moving):
+        return np.zeros(path.shape[1])
+    k = moving[0] if end == 0 else moving[-1]
+    return d[k] / seg[k]
 
 
 def straight_segment(
@@ -139,14 +210,21 @@ def as_path(path, spec: PandaSpec = PANDA) -> np.ndarray:
 
 
 def polyline_segment(
-    path, dt: float = 0.002, spec: PandaSpec = PANDA, limits: SpeedLimits = SpeedLimits()
+    path,
+    dt: float = 0.002,
+    spec: PandaSpec = PANDA,
+    limits: SpeedLimits = SpeedLimits(),
+    v_start: float = 0.0,
+    v_end: float = 0.0,
 ) -> JointTrajectory:
-    """Rest-to-rest motion along the joint-space polyline ``path`` (K, J), K >= 2.
+    """Motion along the joint-space polyline ``path`` (K, J), K >= 2, rest to rest by default.
 
     One 1-DoF ruckig profile on the total arclength, with limits min over segments and joints of
     ``limit / |direction cosine|``, so every joint stays within its limits on every straight
     piece. Dense knots from IK along a Cartesian line make the tool move (nearly) straight in
-    Cartesian space; with two knots this is `straight_segment`.
+    Cartesian space; with two knots this is `straight_segment`. ``v_start`` and ``v_end``
+    (rad/s, at most the arclength velocity limit; see `pass_speed`) start or end it moving along
+    the path: the joint velocity there is that speed times `direction_at` the end.
     """
     path, n_joints = as_path(path, spec), len(spec.arm_joints)
     if dt <= 0.0:
@@ -159,20 +237,64 @@ def polyline_segment(
         zeros = np.zeros((1, n_joints))
         return JointTrajectory(np.zeros(1), path[-1][None], zeros, zeros)
     knots = np.concatenate([[0.0], np.cumsum(seg)])  # (P+1,)
-    length = float(knots[-1])
     direction = d / seg[:, None]  # (P, J) unit directions
-    u = np.abs(direction).max(axis=0)  # (J,) largest direction cosine of each joint
-    moving = u > 0.0
-    v, a, j = (float(np.min(lim[moving] / u[moving])) for lim in limits.scaled(spec))
-    traj = _ruckig_rest_to_rest(length, v, a, j)
+    length, v, a, j = arc_limits(path, spec, limits)
+    if not (0.0 <= v_start <= v * (1 + 1e-9) and 0.0 <= v_end <= v * (1 + 1e-9)):
+        raise MotionError(f"v_start, v_end = {v_start}, {v_end}; expected speeds in [0, {v:.4g}]")
+    traj = _ruckig_1dof(length, v, a, j, min(v_start, v), min(v_end, v))
     n = max(1, math.ceil(traj.duration / dt - 1e-9))
     times = dt * np.arange(n + 1)  # (S,)
     s = np.array([[x[0] for x in traj.at_time(min(t, traj.duration))] for t in times])  # (S, 3)
     s[:, 0] = np.clip(s[:, 0], 0.0, length)
-    s[-1] = (length, 0.0, 0.0)
+    s[-1] = (length, min(v_end, v), 0.0)
     piece = np.clip(np.searchsorted(knots, s[:, 0], side="right") - 1, 0, len(seg) - 1)  # (S,)
     start = path[:-1][keep][piece]  # (S, J)
     positions = start + (s[:, :1] - knots[piece][:, None]) * direction[piece]  # (S, J)
     positions[0], positions[-1] = path[0], path[-1]
     dirs = direction[piece]  # (S, J)
+    dirs[0] = direction[0]
     return JointTrajectory(times, positions, s[:, 1:2] * dirs, s[:, 2:3] * dirs)
+
+
+def transition(
+    q0,
+    qd0,
+    q1,
+    qd1,
+    dt: float = 0.002,
+    spec: PandaSpec = PANDA,
+    limits: SpeedLimits = SpeedLimits(),
+) -> JointTrajectory:
+    """A jerk-limited free-space move from ``q0`` moving at ``qd0`` to ``q1`` moving at ``qd1``
+    (each (J,), zero acceleration at both ends), all joints time-synchronised, inside the
+    datasheet joint limits. It leaves the straight line q0 -> q1 (free space only: check it
+    for collisions as sampled). The last sample is exactly (q1, qd1). MotionError when ruckig
+    finds no such trajectory."""
+    q0, q1 = np.asarray(q0, dtype=np.float64), np.asarray(q1, dtype=np.float64)
+    qd0, qd1 = np.asarray(qd0, dtype=np.float64), np.asarray(qd1, dtype=np.float64)
+    n_joints = len(spec.arm_joints)
+    for name, x in (("q0", q0), ("qd0", qd0), ("q1", q1), ("qd1", qd1)):
+        if x.shape != (n_joints,) or not np.isfinite(x).all():
+            raise MotionError(f"{name} has shape {x.shape}; expected finite ({n_joints},)")
+    if dt <= 0.0:
+        raise MotionError(f"dt = {dt}; expected dt > 0")
+    v, a, j = limits.scaled(spec)
+    inp = InputParameter(n_joints)
+    inp.current_position, inp.current_velocity = list(q0), list(qd0)
+    inp.target_position, inp.target_velocity = list(q1), list(qd1)
+    inp.current_acceleration = inp.target_acceleration = [0.0] * n_joints
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = list(v), list(a), list(j)
+    inp.min_position, inp.max_position = list(spec.q_min), list(spec.q_max)
+    traj = Trajectory(n_joints)
+    result = Ruckig(n_joints).calculate(inp, traj)
+    if result not in (Result.Working, Result.Finished):
+        raise MotionError(f"ruckig found no transition between the two states: {result}")
+    n = max(1, math.ceil(traj.duration / dt - 1e-9))
+    times = dt * np.arange(n + 1)  # (S,)
+    states = [traj.at_time(min(t, traj.duration)) for t in times]
+    positions = np.array([x[0] for x in states])  # (S, J)
+    velocities = np.array([x[1] for x in states])  # (S, J)
+    accelerations = np.array([x[2] for x in states])  # (S, J)
+    positions[0], velocities[0] = q0, qd0
+    positions[-1], velocities[-1], accelerations[-1] = q1, qd1, 0.0
+    return JointTrajectory(times, positions, velocities, accelerations)

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from motion.guard import CollisionModel, GuardConfig, PickPlaceWorld, guard_pick_place
+from motion.guard import CollisionModel, GuardConfig, PickPlaceWorld, at_rest, guard_pick_place
 from motion.ik import IKSolver
 from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
 from motion.trajectory import JointTrajectory
@@ -168,7 +168,7 @@ def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Exp
     hold = JointTrajectory.hold(q, 0.3, sim.dt)
     sim.run(hold, "open", on_frame=on_frame, expected=expected)
     phase = next(ph for ph in phases if ph.name == "descend")
-    up = phase.trajectory
+    up = at_rest(phase).trajectory  # the descent may start moving (it passes from the approach)
     back = JointTrajectory(
         up.times, up.positions[::-1].copy(), -up.velocities[::-1], up.accelerations[::-1]
     )

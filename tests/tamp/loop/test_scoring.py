@@ -63,9 +63,9 @@ def test_the_arm_pushing_over_the_tower_it_just_built_is_a_collision_and_a_distu
 
 @pytest.mark.parametrize("sim_name", SIMULATORS)
 def test_the_carried_block_hitting_a_wall_is_its_own_collision(sim_name, solver):
-    """A 14 cm wall between the slots, run unchecked: the hand passes over it, the block it
-    carries does not."""
-    wall = Obstacle("wall", (0.48, 0.0, 0.07), (0.15, 0.01, 0.07))
+    """A 15 cm wall between the slots, run unchecked: the hand passes over it, the block it
+    carries (its bottom 13.5 cm up in transit) does not."""
+    wall = Obstacle("wall", (0.48, 0.0, 0.075), (0.15, 0.01, 0.075))
     scene = replace(SceneConfig(), obstacles=(wall,))
     poses = layout(("a", "b"), (TABLE, TABLE), scene, seed=0, slots=[0, 4])
     unchecked = replace(ExecConfig(), collision="off")
