@@ -13,7 +13,13 @@ vertical phases next to it, which may have been timed to pass into the free-spac
 without stopping (`motion.pick_place`), are re-timed along the same path to stop there.
 
 The collision model is anything with `robots.collision.PandaCollision`'s ``set_boxes``,
-``hold``, ``valid`` and ``check_path``; this module never imports a simulator.
+``hold``, ``valid`` and ``check_path``; this module never imports a simulator. A model that
+also has ``valid_batch`` (`motion.sphere_check.Screened`: a conservative sphere model beside
+the meshes) screens each phase first, every densified configuration in one batch: where the
+spheres find the whole phase free the meshes would too (they never say "free" where the meshes
+find a contact), and only a phase the spheres flag goes to the mesh model's ``check_path``,
+which has the final word. The motion planner gets the same batch check (`motion.rrt.plan_path`
+``valid_batch``) and verifies what it finds with the meshes.
 """
 
 from __future__ import annotations
@@ -140,6 +146,20 @@ def hold_picked(model: CollisionModel, world: PickPlaceWorld | None) -> None:
         model.hold(half=tuple(half), pose=pose)
 
 
+def _check_path(model: CollisionModel, path: np.ndarray, fingers: float, ignore, step: float):
+    """``model.check_path(path, fingers, ignore, step)`` (a `robots.collision.PathCheck`),
+    screened by ``model.valid_batch`` when the model has one: a path the conservative batch
+    check finds free is free (its ``checks``: the configurations screened)."""
+    screen = getattr(model, "valid_batch", None)
+    if screen is not None:
+        from robots.collision import PathCheck, densify  # the model's own module: loaded
+
+        _, qs, _ = densify(path, np.full(len(path), fingers), step)  # (N, J)
+        if screen(qs, fingers, ignore).all():
+            return PathCheck(True, None, None, None, len(qs))
+    return model.check_path(path, fingers, ignore, step)
+
+
 @contextmanager
 def _margin(model: CollisionModel, value: float):
     """The model's margin set to ``value`` for the block, restored after."""
@@ -159,8 +179,12 @@ def _guard_phase(
     free = phase.name in FREE_SPACE
     # the vertical phases move straight up or down beside blocks the move touches
     with _margin(model, model.margin if free else min(model.margin, config.vertical_margin)):
-        found = model.check_path(
-            thin(phase.trajectory.positions, config.max_step), fingers, ignore, config.max_step
+        found = _check_path(
+            model,
+            thin(phase.trajectory.positions, config.max_step),
+            fingers,
+            ignore,
+            config.max_step,
         )
     t_check = time.perf_counter() - start
     if found.ok:
@@ -183,15 +207,21 @@ def _guard_phase(
     def valid(x: np.ndarray) -> bool:
         return model.valid(x, fingers, ignore)
 
+    batch = None
+    if getattr(model, "valid_batch", None) is not None:
+
+        def batch(x: np.ndarray) -> np.ndarray:
+            return model.valid_batch(x, fingers, ignore)
+
     # plan with a wider berth: the planner checks only every ~0.02 rad
     with _margin(model, model.margin + config.plan_pad):
-        found_path = plan_path(q[0], q[-1], valid, config=rrt)
+        found_path = plan_path(q[0], q[-1], valid, config=rrt, valid_batch=batch)
     if not found_path.ok:
         evidence |= {"planner": found_path.failure, "checks": found_path.checks}
         return None, evidence, t_check, found_path.time_s
     trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
-    again = model.check_path(
-        thin(trajectory.positions, config.max_step), fingers, ignore, config.max_step
+    again = _check_path(
+        model, thin(trajectory.positions, config.max_step), fingers, ignore, config.max_step
     )
     if not again.ok:  # the planner checks at its own resolution; this is the final word
         evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}

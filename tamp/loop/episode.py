@@ -112,9 +112,11 @@ class Episode:
         self.sim.truth.lock()  # simulator ground truth only scores episodes
         self.collision = None  # the arm's own collision model: robot geometry + known boxes
         if config.execution.collision != "off":
+            from motion.sphere_check import Screened
             from robots.collision import PandaCollision
 
-            self.collision = PandaCollision(config.execution.margin)
+            # the meshes have the final word; the sphere model screens each phase in one batch
+            self.collision = Screened(PandaCollision(config.execution.margin))
         self._acts = 0  # moves attempted: each seeds its motion-planner call differently
         self._avoid: dict = {}  # state -> moves the arm failed there (`ArmCosts` avoid)
         self.score = Scorer(self.sim.truth, problem, config.scene)

@@ -105,3 +105,73 @@ def test_a_free_move_through_a_wall_is_rerouted_or_refused(model, planned):
     assert np.allclose(way.positions[[0, -1]], transit.positions[[0, -1]])
     box = Box("box", PICK, (0.6, 0.6, 0.6))  # swallows the whole workspace: no way at all
     assert guard_free_move(transit, model, [box], seed=1) is None
+
+
+def test_a_detour_stops_the_vertical_phases_beside_it(model, planned):
+    """The planned lift ends and the lower starts moving (the transit passes through), a
+    detour starts and ends at rest: the guard re-times both along the same path to stop."""
+    by_name = {p.name: p for p in planned}
+    assert np.abs(by_name["lift"].trajectory.velocities[-1]).max() > 0.05
+    assert np.abs(by_name["lower"].trajectory.velocities[0]).max() > 0.05
+    out = guard_pick_place(planned, model, _world(WALL), seed=4)
+    assert out.ok and "transit" in out.rerouted
+    for before, after in zip(out.phases, out.phases[1:], strict=False):
+        np.testing.assert_array_equal(
+            after.trajectory.positions[0], before.trajectory.positions[-1]
+        )
+        np.testing.assert_allclose(
+            after.trajectory.velocities[0], before.trajectory.velocities[-1], atol=1e-9
+        )
+    lift, lower = (next(p for p in out.phases if p.name == n) for n in ("lift", "lower"))
+    assert np.abs(lift.trajectory.velocities[-1]).max() < 1e-12
+    assert np.abs(lower.trajectory.velocities[0]).max() < 1e-12
+    for phase in (lift, lower):  # the same path: its ends and every sample on the old samples
+        old = by_name[phase.name].trajectory.positions
+        np.testing.assert_array_equal(phase.trajectory.positions[[0, -1]], old[[0, -1]])
+
+
+class _Counted:
+    """A collision model that counts its mesh path checks."""
+
+    def __init__(self, inner):
+        self.inner, self.paths = inner, 0
+
+    @property
+    def margin(self) -> float:
+        return self.inner.margin
+
+    @margin.setter
+    def margin(self, value: float) -> None:
+        self.inner.margin = value
+
+    def check_path(self, *args, **kwargs):
+        self.paths += 1
+        return self.inner.check_path(*args, **kwargs)
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+
+@pytest.mark.parametrize("extra", ["none", "wall", "side", "board"])
+def test_sphere_screening_gives_the_meshes_verdicts_and_skips_them_where_clear(
+    model, planned, extra
+):
+    from motion.sphere_check import Screened
+
+    boxes = {
+        "none": (),
+        "wall": (WALL,),
+        "side": (Box("b", (PICK[0], PICK[1] + 0.05, 0.025), HALF),),
+        "board": (Box("board", (PLACE[0], PLACE[1], 0.11), (0.03, 0.03, 0.005)),),
+    }[extra]
+    config = GuardConfig(plan=False)
+    alone = guard_pick_place(planned, model, _world(*boxes), config)
+    counted = _Counted(model)
+    screened = Screened(counted)
+    both = guard_pick_place(planned, screened, _world(*boxes), config)
+    assert (both.ok, both.failure) == (alone.ok, alone.failure)
+    assert both.evidence == alone.evidence  # a flagged phase: the meshes' own contact
+    if extra == "none":  # the spheres clear every phase: the meshes are never asked
+        assert counted.paths == 0
+    else:
+        assert counted.paths >= 1
