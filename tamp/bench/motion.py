@@ -23,7 +23,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from motion.ik import IKSolver, top_down_pose
+from motion.ik import IKSolver, pose_yaw, top_down_pose
+from motion.pick_place import PickPlaceRequest, waypoint_targets
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
@@ -62,8 +63,11 @@ class MotionBench:
     ik: dict
 
 
-def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
-    """Wall time of one batched IK call on ``n`` random top-down targets in the block area."""
+def time_ik(solver: IKSolver, n: int = 100, seed: int = 0, moves: int = 20) -> dict:
+    """Wall time of one batched IK call on ``n`` random top-down targets in the block area, and
+    of one move's six waypoints (`motion.pick_place.waypoint_targets`) in one batched call:
+    the median over ``moves`` random pick-and-places from the home pose (each call timed alone
+    after one warm-up)."""
     rng = np.random.default_rng(seed)
     targets = np.stack(
         [
@@ -78,7 +82,18 @@ def time_ik(solver: IKSolver, n: int = 100, seed: int = 0) -> dict:
     solver.solve(targets[:2], q0)  # warm-up
     t0 = time.perf_counter()
     result = solver.solve(targets, q0)
-    return {"n": n, "time_s": time.perf_counter() - t0, "converged": int(result.ok.sum())}
+    out = {"n": n, "time_s": time.perf_counter() - t0, "converged": int(result.ok.sum())}
+    times, solved = [], 0
+    for _ in range(moves):
+        pick = (rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), 0.025)
+        place = (rng.uniform(0.35, 0.65), rng.uniform(-0.3, 0.3), rng.choice([0.025, 0.075]))
+        request = PickPlaceRequest(pick, rng.uniform(-1.5, 1.5), place, 0.0, 0.1)
+        six = waypoint_targets(request, pose_yaw(solver.fk(q0)[0]))  # (6, 4, 4)
+        t0 = time.perf_counter()
+        solved += int(solver.solve(six, q0).ok.all())
+        times.append(time.perf_counter() - t0)
+    out |= {"moves": moves, "waypoints_median_s": float(np.median(times)), "moves_solved": solved}
+    return out
 
 
 def summarise(

@@ -98,8 +98,17 @@ def motion_command(args: argparse.Namespace) -> int:
     ik = result.ik
     print(
         f"IK: one batched call on {ik['n']} targets took {ik['time_s']:.3f} s "
-        f"({ik['converged']}/{ik['n']} converged)"
+        f"({ik['converged']}/{ik['n']} converged); a move's six waypoints in one call: "
+        f"median {1000 * ik['waypoints_median_s']:.1f} ms over {ik['moves']} random moves "
+        f"({ik['moves_solved']} solved)"
     )
+    for sim, s in result.summary.items():
+        print(
+            f"{sim} per move: wall {s['wall_per_move_s']:.3f} s, simulated "
+            f"{s['sim_per_move_s']:.2f} s, IK and timing {s['ik_per_move_s']:.3f} s, "
+            f"collision checks {s['check_per_move_s']:.3f} s, motion planner "
+            f"{s['path_per_move_s']:.3f} s"
+        )
     if args.out:
         also = ", recordings/" if args.record else ""
         print(f"wrote results.json, episodes.csv{also} to {args.out}")
