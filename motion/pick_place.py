@@ -349,16 +349,14 @@ def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> t
         whether it stops at both ends instead: when ruckig finds no curve in the joint limits,
         or the curve takes the hand more than 1 mm below the lower of its two ends (the
         hover and transit heights keep the hand and the held object above every stack)."""
-        line = _kept_up(solver, w[src], w[dst], config)
-        if not (qd0.any() or qd1.any()):
-            return line, True
-        try:
-            curve = transition(w[src], qd0, w[dst], qd1, dt, spec, config.transit)
-        except MotionError:
-            return line, True
-        if _dip(solver, curve.positions) > 1e-3:
-            return line, True
-        return curve, False
+        if qd0.any() or qd1.any():
+            try:
+                curve = transition(w[src], qd0, w[dst], qd1, dt, spec, config.transit)
+            except MotionError:
+                curve = None
+            if curve is not None and _dip(solver, curve.positions) <= 1e-3:
+                return curve, False
+        return _kept_up(solver, w[src], w[dst], config), True
 
     zero = np.zeros(solver.dof)
     approach, still = free("now", "pre_grasp", zero, down * direction_at(paths["grasp"], 0))
