@@ -171,6 +171,28 @@ def rules_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+def peer_list(text: str) -> tuple[str, ...]:
+    """``--peers``: comma-separated peer planners (`tamp.bench.peers.side_by_side.PEERS`)."""
+    from tamp.bench.peers.side_by_side import parse
+
+    try:
+        return parse(text)
+    except TampError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--peers: ")) from None
+
+
+def peers_option(p: argparse.ArgumentParser) -> None:
+    """``--peers``: classical planners run beside ours on the same instances."""
+    p.add_argument(
+        "--peers",
+        type=peer_list,
+        metavar="PEER[,PEER...]",
+        help="also run these planners (pyperplan: GBF+hFF; lama: Fast Downward lama-first) on "
+        "every instance within the same --time-limit, which they need; ours then plans one "
+        "instance at a time; a table side by side (needs the bench extra)",
+    )
+
+
 def progress_option(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--no-progress", dest="progress", action="store_false", help="no progress bar on stderr"

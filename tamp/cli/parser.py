@@ -17,6 +17,7 @@ from tamp.cli.options import (
     episode_options,
     executability_options,
     output_options,
+    peers_option,
     perception_bench_options,
     planner_options,
     progress_option,
@@ -224,6 +225,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         "--data", required=True, metavar="DIR", help="folder with domain.pddl and problem files"
     )
     rules_option(folder)
+    peers_option(folder)
     for p in (planbench, folder):
         p.add_argument(
             "--limit",

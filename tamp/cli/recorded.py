@@ -282,7 +282,10 @@ def planning_config(args: argparse.Namespace, domain: str | None = None) -> dict
     """``bench planbench``, ``bench pddl`` and ``bench random``: the planner config the suite
     runs with (``domain``: its rules' defaults) and the suite's own options."""
     config = planner_config(args, domain)
-    if getattr(args, "one_at_a_time", False):
+    peers = getattr(args, "peers", None)
+    if peers and config.time_limit_s is None:
+        raise TampError("--peers needs --time-limit SECONDS: the same limit for every planner")
+    if getattr(args, "one_at_a_time", False) or peers:
         config = replace(config, batched=False)
     body = {
         **asdict(config),
@@ -297,6 +300,8 @@ def planning_config(args: argparse.Namespace, domain: str | None = None) -> dict
             body[f"suite_{name}"] = list(value) if isinstance(value, tuple) else value
     if hasattr(args, "lama"):
         body["lama"] = args.lama
+    if hasattr(args, "peers"):
+        body["peers"] = list(peers) if peers else None
     return body
 
 

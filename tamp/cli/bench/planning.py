@@ -7,11 +7,12 @@ import argparse
 import json
 import sys
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import asdict, replace
 
 from tqdm import tqdm
 
 from tamp.bench import planning, results, suites, tables
+from tamp.bench.peers import side_by_side
 from tamp.cli.bench import bar, interrupted
 from tamp.cli.options import planner_config
 from tamp.cli.recorded import out_folder as output_folder
@@ -31,7 +32,10 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
     domain = rules.pop() if len(rules) == 1 else None
     recorded = planning_config(args, domain)
     config = planner_config(args, domain)
-    if getattr(args, "one_at_a_time", False):
+    peers = getattr(args, "peers", None)
+    if peers:
+        side_by_side.require(peers)  # before any planning: a missing package in one line
+    if getattr(args, "one_at_a_time", False) or peers:
         config = replace(config, batched=False)
     horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
@@ -62,18 +66,53 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
         result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
     body = results.results(result, args.argv)
     body["config"] = {**body["config"], **recorded}
+    lines = None
+    if peers:
+        lines, rows = _peers(suite, result, peers, config.time_limit_s, args.progress)
+        body["peers"] = {
+            "time_limit_s": config.time_limit_s,
+            "summary": [asdict(line) for line in lines],
+            "instances": [asdict(row) for row in rows],
+        }
     if args.out is not None:
         paths = results.write(result, args.out, body)
+        if lines is not None:
+            results.write_csv(results.out_folder(args.out) / "peers.csv", rows)
+            paths = [*paths, results.out_folder(args.out) / "peers.csv"]
     if args.json:
         print(json.dumps(body, indent=2))
     else:
         print(tables.planning_report(result))
+        if lines is not None:
+            print(f"\nside by side, {config.time_limit_s:g} s per instance:")
+            print(side_by_side.table(lines))
         if lengths:
             print(f"\nplan lengths by {result.size_name} (mean over seeds):")
             print(tables.lengths_table(result))
         if args.out is not None:
             print(f"\nwrote {', '.join(p.name for p in paths)} to {args.out}")
     return 0
+
+
+def _peers(
+    suite: suites.Suite,
+    bench: planning.Bench,
+    peers: tuple[str, ...],
+    limit: float,
+    progress: bool,
+) -> tuple[list[side_by_side.Line], tuple[side_by_side.PeerRow, ...]]:
+    """The peers on the suite's PDDL files, and the summary lines beside ours (the first
+    horizon and seed)."""
+    names = [i.name for i in suite.instances]
+    instances = side_by_side.files(suite.source, names)
+    total = len(peers) * len(instances)
+    with bar(total, f"peers ({', '.join(peers)})", progress, "instance") as update:
+        rows = side_by_side.run(instances, peers, limit, update)
+    ours = [
+        (r.instance, r.length if r.status == "valid" else None, r.time_s)
+        for r in bench.runs[0].rows
+    ]
+    return side_by_side.summarise(suite.name, ours, rows), rows
 
 
 def _lama(suite: suites.Suite, bench: planning.Bench, limit: float, progress: bool):

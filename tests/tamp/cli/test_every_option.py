@@ -64,6 +64,7 @@ SAMPLES = {
     "--problems": "blocked,tall",
     "--planner": "search",
     "--record": "episode.rrd",  # run and demo: a file (the benchmarks: a flag)
+    "--peers": "pyperplan,lama",
 }
 # what an option needs to take effect, per command where it differs; tried in order
 NEEDS = {
@@ -81,6 +82,7 @@ NEEDS = {
     "--domain": [["problem.pddl"]],
     "--min-blocks": [["--max-blocks", "9"]],
     "--data": [["--blocks", "4"]],
+    "--peers": [["--time-limit", "5"]],  # the same limit for every planner
     # a scene file (the shipped example's name), another goal, and the state observed
     "--goal": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
 }

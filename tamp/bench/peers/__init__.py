@@ -1,0 +1,5 @@
+"""Classical planners run beside ours on the same PDDL instances at the same per-instance time
+limit (``tamp bench pddl --peers pyperplan,lama``): pyperplan's greedy best-first search with
+h_FF (`gbf`) and Fast Downward's LAMA (`tamp.bench.fast_downward.lama_length`); `side_by_side`
+runs them and summarises coverage, plan length and time per domain. Benchmark-only: both come
+with the ``bench`` extra and nothing at plan time imports them."""
