@@ -33,8 +33,6 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
     recorded = planning_config(args, domain)
     config = planner_config(args, domain)
     peers = getattr(args, "peers", None)
-    if peers:
-        side_by_side.require(peers)  # before any planning: a missing package in one line
     if getattr(args, "one_at_a_time", False) or peers:
         config = replace(config, batched=False)
     horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
@@ -145,6 +143,8 @@ def pddl_command(args: argparse.Namespace) -> int:
     """Every problem of a folder of PDDL (``--limit``: a spread of them)."""
     planning_config(args)
     output_folder(args.out)
+    if args.peers:
+        side_by_side.require(args.peers)  # before any work: a missing package in one line
     with _searching(args.progress) as update:
         suite = suites.pddl_folder(args.data, args.limit, args.out, args.domain_rules, update)
     return _run(suite, args)
