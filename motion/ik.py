@@ -256,6 +256,9 @@ class IKSolver:
         pick = np.arange(b)
         ok, q = valid.any(1), q[pick, best]
         pos_err, rot_err = pos_err[pick, best], rot_err[pick, best]
+        if ok.any():  # the batch stopped on its first solutions: polish the chosen ones
+            rows = np.flatnonzero(ok)
+            q[rows], pos_err[rows], rot_err[rows], _ = self._iterate(q[rows], h[rows], 3)
         out = IKResult(ok=ok, q=q, pos_err=pos_err, rot_err=rot_err)
         for a in (out.ok, out.q, out.pos_err, out.rot_err):
             a.flags.writeable = False

@@ -246,7 +246,8 @@ def _cube_targets(
 
 
 def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, max_jump: float):
-    """Batched IK, then re-solve from the previous waypoint where the joint path jumps or fails."""
+    """Batched IK, then re-solve from the previous waypoint where the joint path jumps (one
+    Gauss-Newton run from it) or fails (every seed again)."""
     first = solver.solve(targets, q_now)
     ok, q = first.ok.copy(), first.q.copy()  # (W,), (W, J)
     pos_err, rot_err = first.pos_err.copy(), first.rot_err.copy()
@@ -256,7 +257,10 @@ def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, m
         jump = float(np.abs(q[k] - prev).max())
         if (ok[k] and jump <= max_jump) or (k > 0 and not ok[k - 1]):
             continue  # fine as it is, or no valid previous solution to seed from
-        again = solver.solve(targets[k : k + 1], prev)
+        if ok[k]:  # solved, but on another branch: Gauss-Newton from the previous waypoint
+            again = solver.follow(targets[k : k + 1], prev, solver.config.max_iterations)
+        else:  # unsolved: every seed again, the previous waypoint's solution first
+            again = solver.solve(targets[k : k + 1], prev)
         better = float(np.abs(again.q[0] - prev).max()) < jump
         if again.ok[0] and (not ok[k] or better):
             ok[k], q[k] = True, again.q[0]
