@@ -12,6 +12,7 @@ from tamp.bench.official import OFFICIAL, default_data
 from tamp.cli.types import (
     MAX_ITERS,
     MAX_RESTARTS,
+    PLAN_THREADS,
     _names,
     block_counts,
     bounded,
@@ -480,7 +481,7 @@ def executability_options(p: argparse.ArgumentParser) -> None:
         help="physical friction grasp or a weld attach (friction)",
     )
     p.add_argument("--seed", type=seed, default=0, help="scene layout and planner seed (0)")
-    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     scene_options(p)
     record_option(p, "SIM-INSTANCE-SOURCE")  # a plan run once for several sources: the first
     progress_option(p)

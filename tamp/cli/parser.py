@@ -30,6 +30,7 @@ from tamp.cli.options import (
 )
 from tamp.cli.types import (
     MAX_BLOCKS,
+    PLAN_THREADS,
     block_counts,
     bounded,
     nonnegative,
@@ -41,10 +42,6 @@ from tamp.cli.types import (
 from tamp.sim.base import SIMULATORS
 
 EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch
-PLAN_THREADS = (
-    "torch threads while planning (1: one problem's tensors are small, and more threads wait "
-    "for cores on a busy machine)"
-)
 
 
 def version() -> str:
@@ -160,7 +157,7 @@ def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
         "perception/support-latplan.pt)",
     )
     p.add_argument("--seed", type=seed, default=0, help="planner seed (0)")
-    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     output_options(p, "write the plan file (VAL format) here")
     p.set_defaults(
         func=_lazy("tamp.cli.images", "images_command"),
@@ -214,7 +211,7 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
             help="keep a window's strongest move even when it is illegal (the plan is then "
             "inexecutable); measures the soft planner without the decoder's legality filter",
         )
-        p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+        p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
         progress_option(p)
         output_options(p, "write instances.csv, results.json and steps.png into this folder")
     planbench, random_ = bench.choices["planbench"], bench.choices["random"]
@@ -331,7 +328,7 @@ def _perception_benchmark(bench, bench_opts: argparse.ArgumentParser) -> None:
     )
     perception_bench_options(p, str(CHECKPOINT))
     p.add_argument("--seed", type=seed, default=0, help="planner and layout seed (0)")
-    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     progress_option(p)
     output_options(p, "write results.json, instances.csv and example.png into this folder")
     p.set_defaults(
@@ -368,7 +365,7 @@ def _latplan_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--seeds", type=positive, default=3, metavar="S", help="planner seeds (3)")
     p.add_argument("--limit", type=positive, metavar="N", help="a spread of N instances (40)")
-    p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+    p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     progress_option(p)
     output_options(p, "write results.json and instances.csv into this folder")
     p.set_defaults(

@@ -56,6 +56,9 @@ def bounded(low: int, high: int, what: str = "an integer"):
 
 seed = bounded(0, MAX_SEED, "a seed")
 threads = bounded(1, MAX_THREADS, f"a count of threads (4 x this machine's {CORES} cores)")
+# planning's --threads default: one problem's tensors are small, and a second thread only waits
+# for a core on a busy machine (BENCHMARKS.md: `tamp plan` 3x faster with 1 than with 2 under load)
+PLAN_THREADS = "torch threads while planning (1; more help only on an idle machine)"
 window = bounded(1, MAX_WINDOW, "a window length")
 
 
