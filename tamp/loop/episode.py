@@ -29,7 +29,6 @@ import dataclasses
 import time
 from collections import Counter
 from collections.abc import Callable, Mapping
-from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -49,6 +48,7 @@ from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from tamp.slots import plan_on_places
+from tamp.sweep import torch_threads
 from task.domains import get_domain
 from task.planner import plan
 from task.problem import Move, Problem
@@ -397,19 +397,6 @@ class Episode:
 
     def _show(self, text: str) -> None:
         self.status_text = text
-
-
-@contextmanager
-def torch_threads(n: int):
-    """Run the block with ``n`` torch intra-op threads, then restore the previous setting."""
-    import torch
-
-    before = torch.get_num_threads()
-    torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(before)
 
 
 def run_episode(problem: Problem, config: LoopConfig = LoopConfig(), seed: int = 0, **kw):
