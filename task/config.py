@@ -51,6 +51,9 @@ class PlannerConfig:
     fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans);
     # "greedy": lazy greedy best-first on its `estimate` and `helpful` moves (far larger
     # problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
+    window_share: float = 1.0  # with a time limit and the fallback on, the windows stop at
+    # this share of the limit and the fallback searches in the rest (1: the windows may use all
+    # of it, leaving the complete search none; the STRIPS lift's defaults: 0.5)
 
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:
@@ -89,6 +92,9 @@ class PlannerConfig:
         if not 0.0 <= self.lookahead_share <= 1.0:
             share = self.lookahead_share
             raise TampError(f"PlannerConfig.lookahead_share must be in [0, 1], got {share}")
+        if not 0.0 < self.window_share <= 1.0:
+            share = self.window_share
+            raise TampError(f"PlannerConfig.window_share must be in (0, 1], got {share}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:
             raise TampError(f"PlannerConfig.time_limit_s must be > 0, got {self.time_limit_s}")
         sharp = self.decode_tau if self.decode_tau is not None else self.tau_end

@@ -264,10 +264,15 @@ def _run(
 
     ``indices``: the problems' positions in the caller's list (what ``source`` and ``costs``
     are told). ``config.time_limit_s`` holds inside a window too: a window the limit cuts
-    short is abandoned (none of its moves are kept)."""
+    short is abandoned (none of its moves are kept). With the fallback on, the windows stop at
+    ``config.window_share`` of the limit, the fallback searching in the rest."""
     start = time.perf_counter()
     limit = config.time_limit_s
     deadline = None if limit is None else start + limit
+    fallback = _fallback_on(config, source, costs)
+    windows_end = deadline
+    if limit is not None and fallback:
+        windows_end = start + config.window_share * limit
     states = [domain.initial_state(p) for p in problems]  # the world
     visited = [{s} for s in states]  # per problem, every world state its plan passed through
     moves: list[list] = [[] for _ in problems]
@@ -277,7 +282,6 @@ def _run(
     active = [i for i in range(len(problems)) if not solved[i]]
     on_done(len(problems) - len(active))
     timed_out = False
-    fallback = _fallback_on(config, source, costs)
     trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
     for _ in range(config.max_windows):
         if not active:
@@ -294,7 +298,7 @@ def _run(
                 generator,
                 source,
                 costs,
-                deadline,
+                windows_end,
             )
         except OutOfTime:
             timed_out = True  # stop with the moves so far; each unsolved problem says so

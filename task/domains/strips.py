@@ -302,7 +302,13 @@ class Strips:
     # helpful actions takes over (`PlannerConfig.fallback`; `lazy_search.lazy_greedy`); plans
     # leave with their cycles and redundant moves cut (`task.symbolic.shorten`)
     planner_defaults = MappingProxyType(
-        {"fallback": True, "fallback_search": "greedy", "fallback_nodes": 50_000, "shorten": True}
+        {
+            "fallback": True,
+            "fallback_search": "greedy",
+            "fallback_nodes": 50_000,
+            "shorten": True,
+            "window_share": 0.5,  # under a time limit, half of it for the greedy search
+        }
     )
 
     @staticmethod

@@ -137,3 +137,18 @@ def test_unknown_fallback_search_lists_the_options():
     with pytest.raises(TampError, match="astar") as info:
         PlannerConfig(fallback_search="dfs")
     assert "greedy" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_under_a_time_limit_the_windows_leave_the_search_its_share():
+    """Windows slow enough to spend any limit on 30 balls: with the lift's share (half) the
+    greedy search still gets the other half and solves it; a share outside (0, 1] is refused."""
+    problem = gripper_problem(30, 0)
+    slow = PlannerConfig.for_domain("strips", restarts=2, iters=2000, time_limit_s=6.0)
+    assert slow.window_share == 0.5
+    result = plan(problem, slow, seed=0)
+    assert result.solved, result.stats
+    assert result.stats["fallback"]["trigger"] == "time_limit"
+    _valid(problem, LIFT.to_actions(problem, result.plan.moves))
+    with pytest.raises(TampError, match="window_share") as info:
+        PlannerConfig(window_share=0.0)
+    assert "\n" not in str(info.value)
