@@ -62,13 +62,11 @@ def test_the_lift_grounds_hanoi_and_its_crisp_side_finds_the_optimum(seed):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="the soft planner does not solve Hanoi-3 at defaults")
-def test_the_soft_planner_solves_hanoi_three():
-    """Measured at the defaults: NO_PLAN after its window budget in 115-133 s on 2 loaded
-    cores (also with one 7-move window of 150 Adam steps); the plan it gives back is legal step
-    by step, only the goal is not reached. Strict: a planner that solves it flips this test.
-    With ``PlannerConfig(fallback=True)`` (the complete search after the windows) it is solved:
-    15 actions (the optimum is 7), 33 s."""
+def test_the_planner_solves_hanoi_three_at_the_lifts_defaults():
+    """The lift's defaults (the windows, then the complete greedy search on h_FF, the plan
+    shortened) solve Hanoi-3. The windows alone did not (NO_PLAN after their budget in
+    115-133 s on 2 loaded cores; this test was a strict xfail until the lift's fallback
+    became its default)."""
     problem, pddl = _lifted(3, 0)
     result = plan(problem, PlannerConfig.for_domain("strips"), seed=0)
     moves = result.plan.moves
