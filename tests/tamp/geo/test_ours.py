@@ -156,7 +156,7 @@ def test_the_episode_planners_shared_config_is_accepted():
     assert ours.seed == 3 and ours.costs.choices == ("top",)
     # a sixth of the wall clock for the differentiable planner, the complete search the rest
     assert ours.planner.time_limit_s == 5.0 and ours.soft_time_s == 5.0
-    assert ours.search.max_time_s == 30.0
+    assert ours.search.max_time_s == 30.0 and ours.search.max_nodes == 5_000
     assert ours.planner.fallback is True
 
 
