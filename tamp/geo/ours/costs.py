@@ -30,7 +30,6 @@ records states priced and the time spent (ms per state).
 
 from __future__ import annotations
 
-import itertools
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from motion.grasps import HAND_BOXES, Grasp, world_tcp
+from motion.grasps import HAND_BOXES, Grasp
 from motion.ik import IKSolver, top_down_pose
 from tamp.geo.ours.bridge import Bridged
 from tamp.geo.places import free, supported_on
@@ -49,7 +48,6 @@ from task.domains.base import State
 from task.domains.blocksworld import check_move as legal
 from task.problem import Move
 
-CORNERS = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))  # (8, 3)
 TOUCH = 0.001  # m, boxes may touch this deep (contact)
 
 
@@ -77,31 +75,6 @@ def hand_shape(grasp: Grasp) -> tuple:
     return tuple(out)
 
 
-def hand_boxes(grasp: Grasp, xyz, yaw: float, margin: float = 0.0) -> np.ndarray:
-    """(3, 2, 3) lower and upper corners (m) of the axis-aligned boxes around the hand's palm
-    and fingers (`hand_shape`, grown by ``margin``, m) holding an object at centre ``xyz``,
-    turned ``yaw``."""
-    tcp = world_tcp(grasp, xyz, yaw)  # (4, 4)
-    out = []
-    for centre, half in hand_shape(grasp):
-        pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
-        world = pts @ tcp[:3, :3].T + tcp[:3, 3]  # (8, 3)
-        out.append((world.min(0), world.max(0)))
-    return np.asarray(out)
-
-
-def hand_corners(grasps: Sequence[Grasp], margin: float = 0.0) -> np.ndarray:
-    """(G, 3, 8, 3) the corners (m) of the hand's palm and finger boxes (`hand_shape`, grown by
-    ``margin``) at each grasp, in the frame of the object held (its centre, unturned)."""
-    out = np.zeros((len(grasps), len(HAND_BOXES), 8, 3))
-    for i, g in enumerate(grasps):
-        m = g.matrix  # (4, 4) TCP in the object frame
-        for k, (centre, half) in enumerate(hand_shape(g)):
-            pts = np.asarray(centre) + CORNERS * (np.asarray(half) + margin)  # (8, 3), TCP frame
-            out[i, k] = pts @ m[:3, :3].T + m[:3, 3]
-    return out
-
-
 def hand_obbs(grasps: Sequence[Grasp], margin: float = 0.0):
     """The hand's palm and finger boxes (`hand_shape`, grown by ``margin``) at each grasp as
     oriented boxes in the frame of the object held: centres (G, 3, 3), axes (G, 3, 3, 3) (each
@@ -124,6 +97,19 @@ def solid_obbs(solids: Sequence[Solid]):
     halves = np.array([s.half for s in solids], dtype=np.float64).reshape(-1, 3)
     yaws = np.array([0.0 if s.cylinder else s.yaw for s in solids], dtype=np.float64)
     return centres, _turn(yaws), halves
+
+
+def hand_in_world(hand, xyz, yaw: float):
+    """``hand`` (`hand_obbs` of G grasps, in the held object's frame) with the object centred
+    at ``xyz`` (m) turned ``yaw`` (rad): the 3 G boxes in the world, flat, as `obb_overlap`
+    takes them."""
+    centres, axes, halves = hand
+    turn = _turn(np.asarray(yaw))  # (3, 3)
+    return (
+        (centres @ turn.T + np.asarray(xyz)).reshape(-1, 3),
+        (turn @ axes).reshape(-1, 3, 3),
+        halves.reshape(-1, 3),
+    )
 
 
 def _turn(yaws: np.ndarray) -> np.ndarray:
@@ -158,18 +144,6 @@ def obb_overlap(a, b, touch: float = TOUCH) -> np.ndarray:
     length = np.linalg.norm(axes, axis=-1)  # 0 for parallel edges: never separating
     out[ia, ib] = ~(gap > reach_a + reach_b - touch * length).any(-1)
     return out
-
-
-def solid_boxes(solids: Sequence[Solid]) -> np.ndarray:
-    """(S, 2, 3) axis-aligned bounds (m) of upright solids (turned ones: their bounding box)."""
-    out = []
-    for s in solids:
-        c, d = abs(np.cos(s.yaw)), abs(np.sin(s.yaw))
-        hx = c * s.half[0] + d * s.half[1]
-        hy = d * s.half[0] + c * s.half[1]
-        half = np.array([hx, hy, s.half[2]]) if not s.cylinder else np.array(s.half)
-        out.append((np.asarray(s.centre) - half, np.asarray(s.centre) + half))
-    return np.asarray(out).reshape(-1, 2, 3)
 
 
 class _Window:
@@ -212,7 +186,7 @@ class GeoCosts:
         self.grasps: dict[str, tuple[Grasp, ...]] = dict(grasps)
         self._base: dict[State, tuple[np.ndarray, dict]] = {}
         self._ik: dict[tuple[int, int, int], tuple[np.ndarray, bool]] = {}
-        self._hands: dict[str, np.ndarray] = {}  # object -> `hand_corners` of its grasps
+        self._hands: dict[str, tuple] = {}  # object -> `hand_obbs` of its grasps
         self.failed: dict[tuple[State, Move, str], set] = {}
         self.stats = {"states": 0, "price_s": 0.0, "ik_targets": 0}
 
@@ -312,17 +286,11 @@ class GeoCosts:
         solids = tuple(np.concatenate(parts) for parts in zip(fixed, *others, strict=True))
         if x not in self._hands:
             self._hands[x] = hand_obbs(self.grasps[x], self.config.margin)
-        centres, axes, halves = self._hands[x]  # (G, 3, ...) in x's frame
-        g = len(centres)
-        if not g or not len(solids[0]):
+        count = len(self._hands[x][0])  # G grasps
+        if not count or not len(solids[0]):
             return {g.name for g in self.grasps[x]}
-        turn = _turn(np.asarray(yaw))  # (3, 3)
-        hand = (
-            (centres @ turn.T + np.asarray(xyz)).reshape(-1, 3),
-            (turn @ axes).reshape(-1, 3, 3),
-            halves.reshape(-1, 3),
-        )  # the hand's 3 G boxes in the world
-        hit = obb_overlap(hand, solids).reshape(g, -1).any(-1)  # (G,)
+        hand = hand_in_world(self._hands[x], xyz, yaw)
+        hit = obb_overlap(hand, solids).reshape(count, -1).any(-1)  # (G,)
         return {g.name for g, h in zip(self.grasps[x], hit, strict=True) if not h}
 
     def _solve(self, points: list) -> tuple[np.ndarray, np.ndarray]:

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motion.grasps import grasps
+from motion.grasps import grasps, world_tcp
 from tamp.geo.check import check_move
 from tamp.geo.ours.bridge import bridge
-from tamp.geo.ours.costs import GeoCosts, hand_boxes, hand_corners
+from tamp.geo.ours.costs import GeoCosts, hand_in_world, hand_obbs, hand_shape
 from tamp.world.goal import parse_goal
 from task.costs import IMPOSSIBLE
 from task.domains import blocksworld as bw
@@ -68,14 +68,17 @@ def test_a_failure_rules_a_move_out_only_under_its_grasp_and_place(priced):
 
 @pytest.mark.parametrize("yaw", [0.0, 0.4])
 def test_the_batched_hand_boxes_are_those_of_each_grasp_alone(yaw):
+    """Every grasp's palm and finger boxes, batched in the object's frame and turned with it,
+    stand where `motion.grasps.world_tcp` puts that grasp's hand alone."""
     made = grasps("cuboid", (0.02, 0.03, 0.025))
-    corners = hand_corners(made, 0.004)  # (G, 3, 8, 3)
     xyz = np.array([0.5, 0.1, 0.025])
-    turn = np.array([[np.cos(yaw), -np.sin(yaw), 0], [np.sin(yaw), np.cos(yaw), 0], [0, 0, 1]])
-    pts = corners @ turn.T + xyz
+    centres, axes, halves = hand_in_world(hand_obbs(made, 0.004), xyz, yaw)  # 3 G boxes
     for i, g in enumerate(made):
-        one = hand_boxes(g, xyz, yaw, 0.004)  # (3, 2, 3)
-        assert np.allclose(one[:, 0], pts[i].min(1)) and np.allclose(one[:, 1], pts[i].max(1))
+        tcp = world_tcp(g, xyz, yaw)  # (4, 4)
+        for k, (centre, half) in enumerate(hand_shape(g)):
+            assert np.allclose(centres[3 * i + k], tcp[:3, :3] @ np.asarray(centre) + tcp[:3, 3])
+            assert np.allclose(axes[3 * i + k], tcp[:3, :3])
+            assert np.allclose(halves[3 * i + k], np.asarray(half) + 0.004)
 
 
 def test_oriented_boxes_overlap_only_where_they_truly_interpenetrate():
