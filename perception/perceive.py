@@ -1,7 +1,8 @@
 """From RGB images to soft support matrices: segmentation, model inputs, KL anchors, blur.
 
 `Perceiver` wraps a trained `SupportModel`: ``inputs`` finds each block's box by its colour
-and stacks the images; ``support`` runs the model. Everything after segmentation is a torch
+and stacks the images; ``support`` runs the model, on the perceiver's ``device`` (the CPU unless
+told, e.g. "cuda"). Everything after segmentation is a torch
 function of the images and the weights, so planning losses can reach the weights.
 """
 
@@ -48,20 +49,23 @@ class Perceiver:
         model: SupportModel,
         segment: SegmentConfig = SegmentConfig(),
         input_hw: Sequence[int] | None = None,
+        device: str = "cpu",
     ) -> None:
-        self.model = model.eval()
+        self.device = torch.device(device)
+        self.model = model.to(self.device).eval()
         self.segment = segment
         self.input_hw = None if input_hw is None else tuple(int(v) for v in input_hw)
         for p in self.model.parameters():
             p.requires_grad_(False)
 
     @classmethod
-    def load(cls, path: str | Path, scene: str | None = None) -> Perceiver:
+    def load(cls, path: str | Path, scene: str | None = None, device: str = "cpu") -> Perceiver:
         """The checkpoint at ``path``; one trained at one input size for several resolutions
         (its meta's ``input_hw``) resizes every image to that size first. With ``scene`` (the
-        image scene it is to read), one trained on another scene is refused (`load_checkpoint`)."""
+        image scene it is to read), one trained on another scene is refused (`load_checkpoint`).
+        ``device``: where the model runs (a torch device name such as "cuda")."""
         model, meta = load_checkpoint(path, scene)
-        return cls(model, input_hw=meta.get("input_hw"))
+        return cls(model, input_hw=meta.get("input_hw"), device=device)
 
     def inputs(
         self,
@@ -69,7 +73,8 @@ class Perceiver:
         colours: Sequence[Sequence[Sequence[float]]],
         names: Sequence[Sequence[str]] | None = None,
     ) -> tuple[Tensor, Tensor, Tensor]:
-        """Model inputs of B images: (B, 3, H, W) float, boxes (B, N, 4), mask (B, N).
+        """Model inputs of B images: (B, 3, H, W) float, boxes (B, N, 4), mask (B, N), on
+        the perceiver's device.
 
         ``colours[b]`` lists the RGB colour (in [0, 1]) of each block of image b, in the
         problem's entity order; N is the most blocks of any image (padding is masked).
@@ -91,7 +96,8 @@ class Perceiver:
             boxes[b, : len(cols)] = find_boxes(im, cols, who, self.segment)
             mask[b, : len(cols)] = True
         stack = torch.from_numpy(np.stack(images)).permute(0, 3, 1, 2)  # (B, 3, H, W) uint8
-        return as_float(stack), torch.from_numpy(boxes), torch.from_numpy(mask)
+        images_, boxes_ = as_float(stack.to(self.device)), torch.from_numpy(boxes).to(self.device)
+        return images_, boxes_, torch.from_numpy(mask).to(self.device)
 
     def support(self, inputs: tuple[Tensor, Tensor, Tensor]) -> Tensor:
         """Soft supports F (B, N, N+K) of `inputs` (see `inputs`) by this perceiver's model."""

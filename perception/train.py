@@ -31,6 +31,8 @@ class TrainConfig:
     lr: float = 2e-3
     weight_decay: float = 1e-5
     seed: int = 0
+    device: str = "cpu"  # torch device of the model and its batches ("cuda": a GPU); the
+    # initialisation and the batch order are drawn on the CPU, the same on every device
 
 
 def as_float(images: Tensor) -> Tensor:
@@ -50,15 +52,18 @@ def nll(F: Tensor, target: Tensor, mask: Tensor) -> Tensor:
 
 @torch.no_grad()
 def evaluate(model: SupportModel, data: dict[str, Tensor], batch: int = 64) -> dict[str, float]:
-    """Relation and scene accuracy, and the mean NLL, of ``model`` on ``data`` (`tensors`)."""
+    """Relation and scene accuracy, and the mean NLL, of ``model`` on ``data`` (`tensors`),
+    each batch read on the model's device."""
     model.eval()
+    device = next(model.parameters()).device
     right = blocks = scenes = 0
     loss = 0.0
     m = len(data["images"])
     for start in range(0, m, batch):
         sl = slice(start, start + batch)
-        F = model(as_float(data["images"][sl]), data["boxes"][sl], data["mask"][sl])
-        mask, target = data["mask"][sl], data["target"][sl]
+        images, boxes = data["images"][sl].to(device), data["boxes"][sl].to(device)
+        mask, target = data["mask"][sl].to(device), data["target"][sl].to(device)
+        F = model(as_float(images), boxes, mask)
         ok = (F.argmax(-1) == target) | ~mask  # (B, N)
         right += int((ok & mask).sum())
         blocks += int(mask.sum())
@@ -85,6 +90,8 @@ def train(
     with torch.random.fork_rng():  # seeded initialisation without touching the global RNG
         torch.manual_seed(config.seed)
         model = SupportModel(model_config)
+    device = torch.device(config.device)
+    model = model.to(device)
     opt = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     m = len(data["images"])
     steps = config.epochs * ((m + config.batch - 1) // config.batch)
@@ -95,8 +102,9 @@ def train(
         total = 0.0
         for start in range(0, m, config.batch):
             idx = order[start : start + config.batch]
-            F = model(as_float(data["images"][idx]), data["boxes"][idx], data["mask"][idx])
-            loss = nll(F, data["target"][idx], data["mask"][idx])
+            batch = {k: data[k][idx].to(device) for k in ("images", "boxes", "mask", "target")}
+            F = model(as_float(batch["images"]), batch["boxes"], batch["mask"])
+            loss = nll(F, batch["target"], batch["mask"])
             opt.zero_grad(set_to_none=True)
             loss.backward()
             opt.step()
@@ -112,7 +120,7 @@ def save_checkpoint(path: str | Path, model: SupportModel, meta: dict) -> Path:
     """Write the weights, the model config and ``meta`` (how they were made) to ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    state = {k: v.detach().clone() for k, v in model.state_dict().items()}
+    state = {k: v.detach().cpu().clone() for k, v in model.state_dict().items()}  # on any device
     torch.save({"config": dataclasses.asdict(model.config), "state": state, "meta": meta}, path)
     return path
 

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 # moves per window (horizon, lookahead): far beyond any plan the windows decode, and the window's
 # (B, T, N, A) logits and T-step rollout graph grow with it (1_000_000 hung before planning)
 MAX_HORIZON = 1000
 FALLBACK_SEARCHES = ("astar", "greedy")  # `PlannerConfig.fallback_search`
+DEVICES = ("cpu", "cuda", "cuda:N")  # `PlannerConfig.device`: torch devices planning runs on
+_DEVICE = re.compile(r"cpu|cuda(:\d+)?")
 
 
 @dataclass(frozen=True)
@@ -54,6 +57,9 @@ class PlannerConfig:
     window_share: float = 1.0  # with a time limit and the fallback on, the windows stop at
     # this share of the limit and the fallback searches in the rest (1: the windows may use all
     # of it, leaving the complete search none; the STRIPS lift's defaults: 0.5)
+    device: str = "cpu"  # torch device of the window tensors (and of a perception model read
+    # alongside): "cpu", "cuda" or "cuda:N"; never falls back (`torch_device` refuses one that
+    # this machine lacks). Decoding and the crisp checks stay on the CPU
 
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:
@@ -80,6 +86,7 @@ class PlannerConfig:
                 raise TampError(
                     f"PlannerConfig.{name} must be in 1..{MAX_HORIZON}, got {getattr(self, name)}"
                 )
+        check_device_name(self.device)
         if self.fallback_search not in FALLBACK_SEARCHES:
             from task.errors import one_of
 
@@ -100,3 +107,45 @@ class PlannerConfig:
         sharp = self.decode_tau if self.decode_tau is not None else self.tau_end
         if self.tau <= 0 or self.tau_end <= 0 or self.lr <= 0 or sharp <= 0:
             raise TampError("PlannerConfig.tau, tau_end, decode_tau and lr must be > 0")
+
+
+def check_device_name(name: str) -> str:
+    """``name`` when it spells a device planning knows (`DEVICES`), else TampError listing
+    them. Whether this machine has it is `torch_device`'s question."""
+    from task.errors import TampError, one_of
+
+    if not isinstance(name, str) or not _DEVICE.fullmatch(name):
+        raise TampError(f"unknown device {one_of(name, DEVICES)}")
+    return name
+
+
+def device_problem(name: str) -> str | None:
+    """Why this machine cannot run torch on device ``name`` (one line), or None when it can.
+    Imports torch only for a CUDA device."""
+    check_device_name(name)
+    if name == "cpu":
+        return None
+    import torch
+
+    if not torch.backends.cuda.is_built():
+        return f"this torch build has no CUDA (torch {torch.__version__})"
+    count = torch.cuda.device_count()
+    if count == 0:
+        return f"no CUDA device is visible (torch {torch.__version__}, CUDA {torch.version.cuda})"
+    index = int(name.partition(":")[2] or 0)
+    if index >= count:
+        return f"only {count} CUDA device(s) here (valid: cuda, cuda:0..cuda:{count - 1})"
+    return None
+
+
+def torch_device(name: str):
+    """The `torch.device` named ``name``; TampError (one line) when it is unknown or this
+    machine lacks it: a request for CUDA never silently runs on the CPU."""
+    from task.errors import TampError
+
+    why = device_problem(name)
+    if why is not None:
+        raise TampError(f"device {name!r}: {why}")
+    import torch
+
+    return torch.device(name)

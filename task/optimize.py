@@ -23,11 +23,12 @@ from task.rollout import Rollout, check_deadline, rollout
 def initial_logits(
     batch: SoftBatch, horizon: int, config: PlannerConfig, generator: torch.Generator
 ) -> Tensor:
-    """Gaussian logits, (B, T, N, A); each restart row draws its own noise."""
+    """Gaussian logits, (B, T, N, A), on the batch's device; each restart row draws its own
+    noise. ``generator`` is a CPU generator, so every device starts from the same logits."""
     b, n, a = batch.action_mask.shape
     shape = (b, horizon, n, a)
     noise = torch.randn(shape, generator=generator, dtype=torch.float64)
-    return (config.init_noise * noise).to(batch.F0.dtype)
+    return (config.init_noise * noise).to(batch.F0.dtype).to(batch.F0.device)
 
 
 def optimise_window(
@@ -112,6 +113,7 @@ def with_beliefs(batch: SoftBatch, beliefs: WindowBeliefs | None) -> tuple[SoftB
     if beliefs is None:
         return batch, batch.F0.new_zeros(())
     F0, goal, penalty = beliefs.compute()  # (P, N, Y), (P, N, Y), (P,)
+    F0, goal, penalty = (t.to(batch.F0.device) for t in (F0, goal, penalty))
     rows = batch.F0.shape[0]
     if F0.shape[1:] != batch.F0.shape[1:] or goal.shape != F0.shape or rows % F0.shape[0]:
         raise TampError(
@@ -136,7 +138,8 @@ def with_costs(batch: SoftBatch, costs: WindowCosts | None) -> Tensor | None:
         raise TampError(
             f"move costs of shape {tuple(c.shape)} do not fit a batch of {tuple(batch.F0.shape)}"
         )
-    return c.to(batch.F0.dtype).repeat_interleave(rows // c.shape[0], dim=0)  # (B, N, Y)
+    c = c.to(device=batch.F0.device, dtype=batch.F0.dtype)  # a CPU source's onto the batch's
+    return c.repeat_interleave(rows // c.shape[0], dim=0)  # (B, N, Y)
 
 
 def temperature(config: PlannerConfig, k: int) -> float:

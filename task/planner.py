@@ -24,11 +24,11 @@ from dataclasses import replace
 import torch
 
 from task.beliefs import BeliefSource, WindowBeliefs
-from task.config import PlannerConfig
+from task.config import PlannerConfig, torch_device
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
 from task.decode import decode_best
 from task.domains import get_domain
-from task.domains.base import Domain, State, resolve_goal_loss
+from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
@@ -48,9 +48,11 @@ def _window(
     costs: WindowCosts | None = None,
     deadline: float | None = None,
 ):
-    batch = domain.encode(problems, states, torch.float32).repeat(config.restarts)
-    horizons = torch.tensor(config.horizons()).repeat(len(problems))  # (B,)
-    steps = torch.arange(int(horizons.max())) < horizons[:, None]  # (B, T)
+    device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
+    batch = on_device(domain.encode(problems, states, torch.float32), device)
+    batch = batch.repeat(config.restarts)
+    horizons = torch.tensor(config.horizons(), device=device).repeat(len(problems))  # (B,)
+    steps = torch.arange(int(horizons.max()), device=device) < horizons[:, None]  # (B, T)
     _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs, deadline)
     return decode_best(
         domain,
@@ -66,6 +68,13 @@ def _window(
         config.rank_prefixes,
         config.park_free,
     )
+
+
+def on_device(batch: SoftBatch, device: torch.device) -> SoftBatch:
+    """``batch`` with every tensor, its ``static`` ones too, on ``device`` (domains encode on
+    the CPU; the window's optimisation and rollout then run where the batch is)."""
+    static = {k: v.to(device) for k, v in batch.static.items()}
+    return SoftBatch(*(t.to(device) for t in batch.astuple()), static=static)
 
 
 def _retry_frozen(
@@ -384,6 +393,7 @@ def plan_batch(
     problem (the batch's time divided among its problems when batched). ``beliefs`` gives
     every window soft initial and goal supports (planning from perception, `task.beliefs`);
     ``costs`` every window move costs (the arm in the objective, `task.costs`).
+    The windows run on ``config.device`` (TampError when this machine lacks it).
     """
     if not problems:
         return []
@@ -395,7 +405,8 @@ def plan_batch(
         raise ProblemError(
             f"unknown goal loss for {domain.name} {one_of(config.goal_loss, domain.goal_losses)}"
         )
-    generator = torch.Generator().manual_seed(seed)
+    torch_device(config.device)  # refused in one line where this machine lacks it
+    generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
     report = progress or (lambda k: None)
     if not config.batched:
         return [

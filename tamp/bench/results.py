@@ -52,11 +52,15 @@ def git_state(root: Path | None = None) -> tuple[str | None, bool | None]:
     return commit.strip(), bool(status.strip())
 
 
-def machine(argv: Sequence[str] | None = None) -> dict:
+def machine(argv: Sequence[str] | None = None, device: str | None = None) -> dict:
     """Where and from what the benchmark ran: the machine, its load average as the run ended,
-    the date, the command line ``tamp`` + ``argv`` (None when no command line ran it) and
-    `git_state`."""
+    the date, the command line ``tamp`` + ``argv`` (None when no command line ran it),
+    `git_state`, and the torch ``device`` planning ran on (None: the CPU) with the GPU's name
+    on a CUDA device."""
     import torch
+
+    device = device or "cpu"
+    gpu = torch.cuda.get_device_name(torch.device(device)) if device != "cpu" else None
 
     commit, dirty = git_state()
     return {
@@ -66,7 +70,9 @@ def machine(argv: Sequence[str] | None = None) -> dict:
         "python": platform.python_version(),
         "torch": torch.__version__,
         "torch_threads": torch.get_num_threads(),
-        "device": "cpu",
+        "device": device,
+        "gpu": gpu,
+        "cuda": torch.version.cuda,
         "date": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
         "load_1min": round(os.getloadavg()[0], 2),  # other work on the machine as it finished
         "command": None if argv is None else f"tamp {shlex.join(argv)}".strip(),
@@ -88,7 +94,7 @@ def results(bench: Bench, argv: Sequence[str] | None = None) -> dict:
         "seeds": list(bench.seeds),
         "horizons": list(bench.horizons),
         "config": asdict(bench.config),
-        "machine": machine(argv),
+        "machine": machine(argv, bench.config.device),
         "summary": [s.asdict() for s in main_rows(bench)],
         "size_name": bench.size_name,
         "by_size": [s.asdict() for s in size_rows(bench)],

@@ -78,7 +78,7 @@ def most_likely_state(problem: Problem, F: Tensor) -> tuple[str, ...]:
     n, rows = problem.n, F.shape[0]
     if F.ndim != 2 or rows < n or F.shape[1] != rows + len(problem.fixed):
         raise ProblemError(f"soft state of shape {tuple(F.shape)} does not fit {n} blocks")
-    logf = torch.log(F.detach().double().clamp_min(1e-300))  # (N, Y)
+    logf = torch.log(F.detach().cpu().double().clamp_min(1e-300))  # (N, Y), read on the CPU
     blocks = torch.cat([logf[:n, :n], logf[:n, rows:]], dim=1)  # (n, n+1), table last
     names = [*problem.entities, TABLE]
     if n <= ENUMERATE_UP_TO:

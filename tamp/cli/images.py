@@ -69,8 +69,8 @@ def images_command(args: argparse.Namespace) -> int:
     names, rgbs = blocks_in(images, paths, args.image_scene)
     # a checkpoint trained at one input size for several resolutions resizes every image
     options = {"input_hw": meta["input_hw"]} if meta.get("input_hw") else {}
-    perceiver = Perceiver(model, **options)
     config = planner_config(args, blocksworld.NAME)
+    perceiver = Perceiver(model, **options, device=config.device)
     setup_s = time.perf_counter() - t0
     threads = torch.get_num_threads()
     torch.set_num_threads(args.threads)

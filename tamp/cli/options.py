@@ -16,6 +16,7 @@ from tamp.cli.types import (
     _names,
     block_counts,
     bounded,
+    device,
     nonnegative,
     placement,
     positive,
@@ -54,6 +55,7 @@ _OVERRIDES = (
     "time_limit_s",
     "lambda_motion",
     "park_free",
+    "device",
 )
 
 
@@ -134,6 +136,13 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         help="stop planning at this wall-clock limit with the moves so far, and say so (none)",
     )
     g.add_argument(
+        "--device",
+        type=device,
+        metavar="DEVICE",
+        help=f"torch device of the planner's tensors (and of perception): cpu, cuda or cuda:N "
+        f"({d.device}; refused where this machine has no such device)",
+    )
+    g.add_argument(
         "--tau-end",
         type=positive_float,
         metavar="TAU",
@@ -141,6 +150,18 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         f"({d.tau_end:g}; {d.tau:g} = no annealing, the paper's planner)",
     )
     return p
+
+
+def device_option(p: argparse.ArgumentParser, whose: str) -> None:
+    """``--device cpu|cuda|cuda:N`` for a command that runs torch outside the planner."""
+    p.add_argument(
+        "--device",
+        type=device,
+        default="cpu",
+        metavar="DEVICE",
+        help=f"torch device of {whose} tensors: cpu, cuda or cuda:N (cpu; refused where this "
+        "machine has no such device)",
+    )
 
 
 def data_option(p: argparse.ArgumentParser, domains: bool = False) -> None:

@@ -14,6 +14,7 @@ from tamp.cli.options import (
     IMAGE_SCENES,
     Parser,
     data_option,
+    device_option,
     episode_options,
     executability_options,
     output_options,
@@ -487,6 +488,7 @@ def _perception_commands(sub) -> None:
     p.add_argument("--epochs", type=positive, default=EPOCHS, help="(%(default)s)")
     p.add_argument("--seed", type=seed, default=0, help="initialisation and batch order (0)")
     p.add_argument("--threads", type=threads, default=2, help="torch threads (2)")
+    device_option(p, "the model's and its batches'")
     p.add_argument(
         "--out",
         required=True,
@@ -506,6 +508,7 @@ def _perception_commands(sub) -> None:
     p.add_argument(
         "--blur", type=radius, default=0, metavar="R", help="Gaussian blur radius, pixels (0)"
     )
+    device_option(p, "the model's")
     p.add_argument("--json", action="store_true")
     p.set_defaults(
         func=_lazy("tamp.cli.perception", "eval_command"),

@@ -126,7 +126,7 @@ def train_command(args: argparse.Namespace) -> int:
     test_raw = pdata.load_many(args.test.split(",")[:1])
     train_data, test_data = pdata.tensors(train_raw), pdata.tensors(test_raw)
     hw = list(train_raw.images.shape[1:3])
-    config = TrainConfig(epochs=args.epochs, seed=args.seed)
+    config = TrainConfig(epochs=args.epochs, seed=args.seed, device=args.device)
     with tqdm(
         total=config.epochs, desc="train", unit="epoch", file=sys.stderr, disable=not args.progress
     ) as bar:
@@ -190,6 +190,7 @@ def eval_command(args: argparse.Namespace) -> int:
     recorded = eval_config(args)
     checkpoint(args.checkpoint)
     model, meta = load_checkpoint(args.checkpoint)
+    model = model.to(args.device)
     data = pdata.load(args.data)
     if args.blur:
         from perception.perceive import blur

@@ -397,12 +397,18 @@ def train_config(args: argparse.Namespace) -> dict:
         "epochs": args.epochs,
         "seed": args.seed,
         "threads": args.threads,
+        "device": args.device,
     }
 
 
 def eval_config(args: argparse.Namespace) -> dict:
     """``perception eval``."""
-    return {"data": args.data, "checkpoint": str(args.checkpoint), "blur": args.blur}
+    return {
+        "data": args.data,
+        "checkpoint": str(args.checkpoint),
+        "blur": args.blur,
+        "device": args.device,
+    }
 
 
 def validate_config(args: argparse.Namespace) -> dict:

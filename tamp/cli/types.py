@@ -170,3 +170,18 @@ def _names(what: str, valid: tuple[str, ...]):
         return names
 
     return parse
+
+
+def device(text: str) -> str:
+    """``--device cpu|cuda|cuda:N``: a torch device this machine has (`task.config.DEVICES`);
+    one line naming why not otherwise (a CPU-only torch, no visible GPU). torch is imported
+    only for a CUDA device."""
+    from task.config import device_problem
+
+    try:
+        why = device_problem(text)
+    except TampError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    if why is not None:
+        raise argparse.ArgumentTypeError(f"{text}: {why}")
+    return text

@@ -50,7 +50,8 @@ def camera_goal(problem: Problem, config: LoopConfig, seed: int):
     Returns ``(perceiver, goal_image, target)``: ``target`` is ``problem`` with the perceived
     goal, what the robot plans for and tests.
     """
-    perceiver = Perceiver.load(config.checkpoint or CHECKPOINT, scene="cubes")  # workcell renders
+    # workcell renders, read on the planner's device
+    perceiver = Perceiver.load(config.checkpoint or CHECKPOINT, "cubes", config.planner.device)
     goal_state = complete_goal(problem)
     with StateRenderer(config.sim, config.scene, config.camera) as renderer:
         goal_image = renderer.render(problem.entities, goal_state, seed + 1)

@@ -91,8 +91,9 @@ def load(root: str | Path = DEFAULT, limit: int | None = None) -> LatPlanData:
     return LatPlanData(root, domain, tuple(instances), tuple(folders))
 
 
-def load_perceiver(path: str | Path) -> Perceiver:
-    """The perception checkpoint at ``path``; one-line DataError naming the fix if absent.
+def load_perceiver(path: str | Path, device: str = "cpu") -> Perceiver:
+    """The perception checkpoint at ``path`` (its model on torch ``device``); one-line
+    DataError naming the fix if absent.
 
     A checkpoint trained on another scene (the cube one, the documented negative control) is
     not refused, but warned about on stderr, and `report` records its scene
@@ -107,7 +108,7 @@ def load_perceiver(path: str | Path) -> Perceiver:
     trained = checkpoint_scene(meta)
     if trained != SCENE:
         print(f"warning: {scene_warning(path, trained)}", file=sys.stderr, flush=True)
-    return Perceiver(model, input_hw=meta.get("input_hw"))
+    return Perceiver(model, input_hw=meta.get("input_hw"), device=device)
 
 
 def scene_warning(path: str | Path, trained: str | None) -> str:

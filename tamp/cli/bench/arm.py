@@ -74,7 +74,7 @@ def motion_command(args: argparse.Namespace) -> int:
     inject = str(base.inject)
     body = {
         "config": recorded,
-        "machine": results.machine(args.argv),
+        "machine": results.machine(args.argv, getattr(args, "device", None)),
         "ik_batch": result.ik,
         "summary": result.summary,
     }
@@ -192,7 +192,7 @@ def executability_command(args: argparse.Namespace) -> int:
                 body = {
                     "config": recorded,
                     "partial": {"done": len(done), "of": total},
-                    "machine": results.machine(args.argv),
+                    "machine": results.machine(args.argv, getattr(args, "device", None)),
                     "summary": bench.given_summary(done, sims) if done else [],
                 }
                 results.write_json(folder / "results.json", body)
@@ -201,7 +201,7 @@ def executability_command(args: argparse.Namespace) -> int:
     summary, wall = bench.given_summary(rows, sims), time.perf_counter() - wall0
     body = {
         "config": recorded,
-        "machine": results.machine(args.argv),
+        "machine": results.machine(args.argv, getattr(args, "device", None)),
         "wall_s": wall,
         "summary": summary,
     }

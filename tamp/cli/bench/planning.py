@@ -55,7 +55,7 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
                 body = {
                     "config": recorded,
                     "partial": partial,
-                    "machine": results.machine(args.argv),
+                    "machine": results.machine(args.argv, getattr(args, "device", None)),
                 }
                 results.write_json(out / "results.json", body)
                 results.write_csv(out / "instances.csv", done)

@@ -42,8 +42,8 @@ def perception_command(args: argparse.Namespace) -> int:
     torch.set_num_threads(args.threads)
     suite = suites.planbench(args.data, args.n)
     chosen = list(suite.instances)
-    perceiver = Perceiver.load(args.checkpoint, scene="cubes")  # PlanBench renders
     config = planner_config(args)
+    perceiver = Perceiver.load(args.checkpoint, "cubes", config.device)  # PlanBench renders
     horizons = args.horizons or (config.horizon,)
     modes = [  # ground truth (no images) once, as crisp "true"
         PerceptionMode(
@@ -94,7 +94,7 @@ def perception_command(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "threads": args.threads,
         "cores": os.cpu_count(),
-        "machine": results.machine(args.argv),
+        "machine": results.machine(args.argv, getattr(args, "device", None)),
         "date": time.strftime("%Y-%m-%d"),
         "redrawn_renders": result.redrawn,
         "corruption": corruption.name,
@@ -136,9 +136,9 @@ def latplan_command(args: argparse.Namespace) -> int:
         checkpoint(args.checkpoint)
     data = latplan.load(args.data, args.limit)
     images = any(m != "state" for m in modes)
-    perceiver = latplan.load_perceiver(args.checkpoint) if images else None
-    torch.set_num_threads(args.threads)
     config = planner_config(args, "blocksworld")
+    perceiver = latplan.load_perceiver(args.checkpoint, config.device) if images else None
+    torch.set_num_threads(args.threads)
     seeds = tuple(range(args.seeds))
     total = latplan.total(len(data.instances), len(res), modes, len(seeds))
     with bar(total, f"latplan ({len(data.instances)} instances)", args.progress) as update:
@@ -153,7 +153,9 @@ def latplan_command(args: argparse.Namespace) -> int:
         "config": asdict(config),
         "recorded": recorded,
     }
-    body = latplan.report(data, rows, summary, options, results.machine(args.argv))
+    body = latplan.report(
+        data, rows, summary, options, results.machine(args.argv, getattr(args, "device", None))
+    )
     if args.out is not None:
         out = results.out_folder(args.out)
         results.write_json(out / "results.json", body)
@@ -196,7 +198,7 @@ def poses_command(args: argparse.Namespace) -> int:
         )
     body = {
         "config": recorded,
-        "machine": results.machine(args.argv),
+        "machine": results.machine(args.argv, getattr(args, "device", None)),
         "summary": result.summary,
     }
     if args.out:
@@ -256,12 +258,16 @@ def segmentation_command(args: argparse.Namespace) -> int:
                 body = {
                     **head,
                     "partial": {"done": len(files), "of": len(datasets)},
-                    "machine": results.machine(args.argv),
+                    "machine": results.machine(args.argv, getattr(args, "device", None)),
                     "files": files,
                 }
                 results.write_json(results.out_folder(args.out) / "results.json", body)
             return interrupted(args.out, len(files), len(datasets), "files")
-    body = {**head, "machine": results.machine(args.argv), "files": files}
+    body = {
+        **head,
+        "machine": results.machine(args.argv, getattr(args, "device", None)),
+        "files": files,
+    }
     if args.out is not None:
         results.write_json(results.out_folder(args.out) / "results.json", body)
     if args.json:

@@ -20,6 +20,7 @@ from perception import CHECKPOINT
 from perception import data as pdata
 from tamp.cli import build_parser, main
 from tamp.cli.recorded import PRESENTATION
+from task.config import check_device_name
 from task.errors import TampError
 
 # the positional arguments and required options of each command (never read by `recorded`)
@@ -65,6 +66,7 @@ SAMPLES = {
     "--planner": "search",
     "--record": "episode.rrd",  # run and demo: a file (the benchmarks: a flag)
     "--peers": "pyperplan,lama",
+    "--device": "cuda",  # accepted in the walk as on a machine with a GPU (`_inputs`)
 }
 # what an option needs to take effect, per command where it differs; tried in order
 NEEDS = {
@@ -94,7 +96,9 @@ NOT_RUNS = {"bench record"}
 def _inputs(tmp_path_factory):
     """The base invocation of commands that refuse missing input files before any work: a
     tiny support dataset (one blank 30x45 image, no block; the walk reads no pixel) and the
-    shipped checkpoint."""
+    shipped checkpoint. ``--device cuda`` is accepted as on a machine with a GPU (the walk
+    runs nothing on it; tests/tamp/cli/test_device_option.py checks the refusal where there
+    is none)."""
     blank = pdata.SupportData(
         images=np.zeros((1, 30, 45, 3), np.uint8),
         colours=np.full((1, 4), -1, np.int8),
@@ -105,6 +109,7 @@ def _inputs(tmp_path_factory):
     path = pdata.save(tmp_path_factory.mktemp("inputs") / "tiny.npz", blank)
     with pytest.MonkeyPatch.context() as patch:
         patch.setitem(BASE, "bench segmentation", [str(path), "--checkpoint", str(CHECKPOINT)])
+        patch.setattr("task.config.device_problem", lambda name: check_device_name(name) and None)
         yield
 
 
