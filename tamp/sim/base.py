@@ -2,15 +2,18 @@
 
 A backend owns a world with the Panda, a table and the blocks of a scene. The same
 `motion.trajectory.JointTrajectory` (sampled at the simulator's ``dt`` = 2 ms in both
-backends) drives both: each physics step gets the trajectory's joint targets. What the loop
+backends) drives both. The physics steps ``physics_dt`` = 4 ms (`PHYSICS_DT`): each step gets
+the joint targets of the last trajectory sample it covers, so every other sample is commanded
+(the controller runs at 250 Hz; a 2 ms step cost twice the wall time, and the grasps, tracking
+and scores hold at 4 ms). What the loop
 may sense is what a real robot has: joint positions, finger opening and the contact force on
 each finger (from whatever it touches), and camera images. The true block poses, and the
 snapshots a video is drawn from, sit behind ``sim.truth`` (`tamp.sim.truth.GroundTruth`), which
 scores episodes and which an episode locks.
 
 Contact scoring (``Simulator.touched``, the experimenter's, never a sensor): after every physics
-step, whatever touches the arm, the hand or the block held in it is counted, except the
-contacts the running trajectory is meant to make (`Expected`).
+step, whatever touches the arm, the hand or the block held in it is counted (in physics steps
+of ``physics_dt``), except the contacts the running trajectory is meant to make (`Expected`).
 """
 
 from __future__ import annotations
@@ -30,8 +33,8 @@ from tamp.sim.truth import GroundTruth
 from task.errors import TampError, one_of
 
 SIMULATORS = ("pybullet", "mujoco")
-DT = 0.002  # s, physics step of both backends
-TRACK_EVERY = 5  # steps between tracking-error samples
+DT = 0.002  # s, the period trajectories are sampled at (`Simulator.dt`)
+PHYSICS_DT = 0.004  # s, the physics step of both backends: two trajectory samples
 ROBOT = "robot"  # `Simulator._contacts`' name for any link of the Panda
 HELD = "held:"  # `Simulator.touched` key prefix of what the held block touched, e.g. "held:c"
 VIDEO_SIZE = (640, 480)  # (width, height) of `Simulator.render_video` frames
@@ -132,6 +135,7 @@ class Simulator(abc.ABC):
 
     name: str = ""
     dt: float = DT
+    physics_dt: float = PHYSICS_DT
 
     def __init__(
         self,
@@ -258,31 +262,46 @@ class Simulator(abc.ABC):
         on_frame: Callable[[Simulator], None] | None = None,
         expected: Expected = Expected(),
     ) -> float:
-        """Track ``trajectory`` step by step with the gripper held at ``gripper``.
+        """Track ``trajectory`` (sampled every ``dt``) with the gripper held at ``gripper``.
 
-        ``release_at`` (s into the trajectory) opens the gripper there (fault injection: a
-        drop; from then on nothing is held). ``on_frame(self)`` is called every
+        Each physics step of ``physics_dt`` covers `stride` samples and commands the last of
+        them (the final step the trajectory's last sample). ``release_at`` (s into the
+        trajectory) opens the gripper at the first commanded sample at or after it (fault
+        injection: a drop; from then on nothing is held). ``on_frame(self)`` is called every
         ``self.frame_period`` simulated seconds, on one clock across runs (a video's frames stay
         evenly spaced over many moves). After every physics step, the contacts of the arm and
         of the held block that ``expected`` does not name are counted in ``touched``. Returns
-        the largest joint tracking error (rad) seen every ``TRACK_EVERY`` steps and at the end.
+        the largest joint tracking error (rad), measured after every physics step against the
+        sample it commanded.
         """
         worst = 0.0
-        for k in range(len(trajectory.times)):
+        last = len(trajectory.times) - 1
+        for k in self.commanded(last + 1):
             if release_at is not None and trajectory.times[k] >= release_at:
                 gripper = "open"
                 self.detach()
                 expected = replace(expected, held=None, rests=frozenset())
             self._command(trajectory.positions[k], trajectory.velocities[k], gripper)
             self._step()
-            self.time += self.dt
+            self.time += self.physics_dt
             self._count_contacts(expected)
-            if k % TRACK_EVERY == 0 or k == len(trajectory.times) - 1:
-                worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
+            worst = max(worst, float(np.abs(self.arm_q() - trajectory.positions[k]).max()))
             if on_frame is not None and self.time >= self._next_frame:
                 on_frame(self)
                 self._next_frame = max(self._next_frame + self.frame_period, self.time)
         return worst
+
+    @property
+    def stride(self) -> int:
+        """Trajectory samples per physics step (``physics_dt / dt``, a whole number)."""
+        return max(1, round(self.physics_dt / self.dt))
+
+    def commanded(self, samples: int) -> list[int]:
+        """Indices of the samples that `run` commands, one per physics step, of a trajectory
+        with ``samples`` samples: the last sample each step covers (``stride - 1``,
+        ``2 stride - 1``, ...), and the trajectory's last sample for the final step."""
+        s = self.stride
+        return [min(k, samples - 1) for k in range(s - 1, samples + s - 1, s)]
 
     def _count_contacts(self, expected: Expected) -> None:
         """Count in ``touched`` this step's unexpected contacts of the arm and the held block."""

@@ -5,6 +5,12 @@ machine); set ``MUJOCO_GL`` yourself before anything imports mujoco to choose an
 Friction grasps rely on the elliptic cones and impratio the loader sets; the weld grasp mode
 uses one inactive weld equality per block whose relative pose is set at attach time
 (shared/notes/motion-research.md, section 5.3).
+
+Blocks at rest sleep (MuJoCo's sleeping islands, ``sleep_tolerance`` 1 mm/s for 10 steps): a
+sleeping block skips the pipeline, and its contacts with the table and other sleeping blocks
+are not computed (`MuJoCoSim._contacts` lists pairs with something awake). Anything awake
+touching it, a weld to the hand, or writing its ``qpos`` (`MuJoCoSim.set_block_pose`) wakes
+it and whatever it rests on or carries; the arm has actuators and never sleeps.
 """
 
 from __future__ import annotations
@@ -67,7 +73,7 @@ class MuJoCoSim(Simulator):
 
     def __init__(self, entities, poses, *args, **kwargs) -> None:
         super().__init__(entities, poses, *args, **kwargs)
-        s = panda_spec(timestep=self.dt)
+        s = panda_spec(timestep=self.physics_dt)
         cam = self.camera
         s.visual.global_.offwidth = max(cam.width, VIDEO_SIZE[0])
         s.visual.global_.offheight = max(cam.height, VIDEO_SIZE[1])
@@ -141,6 +147,7 @@ class MuJoCoSim(Simulator):
                 objtype=mujoco.mjtObj.mjOBJ_BODY,
                 active=False,
             )
+        s.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
         self.model = m = s.compile()
         self.data = d = mujoco.MjData(m)
         self._arm_q = np.array([m.joint(j).qposadr[0] for j in PANDA.arm_joints])

@@ -2,10 +2,17 @@
 
 Settings follow shared/notes/motion-research.md section 4: finger gear constraint (in the
 loader), position control of the arm with the trajectory's positions and velocities, 40 N per
-finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no GL needed).
+finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no GL needed);
+a physics step of ``physics_dt`` (4 ms) with `SOLVER_ITERATIONS` solver iterations.
 A world made for videos (``video=True``) draws with OpenGL instead, through PyBullet's EGL
 plugin (Mesa llvmpipe on a CPU machine): a 640x480 frame costs about 35 ms of CPU there, about
 120 ms with TinyRenderer (measured on the 2-core development machine).
+
+Blocks at rest sleep (Bullet's deactivation): a block whose squared speed ``|v|^2 + |w|^2``
+stays under `SLEEP_THRESHOLD` for 2 s (Bullet's fixed timeout) drops out of the solver until
+anything awake touches it (the arm never sleeps, nor does a block in the hand: it touches the
+fingers or is welded to the hand) or it is teleported (`PyBulletSim.set_block_pose` wakes every
+block). Resting stacks were most of a physics step; their contacts stay in `_contacts`.
 """
 
 from __future__ import annotations
@@ -36,6 +43,11 @@ ARM_KP, ARM_KD = 0.3, 1.0  # PyBullet position-control gains
 NEAR, FAR = 0.05, 3.0  # m, the camera's clipping planes
 LIGHT_DISTANCE = 40.0  # m, OpenGL's light from the camera target (40 m: shadows, no acne)
 EDGE = 1.02  # depths this far apart (ratio) in a 2x2 window straddle an edge: not interpolated
+# (m/s)^2 + (rad/s)^2: a block sleeps below this for 2 s; at rest they jitter at 5e-9..3e-6
+SLEEP_THRESHOLD = 1e-5
+# the constraint solver's iterations per step (Bullet's default 50): 20 tracks and grasps as
+# 50 does (tracking error 8.4 mrad both on PlanBench instance-450) at 0.7 of a step's cost
+SOLVER_ITERATIONS = 20
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
@@ -74,7 +86,8 @@ class PyBulletSim(Simulator):
         self.client = c = p.connect(p.DIRECT)
         self._gl = self.video and _egl_plugin(c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
-        p.setTimeStep(self.dt, physicsClientId=c)
+        p.setTimeStep(self.physics_dt, physicsClientId=c)
+        p.setPhysicsEngineParameter(numSolverIterations=SOLVER_ITERATIONS, physicsClientId=c)
         plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
         grey = [self.scene.floor_grey] * 3
         half = 0.05 if self._gl else 0.001  # top at z = 0.001; OpenGL's shadows need depth
@@ -105,7 +118,13 @@ class PyBulletSim(Simulator):
             pose, mass = poses[name], body_mass(self.scene, name)
             body = p.createMultiBody(mass, col, vis, pose.xyz, _quat(pose.yaw), physicsClientId=c)
             p.changeDynamics(
-                body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=c
+                body,
+                -1,
+                lateralFriction=1.0,
+                spinningFriction=0.001,
+                activationState=p.ACTIVATION_STATE_ENABLE_SLEEPING,
+                sleepThreshold=SLEEP_THRESHOLD,
+                physicsClientId=c,
             )
             self.blocks[name] = body
         self._weld: int | None = None
@@ -116,6 +135,10 @@ class PyBulletSim(Simulator):
             **{b: n for n, b in self.blocks.items()},
         }
         self._finger_command = ""
+        # contact scoring's names of bodies, and the arm's motor settings, made once
+        self._scored = {**self._names, self.robot.body: ROBOT}
+        self._efforts = list(PANDA.effort)
+        self._kp, self._kd = [ARM_KP] * 7, [ARM_KD] * 7
         self.set_view(self.camera, self.lighting)
         self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
         for _ in range(2 if self._gl else 0):  # the plugin's light lags two images (measured)
@@ -153,11 +176,11 @@ class PyBulletSim(Simulator):
             r.body,
             r.arm,
             p.POSITION_CONTROL,
-            targetPositions=list(q),
-            targetVelocities=list(qd),
-            forces=list(PANDA.effort),
-            positionGains=[ARM_KP] * 7,
-            velocityGains=[ARM_KD] * 7,
+            targetPositions=np.asarray(q, dtype=float).tolist(),
+            targetVelocities=np.asarray(qd, dtype=float).tolist(),
+            forces=self._efforts,
+            positionGains=self._kp,
+            velocityGains=self._kd,
             physicsClientId=c,
         )
         if gripper == self._finger_command:
@@ -195,7 +218,7 @@ class PyBulletSim(Simulator):
         return GripperReading(width, forces[0], forces[1])
 
     def _contacts(self) -> set[tuple[str, str]]:
-        names = {**self._names, self.robot.body: ROBOT}
+        names = self._scored
         pairs = {(pt[1], pt[2]) for pt in p.getContactPoints(physicsClientId=self.client)}
         return {(names[a], names[b]) for a, b in pairs if a in names and b in names}
 
@@ -211,6 +234,10 @@ class PyBulletSim(Simulator):
         body, c = self.blocks[block], self.client
         p.resetBasePositionAndOrientation(body, pose.xyz, _quat(pose.yaw), physicsClientId=c)
         p.resetBaseVelocity(body, [0, 0, 0], [0, 0, 0], physicsClientId=c)
+        for other in self.blocks.values():  # what rested on it falls: nothing stays asleep
+            p.changeDynamics(
+                other, -1, activationState=p.ACTIVATION_STATE_WAKE_UP, physicsClientId=c
+            )
 
     def _between_fingers(self) -> int | None:
         """The block body both fingers touch (the one between them), or None."""

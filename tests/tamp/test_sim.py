@@ -172,5 +172,5 @@ def test_frames_keep_one_clock_across_runs():
                 "open",
                 on_frame=lambda s: times.append(s.time),
             )
-    np.testing.assert_allclose(np.diff(times), 0.1, atol=1.5 * sim.dt)
+    np.testing.assert_allclose(np.diff(times), 0.1, atol=1.5 * sim.physics_dt)
     assert len(times) == 5  # 0.45 s: frames at 0.0, 0.1, 0.2, 0.3, 0.4 (plus a step)
