@@ -44,6 +44,10 @@ class Row:
     windows: int
     lama_length: int | None = None  # LAMA's first plan, PDDL actions (``--lama``; None: none)
     lama_s: float | None = None  # LAMA's wall seconds, translator and search
+    us_length: int | None = None  # Slaney & Thiebaux's US, PDDL actions (``--baselines``)
+    us_s: float | None = None  # US's seconds (None: US did not run)
+    gn1_length: int | None = None  # their GN1, PDDL actions (None: not run, or invalid)
+    gn1_s: float | None = None  # GN1's seconds
 
 
 @dataclass(frozen=True)
@@ -227,6 +231,32 @@ def with_lama(
                 for r in run.rows
             ),
         )
+        for run in bench.runs
+    )
+    return replace(bench, runs=runs)
+
+
+def with_baselines(
+    bench: Bench, suite: Suite, names: Sequence[str], progress: Callable[[int], None] | None = None
+) -> Bench:
+    """``bench`` with the plan length (validated against the instance's PDDL, `replay`; None
+    when invalid) and seconds of each Slaney & Thiebaux baseline in ``names`` ("us", "gn1",
+    `tamp.bench.peers.slaney`) on every row. Each runs once per instance; ``progress(1)``
+    after each instance."""
+    from tamp.bench.peers import slaney
+
+    report = progress or (lambda k: None)
+    found: dict[str, dict] = {}
+    for instance in suite.instances:
+        found[instance.name] = {}
+        for name in names:
+            planned = slaney.run(name, instance.problem)
+            validation = replay(suite.domain, instance, planned.moves)
+            length = validation.length if validation.valid else None
+            found[instance.name] |= {f"{name}_length": length, f"{name}_s": planned.seconds}
+        report(1)
+    runs = tuple(
+        replace(run, rows=tuple(replace(r, **found[r.instance]) for r in run.rows))
         for run in bench.runs
     )
     return replace(bench, runs=runs)

@@ -47,6 +47,16 @@ class Summary:
     lama_ratio: float | None = None  # mean LAMA length / optimum where the optimum is known
     lama_s: float | None = None  # LAMA's mean wall seconds per instance
     vs_lama: float | None = None  # mean our length / LAMA's, where both have a plan
+    us: float | None = None  # instances with a valid US plan (None: US did not run)
+    us_length: float | None = None  # mean length of US's plans (PDDL actions)
+    us_ratio: float | None = None  # mean US length / optimum where the optimum is known
+    us_s: float | None = None  # US's mean seconds per instance
+    vs_us: float | None = None  # mean our length / US's, where both have a plan
+    gn1: float | None = None  # the same for GN1 (`tamp.bench.peers.slaney`)
+    gn1_length: float | None = None
+    gn1_ratio: float | None = None
+    gn1_s: float | None = None
+    vs_gn1: float | None = None
 
     def asdict(self) -> dict:
         return asdict(self)
@@ -111,7 +121,26 @@ def summarise(
         lama_ratio=_mean([r.lama_length / r.optimal for r in lama if r.optimal]),
         lama_s=_mean([r.lama_s for r in rows if r.lama_s is not None]),
         vs_lama=_mean([r.length / r.lama_length for r in valid if r.lama_length]),
+        **_baseline("us", rows, valid),
+        **_baseline("gn1", rows, valid),
     )
+
+
+def _baseline(name: str, rows: Sequence[Row], valid: Sequence[Row]) -> dict:
+    """The Summary fields of baseline ``name`` ("us", "gn1"): its count of valid plans (None
+    when it did not run), mean length, mean length / optimum, mean seconds, ours / its."""
+    length = [getattr(r, f"{name}_length") for r in rows]
+    seconds = [getattr(r, f"{name}_s") for r in rows if getattr(r, f"{name}_s") is not None]
+    found = [(r, k) for r, k in zip(rows, length, strict=True) if k is not None]
+    return {
+        name: sum(1 for _ in found) if seconds else None,
+        f"{name}_length": _mean([k for _, k in found]),
+        f"{name}_ratio": _mean([k / r.optimal for r, k in found if r.optimal]),
+        f"{name}_s": _mean(seconds),
+        f"vs_{name}": _mean(
+            [r.length / getattr(r, f"{name}_length") for r in valid if getattr(r, f"{name}_length")]
+        ),
+    }
 
 
 def mean_over_seeds(per_seed: Sequence[Summary]) -> Summary:

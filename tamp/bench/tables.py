@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 
+from tamp.bench.peers.slaney import LABELS as BASELINE_LABELS
 from tamp.bench.planning import Bench
 from tamp.bench.summary import Summary, latency_rows, main_rows, size_rows
 
@@ -359,8 +360,14 @@ def lengths_table(bench: Bench) -> str:
     """Plan lengths by size, mean over seeds: ours (valid plans) and, where ``--lama`` ran,
     LAMA's first plan beside them. Lengths in moves (4-op actions / 2; blocksworld only)."""
     lama = any(s.lama is not None for s in size_rows(bench))
+    baselines = [
+        b for b in ("us", "gn1") if any(getattr(s, b) is not None for s in size_rows(bench))
+    ]
     head = ["T", bench.size_name, "valid", "moves", "x opt", "s/inst"]
     head += ["LAMA solved", "LAMA moves", "LAMA x opt", "LAMA s", "ours/LAMA"] if lama else []
+    for b in baselines:
+        label = BASELINE_LABELS[b]
+        head += [f"{label} moves", f"{label} x opt", f"{label} s", f"ours/{label}"]
     body = []
     for s in size_rows(bench):
         row = [
@@ -379,9 +386,18 @@ def lengths_table(bench: Bench) -> str:
                 _num(s.lama_s),
                 _num(s.vs_lama),
             ]
+        for b in baselines:
+            row += [
+                _num(getattr(s, f"{b}_length"), 0.5),
+                _num(getattr(s, f"{b}_ratio")),
+                _seconds(getattr(s, f"{b}_s")),
+                _num(getattr(s, f"vs_{b}")),
+            ]
         body.append(row)
     note = "moves: mean over plans found; x opt: mean length / optimum where the optimum is known"
     note += "; ours/LAMA: mean length ratio where both found a plan" if lama else ""
+    if baselines:
+        note += "; US, GN1: Slaney & Thiebaux's near-optimal Blocksworld algorithms (validated)"
     latency = latency_rows(bench)
     if latency:
         rows = [
@@ -392,6 +408,10 @@ def lengths_table(bench: Bench) -> str:
         note += f"\n\nplanning latency by {bench.size_name}, one problem at a time (s):\n"
         note += table(["T", bench.size_name, "plans", "p50", "p90", "max"], rows)
     return table(head, body) + "\n" + note
+
+
+def _seconds(value: float | None) -> str:
+    return "-" if value is None else f"{value:.4f}"
 
 
 def _num(value: float | None, scale: float = 1.0) -> str:

@@ -32,6 +32,7 @@ from tamp.cli.options import (
 from tamp.cli.types import (
     MAX_BLOCKS,
     PLAN_THREADS,
+    baseline_list,
     block_counts,
     bounded,
     nonnegative,
@@ -267,6 +268,14 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         help="also run Fast Downward's LAMA (first plan, --time-limit or "
         "60 s) on every instance: its length and time beside ours (needs the "
         "bench extra)",
+    )
+    random_.add_argument(
+        "--baselines",
+        type=baseline_list,
+        metavar="B[,B]",
+        help="also plan every instance with Slaney & Thiebaux's near-optimal Blocksworld "
+        "algorithms us (unstack-stack) and/or gn1 (Gupta & Nau's, constructive moves first): "
+        "their validated lengths and times beside ours (none)",
     )
     random_.set_defaults(
         func=_lazy("tamp.cli.bench.planning", "random_command"),

@@ -300,6 +300,8 @@ def planning_config(args: argparse.Namespace, domain: str | None = None) -> dict
             body[f"suite_{name}"] = list(value) if isinstance(value, tuple) else value
     if hasattr(args, "lama"):
         body["lama"] = args.lama
+    if hasattr(args, "baselines"):
+        body["baselines"] = list(args.baselines) if args.baselines else None
     if hasattr(args, "peers"):
         body["peers"] = list(peers) if peers else None
     return body

@@ -185,3 +185,11 @@ def device(text: str) -> str:
     if why is not None:
         raise argparse.ArgumentTypeError(f"{text}: {why}")
     return text
+
+
+BASELINES = ("us", "gn1")  # `tamp.bench.peers.slaney.BASELINES`, named without importing it
+
+
+def baseline_list(text: str) -> tuple[str, ...]:
+    """``--baselines us,gn1``: Slaney & Thiebaux's algorithms to run beside ours."""
+    return _names("baseline", BASELINES)(text)

@@ -24,7 +24,7 @@ from task.errors import TampError
 
 def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -> int:
     """Plan ``suite`` as ``args`` say; ``lengths``: also print the plan-length table (and run
-    LAMA beside with ``args.lama``)."""
+    LAMA beside with ``args.lama``, Slaney & Thiebaux's baselines with ``args.baselines``)."""
     import torch
 
     torch.set_num_threads(args.threads)
@@ -62,6 +62,10 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
             return interrupted(args.out, len(done), total, "plans (complete horizon-seed runs)")
     if getattr(args, "lama", False):
         result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
+    if getattr(args, "baselines", None):
+        names = ", ".join(args.baselines)
+        with bar(len(suite.instances), f"baselines ({names})", args.progress, "instance") as update:
+            result = planning.with_baselines(result, suite, args.baselines, update)
     body = results.results(result, args.argv)
     body["config"] = {**body["config"], **recorded}
     lines = None

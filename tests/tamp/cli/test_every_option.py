@@ -66,6 +66,7 @@ SAMPLES = {
     "--planner": "search",
     "--record": "episode.rrd",  # run and demo: a file (the benchmarks: a flag)
     "--peers": "pyperplan,lama",
+    "--baselines": "us,gn1",
     "--device": "cuda",  # accepted in the walk as on a machine with a GPU (`_inputs`)
 }
 # what an option needs to take effect, per command where it differs; tried in order

@@ -1,0 +1,116 @@
+"""Slaney & Thiebaux's US and GN1 (`tamp.bench.peers.slaney`): valid plans, US within twice
+the optimum, GN1 never longer than US, and ``tamp bench random --baselines`` beside ours."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from tamp.bench.peers import slaney
+from tamp.bench.planning import Row
+from tamp.bench.summary import summarise
+from tamp.cli import main
+from task.domains import blocksworld
+from task.domains.blocksworld import TABLE, with_slots
+from task.errors import TampError
+from task.problem import Move, Problem
+from task.symbolic import pddl_io
+from task.symbolic.generate import random_problem
+from task.symbolic.search import optimal_moves
+from task.symbolic.validate import validate
+
+SMALL = [(n, seed) for n in (3, 4, 5, 6, 7) for seed in range(8)]
+
+
+def _reaches_goal(problem: Problem, moves) -> bool:
+    state = blocksworld.initial_state(problem)
+    for move in moves:
+        if blocksworld.check_move(problem, state, move) is not None:
+            return False
+        state = blocksworld.apply_move(problem, state, move)
+    return blocksworld.is_goal(problem, state)
+
+
+@pytest.mark.parametrize(("n", "seed"), SMALL)
+def test_us_and_gn1_plan_validly_us_within_twice_the_optimum_gn1_within_us(n, seed):
+    problem = random_problem(n, seed)
+    us, gn1 = slaney.us(problem), slaney.gn1(problem)
+    optimum = len(optimal_moves(problem))
+    assert _reaches_goal(problem, us) and _reaches_goal(problem, gn1)
+    assert optimum <= len(gn1) <= len(us) <= 2 * optimum
+
+
+def test_the_plans_validate_against_the_pddl():
+    problem = random_problem(6, 3)
+    domain = blocksworld.DOMAIN
+    parsed_domain = pddl_io.parse_domain(domain.pddl_domain_text())
+    parsed = pddl_io.parse_problem(domain.to_pddl(problem), "<random>", parsed_domain)
+    for name in ("us", "gn1"):
+        actions = domain.to_actions(problem, slaney.run(name, problem).moves)
+        assert validate(parsed_domain, parsed, actions).valid, name
+
+
+def _problem(init: dict, goal: dict) -> Problem:
+    names = tuple(sorted(init))
+    return Problem(
+        "hand", blocksworld.NAME, names, tuple(init[x] for x in names), tuple(goal.items())
+    )
+
+
+def test_gn1_makes_a_constructive_move_where_us_parks_first():
+    # a on b, c alone; goal: a on c. US unstacks a (misplaced) to the table first, then
+    # stacks it: 2 moves; GN1 sees that a can go onto c at once: 1 move
+    problem = _problem({"a": "b", "b": TABLE, "c": TABLE}, {"a": "c"})
+    assert slaney.us(problem) == (Move("a", TABLE), Move("a", "c"))
+    assert slaney.gn1(problem) == (Move("a", "c"),)
+
+
+def test_a_block_the_goal_leaves_free_is_misplaced_where_another_must_go():
+    # c (no goal) sits on b, where the goal puts a; d (no goal) on a stays where it is
+    problem = _problem({"a": TABLE, "b": TABLE, "c": "b", "d": "a"}, {"a": "b"})
+    placed = slaney.in_position(problem, blocksworld.initial_state(problem))
+    assert placed == {"a": False, "b": True, "c": False, "d": False}
+    assert len(slaney.gn1(problem)) == 3  # c and d to the table, then a onto b
+
+
+def test_a_deadlock_is_broken_by_the_move_that_lets_a_block_go_in_position():
+    # a on e, h on c; goal a on c, h on a: neither can go in position. Parking a (first in
+    # entity order) frees nothing anyone wants; parking h frees c for a. GN1 parks h: 3 moves
+    # (the optimum); US parks both: 4
+    problem = _problem({"a": "e", "c": TABLE, "e": TABLE, "h": "c"}, {"a": "c", "h": "a"})
+    assert slaney.gn1(problem) == (Move("h", TABLE), Move("a", "c"), Move("h", "a"))
+    assert len(slaney.us(problem)) == 4 and len(optimal_moves(problem)) == 3
+
+
+def test_slotted_problems_and_unknown_baselines_are_refused():
+    slotted = with_slots(random_problem(4, 0), ("s0", "s1", "s2", "s3"))
+    with pytest.raises(TampError, match="plain Blocksworld"):
+        slaney.us(slotted)
+    with pytest.raises(TampError, match=r"unknown baseline 'us2' \(valid: us, gn1\)"):
+        slaney.run("us2", random_problem(4, 0))
+
+
+def test_the_summary_counts_each_baseline_against_ours_and_the_optimum():
+    def row(length, us, gn1):
+        return Row("i", 5, 8, None, 3, 0, length, "valid", 0.5, 1, None, None, us, 0.1, gn1, 0.3)
+
+    s = summarise([row(10, 12, 10), row(8, 8, 8)], 3, 0, None, None)
+    assert (s.us, s.us_length, s.gn1, s.gn1_length) == (2, 10.0, 2, 9.0)
+    assert s.vs_us == pytest.approx((10 / 12 + 1) / 2) and s.vs_gn1 == 1.0
+    assert s.us_ratio == pytest.approx(1.25) and s.us_s == 0.1 and s.gn1_s == 0.3
+    bare = summarise([Row("i", 5, 8, None, 3, 0, 8, "valid", 0.5, 1)], 3, 0, None, None)
+    assert bare.us is None and bare.gn1 is None  # the baselines did not run
+
+
+def test_bench_random_prints_and_records_the_baselines_beside_ours(tmp_path, capsys):
+    argv = ["bench", "random", "--blocks", "6", "--n", "2", "--restarts", "2", "--iters", "5"]
+    argv += ["--baselines", "us,gn1", "--no-progress"]
+    assert main([*argv, "--out", str(tmp_path)]) == 0
+    text = capsys.readouterr().out
+    assert "US moves" in text and "ours/GN1" in text
+    body = json.loads((tmp_path / "results.json").read_text())
+    assert body["config"]["baselines"] == ["us", "gn1"]
+    sizes = body["by_size"]
+    assert sizes[0]["us"] == 2 and sizes[0]["gn1"] == 2
+    assert sizes[0]["gn1_length"] <= sizes[0]["us_length"]
