@@ -466,9 +466,8 @@ def plan_images(
     names_, colours = blocks_in(pair, labels, scene)
     options = {"input_hw": meta["input_hw"]} if meta.get("input_hw") else {}
     config = PlannerConfig.for_domain("blocksworld") if config is None else config
-    found = plan_from_images(
-        pair[0], pair[1], colours, names_, Perceiver(model, **options), perception, config, seed
-    )
+    perceiver = Perceiver(model, **options, device=config.device)  # read where planning runs
+    found = plan_from_images(pair[0], pair[1], colours, names_, perceiver, perception, config, seed)
     domain = pddl_io.parse_domain(BLOCKSWORLD, "<domain>")
     text = blocksworld_pddl.to_pddl(found.problem)
     parsed = pddl_io.parse_problem(text, "<perceived>", domain)

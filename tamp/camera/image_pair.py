@@ -118,7 +118,8 @@ class Unseen:
 
     def compute(self):
         F0, goal, penalty = self.inner.compute()  # (P, N, Y), (P, N, Y), (P,)
-        return torch.where(self.unseen, self.onehot, F0), goal, penalty
+        unseen, onehot = self.unseen.to(F0.device), self.onehot.to(F0.device)  # F0's device
+        return torch.where(unseen, onehot, F0), goal, penalty
 
     def parameters(self):
         return self.inner.parameters()

@@ -424,6 +424,7 @@ def _segmentation_benchmark(bench) -> None:
         metavar="FILE.pt",
         help="perception weights that read the scenes (images resized to its input size)",
     )
+    device_option(p, "the model's")
     progress_option(p)
     output_options(p, "write results.json into this folder")
     p.set_defaults(

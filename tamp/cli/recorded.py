@@ -371,7 +371,11 @@ def segmentation_config(args: argparse.Namespace) -> dict:
     twice = sorted({str(p) for p in args.data if args.data.count(p) > 1})
     if twice:
         raise TampError(f"dataset(s) given twice: {', '.join(twice)}; give each file once")
-    return {"data": [str(p) for p in args.data], "checkpoint": str(args.checkpoint)}
+    return {
+        "data": [str(p) for p in args.data],
+        "checkpoint": str(args.checkpoint),
+        "device": args.device,
+    }
 
 
 def dataset_config(args: argparse.Namespace) -> dict:

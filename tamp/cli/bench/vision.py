@@ -237,6 +237,7 @@ def segmentation_command(args: argparse.Namespace) -> int:
     output_folder(args.out)
     checkpoint(args.checkpoint)
     model, meta = load_checkpoint(args.checkpoint)
+    model = model.to(args.device)
     datasets = {str(path): pdata.load(path) for path in args.data}
     for path, data in datasets.items():
         segmentation.check_scene(path, data.meta, meta)

@@ -26,6 +26,7 @@ RUNS_TORCH = {
     "bench executability",
     "bench perception",
     "bench latplan",
+    "bench segmentation",
     "perception train",
     "perception eval",
 }

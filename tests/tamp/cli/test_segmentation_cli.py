@@ -69,7 +69,11 @@ def test_the_table_and_results_json_count_what_each_threshold_set_finds(capsys, 
     body = json.loads((out / "results.json").read_text())
 
     assert body["benchmark"] == "segmentation"
-    assert body["config"] == {"data": [data], "checkpoint": str(LATPLAN_CHECKPOINT)}
+    assert body["config"] == {
+        "data": [data],
+        "checkpoint": str(LATPLAN_CHECKPOINT),
+        "device": "cpu",
+    }
     assert body["machine"]["command"] == f"tamp {' '.join(argv)} --out {out} --no-progress"
     assert "commit" in body["machine"] and "dirty" in body["machine"]
     assert body["input_hw"] == [100, 150]  # the checkpoint's; these images already are
