@@ -462,3 +462,49 @@ def plan_pick_place(
     if grasp is not None:
         evidence["grasp"] = grasp.name
     return MotionResult(True, phases, None, evidence, ik_time, grasp)
+
+
+def corrected_place(
+    solver: IKSolver,
+    q_now,
+    phases: tuple[Phase, ...],
+    shift,
+    config: PickPlaceConfig = PickPlaceConfig(),
+) -> tuple[Phase, ...] | None:
+    """The place side of a pick-and-place corrected for where the held object sits in the
+    hand: the arm is at ``q_now`` (J,), held still near the end of ``phases``' transit, and
+    the object sits ``-shift`` (3,) (m, base frame, z ignored) away in the hand from where the
+    plan has it, so the plan's lower, place and retreat TCP poses move by ``shift``. Returns
+    the phases that replace the plan's ``lower``, ``open`` and ``retreat``: ``shift`` (a
+    straight Cartesian move of the TCP from where it stands to the moved start of the lower,
+    at the near-contact speed), ``lower`` and ``retreat`` along the planned lines moved by
+    ``shift``, and ``open``; None when an IK point on them fails (run the plan as it is then)."""
+    by_name = {p.name: p for p in phases}
+    if not {"lower", "retreat"} <= set(by_name):
+        raise MotionError("corrected_place needs the plan's lower and retreat phases")
+    q_now = np.asarray(q_now, dtype=np.float64)
+    move = np.zeros(3)
+    move[:2] = np.asarray(shift, dtype=np.float64)[:2]
+    lower = by_name["lower"].trajectory.positions
+    up_q = by_name["retreat"].trajectory.positions[-1]
+    poses = solver.fk(np.stack([lower[0], lower[-1], up_q]))  # (3, 4, 4)
+    poses[:, :3, 3] += move
+    ends = solver.follow(poses, q_now, solver.config.max_iterations)  # seeded at the hand now
+    if not ends.ok.all():
+        return None
+    here = solver.fk(q_now)[0]
+    pre, place, up = poses
+    q_pre, q_place, q_up = ends.q
+    paths = [_vertical_path(solver, here, pre, q_now, q_pre, config.vertical_step)]
+    paths.append(_vertical_path(solver, pre, place, paths[0][-1], q_place, config.vertical_step))
+    paths.append(_vertical_path(solver, place, up, paths[1][-1], q_up, config.vertical_step))
+    spec, dt, limits = solver.spec, config.dt, config.approach
+    shift_path, lower_path, retreat_path = paths
+    if len(shift_path) < 2:
+        shift_path = np.stack([q_now, q_now])
+    return (
+        Phase("shift", polyline_segment(shift_path, dt, spec, limits), "closed", limits),
+        Phase("lower", polyline_segment(lower_path, dt, spec, limits), "closed", limits),
+        Phase("open", JointTrajectory.hold(lower_path[-1], config.open_time, dt), "open"),
+        Phase("retreat", polyline_segment(retreat_path, dt, spec, limits), "open", limits),
+    )

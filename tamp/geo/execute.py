@@ -11,6 +11,14 @@ gripper as a real robot reads them: after closing, the fingers must stand at the
 they must still stand at that width (``dropped``); a joint tracking error beyond
 ``max_tracking`` means the arm was blocked (``tracking_error``). After a failure at the object
 the hand opens and backs out along its descent. Nothing here reads ground truth.
+
+Where the place is tight, a held object that slipped a few millimetres in the fingers (the
+friction grasp, most in MuJoCo) would land out of its cell. Given a ``sense`` of the held
+object's position (the motion-capture sensor the episode observes with) and the IK
+``solver``, the hand stops above the place, looks, and when the object is more than
+`RunConfig.correct_min` off (and at most ``correct_max``) moves by the error before lowering
+(`motion.pick_place.corrected_place`: phases ``shift``, ``lower``, ``open``, ``retreat``);
+the run's evidence says by how much (``corrected_mm``).
 """
 
 from __future__ import annotations
@@ -21,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from motion.pick_place import Phase
+from motion.pick_place import Phase, corrected_place
 from motion.trajectory import JointTrajectory
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
@@ -36,6 +44,9 @@ class RunConfig:
     width_tol: float = 0.007  # m: a held object keeps the fingers at the grasp's width +- this
     min_force: float = 0.2  # N: both fingers push at least this on a freshly closed grasp
     max_tracking: float = 0.3  # rad: beyond this the arm is blocked
+    correct_min: float = 0.0005  # m: a held object this far off the plan above the place: moved
+    correct_max: float = 0.02  # m: ... unless farther off than this (then it runs as planned)
+    look_s: float = 0.3  # s: the hand holds still above the place this long before looking
 
 
 @dataclass(frozen=True)
@@ -56,7 +67,7 @@ def expected_contacts(phase: str, obj: str, rests: tuple[str, str]) -> Expected:
     """The contacts ``phase`` of the move of ``obj`` is meant to make: the hand on ``obj``
     throughout; once held, ``obj`` on what it leaves (lift) and what it goes onto (lower),
     ``rests`` = (from, onto) as the simulator names them, nothing in transit."""
-    during = {"lift": rests[0], "transit": None, "lower": rests[1]}
+    during = {"lift": rests[0], "transit": None, "shift": None, "lower": rests[1]}
     if phase not in during:
         return Expected(obj)
     return Expected(obj, obj, frozenset({during[phase]} - {None}))
@@ -70,25 +81,37 @@ def run_move(
     config: RunConfig = RunConfig(),
     on_frame: Callable[[Simulator], None] | None = None,
     drop_at: float | None = None,
+    sense: Callable[[], np.ndarray] | None = None,
+    solver=None,
 ) -> MoveRun:
     """Run ``check``'s phases (a feasible `MoveCheck` of ``move``) in ``sim``; ``rests``: what
     the object leaves and goes onto (`support_box` names). ``drop_at`` in [0, 1] opens the
-    gripper at that fraction of the transit (fault injection)."""
+    gripper at that fraction of the transit (fault injection). ``sense``: the held object's
+    centre (3,) as a sensor reads it now, and ``solver`` (`motion.ik.IKSolver`): correct the
+    place for the object's slip in the hand (module docstring); None: run as planned."""
     wall0, sim0, path = time.perf_counter(), sim.time, 0.0
     width = check.grasp.width
+    evidence: dict = {}
 
-    def done(failure: str | None = None, **evidence) -> MoveRun:
+    def done(failure: str | None = None, **found) -> MoveRun:
         return MoveRun(
             failure is None,
             failure,
-            evidence,
+            {**evidence, **found},
             sim.time - sim0,
             path,
             time.perf_counter() - wall0,
         )
 
     handling = Expected(move.obj)
-    for phase in check.motion:
+    phases, looked = list(check.motion), False
+    while phases:
+        phase = phases.pop(0)
+        if phase.name == "lower" and sense is not None and solver is not None and not looked:
+            looked = True
+            fixed = _look_and_correct(sim, move, phase, phases, sense, solver, config, on_frame)
+            if fixed is not None:
+                (phase, *phases), evidence["corrected_mm"] = fixed
         release = None
         if phase.name == "transit" and drop_at is not None:
             release = drop_at * phase.trajectory.duration
@@ -121,6 +144,30 @@ def run_move(
 def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:
     """(what the object leaves, what it goes onto) as the simulator names the bodies."""
     return support_box(scene, support), support_box(scene, move.place.target)
+
+
+def _look_and_correct(
+    sim, move: GeoMove, lower: Phase, rest: list, sense, solver, config: RunConfig, on_frame
+):
+    """Hold above the place, read where the held object is and, when it is off the plan by
+    more than ``correct_min`` (at most ``correct_max``), the corrected place side: (phases
+    replacing ``lower`` and ``rest``, the error in mm), else None."""
+    q = sim.arm_q()
+    hold = JointTrajectory.hold(q, config.look_s, sim.dt)
+    sim.run(hold, "closed", on_frame=on_frame, expected=Expected(move.obj, move.obj))
+    seen = np.asarray(sense(), dtype=np.float64)
+    # the object's offset from the TCP in the plane, as planned at the place and as seen now
+    # (a top grasp plans it at 0; a tilted one beside the TCP); the hand moves by the difference
+    place_tcp, tcp_now = solver.fk(np.stack([lower.trajectory.positions[-1], sim.arm_q()]))
+    planned = np.asarray(move.place.xyz[:2]) - place_tcp[:2, 3]
+    error = planned - (seen[:2] - tcp_now[:2, 3])  # (2,) m
+    off = float(np.linalg.norm(error))
+    if not config.correct_min < off <= config.correct_max:
+        return None
+    tail = corrected_place(solver, sim.arm_q(), (lower, *rest), error)
+    if tail is None:
+        return None
+    return tail, round(off * 1000, 1)
 
 
 def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:

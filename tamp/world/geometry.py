@@ -25,6 +25,7 @@ class Tolerances:
 
     z: float = 0.005  # a bottom this close to a face rests on it; farther above floats
     overlap: float = 0.002  # two solids may interpenetrate this much (contact, not overlap)
+    edge: float = 0.0  # a footprint "in" a region may cross its edge this much (sensing)
 
 
 TIGHT = Tolerances()  # the default: a scene file's

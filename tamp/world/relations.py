@@ -57,7 +57,8 @@ def read_facts(scene: Scene, tolerances: Tolerances = TIGHT) -> Facts:
         regions = [
             f.removeprefix("region:")
             for f in rest.faces
-            if f.startswith("region:") and inside(scene.region(f.removeprefix("region:")), o)
+            if f.startswith("region:")
+            and inside(scene.region(f.removeprefix("region:")), o, tolerances.edge)
         ]
         objects = [f for f in rest.faces if f in names]
         if regions:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import numpy as np
@@ -217,3 +218,31 @@ def test_polyline_segment_respects_limits_and_passes_every_knot():
     assert np.abs(traj.velocities[[0, -1]]).max() == 0.0
     middle = np.linalg.norm(traj.positions - knots[1], axis=1).min()
     assert middle < 1e-3  # the path goes through the middle knot
+
+
+@pytest.mark.parametrize("shift", [(0.006, -0.004, 0.0), (-0.01, 0.0, 0.02)])
+def test_a_corrected_place_moves_the_place_side_by_the_shift_in_the_plane(planned, solver, shift):
+    from motion.pick_place import corrected_place
+
+    _, result = planned
+    transit = next(p for p in result.phases if p.name == "transit")
+    q_above = transit.trajectory.positions[-1]
+    tail = corrected_place(solver, q_above, result.phases, shift, CONFIG)
+    assert tail is not None
+    assert tuple(p.name for p in tail) == ("shift", "lower", "open", "retreat")
+    assert tuple(p.gripper for p in tail) == ("closed", "closed", "open", "open")
+    np.testing.assert_array_equal(tail[0].trajectory.positions[0], q_above)
+    for before, after in itertools.pairwise(tail):
+        np.testing.assert_array_equal(
+            after.trajectory.positions[0], before.trajectory.positions[-1]
+        )
+    move = np.array([shift[0], shift[1], 0.0])  # z is ignored: the lower keeps its depth
+    above = solver.fk(q_above)[0]
+    for name, old in (("shift", above), ("lower", _end_pose(solver, result, "lower"))):
+        new = solver.fk(next(p for p in tail if p.name == name).trajectory.positions[-1])[0]
+        np.testing.assert_allclose(new[:3, 3], old[:3, 3] + move, atol=1e-3)
+        np.testing.assert_allclose(new[:3, :3], old[:3, :3], atol=1e-3)
+    retreat = solver.fk(tail[-1].trajectory.positions[-1])[0]
+    np.testing.assert_allclose(
+        retreat[:3, 3], _end_pose(solver, result, "retreat")[:3, 3] + move, atol=1e-3
+    )

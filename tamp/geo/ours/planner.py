@@ -59,8 +59,15 @@ from task.planner import plan
 from task.problem import PlanStatus
 
 SEARCH_NODES = 5_000  # the complete search's expansions at least (its time bounds it first)
-SOFT_SHARE = 6  # the differentiable planner's share of the wall clock: 1 / SOFT_SHARE
+# the differentiable planner's share of the wall clock: 1 / SOFT_SHARE (a sixth left a 10-cube
+# tower's 20-move plan unfinished after 9 windows; with a third its 11 windows and binding took
+# 24 s of 40)
+SOFT_SHARE = 3
 PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True)
+# receding windows per movable object at least (`PlannerConfig.max_windows`): a window commits
+# about three moves and a tower of n objects takes about 2 n moves, so 4 windows stopped long
+# plans short and left them to the fallback's blind search
+WINDOWS_PER_OBJECT = 2
 
 
 @dataclass(frozen=True)
@@ -103,8 +110,8 @@ def as_ours(config) -> OursConfig:
     # on nonmonotonic variants with half its time left (`SEARCH_NODES`)
     search = replace(search, max_nodes=max(search.max_nodes, SEARCH_NODES))
     limit = getattr(config, "max_time_s", None)
-    # the differentiable planner gets a sixth of the wall clock; the complete search what is
-    # left
+    # the differentiable planner gets a third of the wall clock (`SOFT_SHARE`); the complete
+    # search what is left
     soft = limit / SOFT_SHARE if limit else None
     planner = replace(PLANNER, time_limit_s=soft) if limit else PLANNER
     choices = getattr(config, "choices", GeoCostConfig().choices)
@@ -202,8 +209,9 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     costs = GeoCosts(bridged, solver, q, config.costs)
     failures, plans, cuts = [], 0, 0
     state, world, bound = bridged.problem.init, bridged.scene, []
+    windows = max(config.planner.max_windows, WINDOWS_PER_OBJECT * len(scene.objects))
     while len(failures) <= config.replans and cuts <= config.cuts:
-        planner = config.planner
+        planner = replace(config.planner, max_windows=windows)
         if config.soft_time_s is not None:
             left = config.soft_time_s - (time.perf_counter() - t0)
             if left <= 0:

@@ -154,8 +154,8 @@ def test_unsolvable_from_the_complete_search_is_said_with_the_first_attempts_rea
 def test_the_episode_planners_shared_config_is_accepted():
     ours = as_ours(SearchConfig(max_time_s=30.0, seed=3, choices=("top",)))
     assert ours.seed == 3 and ours.costs.choices == ("top",)
-    # a sixth of the wall clock for the differentiable planner, the complete search the rest
-    assert ours.planner.time_limit_s == 5.0 and ours.soft_time_s == 5.0
+    # a third of the wall clock for the differentiable planner, the complete search the rest
+    assert ours.planner.time_limit_s == 10.0 and ours.soft_time_s == 10.0
     assert ours.search.max_time_s == 30.0 and ours.search.max_nodes == 5_000
     assert ours.planner.fallback is True
 

@@ -70,6 +70,21 @@ def test_a_marked_area_without_walls_needs_the_whole_footprint_inside():
     assert ("ontable", "b") in f.atoms and ("in", "b", "mat") not in f.atoms
 
 
+def test_observed_poses_may_cross_a_regions_edge_by_the_edge_tolerance():
+    """A cube 0.5 mm inside a marked area's edge, then 1 mm and 3 mm over it: a file reads it
+    in only when inside; observed poses (`Tolerances.edge`, 2 mm) also 1 mm over, not 3 mm."""
+    mat = {"name": "mat", "min": [0.45, 0.15], "max": [0.65, 0.35]}
+    sensed = Tolerances(z=0.012, overlap=0.004, edge=0.002)
+    for over, in_file, in_sensed in (
+        (0.0, True, True),
+        (0.0015, False, True),
+        (0.0035, False, False),
+    ):
+        s = load_scene(scene(cube("a", 0.4755 - over, 0.25, 0.025), regions=[mat]))
+        assert (("in", "a", "mat") in read_facts(s).atoms) is in_file, over
+        assert (("in", "a", "mat") in read_facts(s, sensed).atoms) is in_sensed, over
+
+
 def test_a_plate_is_a_raised_region_and_a_cube_on_a_post_is_unexplained():
     plate = {"name": "plate", "min": [0.45, 0.15], "max": [0.55, 0.25], "floor": 0.01}
     post = {"name": "post", "centre": [0.4, -0.2, 0.05], "half": [0.03, 0.03, 0.05]}
