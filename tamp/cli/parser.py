@@ -269,14 +269,15 @@ def _planning_benchmarks(bench, bench_opts: argparse.ArgumentParser) -> None:
         "60 s) on every instance: its length and time beside ours (needs the "
         "bench extra)",
     )
-    random_.add_argument(
-        "--baselines",
-        type=baseline_list,
-        metavar="B[,B]",
-        help="also plan every instance with Slaney & Thiebaux's near-optimal Blocksworld "
-        "algorithms us (unstack-stack) and/or gn1 (Gupta & Nau's, constructive moves first): "
-        "their validated lengths and times beside ours (none)",
-    )
+    for p in (planbench, random_):
+        p.add_argument(
+            "--baselines",
+            type=baseline_list,
+            metavar="B[,B]",
+            help="also plan every instance with Slaney & Thiebaux's near-optimal Blocksworld "
+            "algorithms us (unstack-stack) and/or gn1 (Gupta & Nau's, constructive moves "
+            "first): their validated lengths and times beside ours (none; Blocksworld only)",
+        )
     random_.set_defaults(
         func=_lazy("tamp.cli.bench.planning", "random_command"),
         recorded=_lazy("tamp.cli.recorded", "planning_config"),

@@ -301,6 +301,8 @@ def planning_config(args: argparse.Namespace, domain: str | None = None) -> dict
     if hasattr(args, "lama"):
         body["lama"] = args.lama
     if hasattr(args, "baselines"):
+        if args.baselines and getattr(args, "domain", "blocksworld") != "blocksworld":
+            raise TampError(f"--baselines plan Blocksworld only, not --domain {args.domain}")
         body["baselines"] = list(args.baselines) if args.baselines else None
     if hasattr(args, "peers"):
         body["peers"] = list(peers) if peers else None

@@ -140,7 +140,7 @@ def planbench_command(args: argparse.Namespace) -> int:
     data = args.data if args.data is not None else suites.default_data(args.domain)
     with _searching(args.progress) as update:
         suite = suites.planbench(data, args.limit, args.out, args.domain, update, args.domain_rules)
-    return _run(suite, args)
+    return _run(suite, args, lengths=bool(args.baselines))  # the baselines' lengths beside ours
 
 
 def pddl_command(args: argparse.Namespace) -> int:

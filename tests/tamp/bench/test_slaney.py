@@ -114,3 +114,13 @@ def test_bench_random_prints_and_records_the_baselines_beside_ours(tmp_path, cap
     sizes = body["by_size"]
     assert sizes[0]["us"] == 2 and sizes[0]["gn1"] == 2
     assert sizes[0]["gn1_length"] <= sizes[0]["us_length"]
+
+
+def test_bench_planbench_takes_the_baselines_for_blocksworld_only(capsys, planbench_dir):
+    data = ["--data", str(planbench_dir / "blocksworld")]
+    assert main(["bench", "planbench", "--domain", "logistics", "--baselines", "us"]) == 2
+    assert "--baselines plan Blocksworld only" in capsys.readouterr().err
+    argv = ["bench", "planbench", *data, "--limit", "2", "--restarts", "2", "--iters", "5"]
+    assert main([*argv, "--baselines", "gn1", "--no-progress", "--json"]) == 0
+    body = json.loads(capsys.readouterr().out)
+    assert body["config"]["baselines"] == ["gn1"] and body["summary"][0]["gn1"] == 2
