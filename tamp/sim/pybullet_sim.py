@@ -3,7 +3,8 @@
 Settings follow shared/notes/motion-research.md section 4: finger gear constraint (in the
 loader), position control of the arm with the trajectory's positions and velocities, 40 N per
 finger, lateral friction 1.0 on the blocks, ``ER_TINY_RENDERER`` for images (no GL needed);
-a physics step of ``physics_dt`` (4 ms) with `SOLVER_ITERATIONS` solver iterations.
+a physics step of ``physics_dt`` (4 ms) with Bullet's default 50 solver iterations (at 30 or
+fewer a block carried into a wall passes through it instead of stopping the arm).
 A world made for videos (``video=True``) draws with OpenGL instead, through PyBullet's EGL
 plugin (Mesa llvmpipe on a CPU machine): a 640x480 frame costs about 35 ms of CPU there, about
 120 ms with TinyRenderer (measured on the 2-core development machine).
@@ -45,9 +46,6 @@ LIGHT_DISTANCE = 40.0  # m, OpenGL's light from the camera target (40 m: shadows
 EDGE = 1.02  # depths this far apart (ratio) in a 2x2 window straddle an edge: not interpolated
 # (m/s)^2 + (rad/s)^2: a block sleeps below this for 2 s; at rest they jitter at 5e-9..3e-6
 SLEEP_THRESHOLD = 1e-5
-# the constraint solver's iterations per step (Bullet's default 50): 20 tracks and grasps as
-# 50 does (tracking error 8.4 mrad both on PlanBench instance-450) at 0.7 of a step's cost
-SOLVER_ITERATIONS = 20
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
@@ -87,7 +85,6 @@ class PyBulletSim(Simulator):
         self._gl = self.video and _egl_plugin(c)
         p.setGravity(0, 0, -9.81, physicsClientId=c)
         p.setTimeStep(self.physics_dt, physicsClientId=c)
-        p.setPhysicsEngineParameter(numSolverIterations=SOLVER_ITERATIONS, physicsClientId=c)
         plane = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=c)
         grey = [self.scene.floor_grey] * 3
         half = 0.05 if self._gl else 0.001  # top at z = 0.001; OpenGL's shadows need depth
