@@ -20,7 +20,7 @@ from perception.data import resize_image
 from perception.errors import PerceptionError
 from perception.model import SupportModel
 from perception.segment import SegmentConfig, check_image, find_boxes
-from perception.train import as_float, load_checkpoint
+from perception.train import as_float, load_checkpoint, torch_device
 
 
 def blur(images: np.ndarray, radius: int) -> np.ndarray:
@@ -51,7 +51,7 @@ class Perceiver:
         input_hw: Sequence[int] | None = None,
         device: str = "cpu",
     ) -> None:
-        self.device = torch.device(device)
+        self.device = torch_device(device)  # one-line TampError where this machine lacks it
         self.model = model.to(self.device).eval()
         self.segment = segment
         self.input_hw = None if input_hw is None else tuple(int(v) for v in input_hw)

@@ -35,6 +35,28 @@ class TrainConfig:
     # initialisation and the batch order are drawn on the CPU, the same on every device
 
 
+def torch_device(name: str) -> torch.device:
+    """The torch device ``name`` ("cpu", "cuda" or "cuda:N") the model runs on; PerceptionError
+    (one line) for another name or one this machine lacks: never a silent CPU. (The planner's
+    own check is `task.config.torch_device`; perception does not import the planner.)"""
+    try:
+        device = torch.device(name)
+    except (RuntimeError, TypeError):
+        device = None
+    if device is None or device.type not in ("cpu", "cuda"):
+        raise PerceptionError(f"unknown device {name!r} (valid: cpu, cuda, cuda:N)")
+    if device.type == "cpu":
+        return device
+    if not torch.backends.cuda.is_built():
+        raise PerceptionError(
+            f"device {name!r}: this torch build has no CUDA (torch {torch.__version__})"
+        )
+    count = torch.cuda.device_count()
+    if (device.index or 0) >= count:
+        raise PerceptionError(f"device {name!r}: {count} CUDA device(s) visible here")
+    return device
+
+
 def as_float(images: Tensor) -> Tensor:
     """uint8 images (B, 3, H, W) -> float in [0, 1]; float images pass through."""
     return images.float() / 255.0 if images.dtype == torch.uint8 else images
@@ -90,7 +112,7 @@ def train(
     with torch.random.fork_rng():  # seeded initialisation without touching the global RNG
         torch.manual_seed(config.seed)
         model = SupportModel(model_config)
-    device = torch.device(config.device)
+    device = torch_device(config.device)  # one-line TampError where this machine lacks it
     model = model.to(device)
     opt = torch.optim.AdamW(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     m = len(data["images"])

@@ -88,3 +88,12 @@ def test_on_cuda_every_own_domain_plans_its_samples():
     plans = _plans("cuda")
     for name, rows in plans.items():
         assert all(status == "solved" for status, _ in rows), name
+
+
+@pytest.mark.skipif(CUDA, reason="this machine has CUDA")
+def test_perception_on_cuda_where_there_is_none_is_refused_in_one_line():
+    from perception.model import SupportModel
+    from perception.perceive import Perceiver
+
+    with pytest.raises(TampError, match=r"device 'cuda': .*CUDA"):
+        Perceiver(SupportModel(), device="cuda")
