@@ -28,9 +28,7 @@ def _plans(device: str) -> dict:
     out = {}
     for name in ("blocksworld", "logistics", "sokoban"):
         problems = list(get_domain(name).samples(0))
-        config = PlannerConfig.for_domain(
-            name, restarts=4, iters=15, max_windows=12, device=device
-        )
+        config = PlannerConfig.for_domain(name, restarts=4, iters=15, max_windows=12, device=device)
         results = plan_batch(problems, config, seed=3)
         out[name] = [[r.status.value, [str(m) for m in r.plan.moves]] for r in results]
     return out
@@ -88,12 +86,3 @@ def test_on_cuda_every_own_domain_plans_its_samples():
     plans = _plans("cuda")
     for name, rows in plans.items():
         assert all(status == "solved" for status, _ in rows), name
-
-
-@pytest.mark.skipif(CUDA, reason="this machine has CUDA")
-def test_perception_on_cuda_where_there_is_none_is_refused_in_one_line():
-    from perception.model import SupportModel
-    from perception.perceive import Perceiver
-
-    with pytest.raises(TampError, match=r"device 'cuda': .*CUDA"):
-        Perceiver(SupportModel(), device="cuda")
