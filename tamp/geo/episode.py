@@ -18,7 +18,9 @@ grant, a sensor by design) and reads the facts from them with `OBSERVED` toleran
 each move `check_move` decides it again on the observed scene from the arm's configuration now
 (blocked free-space phases rerouted by the motion planner); the move runs
 (`tamp.geo.execute.run_move`; above the place the hand looks at the object it holds and
-corrects for its slip in the fingers, ``sense``) and the scene is observed again. A failed
+corrects for its slip in the fingers, ``sense``) and the scene is observed again. A move that
+fails its check from where the arm stands (IK or a collision; the planner checked it from
+home) is checked again from home after a guarded trip there (`AGAIN_FROM_HOME`). A failed
 check, a failed run, or observed facts other than those the move was to give end the plan:
 the planner plans again from what is observed, up to ``max_replans`` times. Whether the goal
 was reached is scored on
@@ -56,6 +58,10 @@ PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
 # packing sets boxes flush with the edge, and a placement lands within about a millimetre)
 OBSERVED = Tolerances(z=0.012, overlap=0.004, edge=0.002)
 SETTLE_S = 0.3  # simulated seconds the objects settle before each observation
+# a move the planner checked from home that fails from where the arm stands (its IK seeded
+# there, its hand turned as it is) is checked again from home, after a guarded trip there
+AGAIN_FROM_HOME = ("ik_infeasible", "collision")
+HOME_TOL = 0.05  # rad, the arm stands at home when every joint is this near
 
 
 @dataclass(frozen=True)
@@ -295,8 +301,13 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
     if move.grasp is None:
         grasps = grasp_order(world, o, candidate_grasps(o, runner.choices))
     verdict = check_move(world, move, runner, grasps=grasps, q_now=sim.arm_q(), seed=seed)
+    home = 0.0  # rad run on the way home
+    if not verdict.ok and verdict.failure in AGAIN_FROM_HOME:
+        home = _go_home(sim, world, runner, on_frame)
+        if home:
+            verdict = check_move(world, move, runner, grasps, q_now=sim.arm_q(), seed=seed)
     if not verdict.ok:
-        return MoveRecord(move.text(), "", False, verdict.failure, verdict.evidence), world, 0.0
+        return MoveRecord(move.text(), "", False, verdict.failure, verdict.evidence), world, home
     support = dict(read_facts(world, OBSERVED).supports).get(move.obj, TABLE)
     rests = rests_of(world, move, support)
     ran = run_move(
@@ -313,14 +324,36 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
     _settle(sim, on_frame)
     seen = observe(sim, world)
     name = verdict.grasp.name
+    path = home + ran.path_rad
     if not ran.ok:
-        return MoveRecord(move.text(), name, False, ran.failure, ran.evidence), seen, ran.path_rad
+        return MoveRecord(move.text(), name, False, ran.failure, ran.evidence), seen, path
     want = read_facts(moved(world, move.obj, move.place.pose), OBSERVED).atoms
     got = read_facts(seen, OBSERVED).atoms
     if want != got:
         evidence = {"missing": sorted(want - got), "extra": sorted(got - want)}
-        return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, ran.path_rad
-    return MoveRecord(move.text(), name, True), seen, ran.path_rad
+        return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, path
+    return MoveRecord(move.text(), name, True), seen, path
+
+
+def _go_home(sim: Simulator, world: Scene, runner: Tools, on_frame=None) -> float:
+    """Take the empty hand home (`PANDA.q_home`, where the planner checked its moves from)
+    along a guarded free move (`motion.guard.guard_free_move`, rerouted when blocked): the
+    joint path run (rad), 0 when it already stood there (within `HOME_TOL` rad) or no safe
+    way was found."""
+    from motion.guard import guard_free_move
+    from motion.trajectory import TRANSIT, straight_segment
+    from robots.panda import PANDA
+    from tamp.geo.check import boxes
+
+    q = sim.arm_q()
+    if np.abs(q - PANDA.q_home).max() <= HOME_TOL:
+        return 0.0
+    way = straight_segment(q, PANDA.q_home, sim.dt, PANDA, TRANSIT)
+    run = guard_free_move(way, runner.collision, boxes(world), runner.guard)
+    if run is None:
+        return 0.0
+    sim.run(run, "open", on_frame=on_frame)
+    return float(np.linalg.norm(np.diff(run.positions, axis=0), axis=1).sum())
 
 
 def _settle(sim: Simulator, on_frame) -> None:

@@ -21,7 +21,10 @@ without IK, for every grasp family at once. It is a proxy: the planner's moves a
 grasp by the full check (`tamp.geo.ours.planner`), and what fails there comes back as failure
 memory: `avoid(state, move, grasp, place)` rules the move out only under the grasp (None:
 every grasp) and place that failed, so the same move keeps its price while another of its
-grasps is left, and x -> another place is priced on its own.
+grasps is left, and x -> another place is priced on its own. A failure no movable object took
+part in (no IK solution, a post, the table or a wall hit; ``fixed``) holds in every state where
+the object stands where it stood, so later plans do not try that grasp again from another
+order of the other moves.
 
 Every state is priced once (cached); the IK solutions are cached by target position (to the
 mm) across states, so later windows solve only the targets they have not seen. ``stats``
@@ -146,6 +149,12 @@ def obb_overlap(a, b, touch: float = TOUCH) -> np.ndarray:
     return out
 
 
+def _stands(world: Scene, x: str) -> tuple[int, ...]:
+    """Where object ``x`` stands in ``world``: its centre (mm) and yaw (mrad)."""
+    pose = world.object(x).pose
+    return (*(round(float(v) * 1000) for v in pose.xyz), round(float(pose.yaw) * 1000))
+
+
 class _Window:
     """The costs of one window: a fixed (P, N, Y) matrix, alike for every restart row."""
 
@@ -188,6 +197,9 @@ class GeoCosts:
         self._ik: dict[tuple[int, int, int], tuple[np.ndarray, bool]] = {}
         self._hands: dict[str, tuple] = {}  # object -> `hand_obbs` of its grasps
         self.failed: dict[tuple[State, Move, str], set] = {}
+        # failures no movable object caused (IK, a post, the table, a wall): (move, where the
+        # object stands, place) -> grasps, whatever the other objects do
+        self.failed_fixed: dict[tuple[Move, tuple, str], set] = {}
         self.stats = {"states": 0, "price_s": 0.0, "ik_targets": 0}
 
     # ---- the planner's interface
@@ -201,26 +213,38 @@ class GeoCosts:
         """(N, Y) the price of every move x -> y in crisp ``state`` (0 where illegal)."""
         out = self._priced(state)[0].copy()
         problem = self.bridged.problem
-        for s, move, _ in self.failed:
-            if s == state and not self.grasps_left(state, move):
+        remembered = {move for _, move, _ in self.failed} | {m for m, _, _ in self.failed_fixed}
+        world = self.bridged.predict(state) if remembered else None
+        for move in remembered:
+            if legal(problem, state, move) is None and not self.grasps_left(state, move, world):
                 out[problem.entities.index(move.entity), problem.index(move.target)] = IMPOSSIBLE
         return out
 
     # ---- failure memory
 
-    def avoid(self, state: State, move: Move, grasp: str | None, place: str) -> None:
+    def avoid(
+        self, state: State, move: Move, grasp: str | None, place: str, fixed: bool = False
+    ) -> None:
         """Rule ``move`` out in ``state`` under ``grasp`` (a name; None: every grasp) and the
-        place named ``place``, where it failed."""
+        place named ``place``, where it failed. ``fixed``: what failed involved no movable
+        object (no IK solution, a fixed obstacle, the table, a region's wall hit), so the
+        move is ruled out under that grasp and place in every state where its object stands
+        where it stands in ``state``."""
         self.failed.setdefault((tuple(state), move, place), set()).add(grasp)
+        if fixed:
+            key = (move, _stands(self.bridged.predict(state), move.entity), place)
+            self.failed_fixed.setdefault(key, set()).add(grasp)
 
-    def grasps_left(self, state: State, move: Move) -> tuple[str, ...]:
+    def grasps_left(self, state: State, move: Move, world: Scene | None = None) -> tuple[str, ...]:
         """The names of ``move``'s grasps free at both ends in ``state`` (best first: the
-        order of `tamp.geo.check.candidate_grasps`) that no failure ruled out."""
+        order of `tamp.geo.check.candidate_grasps`) that no failure ruled out. ``world``: the
+        predicted world of ``state`` when the caller has it."""
         _, allowed = self._priced(state)
         names = allowed.get(move, ())
-        world = self.bridged.predict(state)
+        world = world or self.bridged.predict(state)
         place = self.bridged.geo_move(world, move).place.name
         gone = self.failed.get((tuple(state), move, place), set())
+        gone = gone | self.failed_fixed.get((move, _stands(world, move.entity), place), set())
         if None in gone:
             return ()
         return tuple(n for n in names if n not in gone)

@@ -68,6 +68,9 @@ PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05,
 # about three moves and a tower of n objects takes about 2 n moves, so 4 windows stopped long
 # plans short and left them to the fallback's blind search
 WINDOWS_PER_OBJECT = 2
+# check failures no movable object takes part in: ruled out wherever the object stands as it
+# stood (`GeoCosts.avoid`'s ``fixed``), not only in the state they happened in
+FIXED_FAILURES = ("ik_infeasible", "no_clearance")
 
 
 @dataclass(frozen=True)
@@ -309,8 +312,12 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
         verdict = check(world, geo, tools, grasps=order)
         if not verdict.ok:
             tried = getattr(verdict, "tried", ())
+            movable = {x.name for x in world.objects}
             for t in tried:
-                costs.avoid(state, move, t.grasp, geo.place.name)
+                fixed = t.failure in FIXED_FAILURES or (
+                    t.failure == "collision" and bool(t.other) and t.other not in movable
+                )
+                costs.avoid(state, move, t.grasp, geo.place.name, fixed)
             if not tried:  # failed before any grasp: the move, at that place, in that state
                 costs.avoid(state, move, None, geo.place.name)
             failure = {"move": str(move), "place": geo.place.name, "failure": verdict.failure}

@@ -66,6 +66,27 @@ def test_a_failure_rules_a_move_out_only_under_its_grasp_and_place(priced):
     assert _price(costs, after, other) >= IMPOSSIBLE
 
 
+@pytest.mark.parametrize("fixed", [False, True])
+def test_a_failure_no_movable_object_caused_holds_wherever_the_object_still_stands(priced, fixed):
+    """t fails under one grasp after n moved away; with ``fixed`` (an IK failure, a post hit)
+    the grasp stays ruled out once w has moved too (t stands where it stood), else only in
+    the state it failed in; after t itself moved, it is back either way."""
+    b, _, kit = priced
+    costs = GeoCosts(b, kit.solver, kit.q)
+    p = b.problem
+    spots = [x.name for x in b.sites if x.name.startswith("table.")]
+    after = bw.apply_move(p, p.init, Move("n", spots[0]))
+    later = bw.apply_move(p, after, Move("w", spots[1]))
+    direct = Move("t", "goal.c0")
+    grasp = costs.grasps_left(after, direct)[0]
+    assert grasp in costs.grasps_left(later, direct)
+    costs.avoid(after, direct, grasp, "goal.c0", fixed=fixed)
+    assert grasp not in costs.grasps_left(after, direct)
+    assert (grasp not in costs.grasps_left(later, direct)) is fixed
+    moved_t = bw.apply_move(p, later, Move("t", spots[2]))  # t stands somewhere new
+    assert grasp in costs.grasps_left(moved_t, direct)
+
+
 @pytest.mark.parametrize("yaw", [0.0, 0.4])
 def test_the_batched_hand_boxes_are_those_of_each_grasp_alone(yaw):
     """Every grasp's palm and finger boxes, batched in the object's frame and turned with it,

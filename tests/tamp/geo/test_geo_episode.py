@@ -4,6 +4,7 @@ on it, each try refused by the executor's check before the arm moves."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from tamp.geo.episode import PLANNERS, planner_by_name, run_geo_episode
@@ -57,3 +58,34 @@ def test_an_unknown_planner_lists_the_valid_ones():
     with pytest.raises(TampError, match="unknown planner 'sfot'"):
         planner_by_name("sfot")
     assert "motion-aware" in PLANNERS
+
+
+class _ArmOnly:
+    """A stand-in simulator: the arm at ``q``, trajectories run by jumping to their end."""
+
+    dt = 0.002
+
+    def __init__(self, q) -> None:
+        self.q, self.runs = np.asarray(q, dtype=np.float64), []
+
+    def arm_q(self):
+        return self.q.copy()
+
+    def run(self, trajectory, gripper, *args, **kwargs):
+        self.runs.append((trajectory, gripper))
+        self.q = trajectory.positions[-1].copy()
+        return 0.0
+
+
+def test_the_empty_hand_goes_home_along_a_guarded_move_to_check_a_move_again():
+    from robots.panda import PANDA
+    from tamp.geo.episode import _go_home
+
+    away = PANDA.q_home + np.array([0.6, 0.2, -0.3, 0.2, 0.1, -0.2, 0.4])
+    sim = _ArmOnly(away)
+    path = _go_home(sim, hemmed(), tools())
+    assert path >= np.linalg.norm(away - PANDA.q_home) - 1e-9  # rad: at least the straight way
+    np.testing.assert_allclose(sim.q, PANDA.q_home, atol=1e-9)
+    assert [g for _, g in sim.runs] == ["open"]
+    assert _go_home(sim, hemmed(), tools()) == 0.0  # at home already: nothing runs
+    assert len(sim.runs) == 1

@@ -1,4 +1,4 @@
-; sorting, seed 0: 8 objects of 3 colours among 12 posts 15 cm tall: a post 4.5-6 cm from each object blocks one of its two top-down grasp axes
+; sorting, seed 0: 8 objects of 3 colours among 12 posts 10 cm tall: a post 4.5-6 cm from each object blocks one of its two top-down grasp axes
 (and
   (in o1 green_zone)
   (in o2 yellow_zone)
