@@ -301,8 +301,13 @@ class Strips:
     # when the windows revisit a state or run out, a complete greedy search on h_FF and the
     # helpful actions takes over (`PlannerConfig.fallback`; `lazy_search.lazy_greedy`); plans
     # leave with their cycles and redundant moves cut (`task.symbolic.shorten`)
+    # windows count ground actions, not moves: a 4-op Blocksworld move is two (pick, place), a
+    # gripper round trip six, so the lift's windows are longer than the hand-written domains'
+    # 3 and 5 (soft only, after 10 windows: miconic task12 h_FF 10 -> 3 left, BENCHMARKS.md)
     planner_defaults = MappingProxyType(
         {
+            "horizon": 4,
+            "lookahead": 8,
             "fallback": True,
             "fallback_search": "greedy",
             "fallback_nodes": 50_000,

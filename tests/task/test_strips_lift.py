@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import random
 from collections import deque
 from pathlib import Path
@@ -13,14 +14,14 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
-from task.domains import get_domain
+from task.domains import get_domain, strips_soft
 from task.domains.base import INF
-from task.domains.strips import problem_from_text
+from task.domains.strips import GRIPPER, problem_from_text
 from task.errors import PDDLError, ProblemError
 from task.planner import plan
 from task.problem import Action
 from task.rollout import rollout
-from task.symbolic import strips
+from task.symbolic import relaxed, strips
 from task.symbolic.validate import validate
 
 LIFT = get_domain("strips")
@@ -130,7 +131,7 @@ def test_values_stay_in_unit_interval_under_soft_actions():
             F = LIFT.consistency(F, batch)
 
 
-@pytest.mark.parametrize("goal_loss", ["hadd", "atoms"])
+@pytest.mark.parametrize("goal_loss", ["ff", "hadd", "atoms"])
 def test_rollout_gradcheck_float64(goal_loss):
     problem = _sample(0, 3)  # a tiny gripper
     batch = LIFT.encode([problem], [problem.data.init], torch.float64)
@@ -153,13 +154,14 @@ def test_relaxed_cost_is_h_add_and_rewards_a_partial_first_step():
     full step's gain (the consumed (at l0) is not charged against the (at l1) it became)."""
     line = problem_from_text(LINE, LINE_PROBLEM, "line")
     batch = LIFT.encode([line], [line.data.init], torch.float64)
+    batch.static["prior"] = torch.ones_like(batch.static["prior"])  # M is the applied mass
     go = line.data.index[Action("go", ("l0", "l1"))]
 
     def cost(eps: float) -> float:
         M = torch.zeros(batch.action_mask.shape, dtype=torch.float64)
         M[0, 0, go], M[0, 0, -1] = eps, 1.0 - eps
         F, _ = LIFT.step(batch.F0, M, batch)
-        return LIFT.goal_loss(F, batch, "hadd").item() - LIFT.goal_loss(F, batch, "atoms").item()
+        return (batch.goal[:, 0] * strips_soft.relaxed_cost(F, batch)).sum().item()
 
     assert cost(0.0) == pytest.approx(3.0, abs=0.1)
     assert cost(1.0) == pytest.approx(2.0, abs=0.1)
@@ -204,7 +206,7 @@ def test_ff_estimate_is_a_relaxed_plan_at_least_lm_cut():
     assert LIFT.estimate(toy, dead) == INF
 
 
-@pytest.mark.parametrize("goal_loss", ["hadd", "atoms"])
+@pytest.mark.parametrize("goal_loss", ["ff", "hadd", "atoms"])
 def test_plans_a_tiny_gripper_end_to_end(goal_loss):
     problem = _sample(3, 3)
     result = plan(problem, PlannerConfig(restarts=4, goal_loss=goal_loss), seed=0)
@@ -286,3 +288,69 @@ def test_ipc_gripper_task01_is_planned_and_valid():
     result = plan(problem, PlannerConfig(), seed=0)
     check = validate(domain, problem.data.pddl_problem, LIFT.to_actions(problem, result.plan))
     assert result.solved and check.valid, check.reason
+
+
+def test_relaxed_cost_is_crisp_h_add_on_ties():
+    """One-hot states of the sample walks: the soft h_add of the goal is the crisp h_add, also
+    where an atom has several equally cheap achievers (a ball either gripper may pick), which
+    a log-sum-exp softmin put tau log k below."""
+    for problem, state in _walks(3):
+        batch = LIFT.encode([problem], [state], torch.float64)
+        soft = (batch.goal[:, 0] * strips_soft.relaxed_cost(batch.F0, batch)).sum().item()
+        h, _ = relaxed.hadd(problem.data, state)
+        crisp = sum(h[problem.data.column[a]] for a in problem.data.goal)
+        assert soft == pytest.approx(crisp, abs=1e-2), problem.name
+
+
+def test_relaxed_plan_size_is_h_ff_on_onehot_states():
+    """The soft relaxed plan on one-hot states: h_FF exactly without ties (a line, gripper
+    after its first pick), between h_FF - 1 and h_add with them (ties split the plan)."""
+    line = problem_from_text(LINE, LINE_PROBLEM, "line")
+    batch = LIFT.encode([line], [line.data.init], torch.float64)
+    assert strips_soft.relaxed_plan_size(batch.F0, batch).item() == pytest.approx(3.0, abs=1e-3)
+    for problem, state in _walks(3):
+        batch = LIFT.encode([problem], [state], torch.float64)
+        soft = strips_soft.relaxed_plan_size(batch.F0, batch).item()
+        ff = relaxed.ff(problem.data, state)
+        h, _ = relaxed.hadd(problem.data, state)
+        crisp_add = sum(h[problem.data.column[a]] for a in problem.data.goal)
+        assert ff - 1.0 <= soft <= crisp_add + 1e-3, problem.name
+
+
+THREE_BALLS = """(define (problem three) (:domain tiny-gripper)
+  (:objects rooma roomb - room left right - gripper ball1 ball2 ball3 - ball)
+  (:init (at-robby rooma) (free left) (free right) (at ball1 rooma) (at ball2 rooma)
+         (at ball3 rooma))
+  (:goal (and (at ball1 roomb) (at ball2 roomb) (at ball3 roomb))))"""
+
+
+def test_ff_goal_term_counts_a_shared_precondition_once():
+    """Gripper, three balls to carry: the move to the other room serves every drop, and the
+    soft relaxed plan counts it once, as h_FF does (7, then 6 after each pick), where h_add
+    counts it per ball (9, then 8). The "ff" goal term falls with the first pick."""
+    problem = problem_from_text(GRIPPER, THREE_BALLS, "three")
+    start = problem.data.init
+    one = LIFT.apply_move(problem, start, Action("pick", ("ball1", "rooma", "left")))
+    two = LIFT.apply_move(problem, one, Action("pick", ("ball2", "rooma", "right")))
+    states = [start, one, two]
+    batch = LIFT.encode([problem] * 3, states, torch.float64)
+    size = strips_soft.relaxed_plan_size(batch.F0, batch).tolist()
+    assert size == pytest.approx([relaxed.ff(problem.data, s) for s in states], abs=2e-2)
+    assert size == pytest.approx([7.0, 6.0, 6.0], abs=2e-2)
+    hadd = (batch.goal[:, 0] * strips_soft.relaxed_cost(batch.F0, batch)).sum(-1)
+    assert hadd.tolist() == pytest.approx([9.0, 8.0, 8.0], abs=1e-2)
+    ff = LIFT.goal_loss(batch.F0, batch, "ff")
+    assert ff[1] < ff[0]
+
+
+def test_prior_favours_the_relaxed_plan_and_keeps_onehot_steps_exact():
+    problem = _sample(3, 4)
+    state = problem.data.init
+    batch = LIFT.encode([problem], [state], torch.float64)
+    prior = batch.static["prior"][0]  # (G + 1,)
+    chosen = set(relaxed.relaxed_plan(problem.data, state))
+    helpful = set(relaxed.helpful(problem.data, state))
+    for j in range(len(problem.data.actions)):
+        bonus = (j in chosen) * strips_soft.PRIOR_PLAN + (j in helpful) * strips_soft.PRIOR_HELPFUL
+        assert prior[j].item() == pytest.approx(math.exp(bonus))
+    assert prior[-1].item() == 1.0  # STAY
