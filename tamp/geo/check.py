@@ -83,7 +83,8 @@ class MoveCheck:
 
 class Tools:
     """What a check needs, built once: the IK solver, the arm's collision model (a private
-    PyBullet client, closed by `close` or on leaving a ``with`` block), the pick-and-place and
+    PyBullet client, closed by `close` or on leaving a ``with`` block, screened by the sphere
+    model for the motion planner's batches: `motion.sphere_check.Screened`), the pick-and-place and
     guard settings, the grasp families to try, and ``q`` (J,), the arm configuration moves are
     planned from (home unless told). ``guard.plan`` False: a blocked phase fails the move
     rather than being rerouted by the motion planner (the search's default: fast)."""
@@ -101,9 +102,12 @@ class Tools:
     ) -> None:
         self.solver = solver or IKSolver()
         if collision is None:
+            from motion.sphere_check import Screened
             from robots.collision import PandaCollision
 
-            collision = PandaCollision(margin)
+            # the mesh model has the final word; the motion planner's batched validity checks
+            # (a blocked free-space phase rerouted at execution) screen with the spheres first
+            collision = Screened(PandaCollision(margin))
         self.collision = collision
         self.q = np.asarray(PANDA.q_home if q is None else q, dtype=np.float64)
         self.pick_place, self.guard, self.choices, self.quick = pick_place, guard, choices, quick
