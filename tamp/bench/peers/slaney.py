@@ -162,17 +162,6 @@ BASELINES: dict[str, Callable[[Problem], tuple[Move, ...]]] = {"us": us, "gn1": 
 LABELS = {"us": "US", "gn1": "GN1"}
 
 
-def parse(text: str) -> tuple[str, ...]:
-    """``"us,gn1"`` as a tuple of baseline names; TampError listing them otherwise."""
-    names = tuple(dict.fromkeys(t.strip() for t in text.split(",") if t.strip()))
-    bad = [n for n in names if n not in BASELINES]
-    if bad or not names:
-        raise TampError(
-            f"--baselines: unknown baseline {one_of(bad[0] if bad else text, BASELINES)}"
-        )
-    return names
-
-
 @dataclass(frozen=True)
 class Baseline:
     """One baseline's plan of one problem: its moves and the seconds it took."""
