@@ -163,6 +163,9 @@ class Simulator(abc.ABC):
         # scoring only: what the arm, the hand or the held block touched while running
         # trajectories and was not expected to (name, or "held:" + name -> physics steps)
         self.touched: dict[str, int] = {}
+        # the block the running trajectory holds (`Expected.held`, None between runs): scoring
+        # counts the contacts of the arm and of this block only, and `_contacts` may omit others
+        self._held: str | None = None
 
     # --- what a backend implements -------------------------------------------------------
     @abc.abstractmethod
@@ -184,8 +187,10 @@ class Simulator(abc.ABC):
 
     @abc.abstractmethod
     def _contacts(self) -> set[tuple[str, str]]:
-        """Every pair of things in contact now, by name: blocks, obstacles, "table", and
-        `ROBOT` for any link of the Panda (scoring only, see `Simulator.run`)."""
+        """The pairs of things in contact now, by name: blocks, obstacles, "table", and
+        `ROBOT` for any link of the Panda (scoring only, see `Simulator.run`). Every pair with
+        the arm or with the block held now (``self._held``) is there; a backend may leave out
+        the others, which scoring never counts."""
 
     @abc.abstractmethod
     def _block_poses(self) -> dict[str, Pose]:
@@ -278,12 +283,14 @@ class Simulator(abc.ABC):
         """
         worst = 0.0
         last = len(trajectory.times) - 1
+        self._held = expected.held
         tracked = -1  # the last TRACK_EVERY bucket whose tracking error was measured
         for k in self.commanded(last + 1):
             if release_at is not None and trajectory.times[k] >= release_at:
                 gripper = "open"
                 self.detach()
                 expected = replace(expected, held=None, rests=frozenset())
+                self._held = None
             self._command(trajectory.positions[k], trajectory.velocities[k], gripper)
             self._step()
             self.time += self.physics_dt
@@ -294,6 +301,7 @@ class Simulator(abc.ABC):
             if on_frame is not None and self.time >= self._next_frame:
                 on_frame(self)
                 self._next_frame = max(self._next_frame + self.frame_period, self.time)
+        self._held = None
         return worst
 
     @property
