@@ -38,14 +38,18 @@ def _encode(problem: Problem) -> tuple[_Code, dict[int, int]]:
 
 
 def _heuristic(state: _Code, goal: dict[int, int], claimed: dict[int, int]) -> int:
-    """Number of blocks that must move at least once (see the module docstring)."""
+    """Number of blocks that must move at least once (see the module docstring). Codes: the
+    blocks 0..n-1, the table n, fixed places (slots) above n; a goal of the table is met on
+    the table or on any slot, a goal of a slot only there."""
     n = len(state)
     must: list[bool | None] = [None] * n
 
     def moves(x: int) -> bool:
         if must[x] is None:
             s = state[x]
-            must[x] = goal.get(x, s) != s or (s < n and (claimed.get(s, x) != x or moves(s)))
+            g = goal.get(x, s)
+            met = g == s or (g == n and s > n)
+            must[x] = not met or (s < n and (claimed.get(s, x) != x or moves(s)))
         return bool(must[x])
 
     return sum(moves(x) for x in range(n))
@@ -54,10 +58,13 @@ def _heuristic(state: _Code, goal: dict[int, int], claimed: dict[int, int]) -> i
 def moves_lower_bound(problem: Problem, state: tuple[str, ...]) -> int:
     """Admissible lower bound on the moves still needed from ``state`` (crisp supports).
 
-    Table slots (`task.domains.blocksworld.slotted`) count as the table: the bound ignores
-    their capacity (a relaxation, so it stays admissible)."""
+    Table slots (`task.domains.blocksworld.slotted`) count as the table where the goal names
+    the table (the bound ignores their capacity: a relaxation, so it stays admissible); a
+    block whose goal is one slot must move while it stands anywhere else (the geometric
+    planner's region cells: without this the bound was blind to every cell goal)."""
     n = problem.n
-    names = {name: min(i, n) for i, name in enumerate(problem.targets)} | {TABLE: n}
+    names = {name: i if i < n else n + 1 + i for i, name in enumerate(problem.targets)}
+    names[TABLE] = n
     code = tuple(names[s] for s in state)
     goal = {names[x]: names[y] for x, y in problem.goal}
     return _heuristic(code, goal, {y: x for x, y in goal.items() if y < len(code)})

@@ -120,3 +120,18 @@ def test_the_planner_keeps_within_the_slots_an_unlimited_plan_exceeds():
         exceeded += _towers(p, _states(p, r_free.plan.moves)) > len(s.fixed)
         assert len(r_tight.plan) <= 2 * len(r_free.plan) + 2
     assert exceeded >= 1
+
+
+def test_the_lower_bound_counts_a_block_off_its_goal_slot_and_not_one_on_any_slot():
+    """A goal naming one slot (the geometric planner's region cells) needs a move while the
+    block stands on another; a goal of the table is met on any slot."""
+    from dataclasses import replace
+
+    from task.symbolic.search import moves_lower_bound
+
+    p = _problem()  # init: a on b, b on s0, c on s1
+    assert moves_lower_bound(p, p.init) == 2  # b must move (onto c), so a must move off it
+    cell = replace(p, goal=(("c", "s2"), ("a", TABLE)))  # c wants s2, a anywhere on the table
+    assert moves_lower_bound(cell, cell.init) == 2  # c is on s1; a is on b, not on a slot
+    moved = bw.apply_move(cell, cell.init, Move("a", "s2"))
+    assert moves_lower_bound(cell, moved) == 1  # a on s2 meets its table goal; c still off s2

@@ -40,6 +40,7 @@ move becomes a `GeoMove` onto a disc (centred on its top) or a peg region (the f
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -57,6 +58,7 @@ from task.domains.blocksworld import apply_move
 from task.domains.blocksworld import check_move as legal
 from task.planner import plan
 from task.problem import PlanStatus
+from task.symbolic.search import moves_lower_bound
 
 SEARCH_NODES = 5_000  # the complete search's expansions at least (its time bounds it first)
 # the differentiable planner's share of the wall clock: 1 / SOFT_SHARE (a sixth left a 10-cube
@@ -64,10 +66,12 @@ SEARCH_NODES = 5_000  # the complete search's expansions at least (its time boun
 # 24 s of 40)
 SOFT_SHARE = 3
 PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True)
-# receding windows per movable object at least (`PlannerConfig.max_windows`): a window commits
-# about three moves and a tower of n objects takes about 2 n moves, so 4 windows stopped long
-# plans short and left them to the fallback's blind search
-WINDOWS_PER_OBJECT = 2
+# receding windows at least per move the bridged problem's lower bound says the goal needs
+# (`PlannerConfig.max_windows`): a window commits one to three moves, and 4 windows stopped a
+# 10-cube tower's 20-move plan short; where the bound is small (a region to fill, objects to
+# move out and back) the windows gain little over the fallback's search, which the bound
+# guides (its cell goals count), so they stay few there
+WINDOWS_PER_BOUND_MOVE = 1.5
 # check failures no movable object takes part in: ruled out wherever the object stands as it
 # stood (`GeoCosts.avoid`'s ``fixed``), not only in the state they happened in
 FIXED_FAILURES = ("ik_infeasible", "no_clearance")
@@ -212,7 +216,8 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     costs = GeoCosts(bridged, solver, q, config.costs)
     failures, plans, cuts = [], 0, 0
     state, world, bound = bridged.problem.init, bridged.scene, []
-    windows = max(config.planner.max_windows, WINDOWS_PER_OBJECT * len(scene.objects))
+    least = moves_lower_bound(bridged.problem, bridged.problem.init)  # moves the goal needs
+    windows = max(config.planner.max_windows, math.ceil(WINDOWS_PER_BOUND_MOVE * least))
     while len(failures) <= config.replans and cuts <= config.cuts:
         planner = replace(config.planner, max_windows=windows)
         if config.soft_time_s is not None:
