@@ -207,7 +207,9 @@ def _request(o: Movable, move: GeoMove, grasp: Grasp, clear_z: float, scene: Sce
     return PickPlaceRequest(*common, grasp=grasp, half=o.half)
 
 
-def _world(scene: Scene, o: Movable, move: GeoMove, grasp: Grasp, support: str):
+def pick_place_world(scene: Scene, o: Movable, move: GeoMove, grasp: Grasp, support: str):
+    """The guard's `motion.guard.PickPlaceWorld` of moving ``o`` as ``move`` says, held by
+    ``grasp``, from ``support`` (a `support_box` name)."""
     from robots.collision import Box
 
     placed = Box(o.name, move.place.xyz, o.half, move.place.yaw)
@@ -248,7 +250,7 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
             if not found.ok[at_place]:
                 out[g.name] = ("ik_infeasible", "place", {"waypoint": "place"})
                 continue
-            world = _world(scene, o, move, g, support)
+            world = pick_place_world(scene, o, move, g, support)
             model.set_boxes(world.boxes)
             model.hold(None)
             ignore = (("hand", o.name),)
@@ -357,7 +359,7 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
             side = "pick" if bad in PICK_WAYPOINTS else "place"
             failure = {"failure": planned.failure, "side": side, "evidence": planned.evidence}
             continue
-        world = _world(scene, o, move, g, support)
+        world = pick_place_world(scene, o, move, g, support)
         guarded = guard_pick_place(planned.phases, tools.collision, world, tools.guard, seed)
         if guarded.ok:
             return guarded.phases

@@ -320,6 +320,7 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
         0.5 if drop else None,
         sense=lambda: np.asarray(_seen_pose(sim, move.obj).xyz),
         solver=runner.solver,
+        screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
     )
     _settle(sim, on_frame)
     seen = observe(sim, world)
@@ -333,6 +334,18 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
         evidence = {"missing": sorted(want - got), "extra": sorted(got - want)}
         return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, path
     return MoveRecord(move.text(), name, True), seen, path
+
+
+def _free(world: Scene, move: GeoMove, grasp, support: str, runner: Tools, phases) -> bool:
+    """Whether ``phases`` (a corrected place side: ``shift``, ``lower``, ``open``, ``retreat``)
+    pass the guard's collision check in ``world`` (the shift as a transit), not rerouted;
+    ``support``: what the object left, as `tamp.geo.check.support_box` names it."""
+    from motion.guard import guard_pick_place
+    from tamp.geo.check import pick_place_world
+
+    named = tuple(replace(p, name="transit") if p.name == "shift" else p for p in phases)
+    where = pick_place_world(world, world.object(move.obj), move, grasp, support)
+    return guard_pick_place(named, runner.collision, where, replace(runner.guard, plan=False)).ok
 
 
 def _go_home(sim: Simulator, world: Scene, runner: Tools, on_frame=None) -> float:

@@ -83,12 +83,15 @@ def run_move(
     drop_at: float | None = None,
     sense: Callable[[], np.ndarray] | None = None,
     solver=None,
+    screen: Callable[[tuple[Phase, ...]], bool] | None = None,
 ) -> MoveRun:
     """Run ``check``'s phases (a feasible `MoveCheck` of ``move``) in ``sim``; ``rests``: what
     the object leaves and goes onto (`support_box` names). ``drop_at`` in [0, 1] opens the
     gripper at that fraction of the transit (fault injection). ``sense``: the held object's
     centre (3,) as a sensor reads it now, and ``solver`` (`motion.ik.IKSolver`): correct the
-    place for the object's slip in the hand (module docstring); None: run as planned."""
+    place for the object's slip in the hand (module docstring); None: run as planned.
+    ``screen``: whether corrected phases are free of collisions (the guard's check; None: not
+    checked); corrected phases it refuses are not run, the planned ones are."""
     wall0, sim0, path = time.perf_counter(), sim.time, 0.0
     width = check.grasp.width
     evidence: dict = {}
@@ -110,6 +113,9 @@ def run_move(
         if phase.name == "lower" and sense is not None and solver is not None and not looked:
             looked = True
             fixed = _look_and_correct(sim, move, phase, phases, sense, solver, config, on_frame)
+            if fixed is not None and screen is not None and not screen(fixed[0]):
+                evidence["uncorrected_mm"] = fixed[1]  # the correction would collide
+                fixed = None
             if fixed is not None:
                 (phase, *phases), evidence["corrected_mm"] = fixed
         release = None

@@ -89,3 +89,23 @@ def test_the_empty_hand_goes_home_along_a_guarded_move_to_check_a_move_again():
     assert [g for _, g in sim.runs] == ["open"]
     assert _go_home(sim, hemmed(), tools()) == 0.0  # at home already: nothing runs
     assert len(sim.runs) == 1
+
+
+def test_a_corrected_place_runs_only_where_the_guard_finds_it_free():
+    """The place side moved by a few millimetres passes the guard; moved 7 cm onto the
+    neighbour it would put the held cube (and the fingers) into, it does not."""
+    from motion.pick_place import corrected_place
+    from tamp.geo.check import check_move, support_box
+    from tamp.geo.episode import _free
+    from tamp.geo.types import TABLE, GeoMove, Place
+
+    scene, kit = hemmed(), tools()
+    move = GeoMove("n", Place("table.x", TABLE, (0.62, 0.0, 0.025), 0.0))
+    verdict = check_move(scene, move, kit)
+    assert verdict.ok, verdict.evidence
+    above = next(p for p in verdict.motion if p.name == "transit").trajectory.positions[-1]
+    support = support_box(scene, TABLE)
+    for shift, free in (((0.002, 0.0), True), ((-0.07, 0.0), False)):
+        tail = corrected_place(kit.solver, above, verdict.motion, shift)
+        assert tail is not None
+        assert _free(scene, move, verdict.grasp, support, kit, tail) is free, shift
