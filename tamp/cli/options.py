@@ -39,8 +39,9 @@ SCENES = ("tabletop", "shelf", "clutter", "cramped")  # `tamp.obstacles` (no sim
 IMAGE_SCENES = ("cubes", "latplan")  # whose blocks an image shows (`tamp.camera.image_pair`)
 
 # every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
-# Blocksworld's "towers", Logistics' and Sokoban's "potential", the STRIPS lift's "hadd"
-GOAL_LOSSES = ("default", "atoms", "towers", "potential", "hadd")
+# Blocksworld's "towers", Logistics' and Sokoban's "potential", the STRIPS lift's "ff" (its
+# default, a soft relaxed plan's size) and "hadd"
+GOAL_LOSSES = ("default", "atoms", "towers", "potential", "ff", "hadd")
 
 _OVERRIDES = (
     "horizon",
