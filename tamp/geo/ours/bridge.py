@@ -59,7 +59,11 @@ ON_SPOT = 0.01  # m, an object this near a table spot stands on it
 FINGERS = 0.07
 SIDE = 0.033
 PACK = PackConfig(fingers=FINGERS, side=SIDE)
-PACK_TRIES = 4  # packings tried (seeds) before a region counts as too small
+PACK_TRIES = 4  # packings tried (seeds) with the margin ...
+# ... and then flush with the region's edges, before it counts as too small: a tight tray packs
+# (free, with a placing order) from about a third of the seeds (packed variant 3: 3 of 8), so
+# 4 seeds left one episode in seven with no arrangement; 12 leave about 1 in 250
+FLUSH_TRIES = 12
 
 
 @dataclass(frozen=True)
@@ -199,7 +203,8 @@ def bridge(
         fixed = [scene.object(x) for x in inside]
         # a few seeds (each R restart rows already), first with the footprints kept
         # `PACK_MARGIN` inside the rectangle, then flush with it where nothing else fits
-        tries = [(m, attempt) for m in (PACK_MARGIN, 0.0) for attempt in range(PACK_TRIES)]
+        tries = [(PACK_MARGIN, attempt) for attempt in range(PACK_TRIES)]
+        tries += [(0.0, attempt) for attempt in range(FLUSH_TRIES)]
         for margin, attempt in tries:
             result = pack(
                 r.inner(),
