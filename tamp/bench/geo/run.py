@@ -42,6 +42,8 @@ ROW_COLUMNS = (
     "motion_failures",
     "replans",
     "collisions",
+    "touched",
+    "failures",
     "planning_time_s",
     "execution_time_s",
     "arm_path_rad",
@@ -121,6 +123,9 @@ def play(item: Item) -> dict:
         "motion_failures": report.motion_failures,
         "replans": report.replans,
         "collisions": report.collisions,
+        # what was touched (physics steps in contact) and each failed move's failure, in order
+        "touched": ";".join(f"{k}:{v}" for k, v in sorted(report.touched.items())),
+        "failures": ";".join(m.failure for m in report.moves if m.failure),
         "planning_time_s": report.planning_time_s,
         "execution_time_s": report.execution_time_s,
         "arm_path_rad": report.arm_path_rad,
