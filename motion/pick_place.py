@@ -499,9 +499,7 @@ def corrected_place(
     paths.append(_vertical_path(solver, pre, place, paths[0][-1], q_place, config.vertical_step))
     paths.append(_vertical_path(solver, place, up, paths[1][-1], q_up, config.vertical_step))
     spec, dt, limits = solver.spec, config.dt, config.approach
-    shift_path, lower_path, retreat_path = paths
-    if len(shift_path) < 2:
-        shift_path = np.stack([q_now, q_now])
+    shift_path, lower_path, retreat_path = paths  # each (K >= 2, J): `_vertical_path`
     return (
         Phase("shift", polyline_segment(shift_path, dt, spec, limits), "closed", limits),
         Phase("lower", polyline_segment(lower_path, dt, spec, limits), "closed", limits),

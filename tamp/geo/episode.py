@@ -150,15 +150,13 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
 
 def observe(sim: Simulator, scene: Scene) -> Scene:
     """``scene`` with every object at the pose the motion-capture sensor reads now."""
-    with sim.truth.oracle():
-        poses = sim.truth.block_poses()
-    return _with_poses(scene, poses)
+    return _with_poses(scene, _sensed(sim))
 
 
-def _seen_pose(sim: Simulator, name: str) -> Pose:
-    """Where the motion-capture sensor reads object ``name`` now (as `observe`)."""
+def _sensed(sim: Simulator) -> dict[str, Pose]:
+    """Every object's pose as the motion-capture sensor reads it now."""
     with sim.truth.oracle():
-        return sim.truth.block_poses()[name]
+        return sim.truth.block_poses()
 
 
 def _with_poses(scene: Scene, poses: dict[str, Pose]) -> Scene:
@@ -318,7 +316,7 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
         RunConfig(),
         on_frame,
         0.5 if drop else None,
-        sense=lambda: np.asarray(_seen_pose(sim, move.obj).xyz),
+        sense=lambda: np.asarray(_sensed(sim)[move.obj].xyz),
         solver=runner.solver,
         screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
     )
