@@ -287,6 +287,10 @@ class MuJoCoSim(Simulator):
         # renders read the world poses of cameras and lights (cam_xpos, light_xdir), which
         # only the kinematics pass recomputes: without this the view lags one set_view behind
         mujoco.mj_camlight(m, self.data)
+        # nor does that pass move the world body's camera before the next physics step (MuJoCo
+        # 4.0.1): set its world pose as the step would, or eye and target apply one step late
+        self.data.cam_xpos[cam.id] = camera.eye
+        mujoco.mju_quat2Mat(self.data.cam_xmat[cam.id], cam.quat)
 
     def set_colour(self, part, rgb) -> None:
         self._check_part(part)
