@@ -179,6 +179,7 @@ class PandaCollision:
         self._pairs = np.array(arm + cube)  # (K, 2); the second is always a link
         self._pair_thr = np.array([self.self_margin] * len(arm) + [self.margin] * len(cube))
         self._shapes: dict[tuple, int] = {}  # half extents -> shape; PyBullet can't free them
+        self._half: dict[int, tuple] = {}  # body -> its half extents (reused by shape)
         table = self._new_box((0.0, 0.0, -_TABLE_HALF[2]), _TABLE_HALF, 0.0)
         self._others: list[tuple[str, int]] = [(TABLE, table)]  # (name, body)
         self._held: int | None = None  # body of the held box
@@ -197,9 +198,28 @@ class PandaCollision:
                 raise RobotError(f"box {name!r}: centre (3,), half (3,) > 0 and yaw must be finite")
             seen.add(name)
         self._check_open()
+        # the old bodies by shape, reused where a new box has the same half extents (moved,
+        # not rebuilt: creating a body costs about 0.3 ms, moving one a few microseconds, and
+        # a check sets its scene's boxes for every phase it tests)
+        spare: dict[tuple, list[int]] = {}
         for _, body in self._others[1:]:
-            p.removeBody(body, physicsClientId=self._c)
-        self._others[1:] = [(b.name, self._new_box(b.centre, b.half, b.yaw)) for b in boxes]
+            spare.setdefault(self._half[body], []).append(body)
+        others = []
+        for b in boxes:
+            half = tuple(float(h) for h in b.half)
+            if spare.get(half):
+                body = spare[half].pop()
+                orn = p.getQuaternionFromEuler((0.0, 0.0, float(b.yaw)))
+                centre = [float(v) for v in b.centre]
+                p.resetBasePositionAndOrientation(body, centre, orn, physicsClientId=self._c)
+            else:
+                body = self._new_box(b.centre, half, b.yaw)
+            others.append((b.name, body))
+        for bodies in spare.values():
+            for body in bodies:
+                p.removeBody(body, physicsClientId=self._c)
+                del self._half[body]
+        self._others[1:] = others
         self._refresh()
 
     def hold(self, size: float | None = None, half=None, pose=None) -> None:
@@ -221,6 +241,7 @@ class PandaCollision:
         self._check_open()
         if self._held is not None:
             p.removeBody(self._held, physicsClientId=self._c)
+            del self._half[self._held]
             self._held = None
         self._held_pose = relative
         if size is not None or half is not None:
@@ -234,7 +255,9 @@ class PandaCollision:
                 p.GEOM_BOX, halfExtents=half, physicsClientId=c
             )
         orn = p.getQuaternionFromEuler((0.0, 0.0, yaw))
-        return p.createMultiBody(0, self._shapes[half], -1, list(centre), orn, physicsClientId=c)
+        body = p.createMultiBody(0, self._shapes[half], -1, list(centre), orn, physicsClientId=c)
+        self._half[body] = half
+        return body
 
     def _refresh(self) -> None:
         """Cache the scene AABBs (O, 2, 3) and forget the ignore masks, which depend on them."""
