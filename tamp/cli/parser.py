@@ -12,6 +12,7 @@ from perception import CHECKPOINT
 from tamp.bench.official import DEFAULT_DATA
 from tamp.cli.options import (
     IMAGE_SCENES,
+    SCENES,
     Parser,
     data_option,
     device_option,
@@ -37,6 +38,7 @@ from tamp.cli.types import (
     bounded,
     nonnegative,
     positive,
+    positive_list,
     radius,
     seed,
     threads,
@@ -74,6 +76,7 @@ def build_parser() -> argparse.ArgumentParser:
     _motion_benchmark(bench, plan_opts)
     _executability_benchmark(bench, plan_opts)
     _tamp_benchmark(bench)
+    _checker_benchmark(bench)
     _perception_benchmark(bench, bench_opts)
     _latplan_benchmark(bench, plan_opts)
     _poses_benchmark(bench)
@@ -326,6 +329,48 @@ def _tamp_benchmark(bench) -> None:
     p.set_defaults(
         func=_lazy("tamp.cli.bench.geo", "tamp_command"),
         recorded=_lazy("tamp.cli.recorded", "tamp_bench_config"),
+    )
+
+
+def _checker_benchmark(bench) -> None:
+    p = bench.add_parser(
+        "checker",
+        help="the sphere collision checker: configurations/s on one core, no false free against "
+        "the meshes, rerouted moves",
+    )
+    p.add_argument(
+        "--scenes",
+        default="shelf,clutter,cramped",
+        metavar="SCENE[,SCENE]",
+        help=f"obstacle scenes with seeded towers of blocks, from {','.join(SCENES)} (%(default)s)",
+    )
+    p.add_argument(
+        "--batch",
+        type=positive_list,
+        default=(1_000, 10_000, 100_000),
+        metavar="B[,B...]",
+        help="configurations per batched call timed (1000,10000,100000)",
+    )
+    p.add_argument("--repeats", type=positive, default=5, help="timed calls per batch size (5)")
+    p.add_argument(
+        "--near",
+        type=positive,
+        default=2_000,
+        help="configurations near obstacles per scene checked by both models (2000)",
+    )
+    p.add_argument("--moves", type=positive, default=20, help="rerouted moves per scene (20)")
+    p.add_argument(
+        "--no-baseline",
+        dest="baseline",
+        action="store_false",
+        help="do not also plan each move with OMPL's RRT-Connect on the mesh model alone",
+    )
+    p.add_argument("--seed", type=seed, default=0, help="scene, sample and planner seed (0)")
+    progress_option(p)
+    output_options(p, "write results.json, throughput.csv and moves.csv into this folder")
+    p.set_defaults(
+        func=_lazy("tamp.cli.bench.checker", "checker_command"),
+        recorded=_lazy("tamp.cli.bench.checker", "checker_config"),
     )
 
 

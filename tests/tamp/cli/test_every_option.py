@@ -60,6 +60,7 @@ SAMPLES = {
     "--limit": "2",
     "--n": "2",
     "--max-replans": "3",
+    "--scenes": "clutter",  # bench checker: a list of scene names
     "--scene": "shelf",  # run and demo: a name or a scene file (the other commands: choices)
     "--goal": "(on b c)",
     "--problems": "blocked,tall",
