@@ -147,3 +147,29 @@ def test_a_binary_file_is_one_line_naming_it(tmp_path, loader):
     with pytest.raises(PDDLError) as excinfo:
         getattr(pddl_io, loader)(path)
     _error(excinfo, str(path), "not a text file")
+
+
+def test_the_compiled_grammar_is_cached_on_disk_and_parses_alike(
+    bw_domain_path, tmp_path, monkeypatch
+):
+    """The grammar's tables are written to the cache folder and read back from it; a parser
+    built without the cache, or from a corrupt cache file, parses the same problem alike."""
+    domain_text = bw_domain_path.read_text()
+
+    def parsed() -> str:
+        pddl_io._grammar.cache_clear()
+        domain = pddl_io.parse_domain(domain_text, "d")
+        return str(pddl_io.parse_problem(PROBLEM, "p", domain))
+
+    monkeypatch.setenv("SOFT_TAMP_NO_CACHE", "1")
+    plain = parsed()
+    monkeypatch.delenv("SOFT_TAMP_NO_CACHE")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert parsed() == plain  # built, then written
+    (cached,) = (tmp_path / "soft-tamp").iterdir()
+    assert cached.stat().st_size > 0
+    assert parsed() == plain  # read back
+    cached.write_bytes(b"not a grammar\n")
+    assert parsed() == plain  # a corrupt file is rebuilt
+    assert cached.read_bytes() != b"not a grammar\n"
+    pddl_io._grammar.cache_clear()
