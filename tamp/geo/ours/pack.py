@@ -2,9 +2,10 @@
 
 `pack` places M axis-aligned footprints (half extents ``(M, 2)``) inside a region's inner
 rectangle, free of each other and of F fixed occupants (objects already there, posts), by Adam
-over the centres of R restart rows at once (one tensor program, nanoGPT style), the best row
-winning. Centres are inside by construction: the unbounded variables u map into the rectangle
-shrunk by each footprint,
+over the centres of R restart rows at once (one tensor program, nanoGPT style); the free row
+of least overlap that admits a placing order wins (else the row of least overlap). Centres
+are inside by construction: the unbounded variables u map into the rectangle shrunk by each
+footprint,
 
     x_m = lo + h_m + (hi - lo - 2 h_m) * sigmoid(u_m)                       (per axis)
 
@@ -250,7 +251,16 @@ def pack(
     best = int(np.argmin(worst))
     order = tuple(range(m))
     if config.ordered:
-        order = placing_order(xy[best], grown_np[best], body_np[best], config.gap, config.tol)
+        # the free rows, least overlap first: the first with a placing order wins (the least
+        # overlap alone may be a row no order can place)
+        order = ()
+        for row in [int(i) for i in np.argsort(worst, kind="stable") if worst[i] <= config.tol]:
+            order = placing_order(xy[row], grown_np[row], body_np[row], config.gap, config.tol)
+            if len(order) == m:
+                best = row
+                break
+        if len(order) != m:
+            order = placing_order(xy[best], grown_np[best], body_np[best], config.gap, config.tol)
     yaws = np.where(turn[best].numpy(), math.pi / 2, 0.0)
     return PackResult(
         positions=xy[best],
