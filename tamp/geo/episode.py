@@ -14,7 +14,10 @@ Planners (`PLANNERS`):
 
 The robot observes object poses as `tamp.loop`'s ``observe="state"`` does (the motion-capture
 oracle, `tamp.loop.sensors.MocapPoses`: the true poses under the ground truth's ``oracle()``
-grant, a sensor by design) and reads the facts from them with `OBSERVED` tolerances. Before
+grant, a sensor by design), or with ``observation="camera"`` estimates them from RGB-D images
+of several cameras and the objects' known models (`tamp.camera.scene_poses.ScenePoses`; the
+estimates' errors are scored against the ground truth for the record, never acted on), and
+reads the facts from them with `OBSERVED` tolerances. Before
 each move `check_move` decides it again on the observed scene from the arm's configuration now
 (blocked free-space phases rerouted by the motion planner); the move runs
 (`tamp.geo.execute.run_move`; above the place the hand looks at the object it holds and
@@ -53,6 +56,7 @@ from tamp.world.schema import Scene
 from task.errors import TampError, one_of
 
 PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
+OBSERVATIONS = ("state", "camera")  # the pose sensors: motion capture, or RGB-D cameras
 # settled poses as the motion-capture sensor reads them: `SceneConfig.tol_z`'s 12 mm; an
 # object counts as in a region when its footprint crosses the edge by at most 2 mm (a tight
 # packing sets boxes flush with the edge, and a placement lands within about a millimetre)
@@ -100,6 +104,9 @@ class GeoReport:
     plan_length: int = 0  # moves of the first plan (0: none)
     replans: int = 0
     plan_stats: tuple[dict, ...] = ()  # each planner call's stats
+    observation: str = "state"  # the pose sensor (one of `OBSERVATIONS`)
+    # camera: the estimates' errors against ground truth (scored, never acted on), `_scored`
+    pose_errors: dict = field(default_factory=dict)
 
     @property
     def solved_clean(self) -> bool:
@@ -148,15 +155,44 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
     return GeoPlan(GeoStatus.SOLVED, tuple(moves), f"a plan of {len(moves)} moves", stats)
 
 
-def observe(sim: Simulator, scene: Scene) -> Scene:
-    """``scene`` with every object at the pose the motion-capture sensor reads now."""
-    return _with_poses(scene, _sensed(sim))
+def observe(sim: Simulator, scene: Scene, camera=None) -> Scene:
+    """``scene`` with every object at the pose the robot's sensor reads now (`_sensed`)."""
+    return _with_poses(scene, _sensed(sim, scene, camera))
 
 
-def _sensed(sim: Simulator) -> dict[str, Pose]:
-    """Every object's pose as the motion-capture sensor reads it now."""
-    with sim.truth.oracle():
-        return sim.truth.block_poses()
+def _sensed(sim: Simulator, scene: Scene, camera=None) -> dict[str, Pose]:
+    """Every object's pose as the robot's sensor reads it now: the motion-capture sensor, or
+    with ``camera`` (a `tamp.camera.scene_poses.ScenePoses`) the poses estimated from its
+    images, ``scene``'s poses the previous estimates (an object no camera sees keeps its own).
+    The camera's estimates are then scored against the ground truth (``scoring()``) for the
+    record only (``camera.errors``)."""
+    if camera is None:
+        with sim.truth.oracle():
+            return sim.truth.block_poses()
+    from tamp.camera.scene_poses import pose_errors
+
+    poses = camera(scene)
+    with sim.truth.scoring():
+        truth = sim.truth.block_poses()
+    camera.errors.append(pose_errors(poses, truth, scene))
+    return poses
+
+
+def _scored(camera) -> dict:
+    """A camera's pose errors over the episode: looks, objects kept unseen (name: looks),
+    mean and max position error (mm) and yaw error (deg, cylinders left out); {} for none."""
+    if camera is None:
+        return {}
+    mm = [e[0] for look in camera.errors for e in look.values()]
+    deg = [e[1] for look in camera.errors for e in look.values() if e[1] is not None]
+    return {
+        "looks": camera.looks,
+        "unseen": dict(camera.unseen),
+        "position_mm_mean": float(np.mean(mm)) if mm else None,
+        "position_mm_max": max(mm, default=None),
+        "yaw_deg_mean": float(np.mean(deg)) if deg else None,
+        "yaw_deg_max": max(deg, default=None),
+    }
 
 
 def _with_poses(scene: Scene, poses: dict[str, Pose]) -> Scene:
@@ -178,6 +214,7 @@ def run_geo_episode(
     tools: Tools | None = None,
     grasp: str = "friction",
     domain: tuple[str, ...] | None = None,
+    observation: str = "state",
 ) -> GeoReport:
     """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
@@ -186,7 +223,10 @@ def run_geo_episode(
     on those move indices; ``tools``: reuse an IK solver and collision model (else built and
     closed here); ``domain``: ``(pddl_domain_text, binding_text)`` the motion-aware planner
     plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules); refused for the
-    other planners, which plan over the moves the geometry allows."""
+    other planners, which plan over the moves the geometry allows. ``observation``: the pose
+    sensor, one of `OBSERVATIONS` (``"camera"``: `tamp.camera.scene_poses.ScenePoses`)."""
+    if observation not in OBSERVATIONS:
+        raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
     plan_fn = planner_by_name(planner)
     if domain is not None:
         if planner != "motion-aware":
@@ -214,6 +254,11 @@ def run_geo_episode(
 
     sim = open_sim(scene, backend, video=video is not None, grasp=grasp)
     sim.truth.lock()
+    camera = None
+    if observation == "camera":
+        from tamp.camera.scene_poses import ScenePoses
+
+        camera = ScenePoses(sim, scene)
     recorder, on_frame = _recorder(video)
     records: list[MoveRecord] = []
     plan_times, plan_stats = [], []
@@ -222,7 +267,7 @@ def run_geo_episode(
     try:
         with torch_threads(1):
             _settle(sim, on_frame)
-            world = observe(sim, scene)
+            world = observe(sim, scene, camera)
             while True:
                 if goal.holds(read_facts(world, OBSERVED)):
                     status = "reached"
@@ -243,7 +288,7 @@ def run_geo_episode(
                         break
                     k = len(records)
                     record, world, ran = _act(
-                        sim, world, move, runner, seed * 1000 + k, on_frame, k in drops
+                        sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
                     )
                     records.append(record)
                     path += ran
@@ -288,12 +333,17 @@ def run_geo_episode(
         plan_length=first_len,
         replans=replans,
         plan_stats=tuple(plan_stats),
+        observation=observation,
+        pose_errors=_scored(camera),
     )
 
 
-def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, drop: bool):
+def _act(
+    sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, drop: bool, camera=None
+):
     """Check ``move`` on the observed ``world`` from the arm's configuration now, run it,
-    settle and observe: (record, observed scene, joint path run in rad)."""
+    settle and observe (``camera``: the camera sensor, None for motion capture): (record,
+    observed scene, joint path run in rad)."""
     o = world.object(move.obj)
     grasps = None
     if move.grasp is None:
@@ -316,12 +366,12 @@ def _act(sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, d
         RunConfig(),
         on_frame,
         0.5 if drop else None,
-        sense=lambda: np.asarray(_sensed(sim)[move.obj].xyz),
+        sense=lambda: np.asarray(_sensed(sim, world, camera)[move.obj].xyz),
         solver=runner.solver,
         screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
     )
     _settle(sim, on_frame)
-    seen = observe(sim, world)
+    seen = observe(sim, world, camera)
     name = verdict.grasp.name
     path = home + ran.path_rad
     if not ran.ok:
