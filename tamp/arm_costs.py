@@ -176,8 +176,10 @@ class ArmCosts:
         places: Sequence[Mapping[str, XY]] | None = None,
         avoid: Mapping[State, set] | None = None,
         reach: float = 0.0,
+        grasps: tuple[str, ...] = (),
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
+        self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
         self.places = places  # per problem: table place -> (x, y), for slotted problems
         self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
@@ -274,7 +276,8 @@ class ArmCosts:
             under.append([problem.entities.index(b) if b != TABLE else -1 for b in plain])
             places.append(np.vstack([up, table]))  # (Y, 3), Y = N + K
             extra.append(self._blocked(problem, plain, now, at is None and slot is None))
-            self._hover(extra[-1], xyz, places[-1], now)
+            yaws = [now[x].yaw for x in problem.entities]
+            self._hover(extra[-1], xyz, places[-1], now, yaws)
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
                 j = _column(problem, key, at, self.reach)
                 if j is not None:
@@ -283,19 +286,42 @@ class ArmCosts:
         half, under = torch.tensor(half).reshape(picks.shape), torch.tensor(under, dtype=torch.long)
         return picks, places, extra, Blocks(picks, half, under.reshape(picks.shape[:2]))
 
-    def _hover(self, extra: np.ndarray, picks: np.ndarray, places: np.ndarray, now) -> None:
+    def _hover(self, extra: np.ndarray, picks: np.ndarray, places: np.ndarray, now, yaws) -> None:
         """Add BLOCKED (in place) to the moves whose pick or place the hand cannot reach from
         above: a pick-and-place hovers and carries the block over the highest stack top
         (`motion.pick_place`), where a far slot may be out of the arm's reach. One batched,
-        detached IK call; the hand's yaw is taken as 0."""
+        detached IK call; the hand's yaw is taken as 0. With ``self.grasps``, a pick or place
+        out of that reach stays open when one of those grasps holds the block there (`_grasped`,
+        ``yaws``: (N,) the picked blocks' yaws; a place's is 0)."""
         top = max(p.xyz[2] for p in now.values()) + self.scene.block_size / 2
         hover = top + HOVER.lift_clearance + self.scene.block_size  # TCP holding a block
         points = np.vstack([picks, places])  # (N + Y, 3)
         points[:, 2] = np.maximum(points[:, 2], hover)
         n = picks.shape[0]
         ok = site_solutions(self.solver, self.q_now, points[None, :n], points[None, n:])[1]
-        extra[~ok[:n].numpy(), :] += BLOCKED
-        extra[:, ~ok[n:].numpy()] += BLOCKED
+        ok = ok.numpy().copy()  # (N + Y,)
+        if self.grasps and not ok.all():  # the executor's other grasps, at the block's height
+            at = np.vstack([picks, places])[~ok]  # (M, 3)
+            turned = np.concatenate([np.asarray(yaws, float), np.zeros(len(points) - n)])
+            ok[~ok] = self._grasped(at, turned[~ok])
+        extra[~ok[:n], :] += BLOCKED
+        extra[:, ~ok[n:]] += BLOCKED
+
+    def _grasped(self, points: np.ndarray, yaws: np.ndarray) -> np.ndarray:
+        """(M,) whether some grasp of ``self.grasps`` (`motion.grasps.grasps` of a cube) holds
+        a block centred at ``points`` (M, 3), turned ``yaws`` (M,), with the arm's IK solved:
+        where the executor's geometric fallback (`tamp.blocks_geo.run_geo`) may still pick or
+        place it when no top-down grasp reaches over the highest stack. One batched IK call."""
+        from motion.grasps import grasps, world_tcp
+
+        family = grasps("cube", (self.scene.block_size / 2,) * 3, self.grasps)
+        if not family or len(points) == 0:
+            return np.zeros(len(points), dtype=bool)
+        targets = np.stack(
+            [world_tcp(g, p, float(y)) for p, y in zip(points, yaws, strict=True) for g in family]
+        )  # (M * G, 4, 4)
+        found = self.solver.solve(targets, self.q_now)
+        return np.asarray(found.ok).reshape(len(points), len(family)).any(1)
 
     def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no

@@ -110,16 +110,27 @@ def plan_on_places(
     seed: int = 0,
     avoid: Mapping | None = None,
     reach: float = 0.0,
+    grasps: tuple[str, ...] = (),
 ) -> PlanResult:
     """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
     table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
     the arm failed, priced out); the plan's moves are plain (`plain_move`). ``reach`` > 0:
     continuous placements, each place's position optimised within ``reach`` m of its centre
     with the logits, per window and restart row: every move onto a place carries the position
-    that the restart row it was decoded from decided in its window (`ArmCosts.decided`)."""
+    that the restart row it was decoded from decided in its window (`ArmCosts.decided`).
+    ``grasps``: the grasp families the executor has besides top-down over the highest stack
+    (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out)."""
     current, at = slotted(problem, problem.init, poses, scene)
     costs = ArmCosts(
-        [current], [poses], scene, solver, q_now, places=[at], avoid=avoid, reach=reach
+        [current],
+        [poses],
+        scene,
+        solver,
+        q_now,
+        places=[at],
+        avoid=avoid,
+        reach=reach,
+        grasps=grasps,
     )
     result = plan(current, config, seed=seed, costs=costs)
     decided = costs.decided(0)

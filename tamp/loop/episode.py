@@ -236,6 +236,17 @@ class Episode:
         self.say(f"plan {len(p.plans)}: {len(p.queue)} moves")
         return True
 
+    def _grasps(self) -> tuple[str, ...]:
+        """The grasp families the executor has beyond top-down over the highest stack: those of
+        its geometric fallback (`tamp.blocks_geo.CHOICES`) when it has one (collision mode
+        "plan" and ``execution.geo_fallback``), else none."""
+        execution = self.config.execution
+        if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
+            return ()
+        from tamp.blocks_geo import CHOICES
+
+        return CHOICES
+
     def _crisp_basis(self, observed):
         """The state decoded moves are checked against: the observed one (``crisp="perceived"``,
         the default: a robot has no oracle) or, with ``crisp="true"``, the simulator's true
@@ -266,6 +277,7 @@ class Episode:
                     seed,
                     self._avoid,
                     self.config.placements,
+                    self._grasps(),
                 )
             costs = ArmCosts([current], [poses], scene, self.solver, q, avoid=self._avoid)
         if self.config.observe == "state":

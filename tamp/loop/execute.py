@@ -52,6 +52,8 @@ class Failure(enum.Enum):
 
 
 COLLISION_MODES = ("plan", "check", "off")
+# what the top-down executor failed with that the geometric room's grasps may still make
+GEO_RETRIED = frozenset({Failure.IK_INFEASIBLE, Failure.COLLISION, Failure.NO_CLEARANCE})
 
 
 @dataclass(frozen=True)
@@ -70,6 +72,10 @@ class ExecConfig:
     margin: float = 0.01  # m: a trajectory passing closer than this to anything is a collision
     guard: GuardConfig = GuardConfig()
     slot_tries: int = 3  # free table slots a move to the table tries before it fails
+    # collision "plan": a move the top-down grasps cannot make (no IK, a collision, no
+    # clearance) is checked and run by the geometric room (`tamp.blocks_geo.run_geo`): side
+    # and tilted grasps too, the transit at the corridor's height; False: top-down only
+    geo_fallback: bool = True
 
     def __post_init__(self) -> None:
         if self.collision not in COLLISION_MODES:
@@ -220,6 +226,19 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
     return last
 
 
+def _geo(sim, solver, move, target, poses, config, scene, collision, seed, drop_at, observe):
+    """``move`` checked and run by the geometric room (`tamp.blocks_geo.run_geo`) to
+    ``target``; the place checked on the poses ``observe`` gives after
+    it (a block the camera cannot see then: ``unobservable``)."""
+    from tamp.blocks_geo import geo_tools, run_geo
+
+    tools = geo_tools(solver, collision, config.guard, plan=True)
+    try:
+        return run_geo(sim, move, target, poses, scene, tools, config, seed, drop_at, None, observe)
+    except PerceptionError as err:
+        return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
+
+
 def execute_move(
     sim: Simulator,
     solver: IKSolver,
@@ -267,6 +286,35 @@ def execute_move(
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
     planned = _plan(sim, solver, move, poses, config, scene, collision, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
+        if planned[0] in GEO_RETRIED and config.geo_fallback and config.collision == "plan":
+            target = place_pose(move, poses, scene)
+            if target is not None:
+                again = _geo(
+                    sim,
+                    solver,
+                    move,
+                    target,
+                    poses,
+                    config,
+                    scene,
+                    collision,
+                    seed,
+                    drop_at,
+                    observe,
+                )
+                if again.ok or again.path_rad > 0:  # it made the move, or it ran and failed
+                    first = result(planned[0], planned[1])  # the top-down tries' times
+                    return replace(
+                        again,
+                        sim_time_s=first.sim_time_s,
+                        wall_time_s=first.wall_time_s,
+                        ik_time_s=first.ik_time_s,
+                        check_time_s=first.check_time_s + again.check_time_s,
+                        path_time_s=first.path_time_s,
+                        planner_runs=first.planner_runs,
+                        planner_failures=first.planner_failures,
+                    )
+                planned[2]["geo"] = again.evidence
         return result(planned[0], planned[1], **planned[2])
     target, phases, ik, rerouted = planned
     supports, handling = _supports(move, poses, scene), Expected(move.entity)

@@ -1,0 +1,187 @@
+"""The closed loop's Blocksworld world as a geometric scene: where `tamp.loop` calls on the
+geometric TAMP room (`tamp.geo`).
+
+The loop moves same-size cubes top-down onto blocks and table slots (`tamp.loop.execute`).
+Where that fails the geometric room has more to offer: grasps and approaches as choices (side
+and tilted grasps, a tower's top reachable whenever some approach reaches it) and transits at
+the heights the corridor between pick and place needs instead of over the highest stack, each
+phase guarded and a blocked free-space phase rerouted by the motion planner. The table stays
+the loop's: a block goes where the loop would put it (onto a block, or onto its table slot),
+so the scene's few slots stay the constraint they are. This module translates:
+
+- `world_scene`: the observed block poses on a `tamp.scene.SceneConfig` table as a
+  `tamp.world.schema.Scene` (cubes of the block size, the scene's obstacles and slot grid);
+  each block's height is snapped to its level in the observed state, so the geometric reader's
+  tight tolerances read the state the loop's looser reader read;
+- `blocks_goal`: a Blocksworld goal as the scene goal (``on`` / ``ontable`` atoms);
+- `run_geo`: one loop move checked (every grasp family, blocked free-space phases rerouted) and run
+  through `tamp.geo.check.check_move` and `tamp.geo.execute.run_move` in the loop's simulator,
+  its outcome as the loop's `tamp.loop.execute.ExecutionResult`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from tamp.scene import PALETTE, Pose, SceneConfig, read_state, towers
+from task.problem import TABLE, Move, Problem
+
+if TYPE_CHECKING:
+    from tamp.geo.check import Tools
+    from tamp.world.goal import Goal
+    from tamp.world.schema import Scene
+
+# the named scenes' table top (`tamp/world/scenes/*.json`), m: (x, y) low and high corners
+TABLE_LO, TABLE_HI = (-0.3, -0.7), (1.0, 0.7)
+CHOICES = ("top", "side", "tilt")  # the grasp families the loop's geometric moves try
+# the order they are tried in (each family in `tamp.geo.check.grasp_order`): side grasps last,
+# as the open fingers of a side grasp beside a block on the table reach the table top (a
+# 7-block tower's top moved to a near slot: the side grasp touched the table for 137 physics
+# steps, the tilted one touched nothing)
+FAMILY_RANK = {"top": 0, "tilt": 1, "side": 2}
+# geometric failures as the loop names them (a failure not listed: ik_infeasible, the arm
+# found no way to make the move)
+FAILURES = {
+    "ik_infeasible": "ik_infeasible",
+    "no_grasp": "ik_infeasible",
+    "no_clearance": "no_clearance",
+    "collision": "collision",
+    "missed_grasp": "grasp_missed",
+    "dropped": "dropped",
+    "tracking_error": "tracking_error",
+}
+
+
+def world_scene(entities: Sequence[str], poses: Mapping[str, Pose], scene: SceneConfig) -> Scene:
+    """The blocks ``entities`` observed at ``poses`` on ``scene``'s table as a geometric scene:
+    cubes of ``scene.block_size`` in the palette's colours, the scene's fixed boxes as
+    obstacles, its slot grid. When the loop's reader reads a state from the poses, each block's
+    centre height is set to its level in it (the geometric reader is tighter than the loop's)."""
+    from tamp.world.schema import Movable, Scene, Slots, Table
+
+    s = scene.block_size
+    poses = dict(poses)
+    reading = read_state(entities, poses, scene)
+    if reading.state is not None:
+        for tower in towers(entities, reading.state):
+            for level, x in enumerate(tower):
+                xyz = poses[x].xyz
+                poses[x] = Pose((float(xyz[0]), float(xyz[1]), s / 2 + level * s), poses[x].yaw)
+    colours = dict(scene.palette)
+    fallback = [rgb for _, rgb in PALETTE]
+    objects = tuple(
+        Movable(
+            x,
+            "cube",
+            (s,),
+            colours.get(x, fallback[i % len(fallback)]),
+            Pose(tuple(float(v) for v in poses[x].xyz), float(poses[x].yaw)),
+        )
+        for i, x in enumerate(entities)
+    )
+    return Scene(
+        scene.name,
+        Table(TABLE_LO, TABLE_HI),
+        obstacles=tuple(scene.obstacles),
+        objects=objects,
+        slots=Slots(tuple(scene.slot_xs), tuple(scene.slot_ys)),
+    )
+
+
+def blocks_goal(problem: Problem) -> Goal:
+    """``problem``'s goal (block -> support) as ``on`` / ``ontable`` atoms."""
+    from tamp.world.goal import Goal
+
+    return Goal(tuple(("ontable", x) if y == TABLE else ("on", x, y) for x, y in problem.goal))
+
+
+def geo_tools(solver, collision, guard, plan: bool = True, choices=CHOICES) -> Tools:
+    """`tamp.geo.check.Tools` over the loop's IK solver and collision model (not closed by the
+    loop's `Episode.close` twice: do not call its ``close``); ``plan``: reroute blocked
+    free-space phases with the motion planner."""
+    from tamp.geo.check import Tools
+
+    return Tools(solver, collision, guard=replace(guard, plan=plan), choices=tuple(choices))
+
+
+def run_geo(
+    sim,
+    move: Move,
+    target: Pose,
+    poses: Mapping[str, Pose],
+    scene: SceneConfig,
+    tools: Tools,
+    config,
+    seed: int = 0,
+    drop_at: float | None = None,
+    on_frame: Callable | None = None,
+    observe: Callable[[], Mapping[str, Pose]] | None = None,
+):
+    """Check ``move`` to ``target`` (the pose the loop places the block at) over every grasp
+    family of ``tools`` from the arm's configuration now, and run
+    it when a grasp passes: the loop's `tamp.loop.execute.ExecutionResult` (``evidence`` names
+    the grasp, or the geometric failure). ``config``: the loop's `ExecConfig` (the place check's
+    tolerances); ``observe``: the block poses after the run (default: the simulator's sensor is
+    not read here, so the place is not checked)."""
+    from tamp.geo.check import candidate_grasps, check_move, grasp_order
+    from tamp.geo.execute import RunConfig, rests_of, run_move
+    from tamp.geo.types import GeoMove, Place
+    from tamp.loop.execute import ExecutionResult, Failure
+
+    wall0, sim0 = time.perf_counter(), sim.time
+    world = world_scene(tuple(poses), poses, scene)
+    name = "table" if move.target == TABLE else f"on.{move.target}"
+    place = Place(name, move.target, tuple(float(v) for v in target.xyz), float(target.yaw))
+    geo = GeoMove(move.entity, place)
+    o = world.object(move.entity)
+    grasps = grasp_order(world, o, candidate_grasps(o, tools.choices))
+    grasps = tuple(sorted(grasps, key=_family_rank))
+    verdict = check_move(world, geo, tools, grasps=grasps, q_now=sim.arm_q(), seed=seed)
+
+    def result(failure: str | None, run=None, **evidence) -> ExecutionResult:
+        kind = None if failure is None else Failure(FAILURES.get(failure, "ik_infeasible"))
+        return ExecutionResult(
+            move,
+            failure is None,
+            kind,
+            {"geo": failure or "ok", **evidence},
+            sim.time - sim0,
+            time.perf_counter() - wall0,
+            check_time_s=verdict.time_s,
+            path_rad=0.0 if run is None else run.path_rad,
+        )
+
+    if not verdict.ok:
+        tried = [f"{t.grasp}:{t.failure}" for t in verdict.tried]
+        return result(verdict.failure, tried=tried)
+    below = next((x for x, p in poses.items() if _on(p, poses[move.entity], scene)), TABLE)
+    rests = rests_of(world, geo, below)
+    run = run_move(sim, geo, verdict, rests, RunConfig(), on_frame, drop_at)
+    grasp = verdict.grasp.name
+    if not run.ok:
+        return result(run.failure, run, grasp=grasp, **run.evidence)
+    if observe is None:
+        return result(None, run, grasp=grasp)
+    seen = observe()[move.entity]
+    dxy = float(np.linalg.norm(seen.xy - np.asarray(geo.place.xyz[:2])))
+    dz = abs(seen.xyz[2] - geo.place.xyz[2])
+    if dxy > config.place_tol_xy or dz > config.place_tol_z:
+        out = result(None, run, grasp=grasp, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4))
+        return replace(out, ok=False, failure=Failure.MISPLACED)
+    return result(None, run, grasp=grasp)
+
+
+def _family_rank(grasp) -> int:
+    """`FAMILY_RANK` of ``grasp`` by its name's family (``top0``, ``tilt+x``, ``side-y:flip``)."""
+    return next((r for f, r in FAMILY_RANK.items() if grasp.name.startswith(f)), len(FAMILY_RANK))
+
+
+def _on(below: Pose, above: Pose, scene: SceneConfig) -> bool:
+    """Whether a block at ``above`` stands on one at ``below`` (the loop's reader's test)."""
+    near = np.linalg.norm(above.xy - below.xy) <= scene.tol_xy
+    return bool(near and abs(above.xyz[2] - below.xyz[2] - scene.block_size) <= scene.tol_z)

@@ -1,0 +1,99 @@
+"""The loop's world as a geometric scene (`tamp.blocks_geo`), the executor's geometric fallback
+(`tamp.loop.execute`: a move top-down grasps over the highest stack cannot make, made with
+another grasp and a lower transit) and the motion-aware prices that agree with it
+(`tamp.arm_costs.ArmCosts`' ``grasps``)."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from motion.ik import IKSolver
+from robots.panda import PANDA
+from tamp.arm_costs import BLOCKED, ArmCosts
+from tamp.blocks_geo import CHOICES, blocks_goal, world_scene
+from tamp.obstacles import with_scene
+from tamp.scene import Pose, SceneConfig, layout, read_state
+from tamp.slots import PlacedMove, slotted
+from tamp.world.relations import read_facts
+from task.problem import TABLE, Problem
+
+CRAMPED = with_scene(SceneConfig(), "cramped")
+TALL = Problem(
+    "tall", "blocksworld", tuple("abcdefg"), (TABLE, "a", "b", "c", "d", "e", "f"), (("a", "g"),)
+)
+
+
+@pytest.fixture(scope="module")
+def solver() -> IKSolver:
+    return IKSolver()
+
+
+def test_the_world_scene_reads_the_loops_state_with_the_scenes_slots():
+    problem = Problem("three", "blocksworld", ("a", "b", "c"), (TABLE, "a", TABLE), (("c", "b"),))
+    poses = layout(problem.entities, problem.init, CRAMPED, seed=0)
+    low = poses["b"]
+    poses["b"] = Pose((low.xyz[0], low.xyz[1], low.xyz[2] - 0.009), low.yaw)  # sunk 9 mm
+    assert read_state(problem.entities, poses, CRAMPED).state == problem.init
+    scene = world_scene(problem.entities, poses, CRAMPED)
+    assert [o.name for o in scene.objects] == list(problem.entities)
+    assert scene.object("b").pose.xyz[2] == pytest.approx(0.075)  # its level, snapped
+    assert scene.slots.xs == CRAMPED.slot_xs and scene.slots.ys == CRAMPED.slot_ys
+    facts = read_facts(scene)
+    assert dict(facts.supports) == dict(zip(problem.entities, problem.init, strict=True))
+    assert blocks_goal(problem).atoms == (("on", "c", "b"),)
+    assert blocks_goal(replace(problem, goal=(("a", TABLE),))).atoms == (("ontable", "a"),)
+
+
+def _tall(slot: int = 0):
+    """A 7-block tower on slot ``slot`` of the cramped table (0: the near (0.40, -0.12), 4: the
+    far (0.72, -0.12)): the poses, the slotted problem, its places and the far row's places."""
+    poses = layout(TALL.entities, TALL.init, CRAMPED, seed=0, slots=[slot])
+    current, at = slotted(TALL, TALL.init, poses, CRAMPED)
+    far = [k for k in current.fixed if at[k][0] > 0.7]
+    return poses, current, at, far
+
+
+def test_a_place_only_other_grasps_reach_stays_open_with_them(solver):
+    """Over a 7-block tower the far row is out of top-down reach at hover height (ruled out
+    without the executor's other grasps); a tilted or side grasp at the block's own height
+    reaches it, so with them the move is priced, not ruled out."""
+    poses, current, at, far = _tall()
+    top, cols = TALL.entities.index("g"), [TALL.n + current.fixed.index(k) for k in far]
+    for grasps, blocked in (((), True), (CHOICES, False)):
+        source = ArmCosts(
+            [current], [poses], CRAMPED, solver, PANDA.q_home, places=[at], grasps=grasps
+        )
+        matrix = source([0], [current.init]).compute()[0]
+        assert bool((matrix[top, cols] >= BLOCKED).all()) == blocked
+
+
+@pytest.mark.sim
+def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
+    """A 7-block tower on a far slot, its top block to a near one: top-down, the hand cannot
+    reach the top from above (no IK at the pre-grasp); the geometric fallback makes the move
+    (a tilted grasp), touching nothing."""
+    from robots.collision import PandaCollision
+    from tamp.loop.execute import ExecConfig, Failure, execute_move
+    from tamp.sim import make_simulator
+
+    poses, _, at, _ = _tall(slot=4)
+    move = PlacedMove("g", TABLE, at["slot0"], "slot0")
+    for fallback in (False, True):
+        sim = make_simulator("pybullet", TALL.entities, poses, CRAMPED)
+        with sim, PandaCollision() as model:
+            observe = sim.truth._read_poses  # the test is the pose sensor
+            config = replace(ExecConfig(), geo_fallback=fallback)
+            done = execute_move(sim, solver, move, observe, config, CRAMPED, collision=model)
+            state = read_state(TALL.entities, observe(), CRAMPED).state
+            if not fallback:
+                assert done.failure is Failure.IK_INFEASIBLE
+                assert state == TALL.init and done.sim_time_s == 0
+                continue
+            assert done.ok, done.evidence
+            assert done.evidence["grasp"].startswith("tilt") and sim.touched == {}
+            assert state == (*TALL.init[:-1], TABLE)
+            xy = observe()["g"].xy
+            assert np.linalg.norm(xy - np.asarray(at["slot0"])) < 0.015
