@@ -592,3 +592,10 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
         help="record the first variant of each problem per planner and simulator to "
         "OUT/videos/ (needs --out)",
     )
+    p.add_argument(
+        "--observe",
+        choices=("state", "camera"),
+        default="state",
+        help="object poses from motion capture, or estimated from three RGB-D cameras and "
+        "the objects' known models, with their errors against ground truth (state)",
+    )

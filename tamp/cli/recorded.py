@@ -252,6 +252,7 @@ def tamp_bench_config(args: argparse.Namespace) -> dict:
         "planners": list(args.planners),
         "sims": list(sim_list(args.sim)),
         "video": args.video,
+        "observe": args.observe,
         "workers": args.workers,
         "ray": args.ray,
     }

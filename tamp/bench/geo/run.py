@@ -6,11 +6,17 @@ Item ``(problem, k, planner, sim)`` plays variant ``seed + k`` of ``problem``
 the same whatever ``workers`` (`tamp.sweep.run_items`). A row records the variant's note, the
 episode's status, whether the goal was reached (ground truth), whether it was reached without a
 motion failure, the first plan's length, planning time (s, every planner call of the episode),
-simulated execution time, the arm's joint path and the unexpected contacts.
+simulated execution time, the arm's joint path and the unexpected contacts; with
+``observe="camera"`` (the episodes' pose sensor, `tamp.camera.scene_poses.ScenePoses`) also
+the camera's pose errors against ground truth over the episode's looks (scored, never acted on):
+mean and max position error (mm), max yaw error (deg) and the looks that kept an object's
+previous estimate because no camera saw it.
 
 `summarise` gives, per (problem, planner, simulator): episodes, solved, solved without a motion
 failure, plan length (median over solved), planning time p50/p90, execution time and arm path
-(medians over solved), episodes with a collision and collisions in all.
+(medians over solved), episodes with a collision and collisions in all; with the camera, the
+mean of the episodes' mean position errors, the largest position and yaw errors and the unseen
+looks in all.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ import numpy as np
 from tamp.sweep import run_items
 
 PLANNERS = ("soft", "motion-aware", "search-then-check")  # the issue's three, side by side
+OBSERVE = ("state", "camera")  # `tamp.geo.episode.OBSERVATIONS`
 # every episode's limits (`run_geo_episode`): moves run (Tower of Hanoi with 5 discs takes 31
 # at best), plans after the first, and each planner call's wall clock (`SearchConfig`)
 LIMITS = {"max_moves": 40, "max_replans": 3, "planning_s": 120.0}
@@ -34,6 +41,7 @@ ROW_COLUMNS = (
     "variant",
     "planner",
     "sim",
+    "observe",
     "status",
     "reached",
     "clean",
@@ -48,6 +56,10 @@ ROW_COLUMNS = (
     "execution_time_s",
     "arm_path_rad",
     "wall_s",
+    "pose_mm_mean",
+    "pose_mm_max",
+    "yaw_deg_max",
+    "unseen",
     "reason",
     "note",
 )
@@ -64,6 +76,7 @@ class Item:
     sim: str
     seed: int
     video: str | None = None
+    observe: str = "state"
 
 
 def items(
@@ -73,9 +86,11 @@ def items(
     sims: Sequence[str],
     seed: int,
     videos: Path | None = None,
+    observe: str = "state",
 ) -> list[Item]:
     """Every episode of the benchmark, problem-major; with ``videos``, the first variant of
-    each problem gets a video per planner and simulator in that folder."""
+    each problem gets a video per planner and simulator in that folder; ``observe``: every
+    episode's pose sensor (one of `OBSERVE`)."""
     out = []
     for problem in problems:
         for k in range(n):
@@ -84,7 +99,9 @@ def items(
                     video = None
                     if videos is not None and k == 0:
                         video = str(videos / f"{problem}-{planner}-{sim}.mp4")
-                    out.append(Item(problem, seed + k, planner, sim, seed * 100_003 + k, video))
+                    out.append(
+                        Item(problem, seed + k, planner, sim, seed * 100_003 + k, video, observe)
+                    )
     return out
 
 
@@ -109,12 +126,15 @@ def play(item: Item) -> dict:
         max_moves=LIMITS["max_moves"],
         max_replans=LIMITS["max_replans"],
         domain=domain,
+        observation=item.observe,
     )
+    errors = report.pose_errors
     return {
         "problem": item.problem,
         "variant": item.variant,
         "planner": item.planner,
         "sim": item.sim,
+        "observe": item.observe,
         "status": report.status,
         "reached": report.reached,
         "clean": report.reached and report.motion_failures == 0,
@@ -130,6 +150,11 @@ def play(item: Item) -> dict:
         "execution_time_s": report.execution_time_s,
         "arm_path_rad": report.arm_path_rad,
         "wall_s": time.perf_counter() - t0,
+        # the camera's estimates against ground truth, over every look (empty: motion capture)
+        "pose_mm_mean": errors.get("position_mm_mean"),
+        "pose_mm_max": errors.get("position_mm_max"),
+        "yaw_deg_max": errors.get("yaw_deg_max"),
+        "unseen": ";".join(f"{k}:{v}" for k, v in sorted(errors.get("unseen", {}).items())),
         "reason": report.reason,
         "note": made.note,
     }
@@ -151,6 +176,27 @@ def _median(values: Sequence[float]) -> float | None:
 
 def _quantile(values: Sequence[float], q: float) -> float | None:
     return float(np.quantile(values, q)) if len(values) else None
+
+
+def _unseen(rows: Sequence[dict]) -> int:
+    """Looks that kept an object's previous estimate, over ``rows``."""
+    return sum(int(part.split(":")[1]) for r in rows for part in r["unseen"].split(";") if part)
+
+
+def camera_summary(rows: Sequence[dict]) -> dict:
+    """The camera's pose errors over ``rows`` (episodes observed by the camera): the mean of
+    their mean position errors (mm), the largest position (mm) and yaw (deg) errors, and the
+    unseen looks; {} when none was."""
+    mine = [r for r in rows if r.get("observe") == "camera" and r["pose_mm_mean"] is not None]
+    if not mine:
+        return {}
+    yaws = [r["yaw_deg_max"] for r in mine if r["yaw_deg_max"] is not None]
+    return {
+        "pose_mm_mean": float(np.mean([r["pose_mm_mean"] for r in mine])),
+        "pose_mm_max": max(r["pose_mm_max"] for r in mine),
+        "yaw_deg_max": max(yaws, default=None),
+        "unseen_looks": _unseen(mine),
+    }
 
 
 def summarise(rows: Sequence[dict]) -> list[dict]:
@@ -179,6 +225,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
                 "collided": sum(r["collisions"] > 0 for r in mine),
                 "collisions": sum(r["collisions"] for r in mine),
                 "statuses": dict(Counter(r["status"] for r in mine)),
+                **camera_summary(mine),
             }
         )
     return out

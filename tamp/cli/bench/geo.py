@@ -28,7 +28,7 @@ def tamp_command(args: argparse.Namespace) -> int:
     if args.video:
         videos = results.out_folder(args.out) / "videos"
         videos.mkdir(exist_ok=True)
-    todo = bench.items(args.problems, args.n, args.planners, sims, args.seed, videos)
+    todo = bench.items(args.problems, args.n, args.planners, sims, args.seed, videos, args.observe)
     done: list[dict] = []
     wall0 = time.perf_counter()
     with tqdm(
@@ -54,20 +54,37 @@ def tamp_command(args: argparse.Namespace) -> int:
         return 0
     print(
         f"TAMP benchmark: {args.n} variant{'s' if args.n != 1 else ''} of "
-        f"{', '.join(args.problems)} from seed {args.seed}; goal: ground truth; {wall:.0f} s wall",
+        f"{', '.join(args.problems)} from seed {args.seed}; observe {args.observe}; "
+        f"goal: ground truth; {wall:.0f} s wall",
         tables.tamp_table(summary, sims),
         sep="\n",
     )
+    if args.observe == "camera":
+        print(_camera_line(bench.camera_summary(rows)))
     if args.out:
         print(f"wrote results.json, episodes.csv to {args.out}")
     return 0
 
 
+def _camera_line(errors: dict) -> str:
+    """The camera's pose errors against ground truth, in one line."""
+    if not errors:
+        return "camera pose error: no look was scored"
+    yaw = "-" if errors["yaw_deg_max"] is None else f"{errors['yaw_deg_max']:.1f}"
+    return (
+        f"camera pose error (every look, against ground truth): position mean "
+        f"{errors['pose_mm_mean']:.1f} mm, max {errors['pose_mm_max']:.1f} mm; yaw max {yaw} "
+        f"deg; {errors['unseen_looks']} looks kept an unseen object's previous estimate"
+    )
+
+
 def _write(args, recorded: dict, rows, summary, wall: float | None, total: int | None) -> dict:
     """results.json (marked partial with ``total``) and episodes.csv under ``--out``; the body."""
-    from tamp.bench.geo.run import ROW_COLUMNS
+    from tamp.bench.geo.run import ROW_COLUMNS, camera_summary
 
     body = {"config": recorded, "machine": results.machine(args.argv), "summary": summary}
+    if args.observe == "camera":
+        body["camera"] = camera_summary(rows)
     if wall is not None:
         body["wall_s"] = wall
     if total is not None:
