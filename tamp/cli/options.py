@@ -550,7 +550,7 @@ def suite_options(p: argparse.ArgumentParser) -> None:
 # `tamp.world.canonical.PROBLEMS` and `tamp.bench.geo.run.PLANNERS` (a test keeps them equal),
 # named here so the parser imports neither
 TAMP_PROBLEMS = ("blocked", "packed", "nonmonotonic", "sorting", "tall", "hanoi")
-TAMP_PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
+TAMP_PLANNERS = ("soft", "motion-aware", "search-then-check", "search", "motion-aware-sampled")
 
 
 def tamp_bench_options(p: argparse.ArgumentParser) -> None:
@@ -578,7 +578,8 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
         default="soft,motion-aware,search-then-check",
         metavar="NAME[,NAME]",
         help="planners side by side (soft: task-only with execution; motion-aware: ours; "
-        "search-then-check: the baseline; search: the complete geometric search alone)",
+        "search-then-check: the baseline; search: the complete geometric search alone; "
+        "motion-aware-sampled: ours with region cells placed by rejection sampling)",
     )
     p.add_argument(
         "--sim",

@@ -6,6 +6,8 @@ Planners (`PLANNERS`):
 - ``"search-then-check"``: `tamp.geo.baseline.plan_search_then_check`;
 - ``"search"``: `tamp.geo.search.plan_search`, the complete best-first search alone;
 - ``"motion-aware"``: `tamp.geo.ours.plan_motion_aware` (imported when asked for);
+- ``"motion-aware-sampled"``: the same with the goal regions' cells placed by rejection
+  sampling at the packer's budget (`tamp.geo.ours.plan_motion_aware_sampled`), an ablation;
 - ``"soft"``: task-only planning with execution, today's loop on these problems: a shortest
   symbolic plan ignoring geometry (`tamp.geo.baseline.symbolic_plan`), each move bound to the
   first candidate place of the scene the plan predicts and no grasp chosen; the executor tries
@@ -55,7 +57,7 @@ from tamp.world.relations import read_facts
 from tamp.world.schema import Scene
 from task.errors import TampError, one_of
 
-PLANNERS = ("soft", "motion-aware", "search-then-check", "search")
+PLANNERS = ("soft", "motion-aware", "search-then-check", "search", "motion-aware-sampled")
 OBSERVATIONS = ("state", "camera")  # the pose sensors: motion capture, or RGB-D cameras
 # settled poses as the motion-capture sensor reads them: `SceneConfig.tol_z`'s 12 mm; an
 # object counts as in a region when its footprint crosses the edge by at most 2 mm (a tight
@@ -125,6 +127,10 @@ def planner_by_name(name: str) -> Planner:
         from tamp.geo.ours import plan_motion_aware
 
         return plan_motion_aware
+    if name == "motion-aware-sampled":  # ours, cells placed by rejection sampling
+        from tamp.geo.ours import plan_motion_aware_sampled
+
+        return plan_motion_aware_sampled
     if name == "soft":
         return plan_soft
     if name == "search":

@@ -12,9 +12,24 @@ through the generic lift and its declared binding instead.
 - `tamp.geo.ours.pack`: gradient-optimised placements in a region, and the sampled baseline;
 - `tamp.geo.ours.bridge`: scene + goal -> Blocksworld on places, and planned moves back;
 - `tamp.geo.ours.costs`: `GeoCosts`, the arm's price of every move, with failure memory;
-- `tamp.geo.ours.planner`: `plan_motion_aware`, `plan_pddl`, `OursConfig`.
+- `tamp.geo.ours.planner`: `plan_motion_aware`, `plan_pddl`, `OursConfig`, and the ablation
+  `plan_motion_aware_sampled` (cells placed by rejection sampling).
 """
 
-from tamp.geo.ours.planner import PLANNER, OursConfig, as_ours, plan_motion_aware, plan_pddl
+from tamp.geo.ours.planner import (
+    PLANNER,
+    OursConfig,
+    as_ours,
+    plan_motion_aware,
+    plan_motion_aware_sampled,
+    plan_pddl,
+)
 
-__all__ = ["PLANNER", "OursConfig", "as_ours", "plan_motion_aware", "plan_pddl"]
+__all__ = [
+    "PLANNER",
+    "OursConfig",
+    "as_ours",
+    "plan_motion_aware",
+    "plan_motion_aware_sampled",
+    "plan_pddl",
+]

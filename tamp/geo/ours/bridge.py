@@ -41,7 +41,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tamp.geo.ours.pack import PackConfig, PackResult, pack
+from tamp.geo.ours.pack import PackConfig, PackResult, pack, pack_sampled
 from tamp.geo.places import PACK_MARGIN, TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose
@@ -156,16 +156,27 @@ def footprint(o: Movable) -> tuple[float, float]:
     return c * hx + s * hy, s * hx + c * hy
 
 
+SAMPLERS = ("gradient", "sampled")  # how region cells are placed: `pack`, `pack_sampled`
+
+
 def bridge(
     scene: Scene,
     goal: Goal,
     table_places: int | None = None,
     config: PackConfig = PACK,
     seed: int = 0,
+    sampler: str = "gradient",
 ) -> Bridged:
     """The Blocksworld problem of ``scene`` and ``goal`` (module docstring). ``table_places``:
-    how many table spots (default: the number of objects + 2). SceneFileError, one line, for
-    an object the geometry cannot explain or a goal the domain cannot express."""
+    how many table spots (default: the number of objects + 2). ``sampler``: how the region
+    cells are placed, ``gradient`` (`pack`) or ``sampled`` (`pack_sampled`, the rejection
+    sampling a greedy TAMP system uses, at the same budget per try: as many position samples
+    as `pack` spends row-steps, and the same tries). SceneFileError, one line, for an object
+    the geometry cannot explain or a goal the domain cannot express."""
+    if sampler not in SAMPLERS:
+        raise SceneFileError(
+            f"placement sampler {sampler!r}: expected one of {', '.join(SAMPLERS)}"
+        )
     facts = read_facts(scene)
     if facts.unexplained:
         raise SceneFileError(f"scene {scene.name}: {'; '.join(facts.issues)}")
@@ -207,21 +218,30 @@ def bridge(
         tries = [(PACK_MARGIN, attempt) for attempt in range(PACK_TRIES)]
         tries += [(0.0, attempt) for attempt in range(FLUSH_TRIES)]
         for margin, attempt in tries:
-            result = pack(
+            args = (
                 r.inner(),
                 [own_footprint(scene.object(x)) for x in movers],
                 [o.pose.xyz[:2] for o in fixed],
                 [footprint(o) for o in fixed],
-                replace(config, margin=margin),
-                seed + attempt,
-                walled=r.wall_height > 0,
             )
+            at = replace(config, margin=margin)
+            if sampler == "sampled":
+                budget = config.restarts * config.steps  # `pack`'s row-steps
+                result = pack_sampled(*args, budget, seed + attempt, at, walled=r.wall_height > 0)
+            else:
+                result = pack(*args, at, seed + attempt, walled=r.wall_height > 0)
             if result.ok:
                 break
         packs.append((r.name, result))
+        (x0, y0), (x1, y1) = r.inner()
         for i, x in enumerate(movers):
-            xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))
-            sites.append(Site(f"{r.name}.c{i}", r.name, xy, r.surface, float(result.yaws[i])))
+            # a failed sampled packing places only some: the rest at the centre (the planner
+            # refuses a packing that is not ok before it plans, `tamp.geo.ours.planner`)
+            xy, yaw = ((x0 + x1) / 2, (y0 + y1) / 2), 0.0
+            if i < len(result.positions):
+                xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))
+                yaw = float(result.yaws[i])
+            sites.append(Site(f"{r.name}.c{i}", r.name, xy, r.surface, yaw))
             cells.append((x, sites[-1].name))
     if not scene.parking:  # no table spots: each region that has no cell offers its centre
         taken = {s.target for s in sites}

@@ -95,6 +95,9 @@ class OursConfig:
     # wall clock (s) of the differentiable planner's attempt, all its plans and bindings
     # together (None: only ``planner.time_limit_s`` per plan)
     soft_time_s: float | None = None
+    # how the goal regions' cells are placed (`tamp.geo.ours.bridge.SAMPLERS`): by gradient,
+    # or by rejection sampling at the same budget (the ablation ``motion-aware-sampled``)
+    sampler: str = "gradient"
 
 
 def _check():
@@ -157,6 +160,16 @@ def plan_motion_aware(
     return _complete(scene, goal, tools, config, first, bound, t0, cell_hints(bridged))
 
 
+def plan_motion_aware_sampled(
+    scene: Scene, goal: Goal, tools, config=OursConfig(), check: Callable | None = None
+) -> GeoPlan:
+    """`plan_motion_aware` with the goal regions' cells placed by rejection sampling
+    (`tamp.geo.ours.pack.pack_sampled`) at the gradient packer's budget: the ablation that
+    says what the gradient placements gain."""
+    config = replace(as_ours(config), sampler="sampled")
+    return plan_motion_aware(scene, goal, tools, config, check)
+
+
 def cell_hints(bridged: Bridged | None) -> dict:
     """The bridged problem's places as `plan_search` hints, (object, target) -> places: the
     packer's cell of each goal object in its region, and the place each object stood on at
@@ -203,7 +216,7 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     """The differentiable planner's attempt (steps 1-3 of the module docstring); a plan that
     ends unsolved carries the moves it bound in ``stats["bound"]``."""
     try:
-        bridged = bridge(scene, goal, config.table_places, config.pack, config.seed)
+        bridged = bridge(scene, goal, config.table_places, config.pack, config.seed, config.sampler)
     except SceneFileError as exc:
         return GeoPlan(GeoStatus.FAILED, reason=str(exc), stats={"time_s": 0.0})
     stats: dict = {"places": len(bridged.sites), "packs": _packs(bridged), "bridged": bridged}

@@ -182,3 +182,28 @@ def test_hanoi_is_planned_through_its_pddl_domain_and_mapped_to_moves_onto_discs
         world = moved(world, m.obj, m.place.pose)
     facts = read_facts(world)
     assert made.goal.holds(facts) and not facts.unexplained and _no_overlap(world)
+
+
+def test_the_sampled_ablation_places_cells_by_rejection_sampling_and_says_when_none_fit():
+    """``motion-aware-sampled`` bridges with `pack_sampled` at the packer's budget: on a roomy
+    region it plans as ours does; on the tight tray of packed variant 1 no sampled arrangement
+    is free, and the planner says so (its complete search may still go on)."""
+    from tamp.geo.episode import planner_by_name
+    from tamp.geo.ours.bridge import bridge
+    from tamp.world.canonical import generate
+
+    s = scene(cube("a", 0.45, 0.2), cube("b", 0.55, 0.2))
+    goal = parse_goal("(on a b)", s)
+    plan = planner_by_name("motion-aware-sampled")
+    result = plan(s, goal, tools(), SearchConfig(seed=0, max_time_s=60))
+    assert result.status is GeoStatus.SOLVED, result.reason
+    made = generate("packed", 1)
+    gradient = bridge(made.scene, made.goal, sampler="gradient")
+    sampled = bridge(made.scene, made.goal, sampler="sampled")
+    assert [p.ok for _, p in gradient.packs] == [True]
+    assert [p.ok for _, p in sampled.packs] == [False]
+    assert sampled.packs[0][1].tries > 0
+    first = as_ours(SearchConfig(seed=0, max_time_s=5))
+    only = replace(first, sampler="sampled", search=None)
+    said = plan_motion_aware(made.scene, made.goal, tools(), only)
+    assert not said.solved and "no free arrangement" in said.reason
