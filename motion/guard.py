@@ -18,8 +18,8 @@ also has ``valid_batch`` (`motion.sphere_check.Screened`: a conservative sphere 
 the meshes) screens each phase first, every densified configuration in one batch: where the
 spheres find the whole phase free the meshes would too (they never say "free" where the meshes
 find a contact), and only a phase the spheres flag goes to the mesh model's ``check_path``,
-which has the final word. The motion planner gets the same batch check (`motion.rrt.plan_path`
-``valid_batch``) and verifies what it finds with the meshes.
+which has the final word. The motion planner searches with the same batch check
+(`motion.rrt.plan_path` ``valid_batch``), and its detour is checked again like any phase.
 """
 
 from __future__ import annotations

@@ -5,8 +5,8 @@ this repository that imports ``ompl``) against the caller's ``valid(q)`` collisi
 shortens the path with our own seeded shortcutting and re-checks every returned segment with
 ``valid`` at the checking resolution. With a batched check (``valid_batch``, e.g. the sphere
 model of `motion.sphere_check`) it first tries the straight segment and seeded one-via-point
-detours, whole segments per call, and verifies what it finds with ``valid``; OMPL runs only when
-that finds nothing. ``path_trajectory`` times the polyline with ruckig, one
+detours, whole segments per call (and, with ``verify``, checks what it finds with ``valid``);
+OMPL runs only when that finds nothing. ``path_trajectory`` times the polyline with ruckig, one
 rest-to-rest straight segment per piece (an RRT path has sharp corners).
 
 Determinism. OMPL 2.0.1 seeds every ``RNG`` object from one process-global seed generator, and
@@ -58,9 +58,12 @@ class PathPlannerConfig:
     shortcut_attempts: int = 50  # random partial shortcuts tried (OMPL's shortcutPath, seeded)
     # with a batched check (``plan_path(..., valid_batch=...)``): via points tried per round,
     # their spread about the midpoint per round (rad), and whether ``valid`` verifies the path
+    # it finds (off: ``valid_batch`` must be at least as strict as ``valid``, so what it finds
+    # free at the checking resolution is free; the sphere model is, tests/motion/
+    # test_sphere_check.py, and the guard checks the timed detour again)
     vias: int = 16
     via_spreads: tuple[float, ...] = (0.3, 0.6, 1.0, 1.5)
-    verify: bool = True
+    verify: bool = False
     batch_time_limit: float = 0.5  # s for the batched RRT-Connect before OMPL takes over
 
     def __post_init__(self):
@@ -256,6 +259,18 @@ class _Batch:
         return alive
 
 
+def _screened(valid_batch: Callable[[np.ndarray], np.ndarray], checker: _Checker):
+    """``valid_batch``, and ``checker`` (the exact check) on each configuration it refuses."""
+
+    def check(q: np.ndarray) -> np.ndarray:
+        ok = np.array(valid_batch(q), dtype=bool)  # (B,)
+        for k in np.flatnonzero(~ok):
+            ok[k] = checker(q[k])
+        return ok
+
+    return check
+
+
 def _through(start, goal, vias: np.ndarray, batch: _Batch, full: bool) -> np.ndarray:
     """(V,) bool: start -> via -> goal valid for each via (V, J) (``full``: at every point;
     else at every 8th, a necessary condition)."""
@@ -378,9 +393,11 @@ def plan_path(
     model). It is tried first when it accepts start and goal: the straight segment, then
     rounds of seeded via points, every segment's points checked in one call or two, then an
     RRT-Connect with whole-edge batched checks for at most ``config.batch_time_limit``; the
-    path it finds is verified with ``valid`` (``config.verify``) and returned when it passes
-    (evidence "search": "via" or "connect"). Otherwise ("batched_failed", "batched_refused")
-    OMPL searches with ``valid`` as without it.
+    path it finds is returned (evidence "search": "via" or "connect"), with ``config.verify``
+    only once ``valid`` accepts every segment of it at the checking resolution. When
+    ``valid_batch`` refuses start or goal and ``valid`` accepts both, the batched search asks
+    ``valid`` about each configuration ``valid_batch`` refuses (evidence "screened"). Otherwise
+    ("batched_failed", "batched_refused") OMPL searches with ``valid`` as without it.
 
     Misuse (shapes, NaN, start or goal outside the limits) raises MotionError; an
     invalid start or goal and a search that runs out of time are failures in the result.
@@ -406,7 +423,14 @@ def plan_path(
     if valid_batch is not None:
         batch = _Batch(valid_batch, checker.step)
         path = None
-        if batch(np.stack([start, goal])).all():  # else the stricter check refuses an end
+        ends = batch(np.stack([start, goal]))
+        if not ends.all() and checker(start) and checker(goal):
+            # the stricter check refuses an end that ``valid`` accepts: ask ``valid`` about
+            # every configuration the batch refuses (the search is then as strict as valid)
+            batch.valid_batch = _screened(valid_batch, checker)
+            evidence["screened"] = True
+            ends = batch(np.stack([start, goal]))
+        if ends.all():
             path = _via_search(start, goal, batch, lo, hi, config)
             if path is None:
                 deadline = time.perf_counter() + min(config.batch_time_limit, config.time_limit)

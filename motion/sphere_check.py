@@ -29,10 +29,13 @@ Its contacts' distances are lower bounds, so the mesh model stays the final word
 pairs the two: the mesh model answers ``valid`` and ``check_path``, the spheres
 ``valid_batch``, which `motion.rrt.plan_path` uses to search).
 
-Speed. A bounding sphere per link (L = 11) is tested first, (B, L, O); only the flagged
-(configuration, link, box) triples are tested sphere by sphere, and self pairs go through the
-bounding spheres, then the link's bounding sphere against the other link's box, then the DOP's
-box, then its 26 planes. Without square roots where only the sign of a clearance matters.
+Speed. Forward kinematics batch-last (`motion.sphere_fk`). A bounding sphere per link (L = 11)
+is tested first, (B, L, O); the flagged (configuration, link) pairs are grouped by link, and
+each link's spheres placed in one matrix product for all its pairs, (M, S, 3), then tested
+against the flagged boxes. Self pairs go through the bounding spheres, then the link's bounding
+sphere against the other link's box, then (grouped by the sphere side, in the other link's
+frame) the DOP's box, then its 26 planes. A configuration with a contact found is not tested
+further (``valid_batch``). Without square roots where only the sign of a clearance matters.
 """
 
 from __future__ import annotations
@@ -153,6 +156,9 @@ class SphereCollision:
         self._radii = np.concatenate([spheres[link][1] for link in PARTS])
         self._count = np.array([len(spheres[link][1]) for link in PARTS])  # (L,)
         self._start = np.cumsum(self._count) - self._count  # (L,) first sphere of each link
+        # per link: its spheres' centres (3, S_l) in its frame and radii (S_l,)
+        self._local_t = [np.ascontiguousarray(spheres[n][0].T, dtype=_FLOAT) for n in PARTS]
+        self._link_radii = [spheres[n][1].astype(_FLOAT) for n in PARTS]
         bounds = [_bound(*spheres[link]) for link in PARTS]
         self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
         self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
@@ -287,17 +293,23 @@ class SphereCollision:
         """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk._links`."""
         return _links(q, fingers, self._off, self._swaps, self._hand, self._tcp)
 
-    def _spheres(self, rot, pos, b: np.ndarray, link: np.ndarray):
-        """Every sphere of the (configuration, link) pairs ``b``, ``link`` (M,) each: the pair
-        it belongs to (N,), its world centre (N, 3) and grown radius (N,), and where each
-        pair's spheres start (M,) (they are consecutive)."""
-        count = self._count[link]  # (M,)
-        first = np.cumsum(count) - count  # (M,)
-        pair = np.repeat(np.arange(len(link)), count)  # (N,)
-        sphere = self._start[link][pair] + np.arange(pair.size) - first[pair]  # (N,)
-        rows, frames = b[pair], link[pair]
-        centres = np.einsum("nij,nj->ni", rot[rows, frames], self._local[sphere])
-        return pair, centres + pos[rows, frames], self._radii[sphere] + self.gap, first
+    def _place(self, rot: np.ndarray, pos: np.ndarray, link: int) -> np.ndarray:
+        """World centres (M, S, 3) of link ``link``'s S spheres in M frames: rotations
+        (M, 3, 3) and origins (M, 3) of that link (or of it relative to another link)."""
+        local = self._local_t[link]  # (3, S)
+        n = rot.shape[0]
+        x = (rot.reshape(n * 3, 3) @ local).reshape(n, 3, -1)  # (M, 3, S): one matrix product
+        return x.transpose(0, 2, 1) + pos[:, None]  # (M, S, 3)
+
+    def _by_link(self, b: np.ndarray, link: np.ndarray):
+        """The (configuration, link) pairs ``b``, ``link`` (M,) grouped by link: yields the
+        link, the positions (M_l,) of its pairs and their configurations (M_l,)."""
+        if not link.size:
+            return
+        order = np.argsort(link, kind="stable")
+        edges = np.flatnonzero(np.diff(link[order])) + 1
+        for group in np.split(order, edges):
+            yield int(link[group[0]]), group, b[group]
 
     # ---- queries -----------------------------------------------------------------------------
 
@@ -370,57 +382,72 @@ class SphereCollision:
         hit = np.zeros(n, dtype=bool)
         found: list[Contact] = []
 
-        def record(b, part, other, clearance, limit: float, pair=None, first=None) -> None:
-            """Mark the rows b (M,) whose clearance is under ``limit``: (M,), or per sphere
-            (N,) of the pairs ``pair`` (N,) starting at ``first`` (M,); ``part`` a name or link
-            indices (M,), ``other`` a name or indices (see `_other`)."""
+        def record(b, part, other, clearance, limit: float) -> None:
+            """Mark the rows b (M,) whose clearance (M,), or any of whose spheres' (M, S), is
+            under ``limit``; ``part`` a name or link indices (M,), ``other`` a name or indices
+            (see `_other`)."""
+            if clearance.ndim == 2:
+                clearance = clearance.min(1)  # (M,)
             bad = clearance < limit
-            hit[b[bad] if pair is None else b[pair[bad]]] = True
-            if detail and bad.any():
-                if pair is not None:
-                    clearance = np.minimum.reduceat(clearance, first)  # (M,)
-                for k in np.flatnonzero(clearance < limit):
+            hit[b[bad]] = True
+            if detail:
+                for k in np.flatnonzero(bad):
                     name = part if isinstance(part, str) else self.parts[part[k]]
                     found.append(Contact(name, self._other(other, k), float(clearance[k])))
+
+        def pending(*arrays):
+            """The entries of ``arrays`` (first: configurations (M,)) whose configuration has
+            no contact yet (all of them with ``detail``: every contact is listed)."""
+            if detail:
+                return arrays
+            keep = ~hit[arrays[0]]
+            return tuple(a[keep] for a in arrays)
 
         m = self.margin
         # the table: a plane at z = 0
         near_b, near_l = np.nonzero((mid[..., 2] - reach < m) & scene[None, :links, 0])
-        if near_b.size:
-            pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
-            record(near_b, near_l, np.zeros_like(near_b), x[:, 2] - r, m, pair, first)
+        for link, _, rows in self._by_link(near_b, near_l):
+            x = self._place(rot[rows, link], pos[rows, link], link)  # (M, S, 3)
+            lowest = x[..., 2] - (self._link_radii[link] + self.gap)  # (M, S)
+            record(rows, np.full(rows.size, link), np.zeros_like(rows), lowest, m)
         # the boxes, each in its own frame (turned about z only)
         if len(self._names) > 1:
             gap = self._box_gap(mid[:, :, None], slice(None), reach[:, None] + m, detail)
-            near_b, near_l, near_o = np.nonzero((gap < 0.0) & scene[None, :links, 1:])
-            if near_b.size:
-                pair, x, r, first = self._spheres(rot, pos, near_b, near_l)
-                gap = self._box_gap(x, near_o[pair], r + m, detail)  # (N,)
-                record(near_b, near_l, near_o + 1, gap + m, m, pair, first)
+            near_b, near_l, near_o = pending(*np.nonzero((gap < 0.0) & scene[None, :links, 1:]))
+            for link, group, rows in self._by_link(near_b, near_l):
+                x = self._place(rot[rows, link], pos[rows, link], link)  # (M, S, 3)
+                box = near_o[group]  # (M,)
+                grown = self._link_radii[link] + self.gap + m  # (S,)
+                gap = self._box_gap(x, box[:, None], grown, detail)  # (M, S)
+                record(rows, np.full(rows.size, link), box + 1, gap + m, m)
         # the links against each other: the distal link's spheres against the other's 26-DOP
         a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
-        apart = np.linalg.norm(mid[:, a] - mid[:, c], axis=-1) - reach[a] - reach[c]  # (B, K')
-        close = apart < self.self_margin
+        apart = reach[a] + reach[c] + self.self_margin  # (K',)
+        close = np.square(mid[:, a] - mid[:, c]).sum(-1) < np.square(apart)  # (B, K')
         if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at these angles
             close &= q[:, self._apart_joint[own]] < self._apart_from[own]
-        near_b, near_k = np.nonzero(close)
+        near_b, near_k = pending(*np.nonzero(close))
         la, lc = a[near_k], c[near_k]
         if near_b.size:  # link a's bounding sphere against link c's box, in c's frame
             centre = np.einsum("mji,mj->mi", rot[near_b, lc], mid[near_b, la] - pos[near_b, lc])
             gap = _box_sdf(centre - self._aabb_c[lc], self._aabb_h[lc]) - reach[la]  # (M,)
             keep = gap < self.self_margin
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
-        if near_b.size:
-            pair, x, r, first = self._spheres(rot, pos, near_b, la)
-            rows, frames = near_b[pair], lc[pair]
-            inner = np.einsum("nji,nj->ni", rot[rows, frames], x - pos[rows, frames])
+        for link, group, rows in self._by_link(near_b, la):
+            other = lc[group]  # (M,) the DOP side
+            r_c = rot[rows, other]  # (M, 3, 3)
+            r_rel = np.swapaxes(r_c, 1, 2) @ rot[rows, link]  # (M, 3, 3) link -> other's frame
+            t_rel = np.einsum("mji,mj->mi", r_c, pos[rows, link] - pos[rows, other])  # (M, 3)
+            inner = self._place(r_rel, t_rel, link)  # (M, S, 3) in the other link's frame
+            grown = self._link_radii[link] + self.gap  # (S,)
             # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
-            gap = _box_sdf(inner - self._aabb_c[frames], self._aabb_h[frames]) - r  # (N,)
-            near = np.flatnonzero(gap < self.self_margin)
-            f = frames[near]
-            dop = np.einsum("nk,jk->nj", inner[near], self._directions) - self._dop[f]
-            gap[near] = dop.max(-1) - r[near]  # (N',) the 26-DOP's lower bound
-            record(near_b, la, ~lc, gap, self.self_margin, pair, first)
+            box_c, box_h = self._aabb_c[other][:, None], self._aabb_h[other][:, None]
+            gap = _box_sdf(inner - box_c, box_h) - grown  # (M, S)
+            near_m, near_s = np.nonzero(gap < self.self_margin)
+            if near_m.size:
+                dop = inner[near_m, near_s] @ self._directions.T - self._dop[other[near_m]]
+                gap[near_m, near_s] = dop.max(-1) - grown[near_s]  # the 26-DOP's lower bound
+            record(rows, np.full(rows.size, link), ~other, gap, self.self_margin)
         if self._held_half is not None:
             self._check_held(rot, pos, mid, scene, held_arm, record)
         return found if detail else ~hit
@@ -472,13 +499,13 @@ class SphereCollision:
             inner = np.einsum("bji,blj->bli", r_box, mid[:, links] - t_box[:, None])
             gap = _box_sdf(inner, half) - reach[links]  # (B, L')
             near_b, near_l = np.nonzero(gap < m)
-            if near_b.size:
-                link = links[near_l]
-                pair, x, r, first = self._spheres(rot, pos, near_b, link)
-                rows = near_b[pair]
-                inner = np.einsum("nji,nj->ni", r_box[rows], x - t_box[rows])
-                sdf = _box_sdf(inner, half) - r  # (N,)
-                record(near_b, HELD, ~link, sdf, m, pair, first)
+            for link, _, rows in self._by_link(near_b, links[near_l]):
+                r_in = np.swapaxes(r_box[rows], 1, 2)  # (M, 3, 3) world -> held box
+                r_rel = r_in @ rot[rows, link]  # (M, 3, 3) link -> held box
+                t_rel = np.einsum("mij,mj->mi", r_in, pos[rows, link] - t_box[rows])  # (M, 3)
+                inner = self._place(np.ascontiguousarray(r_rel), t_rel, link)  # (M, S, 3)
+                sdf = _box_sdf(inner, half) - (self._link_radii[link] + self.gap)  # (M, S)
+                record(rows, HELD, np.full(rows.size, ~link), sdf, m)
 
 
 def _obb_gap(r_a, t_a, half_a, r_b, c_b, h_b) -> np.ndarray:

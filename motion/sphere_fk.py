@@ -90,34 +90,45 @@ def _links(
 ) -> tuple[np.ndarray, np.ndarray]:
     """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3) of the frames of
     `PARTS` (fingers at ``fingers`` m each), then of the TCP, from `_chain`'s offsets ``off``
-    (J, 3), the joint origins' axis ``swaps`` and the hand and TCP transforms (4, 4)."""
+    (J, 3), the joint origins' axis ``swaps`` and the hand and TCP transforms (4, 4).
+
+    Computed batch-last (every quantity a contiguous row of B numbers), then transposed once."""
     n = q.shape[0]
-    rot = np.empty((n, len(PARTS) + 1, 3, 3), dtype=_FLOAT)
-    pos = np.empty((n, len(PARTS) + 1, 3), dtype=_FLOAT)
-    r, t = np.broadcast_to(np.eye(3, dtype=_FLOAT), (n, 3, 3)), np.zeros((n, 3), _FLOAT)
-    rot[:, 0], pos[:, 0] = r, t  # panda_link0 is the base frame
-    c, s = np.cos(q).astype(_FLOAT), np.sin(q).astype(_FLOAT)  # (B, J)
-    cols = [r[:, :, 0], r[:, :, 1], r[:, :, 2]]  # (B, 3) each: the frame's axes
+    rot = np.empty((len(PARTS) + 1, 3, 3, n), dtype=_FLOAT)  # (F, 3, 3, B)
+    pos = np.empty((len(PARTS) + 1, 3, n), dtype=_FLOAT)  # (F, 3, B)
+    qt = np.ascontiguousarray(q.T, dtype=_FLOAT)  # (J, B)
+    c, s = np.cos(qt), np.sin(qt)  # (J, B) each
+    rot[0], pos[0] = np.eye(3, dtype=_FLOAT)[..., None], 0.0  # panda_link0 is the base frame
+    cols = [np.repeat(np.eye(3, dtype=_FLOAT)[:, a, None], n, 1) for a in range(3)]  # (3, B)
+    t = np.zeros((3, n), _FLOAT)
     for j in range(7):
         for axis, v in enumerate(off[j]):  # the joint's origin, in the parent frame
             if v:
-                t = t + v * cols[axis]  # (B, 3)
+                t = t + v * cols[axis]  # (3, B)
         # the origin's rotation is a signed permutation: it only reorders the axes
         cols = [cols[k] if sign > 0 else -cols[k] for k, sign in swaps[j]]
-        cj, sj = c[:, j, None], s[:, j, None]
         x, y = cols[0], cols[1]
-        cols = [x * cj + y * sj, y * cj - x * sj, cols[2]]  # the turn about z
+        cols = [x * c[j] + y * s[j], y * c[j] - x * s[j], cols[2]]  # the turn about z
         for axis in range(3):
-            rot[:, j + 1, :, axis] = cols[axis]
-        pos[:, j + 1] = t
-    r = rot[:, len(_ARM)]
+            rot[j + 1, :, axis] = cols[axis]
+        pos[j + 1] = t
     hand = len(_ARM) + 1
-    rot[:, hand] = r @ hand_t[:3, :3]
-    pos[:, hand] = t + r @ hand_t[:3, 3]
+    _compose(rot[hand - 1], pos[hand - 1], hand_t, rot[hand], pos[hand])
     for k, sign in ((hand + 1, 1.0), (hand + 2, -1.0)):  # the fingers slide along hand y
-        rot[:, k] = rot[:, hand]
-        slide = np.array([0.0, sign * fingers, FINGER_ORIGIN], dtype=_FLOAT)
-        pos[:, k] = pos[:, hand] + rot[:, hand] @ slide
-    rot[:, -1] = rot[:, hand] @ tcp_t[:3, :3]
-    pos[:, -1] = pos[:, hand] + rot[:, hand] @ tcp_t[:3, 3]
-    return rot, pos
+        slide = np.eye(4, dtype=_FLOAT)
+        slide[:3, 3] = (0.0, sign * fingers, FINGER_ORIGIN)
+        _compose(rot[hand], pos[hand], slide, rot[k], pos[k])
+    _compose(rot[hand], pos[hand], tcp_t, rot[-1], pos[-1])
+    # (B, F, 3, 3) and (B, F, 3), contiguous: the checks gather frames by configuration
+    return np.ascontiguousarray(rot.transpose(3, 0, 1, 2)), np.ascontiguousarray(
+        pos.transpose(2, 0, 1)
+    )
+
+
+def _compose(r: np.ndarray, t: np.ndarray, transform: np.ndarray, r_out, t_out) -> None:
+    """Frames r (3, 3, B), t (3, B) followed by a fixed (4, 4) ``transform``, into r_out, t_out."""
+    for a in range(3):
+        r_out[:, a] = (
+            r[:, 0] * transform[0, a] + r[:, 1] * transform[1, a] + r[:, 2] * transform[2, a]
+        )
+    t_out[:] = t + r[:, 0] * transform[0, 3] + r[:, 1] * transform[1, 3] + r[:, 2] * transform[2, 3]

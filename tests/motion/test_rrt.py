@@ -17,6 +17,7 @@ Q_HOME = np.array(PANDA.q_home)
 START = Q_HOME + np.array([-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
 GOAL = Q_HOME + np.array([1.0, 0.0, 0.3, 0.2, 0.0, 0.0, 0.0])
 FAST = PathPlannerConfig(time_limit=5.0)
+VERIFY = PathPlannerConfig(time_limit=5.0, verify=True)
 
 
 # the planner checks segments every STEP rad: a margin of STEP / 2 makes the whole segment valid
@@ -180,14 +181,23 @@ def padded_batch(q: np.ndarray) -> np.ndarray:
     return wall_batch(q, margin=0.55 * STEP)
 
 
-def test_a_batched_check_finds_a_path_that_valid_verifies():
+def test_a_batched_check_finds_a_path_without_calling_valid():
+    """``valid_batch`` is at least as strict as ``valid``: what it finds is returned unverified
+    (``verify`` off, the default), and ``valid`` agrees with it at the checking resolution."""
     r = plan_path(START, GOAL, wall, config=FAST, valid_batch=padded_batch)
+    assert r.ok and r.evidence["search"] in ("via", "connect"), r.evidence
+    assert r.checks == 0 and not r.evidence["verified"]
+    assert dense_ok(r.path, wall, step=r.evidence["step_rad"])
+
+
+def test_a_batched_check_finds_a_path_that_valid_verifies():
+    r = plan_path(START, GOAL, wall, config=VERIFY, valid_batch=padded_batch)
     assert r.ok and r.evidence["search"] in ("via", "connect"), r.evidence
     assert r.evidence["verified"] and "plan_s" not in r.evidence  # OMPL never ran
     assert r.evidence["batch_configs"] > 0 and r.evidence["batch_calls"] > 0
     assert dense_ok(r.path, wall, step=r.evidence["step_rad"])
     np.testing.assert_array_equal(r.path[[0, -1]], np.stack([START, GOAL]))
-    again = plan_path(START, GOAL, wall, config=FAST, valid_batch=padded_batch)
+    again = plan_path(START, GOAL, wall, config=VERIFY, valid_batch=padded_batch)
     np.testing.assert_array_equal(again.path, r.path)  # seeded: the same path
 
 
@@ -207,7 +217,7 @@ def test_a_wall_one_via_point_cannot_pass_needs_the_batched_rrt_connect():
 def test_a_path_valid_refuses_falls_back_to_ompl_with_valid():
     """A batched check laxer than ``valid`` (it sees no wall): its straight line fails the
     verification, and OMPL plans with ``valid`` as without a batched check."""
-    r = plan_path(START, GOAL, padded, config=FAST, valid_batch=lambda q: np.ones(len(q), bool))
+    r = plan_path(START, GOAL, padded, config=VERIFY, valid_batch=lambda q: np.ones(len(q), bool))
     assert r.ok and r.evidence["search"] == "batched_refused" and "plan_s" in r.evidence
     assert dense_ok(r.path, wall)
 
@@ -221,11 +231,21 @@ def test_a_bad_batched_check_raises():
         PathPlannerConfig(vias=0)
 
 
-def test_a_batched_check_that_refuses_an_end_hands_over_to_ompl_at_once():
+def test_a_batched_check_that_refuses_an_end_valid_accepts_asks_valid_about_its_refusals():
     def strict(q: np.ndarray) -> np.ndarray:  # stricter than padded: refuses the start
         return padded_batch(q) & (np.abs(q - START).max(axis=1) > 1e-9)
 
     r = plan_path(START, GOAL, padded, config=FAST, valid_batch=strict)
-    assert r.ok and r.evidence["search"] == "batched_failed", r.evidence
-    assert r.evidence["batch_calls"] == 1 and "plan_s" in r.evidence
+    assert r.ok and r.evidence["search"] in ("via", "connect"), r.evidence
+    assert r.evidence["screened"] and "plan_s" not in r.evidence  # OMPL never ran
+    assert 0 < r.checks < r.evidence["batch_configs"]  # valid only where strict refuses
     assert dense_ok(r.path, wall)
+
+
+def test_a_batched_check_that_refuses_an_end_valid_refuses_too_hands_over_to_ompl_at_once():
+    blocked_start = START.copy()
+    blocked_start[:2] = (0.0, 0.0)  # inside the wall
+
+    r = plan_path(blocked_start, GOAL, wall, config=FAST, valid_batch=wall_batch)
+    assert not r.ok and r.failure == "invalid_start", r.evidence
+    assert r.evidence["search"] == "batched_failed" and r.evidence["batch_calls"] == 1
