@@ -10,7 +10,13 @@ gripper as a real robot reads them: after closing, the fingers must stand at the
 (within ``width_tol``) pushed on both sides (``missed_grasp``); after the lift and the transit
 they must still stand at that width (``dropped``); a joint tracking error beyond
 ``max_tracking`` means the arm was blocked (``tracking_error``). After a failure at the object
-the hand opens and backs out along its descent. Nothing here reads ground truth.
+the hand opens and backs out along its descent. After the release the fingers must stand open
+(their opening within ``width_tol`` of the stroke): an object that turned a little in the
+fingers on the way can stay wedged between the open pads (PyBullet: a pad's edge sunk a
+millimetre into it; the retreat then carries it off and drops it anywhere, once on a post's
+top), so the hand closes on it again and reopens, at most ``release_tries`` times, before
+it retreats; the run's evidence says how often (``regrasped``), or that it stayed stuck
+(``not_released``). Nothing here reads ground truth.
 
 Where the place is tight, a held object that slipped a few millimetres in the fingers (the
 friction grasp, most in MuJoCo) would land out of its cell. Given a ``sense`` of the held
@@ -31,6 +37,7 @@ import numpy as np
 
 from motion.pick_place import Phase, corrected_place
 from motion.trajectory import JointTrajectory
+from robots.panda import PANDA
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
 from tamp.loop.execute import holding
@@ -47,6 +54,8 @@ class RunConfig:
     correct_min: float = 0.0005  # m: a held object this far off the plan above the place: moved
     correct_max: float = 0.02  # m: ... unless farther off than this (then it runs as planned)
     look_s: float = 0.3  # s: the hand holds still above the place this long before looking
+    release_tries: int = 2  # closings on an object still between the opened fingers
+    reclose_s: float = 0.25  # s: the gripper's closing time (`PickPlaceConfig.close_time`)
 
 
 @dataclass(frozen=True)
@@ -137,6 +146,8 @@ def run_move(
             if missed is not None:
                 _back_off(sim, check.motion, on_frame, handling)
                 return done("missed_grasp", **missed)
+        elif phase.name == "open":
+            evidence |= _release(sim, move.obj, rests, phase, config, on_frame)
         elif phase.name in ("lift", "transit"):
             gone = holding(sim, width, config, fresh=False)
             if gone is not None:
@@ -174,6 +185,37 @@ def _look_and_correct(
     if tail is None:
         return None
     return tail, round(off * 1000, 1)
+
+
+def opened(sim: Simulator, config: RunConfig) -> dict | None:
+    """None when the fingers stand open (their opening within ``config.width_tol`` of the
+    stroke); else the gripper's reading."""
+    r = sim.gripper()
+    if r.width >= 2 * PANDA.finger_open - config.width_tol:
+        return None
+    return {
+        "finger_width": round(r.width, 4),
+        "left_force": round(r.left_force, 3),
+        "right_force": round(r.right_force, 3),
+    }
+
+
+def _release(sim, obj: str, rests, open_phase: Phase, config: RunConfig, on_frame) -> dict:
+    """After the ``open`` phase: while the fingers do not stand open (`opened`), the object
+    wedged between them, close on it and open again (the hand where it stands), at most
+    ``config.release_tries`` times. The evidence: ``regrasped`` (closings), and
+    ``not_released`` (the last reading) when the fingers never opened."""
+    stuck, tries = opened(sim, config), 0
+    while stuck is not None and tries < config.release_tries:
+        tries += 1
+        q = sim.arm_q()
+        close = JointTrajectory.hold(q, config.reclose_s, sim.dt)
+        sim.run(close, "closed", on_frame=on_frame, expected=expected_contacts("lower", obj, rests))
+        reopen = JointTrajectory.hold(q, open_phase.trajectory.duration, sim.dt)
+        sim.run(reopen, "open", on_frame=on_frame, expected=Expected(obj))
+        stuck = opened(sim, config)
+    out = {"regrasped": tries} if tries else {}
+    return out if stuck is None else {**out, "not_released": stuck}
 
 
 def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:
