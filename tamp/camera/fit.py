@@ -14,8 +14,9 @@ edges), `fit_object` finds the centre (x, y, z) and, for a box, the yaw about z:
   else of its points); then every parameter is refined by robust least squares on the model's
   signed distance (every visible point lies on the model's surface, `scipy.optimize`);
 - z: the top face, half the height above the centre. Without a top face (an object on it, the
-  hand over it), the visible side band bounds it: `ObjectFit.z_range` is every centre height
-  the points allow, for `tamp.camera.scene_poses` to set the object onto what it rests on.
+  hand over it), the lowest visible side point is taken for its bottom edge, and the visible
+  side band bounds it: `ObjectFit.z_range` is every centre height the points allow, for
+  `tamp.camera.scene_poses` to set the object onto what it rests on.
 
 The yaw reported is the one of the model's symmetric equivalents (mod pi for a cuboid, mod pi/2
 for a square footprint) nearest the previous estimate's, so it does not jump between them.
@@ -191,7 +192,7 @@ def fit_object(
     else:
         high = float(np.percentile(points[:, 2], 99))
         low = float(np.percentile(points[:, 2], 1))
-        z0 = high - half[2]
+        z0 = low + half[2]  # the lowest visible edge: a held object's top is in the hand
         z_range = (high - half[2], max(low + half[2], high - half[2]))
     step = max(1, len(points) // config.max_points)
     sample = points[::step]  # (<= max_points, 3)
