@@ -506,3 +506,26 @@ def corrected_place(
         Phase("open", JointTrajectory.hold(lower_path[-1], config.open_time, dt), "open"),
         Phase("retreat", polyline_segment(retreat_path, dt, spec, limits), "open", limits),
     )
+
+
+def split_lower(
+    solver: IKSolver, lower: Phase, above: float, config: PickPlaceConfig = PickPlaceConfig()
+) -> tuple[Phase, Phase] | None:
+    """``lower`` (a vertical phase ending at the place) cut where the TCP stands ``above`` m
+    over its end: two ``lower`` phases along the same joint path, each rest to rest (the hand
+    stops there, e.g. to look at what it holds once more); None when the phase does not come
+    down from higher than that."""
+    from motion.guard import thin  # the guard imports this module
+
+    knots = thin(lower.trajectory.positions, 0.002)  # (K, J)
+    z = solver.fk(knots)[:, 2, 3]  # (K,)
+    cut = int(np.argmax(z <= z[-1] + above))  # the first knot that low
+    if z[0] <= z[-1] + above or not 0 < cut < len(knots) - 1:
+        return None
+    dt = float(lower.trajectory.times[1] - lower.trajectory.times[0])
+    limits = lower.limits or config.approach
+    upper, rest = knots[: cut + 1], knots[cut:]
+    return (
+        Phase(lower.name, polyline_segment(upper, dt, solver.spec, limits), lower.gripper, limits),
+        Phase(lower.name, polyline_segment(rest, dt, solver.spec, limits), lower.gripper, limits),
+    )

@@ -246,3 +246,21 @@ def test_a_corrected_place_moves_the_place_side_by_the_shift_in_the_plane(planne
     np.testing.assert_allclose(
         retreat[:3, 3], _end_pose(solver, result, "retreat")[:3, 3] + move, atol=1e-3
     )
+
+
+def test_a_lower_split_short_of_the_place_stops_there_and_ends_where_it_did(planned, solver):
+    from motion.pick_place import split_lower
+
+    _, result = planned
+    lower = next(p for p in result.phases if p.name == "lower")
+    upper, rest = split_lower(solver, lower, 0.02, CONFIG)
+    assert (upper.name, rest.name, upper.gripper, rest.gripper) == ("lower",) * 2 + ("closed",) * 2
+    np.testing.assert_array_equal(upper.trajectory.positions[-1], rest.trajectory.positions[0])
+    np.testing.assert_array_equal(rest.trajectory.positions[-1], lower.trajectory.positions[-1])
+    np.testing.assert_array_equal(upper.trajectory.positions[0], lower.trajectory.positions[0])
+    for part in (upper, rest):  # each stops at its ends
+        assert not np.abs(part.trajectory.velocities[[0, -1]]).any()
+    cut, end = solver.fk(np.stack([upper.trajectory.positions[-1], lower.trajectory.positions[-1]]))
+    assert 0.015 < cut[2, 3] - end[2, 3] <= 0.02
+    np.testing.assert_allclose(cut[:2, 3], end[:2, 3], atol=1e-3)  # straight above the place
+    assert split_lower(solver, rest, 0.05, CONFIG) is None  # it starts lower than that
