@@ -10,7 +10,10 @@ model's clearance to the scene's obstacles along the move and to the other block
 their predicted places) at its grasp and release. A place onto a tower that its slot's
 clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a move to a full
 table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so
-does a move the arm failed in that state before (``avoid``, `failed_key`). The matrix is
+does a move the arm failed in that state before (``avoid``, `failed_key`). With ``grasps`` (the
+executor's geometric fallback, `tamp.blocks_geo`: tilted and side grasps, corridor transits) the
+prices agree with what that executor can do: a pick or place out of top-down reach that one of
+those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead. The matrix is
 computed once per state: the table placement is the scene's free slot, or with table places
 (`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
 placements): every window optimises fresh offsets, one set per restart row, with the logits,
@@ -46,6 +49,9 @@ ARM = MoveCostConfig(collision_weight=5.0, block_weight=5.0)
 DEEP = 0.002
 HOVER = PickPlaceConfig()  # the executor's hover and transit heights
 BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refuses it
+# added instead to a move the top-down grasp cannot make but the executor's other grasps may
+# (`ArmCosts`' ``grasps``): about one move's joint distance, chosen, not tuned
+DETOUR = 1.0
 
 
 def predict_poses(
@@ -226,33 +232,48 @@ class ArmCosts:
         """A window whose table places move within ``reach`` of their centres: continuous
         placements, fresh for the window and one set per restart row, optimised with the
         logits."""
-        inputs = self._inputs(list(zip(indices, states, strict=True)))
+        *inputs, other = self._inputs(list(zip(indices, states, strict=True)))
         picks, places, extra, blocks = inputs
         solved = site_solutions(self.solver, self.q_now, picks, places)
-        extra = extra + self._deep(solved, blocks)
+        extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return _Placed(self, indices, restarts, inputs, solved, extra)
 
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
         """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
-        picks, places, extra, blocks = self._inputs(todo)
+        picks, places, extra, blocks, other = self._inputs(todo)
         solved = site_solutions(self.solver, self.q_now, picks, places)
         with torch.no_grad():
             c = move_costs_batch(
                 self.solver, self.q_now, picks, places, self.config, self.boxes, solved, blocks
             )
-        return list(c + extra + self._deep(solved, blocks))  # (P, N, Y) each
+        extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
+        return list(c + extra)  # (P, N, Y) each
+
+    def _detour(self, solved, other: torch.Tensor, n: int) -> torch.Tensor:
+        """(P, N, Y) ``DETOUR - config.infeasible`` per pick and per place whose top-down IK
+        failed (priced `config.infeasible`, as much as `BLOCKED`) where another of the
+        executor's grasps reaches (``other``: (P, N + Y) from `_hover`): the move stays open,
+        at a detour's price. ``n``: N."""
+        p, sites = other.shape
+        failed = ~solved[1].reshape(p, sites)  # (P, N + Y)
+        fix = (DETOUR - self.config.infeasible) * (failed & other).double()  # (P, N + Y)
+        return fix[:, :n, None] + fix[:, None, n:]  # (P, N, Y)
 
     def _deep(self, solved, blocks: Blocks) -> torch.Tensor:
-        """(P, N, Y) BLOCKED where the grasp or release configuration reaches more than `DEEP`
-        into a block other than the held one and the one under it (with the blocks priced)."""
+        """(P, N, Y) BLOCKED where the top-down grasp or release configuration reaches more than
+        `DEEP` into a block other than the held one and the one under it (with the blocks
+        priced). With ``grasps`` the executor tries its other grasps there, so such a move
+        costs `DETOUR` more, not ruled out; once it failed it is (``avoid``)."""
         if self.config.block_weight == 0.0:
             return torch.zeros(())
-        return BLOCKED * (block_depths(self.solver, solved, blocks) > DEEP)
+        penalty = DETOUR if self.grasps else BLOCKED
+        return penalty * (block_depths(self.solver, solved, blocks) > DEEP)
 
     def _inputs(self, todo: list[tuple[int, State]]):
-        """Picks (P, N, 3), places (P, Y, 3), the added costs (P, N, Y) of the pairs and their
-        blocks as boxes (a turned block as its axis-aligned bounding box)."""
-        picks, places, extra, half, under = [], [], [], [], []
+        """Picks (P, N, 3), places (P, Y, 3), the added costs (P, N, Y) of the pairs, their
+        blocks as boxes (a turned block as its axis-aligned bounding box) and (P, N + Y) the
+        picks and places only the executor's other grasps reach (`_hover`)."""
+        picks, places, extra, half, under, other = [], [], [], [], [], []
         s = self.scene.block_size
         for i, state in todo:
             problem, at = self.problems[i], None if self.places is None else self.places[i]
@@ -277,22 +298,24 @@ class ArmCosts:
             places.append(np.vstack([up, table]))  # (Y, 3), Y = N + K
             extra.append(self._blocked(problem, plain, now, at is None and slot is None))
             yaws = [now[x].yaw for x in problem.entities]
-            self._hover(extra[-1], xyz, places[-1], now, yaws)
+            other.append(self._hover(extra[-1], xyz, places[-1], now, yaws))
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
                 j = _column(problem, key, at, self.reach)
                 if j is not None:
                     extra[-1][problem.entities.index(x), j] += BLOCKED
         picks, places, extra = (torch.tensor(np.stack(a)) for a in (picks, places, extra))
         half, under = torch.tensor(half).reshape(picks.shape), torch.tensor(under, dtype=torch.long)
-        return picks, places, extra, Blocks(picks, half, under.reshape(picks.shape[:2]))
+        blocks = Blocks(picks, half, under.reshape(picks.shape[:2]))
+        return picks, places, extra, blocks, torch.tensor(np.stack(other))
 
-    def _hover(self, extra: np.ndarray, picks: np.ndarray, places: np.ndarray, now, yaws) -> None:
+    def _hover(self, extra: np.ndarray, picks: np.ndarray, places: np.ndarray, now, yaws):
         """Add BLOCKED (in place) to the moves whose pick or place the hand cannot reach from
         above: a pick-and-place hovers and carries the block over the highest stack top
         (`motion.pick_place`), where a far slot may be out of the arm's reach. One batched,
         detached IK call; the hand's yaw is taken as 0. With ``self.grasps``, a pick or place
         out of that reach stays open when one of those grasps holds the block there (`_grasped`,
-        ``yaws``: (N,) the picked blocks' yaws; a place's is 0)."""
+        ``yaws``: (N,) the picked blocks' yaws; a place's is 0). Returns (N + Y,) bool: the
+        picks and places only those grasps reach (`_detour`)."""
         top = max(p.xyz[2] for p in now.values()) + self.scene.block_size / 2
         hover = top + HOVER.lift_clearance + self.scene.block_size  # TCP holding a block
         points = np.vstack([picks, places])  # (N + Y, 3)
@@ -300,12 +323,15 @@ class ArmCosts:
         n = picks.shape[0]
         ok = site_solutions(self.solver, self.q_now, points[None, :n], points[None, n:])[1]
         ok = ok.numpy().copy()  # (N + Y,)
+        other = np.zeros_like(ok)  # (N + Y,) out of that reach, in another grasp's
         if self.grasps and not ok.all():  # the executor's other grasps, at the block's height
             at = np.vstack([picks, places])[~ok]  # (M, 3)
             turned = np.concatenate([np.asarray(yaws, float), np.zeros(len(points) - n)])
-            ok[~ok] = self._grasped(at, turned[~ok])
+            other[~ok] = self._grasped(at, turned[~ok])
+        ok |= other
         extra[~ok[:n], :] += BLOCKED
         extra[:, ~ok[n:]] += BLOCKED
+        return other
 
     def _grasped(self, points: np.ndarray, yaws: np.ndarray) -> np.ndarray:
         """(M,) whether some grasp of ``self.grasps`` (`motion.grasps.grasps` of a cube) holds

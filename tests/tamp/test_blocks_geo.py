@@ -12,7 +12,7 @@ import pytest
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, ArmCosts
+from tamp.arm_costs import BLOCKED, DETOUR, ArmCosts
 from tamp.blocks_geo import CHOICES, blocks_goal, world_scene
 from tamp.obstacles import with_scene
 from tamp.scene import Pose, SceneConfig, layout, read_state
@@ -70,6 +70,23 @@ def test_a_place_only_other_grasps_reach_stays_open_with_them(solver):
         assert bool((matrix[top, cols] >= BLOCKED).all()) == blocked
 
 
+def test_the_top_of_a_far_tower_only_other_grasps_reach_is_priced_a_detour(solver):
+    """A 7-block tower on the far row: no top-down IK reaches its top block at all (priced
+    without IK, as much as ruled out); a tilted grasp does, so with the executor's other grasps
+    its moves are open at `DETOUR` more."""
+    poses, current, at, _ = _tall(slot=4)
+    top = TALL.entities.index("g")
+    rows = {}
+    for grasps in ((), CHOICES):
+        source = ArmCosts(
+            [current], [poses], CRAMPED, solver, PANDA.q_home, places=[at], grasps=grasps
+        )
+        rows[grasps] = source([0], [current.init]).compute()[0][top]
+    near = TALL.n + current.fixed.index("slot0")
+    assert rows[()][near] >= BLOCKED
+    assert DETOUR <= rows[CHOICES][near] < BLOCKED
+
+
 @pytest.mark.sim
 def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
     """A 7-block tower on a far slot, its top block to a near one: top-down, the hand cannot
@@ -97,3 +114,20 @@ def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
             assert state == (*TALL.init[:-1], TABLE)
             xy = observe()["g"].xy
             assert np.linalg.norm(xy - np.asarray(at["slot0"])) < 0.015
+
+
+def test_with_other_grasps_a_top_down_release_into_a_neighbour_is_priced_not_ruled_out(solver):
+    """A release behind a 6-block tower whose top-down configuration reaches into it is ruled
+    out for a top-down executor; with the executor's other grasps it costs `DETOUR` more and
+    is still open (a failure there rules it out, `ArmCosts.avoid`)."""
+    from tests.tamp.test_arm_costs import _behind
+
+    cramped, current, at, poses, mover, far = _behind(6)
+    costs = {}
+    for grasps in ((), CHOICES):
+        source = ArmCosts(
+            [current], [poses], cramped, solver, PANDA.q_home, places=[at], grasps=grasps
+        )
+        costs[grasps] = source([0], [current.init]).compute()[0]
+    assert costs[()][mover, far] >= BLOCKED
+    assert DETOUR <= costs[CHOICES][mover, far] < BLOCKED
