@@ -36,6 +36,11 @@ class PlannerConfig:
     lookahead: int = 5  # window length of the long-lookahead restarts (an extension, not paper)
     lookahead_share: float = 0.5  # share of restarts that use ``lookahead``; 0 = the paper's
     max_windows: int = 40  # replanning windows before giving up
+    proof_every: int = 5  # Adam steps between reads of a window that may reach the goal: once
+    # every problem's decoded window reaches it in as few moves as the domain's lower bound
+    # from the window's start allows, no later step could decode a shorter window and the
+    # window stops (0: never, all ``iters`` steps; only without beliefs and move costs;
+    # `task.planner._proofs`)
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
     # in one batch start together and share it), checked at every Adam and rollout step: a
     # window it cuts short is abandoned; None: only max_windows stops the planner
@@ -81,6 +86,8 @@ class PlannerConfig:
         for name in ("horizon", "iters", "restarts", "max_windows", "fallback_nodes"):
             if getattr(self, name) < 1:
                 raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")
+        if self.proof_every < 0:
+            raise TampError(f"PlannerConfig.proof_every must be >= 0, got {self.proof_every}")
         for name in ("horizon", "lookahead"):
             if not 1 <= getattr(self, name) <= MAX_HORIZON:
                 raise TampError(

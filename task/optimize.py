@@ -8,6 +8,7 @@ be alone.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 
 import torch
 from torch import Tensor
@@ -40,6 +41,7 @@ def optimise_window(
     beliefs: WindowBeliefs | None = None,
     costs: WindowCosts | None = None,
     deadline: float | None = None,
+    stop: Callable[[Rollout], bool] | None = None,
 ) -> tuple[Tensor, Rollout]:
     """Optimise the window's logits; returns them and the final rollout (no grad; at
     ``config.decode_tau`` when set, the temperature the decoder reads the moves at).
@@ -50,6 +52,9 @@ def optimise_window(
     ``costs`` (see `task.costs`) adds the expected move cost to the loss, likewise.
     ``deadline`` (a `time.perf_counter` value): raise `task.rollout.OutOfTime` once it has
     passed, checked at every Adam step and every rollout step.
+    ``stop``: shown that rollout after every ``config.proof_every`` Adam steps (not after the
+    last); the optimisation ends early, returning it, when ``stop`` says so (the planner's
+    proof that the window's decode is already an optimal plan, `task.planner`).
     """
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
     groups = [{"params": [logits], "lr": config.lr}]
@@ -69,12 +74,23 @@ def optimise_window(
         roll = rollout(domain, logits, live, steps, config, tau, c, deadline)
         (roll.loss.sum() + penalty).backward()
         opt.step()
-    with torch.no_grad():
-        tau = config.decode_tau
-        tau = temperature(config, config.iters - 1) if tau is None else tau
-        live, _ = with_beliefs(batch, beliefs)
-        c = with_costs(batch, costs)
-        return logits.detach(), rollout(domain, logits, live, steps, config, tau, c, deadline)
+        every = config.proof_every
+        if stop is not None and every and (k + 1) % every == 0 and k + 1 < config.iters:
+            decoded = _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline)
+            if stop(decoded):
+                return logits.detach(), decoded
+    return logits.detach(), _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline)
+
+
+@torch.no_grad()
+def _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline) -> Rollout:
+    """The rollout the decoder reads: at ``config.decode_tau`` (None: the last Adam step's
+    temperature), without a graph."""
+    tau = config.decode_tau
+    tau = temperature(config, config.iters - 1) if tau is None else tau
+    live, _ = with_beliefs(batch, beliefs)
+    c = with_costs(batch, costs)
+    return rollout(domain, logits, live, steps, config, tau, c, deadline)
 
 
 class Adam:

@@ -26,13 +26,13 @@ import torch
 from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig, torch_device
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
-from task.decode import decode_best
+from task.decode import DecodedWindow, decode_best
 from task.domains import get_domain
 from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
-from task.rollout import OutOfTime, check_deadline
+from task.rollout import OutOfTime, Rollout, check_deadline
 from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first, lazy_greedy
 from task.symbolic.shorten import shorten
 
@@ -48,13 +48,23 @@ def _window(
     costs: WindowCosts | None = None,
     deadline: float | None = None,
 ):
+    """The decoded window of each problem (`decode_best`); without beliefs and move costs a
+    window may stop early (`_proofs`)."""
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
     batch = batch.repeat(config.restarts)
     horizons = torch.tensor(config.horizons(), device=device).repeat(len(problems))  # (B,)
     steps = torch.arange(int(horizons.max()), device=device) < horizons[:, None]  # (B, T)
-    _, roll = optimise_window(domain, batch, steps, config, generator, beliefs, costs, deadline)
-    return decode_best(
+    proven: dict[int, DecodedWindow] = {}
+    stop = None
+    if beliefs is None and costs is None and visited is not None:
+        stop = _proofs(domain, problems, states, config, visited, proven)
+    _, roll = optimise_window(
+        domain, batch, steps, config, generator, beliefs, costs, deadline, stop
+    )
+    if len(proven) == len(problems):
+        return [proven[i] for i in range(len(problems))]
+    decoded = decode_best(
         domain,
         problems,
         states,
@@ -68,6 +78,54 @@ def _window(
         config.rank_prefixes,
         config.park_free,
     )
+    return [proven.get(i, window) for i, window in enumerate(decoded)]
+
+
+def _proofs(
+    domain: Domain,
+    problems: Sequence[Problem],
+    states: Sequence[State],
+    config: PlannerConfig,
+    visited: Sequence[set],
+    proven: dict[int, DecodedWindow],
+) -> Callable[[Rollout], bool] | None:
+    """The early stop of a window (`PlannerConfig.proof_every`): the rollout is read as the
+    decoder reads it, and a problem whose best window reaches the goal in as many moves as the
+    domain's admissible lower bound from the window's start state is done: no further Adam
+    step could decode a shorter way to the goal. That window is kept in ``proven`` (later reads
+    and the final decode are not used for it: a problem's plan does not depend on whether the
+    others of its batch are proven too). The stop is True once every problem is proven. None (no reads) when no
+    problem can be (its bound exceeds the longest window) or without the crisp check."""
+    longest = max(config.horizons())
+    bounds = [domain.lower_bound(p, s) for p, s in zip(problems, states, strict=True)]
+    hopeful = [i for i, bound in enumerate(bounds) if bound <= longest]
+    if not hopeful or not config.crisp_check or not config.proof_every:
+        return None
+    r = config.restarts
+
+    def stop(roll: Rollout) -> bool:
+        todo = [i for i in hopeful if i not in proven]
+        rows = torch.tensor([i * r + k for i in todo for k in range(r)], device=roll.gates.device)
+        found = decode_best(
+            domain,
+            [problems[i] for i in todo],
+            [states[i] for i in todo],
+            roll.gates[rows],
+            roll.loss[rows],
+            r,
+            config.threshold,
+            True,
+            [visited[i] for i in todo],
+            None,
+            config.rank_prefixes,
+            config.park_free,
+        )
+        for i, window in zip(todo, found, strict=True):
+            if window.reached and len(window.moves) <= bounds[i]:
+                proven[i] = window
+        return len(proven) == len(problems)
+
+    return stop
 
 
 def on_device(batch: SoftBatch, device: torch.device) -> SoftBatch:

@@ -285,3 +285,39 @@ def test_the_planners_adam_is_torch_adam_step_for_step():
             loss.backward()
             o.step()
         assert torch.equal(ours[0], ref[0]) and torch.equal(ours[1], ref[1]), k
+
+
+def _adam_steps(monkeypatch) -> list:
+    from task import optimize
+
+    steps, step = [], optimize.Adam.step
+    monkeypatch.setattr(optimize.Adam, "step", lambda self: (steps.append(1), step(self))[1])
+    return steps
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_a_window_stops_once_it_reaches_the_goal_in_as_few_moves_as_the_bound(seed, monkeypatch):
+    """`PlannerConfig.proof_every`: a window whose decode reaches the goal in as many moves as
+    the lower bound from its start stops early; no plan is longer than without the stop."""
+    problems = [random_problem(4, seed), random_problem(4, seed + 10)]
+    steps = _adam_steps(monkeypatch)
+    config = replace(FAST, iters=30)
+    full = plan_batch(problems, replace(config, proof_every=0), seed=seed)
+    all_steps = len(steps)
+    steps.clear()
+    early = plan_batch(problems, config, seed=seed)
+    assert len(steps) <= all_steps
+    for p, a, b in zip(problems, full, early, strict=True):
+        assert a.solved and b.solved
+        validate_moves(p, b.plan.moves)
+        assert len(b.plan) <= len(a.plan)
+
+
+def test_a_window_reaching_the_goal_in_the_bound_stops_at_the_first_read(monkeypatch):
+    problem = Problem("one-move", "blocksworld", ("a", "b"), ("table", "table"), (("a", "b"),))
+    steps = _adam_steps(monkeypatch)
+    result = plan(problem, replace(FAST, proof_every=3))
+    assert [str(m) for m in result.plan.moves] == ["move(a -> b)"]
+    assert len(steps) == 3
+    with pytest.raises(TampError, match="proof_every must be >= 0"):
+        PlannerConfig(proof_every=-1)
