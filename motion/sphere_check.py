@@ -74,6 +74,9 @@ APART = (
     ("panda_link7", FINGERS[1], 0, -math.inf),
 )
 APART_CLEARANCE = 0.003  # m
+# the narrow phases test the links in buckets by sphere count (at most 10, 30, more: link0's
+# 46), each link's spheres padded to its bucket's widest: few groups, little padding
+BUCKETS = (10, 30)
 
 
 _MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
@@ -156,9 +159,21 @@ class SphereCollision:
         self._radii = np.concatenate([spheres[link][1] for link in PARTS])
         self._count = np.array([len(spheres[link][1]) for link in PARTS])  # (L,)
         self._start = np.cumsum(self._count) - self._count  # (L,) first sphere of each link
-        # per link: its spheres' centres (3, S_l) in its frame and radii (S_l,)
-        self._local_t = [np.ascontiguousarray(spheres[n][0].T, dtype=_FLOAT) for n in PARTS]
-        self._link_radii = [spheres[n][1].astype(_FLOAT) for n in PARTS]
+        # links by sphere count into BUCKETS; per bucket, every link's spheres padded to the
+        # bucket's largest count by repeating its first (a repeat changes no minimum): centres
+        # (L, S_k, 3) in the link's frame, radii (L, S_k); a link outside the bucket is zeros
+        self._bucket = np.searchsorted(BUCKETS, self._count)  # (L,)
+        self._pad_local, self._pad_radii = [], []
+        for k in range(len(BUCKETS) + 1):
+            width = int(self._count[self._bucket == k].max(initial=1))
+            local, radii = np.zeros((len(PARTS), width, 3)), np.zeros((len(PARTS), width))
+            for link, name in enumerate(PARTS):
+                if self._bucket[link] == k:
+                    rows = np.arange(width)
+                    rows = np.where(rows < self._count[link], rows, 0)
+                    local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
+            self._pad_local.append(local.astype(_FLOAT))
+            self._pad_radii.append(radii.astype(_FLOAT))
         bounds = [_bound(*spheres[link]) for link in PARTS]
         self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
         self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
@@ -183,6 +198,7 @@ class SphereCollision:
         self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
         self._cos, self._sin = np.zeros(0, _FLOAT), np.zeros(0, _FLOAT)  # (O,) of the yaws
         self._arm_vs_held = np.array([k for k, n in enumerate(PARTS) if n not in HAND])
+        self._world_half = np.zeros((3, 0), _FLOAT)  # (3, O): see set_boxes
         self._names: list[str] = [TABLE]  # (O + 1,) the table, then the boxes
         self._box_c = np.zeros((0, 3))  # (O, 3)
         self._halves = np.ones((0, 3))  # (O, 3)
@@ -223,6 +239,12 @@ class SphereCollision:
         self._box_c, self._halves, self._yaws = table[:, :3], table[:, 3:6], table[:, 6]
         self._turns = _turn(self._yaws).astype(_FLOAT)
         self._cos, self._sin = np.cos(self._yaws), np.sin(self._yaws)  # (O,) each
+        # (3, O) half extents of each box's world axis-aligned bounding box (turned about z)
+        c, s_ = np.abs(self._cos), np.abs(self._sin)
+        h = self._halves
+        self._world_half = np.stack(
+            [c * h[:, 0] + s_ * h[:, 1], s_ * h[:, 0] + c * h[:, 1], h[:, 2]]
+        ).astype(_FLOAT)
         self._names = [TABLE, *(b.name for b in boxes)]
         self._masks = {}
 
@@ -293,23 +315,24 @@ class SphereCollision:
         """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk._links`."""
         return _links(q, fingers, self._off, self._swaps, self._hand, self._tcp)
 
-    def _place(self, rot: np.ndarray, pos: np.ndarray, link: int) -> np.ndarray:
-        """World centres (M, S, 3) of link ``link``'s S spheres in M frames: rotations
-        (M, 3, 3) and origins (M, 3) of that link (or of it relative to another link)."""
-        local = self._local_t[link]  # (3, S)
-        n = rot.shape[0]
-        x = (rot.reshape(n * 3, 3) @ local).reshape(n, 3, -1)  # (M, 3, S): one matrix product
-        return x.transpose(0, 2, 1) + pos[:, None]  # (M, S, 3)
+    def _place(self, rot: np.ndarray, pos: np.ndarray, bucket: int, link: np.ndarray):
+        """World centres (M, S, 3) and grown radii (M, S) of the spheres of links ``link``
+        (M,), all in bucket ``bucket`` (padded to its S), in M frames: rotations (M, 3, 3) and
+        origins (M, 3) of those links (or of each relative to another link)."""
+        local = self._pad_local[bucket][link]  # (M, S, 3)
+        x = np.matmul(local, np.swapaxes(rot, 1, 2))  # (M, S, 3): R a for every sphere a
+        return x + pos[:, None], self._pad_radii[bucket][link] + self.gap
 
-    def _by_link(self, b: np.ndarray, link: np.ndarray):
-        """The (configuration, link) pairs ``b``, ``link`` (M,) grouped by link: yields the
-        link, the positions (M_l,) of its pairs and their configurations (M_l,)."""
+    def _by_bucket(self, b: np.ndarray, link: np.ndarray):
+        """The (configuration, link) pairs ``b``, ``link`` (M,) grouped by the links' bucket:
+        yields the bucket, the positions (M_k,) of its pairs, their configurations and links."""
         if not link.size:
             return
-        order = np.argsort(link, kind="stable")
-        edges = np.flatnonzero(np.diff(link[order])) + 1
-        for group in np.split(order, edges):
-            yield int(link[group[0]]), group, b[group]
+        bucket = self._bucket[link]  # (M,)
+        for k in range(len(BUCKETS) + 1):
+            group = np.flatnonzero(bucket == k)
+            if group.size:
+                yield k, group, b[group], link[group]
 
     # ---- queries -----------------------------------------------------------------------------
 
@@ -377,7 +400,10 @@ class SphereCollision:
         scene, own, held_arm = self._mask(ignore)
         n, links = q.shape[0], len(PARTS)
         rot, pos = self._links(q, float(fingers))  # (B, L + 1, 3, 3), (B, L + 1, 3)
-        mid = np.einsum("blij,lj->bli", rot[:, :links], self._bounds) + pos[:, :links]  # (B, L, 3)
+        r = rot[:, :links]  # (B, L, 3, 3)
+        b = self._bounds  # (L, 3) the bounding spheres' centres, each in its link's frame
+        mid = pos[:, :links] + r[..., 0] * b[:, None, 0] + r[..., 1] * b[:, None, 1]
+        mid += r[..., 2] * b[:, None, 2]  # (B, L, 3)
         reach = self._reach + self.gap  # (L,)
         hit = np.zeros(n, dtype=bool)
         found: list[Contact] = []
@@ -406,25 +432,28 @@ class SphereCollision:
         m = self.margin
         # the table: a plane at z = 0
         near_b, near_l = np.nonzero((mid[..., 2] - reach < m) & scene[None, :links, 0])
-        for link, _, rows in self._by_link(near_b, near_l):
-            x = self._place(rot[rows, link], pos[rows, link], link)  # (M, S, 3)
-            lowest = x[..., 2] - (self._link_radii[link] + self.gap)  # (M, S)
-            record(rows, np.full(rows.size, link), np.zeros_like(rows), lowest, m)
+        for k, _, rows, link in self._by_bucket(near_b, near_l):
+            x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
+            record(rows, link, np.zeros_like(rows), x[..., 2] - grown, m)
         # the boxes, each in its own frame (turned about z only)
-        if len(self._names) > 1:
-            gap = self._box_gap(mid[:, :, None], slice(None), reach[:, None] + m, detail)
-            near_b, near_l, near_o = pending(*np.nonzero((gap < 0.0) & scene[None, :links, 1:]))
-            for link, group, rows in self._by_link(near_b, near_l):
-                x = self._place(rot[rows, link], pos[rows, link], link)  # (M, S, 3)
+        if len(self._names) > 1:  # the bounding spheres against the boxes' world bounds
+            near = scene[None, :links, 1:]  # (1, L, O)
+            for axis in range(3):
+                room = self._world_half[axis] + (reach[:, None] + m)  # (L, O)
+                near = near & (np.abs(mid[:, :, axis, None] - self._box_c[:, axis]) < room)
+            near_b, near_l, near_o = pending(*np.nonzero(near))  # (B, L, O) -> (M,) each
+            for k, group, rows, link in self._by_bucket(near_b, near_l):
+                x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
                 box = near_o[group]  # (M,)
-                grown = self._link_radii[link] + self.gap + m  # (S,)
-                gap = self._box_gap(x, box[:, None], grown, detail)  # (M, S)
-                record(rows, np.full(rows.size, link), box + 1, gap + m, m)
+                gap = self._box_gap(x, box[:, None], grown + m, detail)  # (M, S)
+                record(rows, link, box + 1, gap + m, m)
         # the links against each other: the distal link's spheres against the other's 26-DOP
+        if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at any angle
+            own = own & (self._apart_from > -math.inf)
         a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
         apart = reach[a] + reach[c] + self.self_margin  # (K',)
         close = np.square(mid[:, a] - mid[:, c]).sum(-1) < np.square(apart)  # (B, K')
-        if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at these angles
+        if self.self_margin < APART_CLEARANCE:  # ... and those it keeps apart at these angles
             close &= q[:, self._apart_joint[own]] < self._apart_from[own]
         near_b, near_k = pending(*np.nonzero(close))
         la, lc = a[near_k], c[near_k]
@@ -433,21 +462,22 @@ class SphereCollision:
             gap = _box_sdf(centre - self._aabb_c[lc], self._aabb_h[lc]) - reach[la]  # (M,)
             keep = gap < self.self_margin
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
-        for link, group, rows in self._by_link(near_b, la):
+        for k, group, rows, link in self._by_bucket(near_b, la):
             other = lc[group]  # (M,) the DOP side
             r_c = rot[rows, other]  # (M, 3, 3)
             r_rel = np.swapaxes(r_c, 1, 2) @ rot[rows, link]  # (M, 3, 3) link -> other's frame
             t_rel = np.einsum("mji,mj->mi", r_c, pos[rows, link] - pos[rows, other])  # (M, 3)
-            inner = self._place(r_rel, t_rel, link)  # (M, S, 3) in the other link's frame
-            grown = self._link_radii[link] + self.gap  # (S,)
+            inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in other's frame
             # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
             box_c, box_h = self._aabb_c[other][:, None], self._aabb_h[other][:, None]
             gap = _box_sdf(inner - box_c, box_h) - grown  # (M, S)
+            padding = np.arange(gap.shape[1]) >= self._count[link][:, None]  # (M, S)
+            gap[padding] = np.inf  # a repeated sphere: tested once
             near_m, near_s = np.nonzero(gap < self.self_margin)
             if near_m.size:
                 dop = inner[near_m, near_s] @ self._directions.T - self._dop[other[near_m]]
-                gap[near_m, near_s] = dop.max(-1) - grown[near_s]  # the 26-DOP's lower bound
-            record(rows, np.full(rows.size, link), ~other, gap, self.self_margin)
+                gap[near_m, near_s] = dop.max(-1) - grown[near_m, near_s]  # the DOP's bound
+            record(rows, link, ~other, gap, self.self_margin)
         if self._held_half is not None:
             self._check_held(rot, pos, mid, scene, held_arm, record)
         return found if detail else ~hit
@@ -499,13 +529,12 @@ class SphereCollision:
             inner = np.einsum("bji,blj->bli", r_box, mid[:, links] - t_box[:, None])
             gap = _box_sdf(inner, half) - reach[links]  # (B, L')
             near_b, near_l = np.nonzero(gap < m)
-            for link, _, rows in self._by_link(near_b, links[near_l]):
+            for k, _, rows, link in self._by_bucket(near_b, links[near_l]):
                 r_in = np.swapaxes(r_box[rows], 1, 2)  # (M, 3, 3) world -> held box
                 r_rel = r_in @ rot[rows, link]  # (M, 3, 3) link -> held box
                 t_rel = np.einsum("mij,mj->mi", r_in, pos[rows, link] - t_box[rows])  # (M, 3)
-                inner = self._place(np.ascontiguousarray(r_rel), t_rel, link)  # (M, S, 3)
-                sdf = _box_sdf(inner, half) - (self._link_radii[link] + self.gap)  # (M, S)
-                record(rows, HELD, np.full(rows.size, ~link), sdf, m)
+                inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in its frame
+                record(rows, HELD, ~link, _box_sdf(inner, half) - grown, m)
 
 
 def _obb_gap(r_a, t_a, half_a, r_b, c_b, h_b) -> np.ndarray:
