@@ -8,6 +8,9 @@
   (``plan-images``, ``bench latplan``);
 - ``geometry``: pinhole geometry of a camera (intrinsics, pose, projection, back-projection);
 - ``poses``: block poses (centre, yaw) from an RGB-D image, for the arm to act on;
+- ``scene_poses``: the camera pose sensor of a scene file's world (geometric TAMP's
+  ``observation="camera"``): several cameras, objects told apart by colour and by their
+  previous estimates, each fitted with its known model (``fit``: boxes and cylinders);
 - ``latplan``: LatPlan's cylinder row, its generator's camera, and a randomised dataset of it;
 - ``states``: full goal scenes a goal image shows, the most likely state of a soft state.
 
