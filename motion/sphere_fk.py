@@ -115,9 +115,8 @@ def _links(
     hand = len(_ARM) + 1
     _compose(rot[hand - 1], pos[hand - 1], hand_t, rot[hand], pos[hand])
     for k, sign in ((hand + 1, 1.0), (hand + 2, -1.0)):  # the fingers slide along hand y
-        slide = np.eye(4, dtype=_FLOAT)
-        slide[:3, 3] = (0.0, sign * fingers, FINGER_ORIGIN)
-        _compose(rot[hand], pos[hand], slide, rot[k], pos[k])
+        rot[k] = rot[hand]
+        pos[k] = pos[hand] + (sign * fingers) * rot[hand, :, 1] + FINGER_ORIGIN * rot[hand, :, 2]
     _compose(rot[hand], pos[hand], tcp_t, rot[-1], pos[-1])
     # (B, F, 3, 3) and (B, F, 3), contiguous: the checks gather frames by configuration
     return np.ascontiguousarray(rot.transpose(3, 0, 1, 2)), np.ascontiguousarray(
@@ -126,9 +125,12 @@ def _links(
 
 
 def _compose(r: np.ndarray, t: np.ndarray, transform: np.ndarray, r_out, t_out) -> None:
-    """Frames r (3, 3, B), t (3, B) followed by a fixed (4, 4) ``transform``, into r_out, t_out."""
-    for a in range(3):
-        r_out[:, a] = (
-            r[:, 0] * transform[0, a] + r[:, 1] * transform[1, a] + r[:, 2] * transform[2, a]
-        )
-    t_out[:] = t + r[:, 0] * transform[0, 3] + r[:, 1] * transform[1, 3] + r[:, 2] * transform[2, 3]
+    """Frames r (3, 3, B), t (3, B) followed by a fixed (4, 4) ``transform``, into r_out, t_out
+    (the transform's zero entries skipped)."""
+    for a in range(4):
+        out = t_out if a == 3 else r_out[:, a]  # (3, B)
+        terms = [(k, float(transform[k, a])) for k in range(3) if transform[k, a] != 0]
+        value = t.copy() if a == 3 else np.zeros_like(t)
+        for k, w in terms:
+            value += w * r[:, k] if w != 1.0 else r[:, k]
+        out[:] = value

@@ -4,7 +4,9 @@ Per scene (`tamp.bench.collision.scenes`):
 
 - **throughput**: `SphereCollision.valid_batch` on batches of each size, ``repeats`` calls per
   batch, the process pinned to one CPU (`one_core`); configurations per second of the median
-  call, on the ``uniform`` sample and on the ``near`` one (tiled to the batch size);
+  call, by the wall clock and by the process's CPU time (its own work, which other
+  processes on a loaded machine do not inflate as much), on the ``uniform`` sample and on the
+  ``near`` one (tiled to the batch size);
 - **validation**: the sphere model's verdicts on the ``near`` sample against the mesh model's
   (`robots.collision.PandaCollision.valid`, PyBullet's closest points, the guard's final word),
   both at the loop's margin: false "free" (must be 0), false "collision", the mesh model's cost
@@ -14,7 +16,7 @@ Per scene (`tamp.bench.collision.scenes`):
   settings, the margin widened by ``plan_pad``, the sphere model's ``valid_batch`` to search
   and the mesh model to verify) on seeded moves the straight path cannot make; beside it
   (``baseline``) the same moves by OMPL's RRT-Connect on the mesh model alone, as before the
-  sphere model existed.
+  sphere model existed. Each move's planning time by the wall clock and in process CPU time.
 """
 
 from __future__ import annotations
@@ -38,6 +40,7 @@ MOVE_COLUMNS = (
     "ok",
     "search",
     "time_ms",
+    "cpu_ms",
     "batch_ms",
     "verify_ms",
     "batch_configs",
@@ -46,7 +49,16 @@ MOVE_COLUMNS = (
     "waypoints",
     "failure",
 )
-THROUGHPUT_COLUMNS = ("scene", "sample", "batch", "calls", "median_s", "configs_per_s")
+THROUGHPUT_COLUMNS = (
+    "scene",
+    "sample",
+    "batch",
+    "calls",
+    "median_s",
+    "configs_per_s",
+    "median_cpu_s",
+    "configs_per_cpu_s",
+)
 
 
 @dataclass(frozen=True)
@@ -88,12 +100,13 @@ def throughput(spheres, samples: dict[str, np.ndarray], batches: Sequence[int], 
         for batch in batches:
             qs = np.resize(q, (batch, q.shape[1]))  # (batch, J)
             spheres.valid_batch(qs)
-            times = []
+            wall, cpu = [], []
             for _ in range(repeats):
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 spheres.valid_batch(qs)
-                times.append(time.perf_counter() - t0)
-            median = float(np.median(times))
+                wall.append(time.perf_counter() - t0)
+                cpu.append(time.process_time() - c0)
+            median, median_cpu = float(np.median(wall)), float(np.median(cpu))
             rows.append(
                 {
                     "sample": name,
@@ -101,6 +114,8 @@ def throughput(spheres, samples: dict[str, np.ndarray], batches: Sequence[int], 
                     "calls": repeats,
                     "median_s": median,
                     "configs_per_s": batch / median,
+                    "median_cpu_s": median_cpu,
+                    "configs_per_cpu_s": batch / max(median_cpu, 1e-9),
                 }
             )
     return rows
@@ -173,7 +188,9 @@ def reroute(mesh, spheres, starts, goals, margin: float, seed: int, baseline: bo
     try:
         for k, (a, b) in enumerate(zip(starts, goals, strict=True)):
             for name, batch in planners:
+                c0 = time.process_time()
                 r = plan_path(a, b, mesh.valid, config=rrt, valid_batch=batch)
+                cpu_ms = 1e3 * (time.process_time() - c0)
                 ev = r.evidence
                 batch_s = ev.get("batch_s")
                 rows.append(
@@ -183,6 +200,7 @@ def reroute(mesh, spheres, starts, goals, margin: float, seed: int, baseline: bo
                         "ok": r.ok,
                         "search": ev.get("search", "ompl"),
                         "time_ms": 1e3 * r.time_s,
+                        "cpu_ms": cpu_ms,
                         "batch_ms": None if batch_s is None else 1e3 * batch_s,
                         "verify_ms": None if batch_s is None else 1e3 * (r.time_s - batch_s),
                         "batch_configs": ev.get("batch_configs"),
@@ -203,11 +221,14 @@ def _moves_summary(rows: list[dict]) -> dict:
     for name in dict.fromkeys(r["planner"] for r in rows):
         mine = [r for r in rows if r["planner"] == name]
         times = np.array([r["time_ms"] for r in mine])
+        cpu = np.array([r["cpu_ms"] for r in mine])
         out[name] = {
             "moves": len(mine),
             "solved": sum(r["ok"] for r in mine),
             "median_ms": float(np.median(times)) if mine else None,
             "p90_ms": float(np.percentile(times, 90)) if mine else None,
+            "median_cpu_ms": float(np.median(cpu)) if mine else None,
+            "p90_cpu_ms": float(np.percentile(cpu, 90)) if mine else None,
             "searches": dict(Counter(r["search"] for r in mine)),
             "mesh_checks_median": float(np.median([r["mesh_checks"] for r in mine])),
         }

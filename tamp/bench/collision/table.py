@@ -20,9 +20,15 @@ def checker_table(result: dict) -> str:
     """Three tables over the scenes of `tamp.bench.collision.run.run`'s result."""
     scenes = result["scenes"]
     rates = table(
-        ("scene", "sample", "batch", "configs/s"),
+        ("scene", "sample", "batch", "configs/s", "configs/CPU-s"),
         [
-            (s["scene"], r["sample"], r["batch"], f"{r['configs_per_s']:,.0f}")
+            (
+                s["scene"],
+                r["sample"],
+                r["batch"],
+                f"{r['configs_per_s']:,.0f}",
+                f"{r['configs_per_cpu_s']:,.0f}",
+            )
             for s in scenes
             for r in s["throughput"]
         ],
@@ -57,7 +63,16 @@ def checker_table(result: dict) -> str:
         ],
     )
     moves = table(
-        ("scene", "planner", "solved", "median ms", "p90 ms", "mesh checks", "found by"),
+        (
+            "scene",
+            "planner",
+            "solved",
+            "median ms",
+            "p90 ms",
+            "CPU ms p50/p90",
+            "mesh checks",
+            "found by",
+        ),
         [
             (
                 s["scene"],
@@ -65,6 +80,7 @@ def checker_table(result: dict) -> str:
                 f"{m['solved']}/{m['moves']}",
                 _ms(m["median_ms"]),
                 _ms(m["p90_ms"]),
+                f"{_ms(m['median_cpu_ms'])}/{_ms(m['p90_cpu_ms'])}",
                 f"{m['mesh_checks_median']:.0f}",
                 ", ".join(f"{k} {v}" for k, v in sorted(m["searches"].items())),
             )
