@@ -77,6 +77,7 @@ APART_CLEARANCE = 0.003  # m
 # the narrow phases test the links in buckets by sphere count (at most 10, 30, more: link0's
 # 46), each link's spheres padded to its bucket's widest: few groups, little padding
 BUCKETS = (10, 30)
+CLUSTER = 10  # spheres per cluster of a link in the self-collision narrow phase
 
 
 _MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
@@ -174,6 +175,7 @@ class SphereCollision:
                     local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
             self._pad_local.append(local.astype(_FLOAT))
             self._pad_radii.append(radii.astype(_FLOAT))
+        self._clusters(spheres)
         bounds = [_bound(*spheres[link]) for link in PARTS]
         self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
         self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
@@ -214,6 +216,37 @@ class SphereCollision:
         minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
         high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
         self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
+
+    def _clusters(self, spheres) -> None:
+        """Each link's spheres in clusters of at most `CLUSTER` along the link's longest
+        direction, for the self-collision narrow phase: per cluster its link (C,), centres
+        (C, CLUSTER, 3) padded by repeating its first, radii (C, CLUSTER), count (C,) and
+        bounding sphere (C, 3), (C,); per link its first cluster (L,) and number of them."""
+        link_of, local, radii, count, mids, reach = [], [], [], [], [], []
+        self._first_cluster = np.zeros(len(PARTS), dtype=int)
+        self._n_clusters = np.zeros(len(PARTS), dtype=int)
+        for link, name in enumerate(PARTS):
+            centres, r = spheres[name]
+            self._first_cluster[link] = len(link_of)
+            parts = -(-len(r) // CLUSTER)  # ceil
+            self._n_clusters[link] = parts
+            spread = centres - centres.mean(0)
+            axis = np.linalg.svd(spread, full_matrices=False)[2][0] if len(r) > 1 else np.eye(3)[0]
+            for chunk in np.array_split(np.argsort(spread @ axis, kind="stable"), parts):
+                rows = np.where(np.arange(CLUSTER) < chunk.size, np.arange(CLUSTER), 0)
+                link_of.append(link)
+                local.append(centres[chunk][rows])
+                radii.append(r[chunk][rows])
+                count.append(chunk.size)
+                mid, far = _bound(centres[chunk], r[chunk])
+                mids.append(mid)
+                reach.append(far)
+        self._cluster_link = np.array(link_of)  # (C,)
+        self._cluster_local = np.array(local, dtype=_FLOAT)  # (C, CLUSTER, 3)
+        self._cluster_radii = np.array(radii, dtype=_FLOAT)  # (C, CLUSTER)
+        self._cluster_count = np.array(count)  # (C,)
+        self._cluster_mid = np.array(mids, dtype=_FLOAT)  # (C, 3)
+        self._cluster_reach = np.array(reach, dtype=_FLOAT)  # (C,)
 
     # ---- the scene ---------------------------------------------------------------------------
 
@@ -462,25 +495,43 @@ class SphereCollision:
             gap = _box_sdf(centre - self._aabb_c[lc], self._aabb_h[lc]) - reach[la]  # (M,)
             keep = gap < self.self_margin
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
-        for k, group, rows, link in self._by_bucket(near_b, la):
-            other = lc[group]  # (M,) the DOP side
-            r_c = rot[rows, other]  # (M, 3, 3)
-            r_rel = np.swapaxes(r_c, 1, 2) @ rot[rows, link]  # (M, 3, 3) link -> other's frame
-            t_rel = np.einsum("mji,mj->mi", r_c, pos[rows, link] - pos[rows, other])  # (M, 3)
-            inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in other's frame
-            # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
-            box_c, box_h = self._aabb_c[other][:, None], self._aabb_h[other][:, None]
-            gap = _box_sdf(inner - box_c, box_h) - grown  # (M, S)
-            padding = np.arange(gap.shape[1]) >= self._count[link][:, None]  # (M, S)
-            gap[padding] = np.inf  # a repeated sphere: tested once
-            near_m, near_s = np.nonzero(gap < self.self_margin)
-            if near_m.size:
-                dop = inner[near_m, near_s] @ self._directions.T - self._dop[other[near_m]]
-                gap[near_m, near_s] = dop.max(-1) - grown[near_m, near_s]  # the DOP's bound
-            record(rows, link, ~other, gap, self.self_margin)
+        if near_b.size:
+            self._self_pairs(rot, pos, near_b, la, lc, record)
         if self._held_half is not None:
             self._check_held(rot, pos, mid, scene, held_arm, record)
         return found if detail else ~hit
+
+    def _self_pairs(self, rot, pos, b, link, other, record) -> None:
+        """The flagged link pairs (M,): configurations ``b``, sphere side ``link``, DOP side
+        ``other``; each sphere-side cluster's bounding sphere against the other link's box,
+        then its spheres against that box and, where near, against the 26-DOP."""
+        r_c = rot[b, other]  # (M, 3, 3)
+        r_rel = np.swapaxes(r_c, 1, 2) @ rot[b, link]  # (M, 3, 3) link -> the other's frame
+        t_rel = np.einsum("mji,mj->mi", r_c, pos[b, link] - pos[b, other])  # (M, 3)
+        parts = self._n_clusters[link]  # (M,)
+        pair = np.repeat(np.arange(b.size), parts)  # (N,) each pair's clusters
+        cluster = self._first_cluster[link][pair] + np.arange(pair.size)
+        cluster -= np.repeat(np.cumsum(parts) - parts, parts)  # (N,)
+        frame = other[pair]  # (N,)
+        box_c, box_h = self._aabb_c[frame], self._aabb_h[frame]  # (N, 3) each
+        centre = np.einsum("nij,nj->ni", r_rel[pair], self._cluster_mid[cluster]) + t_rel[pair]
+        reach = self._cluster_reach[cluster] + self.gap  # (N,)
+        keep = _box_sdf(centre - box_c, box_h) - reach < self.self_margin
+        pair, cluster, frame = pair[keep], cluster[keep], frame[keep]
+        box_c, box_h = box_c[keep, None], box_h[keep, None]  # (N', 1, 3) each
+        local = self._cluster_local[cluster]  # (N', S, 3)
+        inner = np.matmul(local, np.swapaxes(r_rel[pair], 1, 2)) + t_rel[pair, None]
+        grown = self._cluster_radii[cluster] + self.gap  # (N', S)
+        # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
+        gap = _box_sdf(inner - box_c, box_h) - grown  # (N', S)
+        gap[np.arange(CLUSTER) >= self._cluster_count[cluster][:, None]] = np.inf  # repeats
+        near_n, near_s = np.nonzero(gap < self.self_margin)
+        if near_n.size:
+            dop = inner[near_n, near_s] @ self._directions.T - self._dop[frame[near_n]]
+            gap[near_n, near_s] = dop.max(-1) - grown[near_n, near_s]  # the 26-DOP's bound
+        least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its clusters
+        np.minimum.at(least, pair, gap.min(1))
+        record(b, link, ~other, least, self.self_margin)
 
     def _box_gap(self, points: np.ndarray, box, reach, exact: bool) -> np.ndarray:
         """Clearance of points (..., 3) to the boxes ``box`` (indices broadcasting with the
