@@ -239,11 +239,14 @@ class _Batch:
             raise MotionError(f"valid_batch returned shape {ok.shape} for {len(q)} configurations")
         return ok
 
-    def segments(self, a: np.ndarray, b: np.ndarray, stride: int = 8, full: bool = True):
+    def segments(
+        self, a: np.ndarray, b: np.ndarray, stride: int = 8, full: bool = True, rest: bool = False
+    ):
         """(P,) bool: whether each segment a[p] -> b[p] ((P, J) each) is valid at the points
         ``a + k/n (b - a)``, 0 <= k <= n = ceil(|b - a| / step) (the ends included), in two
         batched calls: every ``stride``-th point of every segment, then the rest of those
-        still valid (``full``; else only the first call: a necessary condition)."""
+        still valid (``full``; else only the first call: a necessary condition). ``rest``:
+        the first call's points are known valid; only the second call is made."""
         n = np.maximum(1, np.ceil(np.linalg.norm(b - a, axis=1) / self.step)).astype(int)  # (P,)
         seg = np.repeat(np.arange(len(n)), n + 1)  # (N,) the segment of each point
         k = np.arange(seg.size) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)  # (N,) 0..n
@@ -251,7 +254,7 @@ class _Batch:
         points = a[seg] + t * (b[seg] - a[seg])  # (N, J)
         alive = np.ones(len(n), dtype=bool)
         coarse = (k % stride == 0) | (k == n[seg])
-        for part in (coarse, ~coarse) if full else (coarse,):
+        for part in (~coarse,) if rest else (coarse, ~coarse) if full else (coarse,):
             rows = np.flatnonzero(part & alive[seg])
             if rows.size:
                 bad = rows[~self(points[rows])]
@@ -271,11 +274,12 @@ def _screened(valid_batch: Callable[[np.ndarray], np.ndarray], checker: _Checker
     return check
 
 
-def _through(start, goal, vias: np.ndarray, batch: _Batch, full: bool) -> np.ndarray:
+def _through(start, goal, vias: np.ndarray, batch: _Batch, full: bool, rest: bool = False):
     """(V,) bool: start -> via -> goal valid for each via (V, J) (``full``: at every point;
-    else at every 8th, a necessary condition)."""
+    else at every 8th, a necessary condition; ``rest``: every 8th point is known valid)."""
     ends = np.broadcast_to(start, vias.shape), np.broadcast_to(goal, vias.shape)
-    ok = batch.segments(np.concatenate([ends[0], vias]), np.concatenate([vias, ends[1]]), full=full)
+    a, b = np.concatenate([ends[0], vias]), np.concatenate([vias, ends[1]])
+    ok = batch.segments(a, b, full=full, rest=rest)
     return ok[: len(vias)] & ok[len(vias) :]  # (V,) both halves valid
 
 
@@ -287,7 +291,7 @@ def _shortest_via(start, goal, vias: np.ndarray, batch: _Batch) -> np.ndarray | 
     alive = alive[np.argsort(lengths[alive], kind="stable")]
     for k in range(0, alive.size, 2):
         chunk = vias[alive[k : k + 2]]
-        ok = _through(start, goal, chunk, batch, full=True)
+        ok = _through(start, goal, chunk, batch, full=True, rest=True)  # every 8th: done
         if ok.any():
             return chunk[int(np.argmax(ok))]
     return None
