@@ -357,11 +357,12 @@ def _reference_valid(model: SphereCollision, q: np.ndarray, fingers: float) -> n
     return free
 
 
-@pytest.mark.parametrize("self_margin", [0.0, 0.005])
+@pytest.mark.parametrize("self_margin", [0.0, 0.002, 0.005])
 def test_valid_batch_agrees_with_a_check_without_culling(self_margin):
     """The broad phases, buckets and clusters only skip work: 2,100 configurations beside
     boxes and about q_home (a quarter free; a 5 mm wider margin flips about 2 % of them) get
-    the verdicts of every sphere tested against everything."""
+    the verdicts of every sphere tested against everything. From APART_CLEARANCE on, the
+    wrist's pairs are tested too, and refuse nearly all of them."""
     model = SphereCollision(margin=0.01, self_margin=self_margin)
     rng = np.random.default_rng(6)
     free = total = 0
@@ -373,5 +374,6 @@ def test_valid_batch_agrees_with_a_check_without_culling(self_margin):
         fast = model.valid_batch(q, fingers)
         assert np.array_equal(fast, _reference_valid(model, q, fingers)), k
         free, total = free + int(fast.sum()), total + len(q)
-    assert 0.1 * total < free < 0.9 * total
+    if self_margin < APART_CLEARANCE:
+        assert 0.1 * total < free < 0.9 * total
     model.set_boxes([])
