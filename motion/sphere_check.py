@@ -30,12 +30,16 @@ pairs the two: the mesh model answers ``valid`` and ``check_path``, the spheres
 ``valid_batch``, which `motion.rrt.plan_path` uses to search).
 
 Speed. Forward kinematics batch-last (`motion.sphere_fk`). A bounding sphere per link (L = 11)
-is tested first, (B, L, O); the flagged (configuration, link) pairs are grouped by link, and
-each link's spheres placed in one matrix product for all its pairs, (M, S, 3), then tested
-against the flagged boxes. Self pairs go through the bounding spheres, then the link's bounding
-sphere against the other link's box, then (grouped by the sphere side, in the other link's
-frame) the DOP's box, then its 26 planes. A configuration with a contact found is not tested
-further (``valid_batch``). Without square roots where only the sign of a clearance matters.
+is tested first: against the table, and against each box's world bounds axis by axis,
+(B, L, O); the flagged (configuration, link) pairs go to the narrow phase in three `BUCKETS` of
+links by sphere count (each link's spheres padded to its bucket's widest, placed in one batched
+product per bucket). Self pairs go through the bounding spheres (the pairs `APART` always keeps
+apart never), then the link's bounding sphere against the other link's box, then clusters of at
+most `CLUSTER` spheres of the link (their bounding spheres against that box first), then each
+sphere against the DOP's box and, where near, its 26 planes. A configuration with a contact
+found is not tested further (``valid_batch``). Without square roots where only the sign of a
+clearance matters. tests/motion/test_sphere_check.py checks the verdicts against a check that
+tests every sphere against everything.
 """
 
 from __future__ import annotations
