@@ -39,8 +39,8 @@ class PlannerConfig:
     proof_every: int = 5  # Adam steps between reads of a window that may reach the goal: once
     # every problem's decoded window reaches it in as few moves as the domain's lower bound
     # from the window's start allows, no later step could decode a shorter window and the
-    # window stops (0: never, all ``iters`` steps; only without beliefs and move costs;
-    # `task.planner._proofs`)
+    # window stops (0: never, all ``iters`` steps; only windows of one problem, without
+    # beliefs and move costs; `task.planner._proofs`)
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
     # in one batch start together and share it), checked at every Adam and rollout step: a
     # window it cuts short is abandoned; None: only max_windows stops the planner

@@ -26,7 +26,7 @@ import torch
 from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig, torch_device
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
-from task.decode import DecodedWindow, decode_best
+from task.decode import DecodedWindow, decode_best, decode_row
 from task.domains import get_domain
 from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
@@ -36,9 +36,13 @@ from task.rollout import OutOfTime, Rollout, check_deadline
 from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first, lazy_greedy
 from task.symbolic.shorten import shorten
 
-NEAR_GOAL = 10.0  # `_proofs` decodes a problem early only when one of its restarts' soft goal
-# cross-entropy at the decode temperature is below this (a cheap filter: it can delay a stop,
+NEAR_GOAL = 10.0  # `_proofs` decodes a restart early only when its soft goal cross-entropy at
+# the decode temperature is below this (a cheap filter: it can delay a stop,
 # never make one wrong; far rows read 30 to 1000, rows that reach it about 0)
+PROOF_PROBLEMS = 1  # windows of at most this many problems are read early (`_proofs`): a read
+# costs about a third of an Adam step, and a window stops only once all its problems are proven,
+# which in a batch of many rarely happens (PlanBench's 150 4-block problems in one batch: 8%
+# more CPU with reads, none stopped early)
 
 
 def _window(
@@ -52,8 +56,8 @@ def _window(
     costs: WindowCosts | None = None,
     deadline: float | None = None,
 ):
-    """The decoded window of each problem (`decode_best`); without beliefs and move costs a
-    window may stop early (`_proofs`)."""
+    """The decoded window of each problem (`decode_best`); a window of one problem
+    (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early (`_proofs`)."""
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
     batch = batch.repeat(config.restarts)
@@ -61,7 +65,7 @@ def _window(
     steps = torch.arange(int(horizons.max()), device=device) < horizons[:, None]  # (B, T)
     proven: dict[int, DecodedWindow] = {}
     stop = None
-    if beliefs is None and costs is None and visited is not None:
+    if len(problems) <= PROOF_PROBLEMS and beliefs is None and costs is None and visited:
         stop = _proofs(domain, problems, states, config, visited, proven)
     _, roll = optimise_window(
         domain, batch, steps, config, generator, beliefs, costs, deadline, stop
@@ -100,8 +104,8 @@ def _proofs(
     and the final decode are not used for it: a problem's plan does not depend on whether the
     others of its batch are proven too). The stop is True once every problem is proven. None
     (no reads) when no problem can be (its bound exceeds the longest window) or without the
-    crisp check. Only the problems with a restart near the goal in the rollout (`NEAR_GOAL`)
-    are decoded."""
+    crisp check. Only the restarts near the goal in the rollout (`NEAR_GOAL`) are decoded, the
+    best of them by the decoder's ranking (`DecodedWindow.key`)."""
     longest = max(config.horizons())
     bounds = [domain.lower_bound(p, s) for p, s in zip(problems, states, strict=True)]
     hopeful = [i for i, bound in enumerate(bounds) if bound <= longest]
@@ -110,28 +114,32 @@ def _proofs(
     r = config.restarts
 
     def stop(roll: Rollout) -> bool:
-        near = (roll.goal.view(len(problems), r).min(-1).values < NEAR_GOAL).tolist()  # (P,)
-        todo = [i for i in hopeful if i not in proven and near[i]]
+        near = (roll.goal < NEAR_GOAL).view(len(problems), r).tolist()  # (P, R)
+        todo = [i for i in hopeful if i not in proven and any(near[i])]
         if not todo:
             return False
-        rows = torch.tensor([i * r + k for i in todo for k in range(r)], device=roll.gates.device)
-        found = decode_best(
-            domain,
-            [problems[i] for i in todo],
-            [states[i] for i in todo],
-            roll.gates[rows],
-            roll.loss[rows],
-            r,
-            config.threshold,
-            True,
-            [visited[i] for i in todo],
-            None,
-            config.rank_prefixes,
-            config.park_free,
-        )
-        for i, window in zip(todo, found, strict=True):
-            if window.reached and len(window.moves) <= bounds[i]:
-                proven[i] = window
+        gates, losses = roll.gates.cpu(), roll.loss.cpu().tolist()
+        for i in todo:
+            windows = []
+            for k in (k for k in range(r) if near[i][k]):
+                row = i * r + k
+                window = decode_row(
+                    domain,
+                    problems[i],
+                    states[i],
+                    gates[row],
+                    config.threshold,
+                    losses[row],
+                    True,
+                    visited[i],
+                    None,
+                    config.rank_prefixes,
+                    config.park_free,
+                )
+                windows.append(replace(window, row=k))
+            best = min(windows, key=DecodedWindow.key)
+            if best.reached and len(best.moves) <= bounds[i]:
+                proven[i] = best
         return len(proven) == len(problems)
 
     return stop

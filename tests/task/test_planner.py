@@ -295,22 +295,29 @@ def _adam_steps(monkeypatch) -> list:
     return steps
 
 
-@pytest.mark.parametrize("seed", range(2))
+@pytest.mark.parametrize("seed", range(3))
 def test_a_window_stops_once_it_reaches_the_goal_in_as_few_moves_as_the_bound(seed, monkeypatch):
     """`PlannerConfig.proof_every`: a window whose decode reaches the goal in as many moves as
     the lower bound from its start stops early; no plan is longer than without the stop."""
-    problems = [random_problem(4, seed), random_problem(4, seed + 10)]
+    problem = random_problem(4, seed)
     steps = _adam_steps(monkeypatch)
     config = replace(FAST, iters=30)
-    full = plan_batch(problems, replace(config, proof_every=0), seed=seed)
+    full = plan(problem, replace(config, proof_every=0), seed=seed)
     all_steps = len(steps)
     steps.clear()
-    early = plan_batch(problems, config, seed=seed)
+    early = plan(problem, config, seed=seed)
     assert len(steps) <= all_steps
-    for p, a, b in zip(problems, full, early, strict=True):
-        assert a.solved and b.solved
-        validate_moves(p, b.plan.moves)
-        assert len(b.plan) <= len(a.plan)
+    assert full.solved and early.solved
+    validate_moves(problem, early.plan.moves)
+    assert len(early.plan) <= len(full.plan)
+
+
+def test_windows_of_many_problems_are_not_read_early(monkeypatch):
+    problems = [random_problem(3, 0), random_problem(3, 1)]
+    steps = _adam_steps(monkeypatch)
+    results = plan_batch(problems, replace(FAST, iters=10, proof_every=2))
+    assert all(r.solved for r in results)
+    assert len(steps) == 10 * max(r.stats["windows"] for r in results)
 
 
 def test_a_window_reaching_the_goal_in_the_bound_stops_at_the_first_read(monkeypatch):
