@@ -26,6 +26,10 @@ part in (no IK solution, a post, the table or a wall hit; ``fixed``) holds in ev
 the object stands where it stood, so later plans do not try that grasp again from another
 order of the other moves.
 
+With empty region cells (`tamp.geo.ours.cells`) a window's costs are one matrix per restart
+row, the cells' places optimised with the logits, and the row whose moves are committed fixes
+them (`GeoCosts.settle`; a moved cell forgets the prices seen so far).
+
 Every state is priced once (cached); the IK solutions are cached by target position (to the
 mm) across states, so later windows solve only the targets they have not seen. ``stats``
 records states priced and the time spent (ms per state).
@@ -35,14 +39,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 
 from motion.grasps import HAND_BOXES, Grasp
 from motion.ik import IKSolver, top_down_pose
-from tamp.geo.ours.bridge import Bridged
+from tamp.geo.ours.bridge import PACK, Bridged
+from tamp.geo.ours.cells import CellConfig, Cells, CellWindow
+from tamp.geo.ours.pack import PackConfig
 from tamp.geo.places import free, supported_on
 from tamp.world.geometry import Solid, fixed_solids, of_movable
 from tamp.world.schema import Scene
@@ -62,6 +68,9 @@ class GeoCostConfig:
     choices: tuple[str, ...] = ("top", "side", "tilt")  # grasp families priced
     ik: bool = True  # rule out a grasp or release with no top-down IK solution (needs a solver)
     margin: float = 0.004  # m, the open hand's boxes grown by this (the collision margin)
+    # the goal regions' empty cells as variables of the planner's Adam, per restart row
+    # (`tamp.geo.ours.cells`); None: they stay where the packer put them
+    cells: CellConfig | None = field(default_factory=CellConfig)
 
 
 def hand_shape(grasp: Grasp) -> tuple:
@@ -170,7 +179,7 @@ class _Window:
         return []
 
     def commit(self, rows, moves) -> None:
-        """Nothing to record: the places are fixed before planning (`tamp.geo.ours.pack`)."""
+        """Nothing to record: no cell of this window is empty (or cells are off)."""
 
 
 class GeoCosts:
@@ -185,8 +194,11 @@ class GeoCosts:
         q=None,
         config: GeoCostConfig = GeoCostConfig(),
         grasps=None,
+        pack: PackConfig = PACK,
     ) -> None:
         self.bridged, self.solver, self.config = bridged, solver, config
+        # the empty cells the planner's Adam moves (`pack`: the packer's settings they keep)
+        self.cells = None if config.cells is None else Cells(bridged, pack, config.cells)
         self.q = None if q is None else np.asarray(q, dtype=np.float64)
         if grasps is None:
             from tamp.geo.check import candidate_grasps
@@ -205,9 +217,22 @@ class GeoCosts:
     # ---- the planner's interface
 
     def __call__(self, indices: Sequence[int], states: Sequence[State], restarts: int = 1):
-        """The costs of a window (`task.costs.CostSource`): (P, N, Y), one row per problem."""
-        rows = [torch.from_numpy(self.price(s)) for s in states]
-        return _Window(torch.stack(rows))
+        """The costs of a window (`task.costs.CostSource`): (P, N, Y), one row per problem, or
+        with empty cells (`tamp.geo.ours.cells`) one per restart row, their places optimised
+        with the logits."""
+        rows = torch.stack([torch.from_numpy(self.price(s)) for s in states])
+        if self.cells is not None and any(self.cells.empty(self.bridged, s) for s in states):
+            return CellWindow(self, rows, self.bridged, states, restarts)
+        return _Window(rows)
+
+    def settle(self, cell: str, xy) -> None:
+        """Fix ``cell`` at ``xy`` (m) where its region's packing stays free
+        (`tamp.geo.ours.cells.Cells.settle`); the prices of the states seen so far are
+        forgotten when it moved (they depend on where the cells are)."""
+        settled = self.cells.settle(self.bridged, cell, xy)
+        if settled is not self.bridged:
+            self.bridged = settled
+            self._base.clear()
 
     def price(self, state: State) -> np.ndarray:
         """(N, Y) the price of every move x -> y in crisp ``state`` (0 where illegal)."""

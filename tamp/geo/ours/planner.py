@@ -6,8 +6,10 @@
    (`tamp.geo.ours.bridge`: the goal regions' cells placed jointly by gradient,
    `tamp.geo.ours.pack`);
 2. plan it with `task.planner.plan` and the arm's prices in the objective (`GeoCosts`): the
-   receding windows, then, when they revisit a state or run out, the planner's complete lazy
-   fallback (`task.symbolic.lazy_search`) over the moves the prices allow;
+   receding windows (the empty cells' places optimised with each restart row's logits and
+   fixed by the committed row, `tamp.geo.ours.cells`), then, when they revisit a state or
+   run out, the planner's complete lazy fallback (`task.symbolic.lazy_search`) over the moves
+   the prices allow;
 3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
    full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
    no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
@@ -226,7 +228,7 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
         why = f"no free arrangement of the goal objects in region(s) {', '.join(unpacked)}"
         return GeoPlan(GeoStatus.BUDGET, reason=why, stats=stats)
     solver, q = getattr(tools, "solver", None), getattr(tools, "q", None)
-    costs = GeoCosts(bridged, solver, q, config.costs)
+    costs = GeoCosts(bridged, solver, q, config.costs, pack=config.pack)
     failures, plans, cuts = [], 0, 0
     state, world, bound = bridged.problem.init, bridged.scene, []
     least = moves_lower_bound(bridged.problem, bridged.problem.init)  # moves the goal needs
@@ -244,6 +246,8 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
         plans += 1
         now = replace(bridged.problem, init=state)
         result = plan(now, planner, seed=config.seed + plans - 1, costs=costs)
+        bridged = costs.bridged  # the cells the committed windows settled
+        stats["bridged"] = bridged
         stats.update(_planner_stats(result, costs))
         if result.status is PlanStatus.UNSOLVABLE and state == bridged.problem.init:
             why = result.stats.get("fallback", {}).get("reason", "no plan")
@@ -354,7 +358,10 @@ def _packs(bridged: Bridged) -> dict:
 
 
 def _planner_stats(result, costs: GeoCosts) -> dict:
+    cells = costs.cells
     out = {
+        "cells_settled": 0 if cells is None else len(cells.moved) - cells.kept,
+        "cells_kept": 0 if cells is None else cells.kept,
         "windows": result.stats.get("windows", 0),
         "plan_s": result.stats.get("time_s", 0.0),
         "priced_states": costs.stats["states"],
