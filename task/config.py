@@ -40,7 +40,9 @@ class PlannerConfig:
     # every problem's decoded window reaches it in as few moves as the domain's lower bound
     # from the window's start allows, no later step could decode a shorter window and the
     # window stops (0: never, all ``iters`` steps; only windows of one problem, without
-    # beliefs and move costs; `task.planner._proofs`)
+    # beliefs, and without move costs unless ``proof_costs``; `task.planner._proofs`)
+    proof_costs: bool = False  # stop early with move costs too: a window reaching the goal in
+    # as few moves as the bound wins over a cheaper one of that length a later step might decode
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
     # in one batch start together and share it), checked at every Adam and rollout step: a
     # window it cuts short is abandoned; None: only max_windows stops the planner

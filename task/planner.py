@@ -65,7 +65,8 @@ def _window(
     steps = torch.arange(int(horizons.max()), device=device) < horizons[:, None]  # (B, T)
     proven: dict[int, DecodedWindow] = {}
     stop = None
-    if len(problems) <= PROOF_PROBLEMS and beliefs is None and costs is None and visited:
+    priced_ok = costs is None or config.proof_costs
+    if len(problems) <= PROOF_PROBLEMS and beliefs is None and priced_ok and visited:
         stop = _proofs(domain, problems, states, config, visited, proven)
     _, roll = optimise_window(
         domain, batch, steps, config, generator, beliefs, costs, deadline, stop
@@ -119,6 +120,7 @@ def _proofs(
         if not todo:
             return False
         gates, losses = roll.gates.cpu(), roll.loss.cpu().tolist()
+        priced = None if roll.costs is None else roll.costs.detach().cpu()  # (B, N, Y)
         for i in todo:
             windows = []
             for k in (k for k in range(r) if near[i][k]):
@@ -132,7 +134,7 @@ def _proofs(
                     losses[row],
                     True,
                     visited[i],
-                    None,
+                    None if priced is None else priced[row],
                     config.rank_prefixes,
                     config.park_free,
                 )

@@ -67,7 +67,9 @@ SEARCH_NODES = 5_000  # the complete search's expansions at least (its time boun
 # tower's 20-move plan unfinished after 9 windows; with a third its 11 windows and binding took
 # 24 s of 40)
 SOFT_SHARE = 3
-PLANNER = PlannerConfig(restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True)
+PLANNER = PlannerConfig(
+    restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True, proof_costs=True
+)
 # receding windows at least per move the bridged problem's lower bound says the goal needs
 # (`PlannerConfig.max_windows`): a window commits one to three moves, and 4 windows stopped a
 # 10-cube tower's 20-move plan short; where the bound is small (a region to fill, objects to
