@@ -121,10 +121,11 @@ def throughput(spheres, samples: dict[str, np.ndarray], batches: Sequence[int], 
     return rows
 
 
-def validate(mesh, spheres, q: np.ndarray, margin: float) -> dict:
-    """Both models' verdicts on ``q`` (N, J) at ``margin`` (their boxes as set): counts, each
-    model's cost per configuration, and the meshes' clearance where the spheres refuse a
-    configuration the meshes accept (None: beyond ``margin + PROBE``)."""
+def validate(mesh, spheres, boxes, q: np.ndarray, margin: float) -> dict:
+    """Both models' verdicts on ``q`` (N, J) at ``margin`` (the scene's ``boxes`` set in both):
+    counts, each model's cost per configuration, and where the spheres refuse a configuration
+    the meshes accept, how much farther than its threshold the meshes' closest pair is
+    (`_excess`)."""
     mesh.margin = spheres.margin = margin
     t0 = time.perf_counter()
     fast = spheres.valid_batch(q)  # (N,)
@@ -133,9 +134,8 @@ def validate(mesh, spheres, q: np.ndarray, margin: float) -> dict:
     exact = np.array([mesh.valid(x) for x in q])  # (N,)
     mesh_s = time.perf_counter() - t0
     refused = np.flatnonzero(~fast & exact)
-    excess = _excess(mesh, q[refused], margin)  # (F,) m, NaN: beyond the probe
+    excess = _excess(mesh, boxes, q[refused], margin)  # (F,) m, NaN: beyond the probe
     measured = excess[np.isfinite(excess)]
-    mesh.margin = margin
     return {
         "n": len(q),
         "mesh_free": int(exact.sum()),
@@ -151,23 +151,26 @@ def validate(mesh, spheres, q: np.ndarray, margin: float) -> dict:
     }
 
 
-def _excess(mesh, q: np.ndarray, margin: float) -> np.ndarray:
-    """How much farther than its threshold (``margin`` to a box or the table, 0 to another
-    link) the meshes' closest pair is at each configuration of ``q`` (F, J) the mesh model
-    accepts (F,) m, probed up to ``PROBE`` beyond it (NaN: farther)."""
+def _excess(mesh, boxes, q: np.ndarray, margin: float) -> np.ndarray:
+    """How much farther than its threshold (``margin`` to a box or the table, the mesh model's
+    self margin to another link) the meshes' closest pair is at each configuration of ``q``
+    (F, J), (F,) m, probed up to ``PROBE`` beyond it (NaN: farther). A second mesh model with
+    the thresholds widened by ``PROBE`` and the scene's ``boxes`` answers (a mesh model fixes
+    its self threshold when it is built)."""
+    from robots.collision import PandaCollision
+
     link = set(mesh.parts)
-    self_margin = mesh.self_margin
-    mesh.margin, mesh.self_margin = margin + PROBE, self_margin + PROBE
-    try:
-        out = np.full(len(q), np.nan)
+    out = np.full(len(q), np.nan)
+    if not len(q):
+        return out
+    with PandaCollision(margin + PROBE, self_margin=mesh.self_margin + PROBE) as probe:
+        probe.set_boxes(boxes)
         for k, x in enumerate(q):
-            hits = mesh.contacts(x)
+            hits = probe.contacts(x)
             if hits:
                 out[k] = min(
-                    c.distance - (self_margin if c.other in link else margin) for c in hits
+                    c.distance - (mesh.self_margin if c.other in link else margin) for c in hits
                 )
-    finally:
-        mesh.margin, mesh.self_margin = margin, self_margin
     return out
 
 
@@ -250,7 +253,7 @@ def run_scene(name: str, config: CheckerBenchConfig, progress=None) -> tuple[dic
         progress(f"{name}: throughput")
     with PandaCollision(margin=config.margin) as mesh:
         mesh.set_boxes(boxes)
-        check = validate(mesh, spheres, near, config.margin)
+        check = validate(mesh, spheres, boxes, near, config.margin)
         if progress:
             progress(f"{name}: validation")
         starts, goals = scenes.blocked_moves(mesh, spheres, config.moves, config.seed + 3)
