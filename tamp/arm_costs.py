@@ -13,11 +13,11 @@ table and a grasp or release reaching `DEEP` into another block get ``blocked`` 
 does a move the arm failed in that state before (``avoid``, `failed_key`). With ``grasps`` (the
 executor's geometric fallback, `tamp.blocks_geo`: tilted and side grasps, corridor transits) the
 prices agree with what that executor can do: a pick or place out of top-down reach that one of
-those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead. The matrix is
-computed once per state: the table placement is the scene's free slot, or with table places
-(`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
-placements): every window optimises fresh offsets, one set per restart row, with the logits,
-and the source records, for each committed move, the position the chosen row decided it with
+those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead. The
+matrix is computed once per state: the table placement is the scene's free slot, or with table
+places (`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
+placements): every window optimises fresh offsets, one set per restart row, with the logits, and the
+source records, for each committed move, the position the chosen row decided it with
 (`ArmCosts.decided`).
 """
 
@@ -186,6 +186,7 @@ class ArmCosts:
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
         self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
+        self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
         self.places = places  # per problem: table place -> (x, y), for slotted problems
         self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
@@ -337,17 +338,26 @@ class ArmCosts:
         """(M,) whether some grasp of ``self.grasps`` (`motion.grasps.grasps` of a cube) holds
         a block centred at ``points`` (M, 3), turned ``yaws`` (M,), with the arm's IK solved:
         where the executor's geometric fallback (`tamp.blocks_geo.run_geo`) may still pick or
-        place it when no top-down grasp reaches over the highest stack. One batched IK call."""
+        place it when no top-down grasp reaches over the highest stack. One batched IK call for
+        the poses (to the mm and 0.01 rad) this source has not tested before."""
         from motion.grasps import grasps, world_tcp
 
         family = grasps("cube", (self.scene.block_size / 2,) * 3, self.grasps)
         if not family or len(points) == 0:
             return np.zeros(len(points), dtype=bool)
-        targets = np.stack(
-            [world_tcp(g, p, float(y)) for p, y in zip(points, yaws, strict=True) for g in family]
-        )  # (M * G, 4, 4)
-        found = self.solver.solve(targets, self.q_now)
-        return np.asarray(found.ok).reshape(len(points), len(family)).any(1)
+        keys = [
+            (*np.round(p, 3).tolist(), round(float(y), 2))
+            for p, y in zip(points, yaws, strict=True)
+        ]
+        new = list(dict.fromkeys(k for k in keys if k not in self._reached))  # unseen poses
+        if new:
+            targets = np.stack(
+                [world_tcp(g, k[:3], k[3]) for k in new for g in family]
+            )  # (M * G, 4, 4)
+            found = np.asarray(self.solver.solve(targets, self.q_now).ok)
+            for k, ok in zip(new, found.reshape(len(new), len(family)).any(1), strict=True):
+                self._reached[k] = bool(ok)
+        return np.array([self._reached[k] for k in keys], dtype=bool)
 
     def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no
