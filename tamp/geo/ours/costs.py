@@ -310,7 +310,9 @@ class GeoCosts:
                 names = ()
                 if ok:
                     at = self._free_grasps(world, x, geo.place.xyz, geo.place.yaw, fixed, bodies)
-                    names = tuple(g for g in picks[x] if g in at)
+                    # best first, in `candidate_grasps`' order (a set's order changes with
+                    # the process's string hashing, and with it which grasp binding tries first)
+                    names = tuple(g.name for g in self.grasps[x] if g.name in picks[x] & at)
                 allowed[move] = names
                 if not names:
                     out[i, j] = IMPOSSIBLE

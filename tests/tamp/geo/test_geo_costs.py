@@ -129,3 +129,17 @@ def test_oriented_boxes_overlap_only_where_they_truly_interpenetrate():
             one = obb_overlap(*(tuple(p[k : k + 1] for p in many) for k in (i, j)))
             assert table[i, j] == one[0, 0]
     assert table[0, 2] and not table[0, 1]
+
+
+def test_the_grasps_left_of_a_move_come_in_the_candidates_order(priced):
+    """Best first, as `candidate_grasps` orders them: not a set's order, which changes with the
+    process's string hashing (and with it the grasp binding tries first)."""
+    b, costs, _ = priced
+    p = b.problem
+    _, allowed = costs._priced(p.init)
+    seen = 0
+    for move, names in allowed.items():
+        order = [g.name for g in costs.grasps[move.entity]]
+        assert list(names) == [n for n in order if n in names]
+        seen += len(names) > 1
+    assert seen  # some move has several grasps to order
