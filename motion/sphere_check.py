@@ -51,9 +51,21 @@ from itertools import combinations
 import numpy as np
 
 from motion.errors import MotionError
-from motion.sphere_fk import _FLOAT, _HAND, PARTS, _chain, _link_spheres, _links, _onehot
+from motion.sphere_fk import (
+    _FLOAT,
+    PARTS,
+    _bound,
+    _chain,
+    _clusters,
+    _dops,
+    _link_spheres,
+    _links,
+    _obb_gap,
+    _onehot,
+    _turn,
+)
 from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck, densify
-from robots.panda import PANDA, PandaSpec, data_dir
+from robots.panda import PANDA, PandaSpec
 from robots.panda_spheres import COVER_GAP, FINGERS
 
 Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in PandaCollision
@@ -82,48 +94,6 @@ APART_CLEARANCE = 0.003  # m
 # 46), each link's spheres padded to its bucket's widest: few groups, little padding
 BUCKETS = (10, 30)
 CLUSTER = 10  # spheres per cluster of a link in the self-collision narrow phase
-
-
-_MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
-    _HAND: "hand.obj",
-    FINGERS[0]: "finger.obj",
-    FINGERS[1]: "finger.obj",
-}
-
-
-def _directions() -> np.ndarray:
-    """The 26 unit directions of a 26-DOP (26, 3): faces, edges and corners of a cube."""
-    grid = np.stack(np.meshgrid(*[(-1.0, 0.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
-    grid = grid[np.abs(grid).sum(1) > 0]
-    return grid / np.linalg.norm(grid, axis=1, keepdims=True)
-
-
-def _dops() -> tuple[np.ndarray, np.ndarray]:
-    """Per link, the support offsets (L, 26) of its collision mesh's vertices along
-    `_directions` (the 26-DOP holding its convex hull, in its frame; fingers in their own)."""
-    directions = _directions()
-    out = np.zeros((len(PARTS), len(directions)))
-    for k, link in enumerate(PARTS):
-        path = data_dir() / "franka_panda" / "meshes" / "collision" / _MESHES[link]
-        rows = [line.split()[1:4] for line in path.read_text().splitlines() if line[:2] == "v "]
-        v = np.array(rows, dtype=float)  # (V, 3)
-        if link == FINGERS[1]:  # the URDF turns the right finger's mesh by pi about z
-            v = v * np.array([-1.0, -1.0, 1.0])
-        out[k] = (v @ directions.T).max(0)
-    return directions, out
-
-
-def _bound(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
-    """A sphere (centre (3,), radius) holding all the given spheres: around their box's middle."""
-    mid = (np.min(centres - radii[:, None], 0) + np.max(centres + radii[:, None], 0)) / 2
-    return mid, float((np.linalg.norm(centres - mid, axis=1) + radii).max())
-
-
-def _turn(yaw: np.ndarray) -> np.ndarray:
-    """Rotations (..., 3, 3) about z by ``yaw`` (...)."""
-    c, s = np.cos(yaw), np.sin(yaw)
-    z, o = np.zeros_like(yaw), np.ones_like(yaw)
-    return np.stack([c, -s, z, s, c, z, z, z, o], -1).reshape(*yaw.shape, 3, 3)
 
 
 def _box_sdf(points: np.ndarray, half: np.ndarray) -> np.ndarray:
@@ -222,35 +192,13 @@ class SphereCollision:
         self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
 
     def _clusters(self, spheres) -> None:
-        """Each link's spheres in clusters of at most `CLUSTER` along the link's longest
-        direction, for the self-collision narrow phase: per cluster its link (C,), centres
-        (C, CLUSTER, 3) padded by repeating its first, radii (C, CLUSTER), count (C,) and
-        bounding sphere (C, 3), (C,); per link its first cluster (L,) and number of them."""
-        link_of, local, radii, count, mids, reach = [], [], [], [], [], []
-        self._first_cluster = np.zeros(len(PARTS), dtype=int)
-        self._n_clusters = np.zeros(len(PARTS), dtype=int)
-        for link, name in enumerate(PARTS):
-            centres, r = spheres[name]
-            self._first_cluster[link] = len(link_of)
-            parts = -(-len(r) // CLUSTER)  # ceil
-            self._n_clusters[link] = parts
-            spread = centres - centres.mean(0)
-            axis = np.linalg.svd(spread, full_matrices=False)[2][0] if len(r) > 1 else np.eye(3)[0]
-            for chunk in np.array_split(np.argsort(spread @ axis, kind="stable"), parts):
-                rows = np.where(np.arange(CLUSTER) < chunk.size, np.arange(CLUSTER), 0)
-                link_of.append(link)
-                local.append(centres[chunk][rows])
-                radii.append(r[chunk][rows])
-                count.append(chunk.size)
-                mid, far = _bound(centres[chunk], r[chunk])
-                mids.append(mid)
-                reach.append(far)
-        self._cluster_link = np.array(link_of)  # (C,)
-        self._cluster_local = np.array(local, dtype=_FLOAT)  # (C, CLUSTER, 3)
-        self._cluster_radii = np.array(radii, dtype=_FLOAT)  # (C, CLUSTER)
-        self._cluster_count = np.array(count)  # (C,)
-        self._cluster_mid = np.array(mids, dtype=_FLOAT)  # (C, 3)
-        self._cluster_reach = np.array(reach, dtype=_FLOAT)  # (C,)
+        """The self-collision narrow phase's clusters (`sphere_fk._clusters`), as float32."""
+        link_of, local, radii, count, mids, reach, first, parts = _clusters(spheres, CLUSTER)
+        self._cluster_link, self._cluster_count = link_of, count  # (C,) each
+        self._cluster_local = local.astype(_FLOAT)  # (C, CLUSTER, 3)
+        self._cluster_radii = radii.astype(_FLOAT)  # (C, CLUSTER)
+        self._cluster_mid, self._cluster_reach = mids.astype(_FLOAT), reach.astype(_FLOAT)
+        self._first_cluster, self._n_clusters = first, parts  # (L,) each
 
     # ---- the scene ---------------------------------------------------------------------------
 
@@ -590,23 +538,6 @@ class SphereCollision:
                 t_rel = np.einsum("mij,mj->mi", r_in, pos[rows, link] - t_box[rows])  # (M, 3)
                 inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in its frame
                 record(rows, HELD, ~link, _box_sdf(inner, half) - grown, m)
-
-
-def _obb_gap(r_a, t_a, half_a, r_b, c_b, h_b) -> np.ndarray:
-    """Separating-axis test of M pairs of boxes: A (rotations (M, 3, 3), centres (M, 3), half
-    extents (3,)) against B (rotations (M, 3, 3), centres (M, 3), half extents (M, 3)); the
-    largest separation (M,) over the 15 axes (< 0: the boxes overlap)."""
-    a_axes, b_axes = np.swapaxes(r_a, 1, 2), np.swapaxes(r_b, 1, 2)  # (M, 3, 3): rows are axes
-    cross = np.cross(a_axes[:, :, None], b_axes[:, None, :]).reshape(-1, 9, 3)  # (M, 9, 3)
-    norm = np.linalg.norm(cross, axis=-1, keepdims=True)
-    cross = np.where(norm > 1e-6, cross / np.maximum(norm, 1e-6), 0.0)
-    axes = np.concatenate([a_axes, b_axes, cross], axis=1)  # (M, 15, 3)
-    along = np.abs(np.einsum("mki,mi->mk", axes, c_b - t_a))  # (M, 15)
-    rad_a = np.abs(np.einsum("mki,mji->mkj", axes, a_axes)) @ half_a  # (M, 15)
-    rad_b = (np.abs(np.einsum("mki,mji->mkj", axes, b_axes)) * h_b[:, None]).sum(-1)
-    sep = along - rad_a - rad_b  # (M, 15); a zero axis never separates
-    sep = np.where(np.linalg.norm(axes, axis=-1) > 0.5, sep, -np.inf)
-    return sep.max(-1)
 
 
 class Screened:

@@ -3,7 +3,10 @@
 The URDF's joint origins (parsed once by `_chain`, revolute joints as quarter-turn rotations and
 offsets), the link frames `PARTS` in the order `SphereCollision` uses, and the spheres of
 `robots.panda_spheres` (cuRobo's SPHERES plus the COVER rows) per link in its own frame, and
-`_links`: the world frames of every link and the TCP for B configurations at once (float32).
+`_links`: the world frames of every link and the TCP for B configurations at once (float32);
+and the model's fixed geometry: bounding spheres (`_bound`), each link's 26-DOP (`_dops`), its
+spheres in clusters (`_clusters`), turns about z (`_turn`) and the separating-axis test of two
+boxes (`_obb_gap`).
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from motion.errors import MotionError
-from robots.panda import PandaSpec, urdf_path
+from robots.panda import PandaSpec, data_dir, urdf_path
 from robots.panda_spheres import COVER, FINGER_ORIGIN, FINGERS, SPHERES
 
 _ARM = tuple(f"panda_link{i}" for i in range(1, 8))
@@ -83,6 +86,98 @@ def _link_spheres():
         radii = np.array([r for name, _, r in rows if name == link], dtype=float)
         out[link] = (centres.reshape(-1, 3), radii)
     return out
+
+
+_MESHES = {f"panda_link{i}": f"link{i}.obj" for i in range(8)} | {
+    _HAND: "hand.obj",
+    FINGERS[0]: "finger.obj",
+    FINGERS[1]: "finger.obj",
+}
+
+
+def _directions() -> np.ndarray:
+    """The 26 unit directions of a 26-DOP (26, 3): faces, edges and corners of a cube."""
+    grid = np.stack(np.meshgrid(*[(-1.0, 0.0, 1.0)] * 3, indexing="ij"), -1).reshape(-1, 3)
+    grid = grid[np.abs(grid).sum(1) > 0]
+    return grid / np.linalg.norm(grid, axis=1, keepdims=True)
+
+
+def _dops() -> tuple[np.ndarray, np.ndarray]:
+    """Per link, the support offsets (L, 26) of its collision mesh's vertices along
+    `_directions` (the 26-DOP holding its convex hull, in its frame; fingers in their own)."""
+    directions = _directions()
+    out = np.zeros((len(PARTS), len(directions)))
+    for k, link in enumerate(PARTS):
+        path = data_dir() / "franka_panda" / "meshes" / "collision" / _MESHES[link]
+        rows = [line.split()[1:4] for line in path.read_text().splitlines() if line[:2] == "v "]
+        v = np.array(rows, dtype=float)  # (V, 3)
+        if link == FINGERS[1]:  # the URDF turns the right finger's mesh by pi about z
+            v = v * np.array([-1.0, -1.0, 1.0])
+        out[k] = (v @ directions.T).max(0)
+    return directions, out
+
+
+def _bound(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
+    """A sphere (centre (3,), radius) holding all the given spheres: around their box's middle."""
+    mid = (np.min(centres - radii[:, None], 0) + np.max(centres + radii[:, None], 0)) / 2
+    return mid, float((np.linalg.norm(centres - mid, axis=1) + radii).max())
+
+
+def _clusters(spheres, size: int):
+    """Each link's spheres (`_link_spheres`) in clusters of at most ``size`` along the link's
+    longest direction: per cluster its link (C,), centres (C, size, 3) padded by repeating its
+    first, radii (C, size), count (C,) and bounding sphere (`_bound`: (C, 3), (C,)); per link
+    its first cluster (L,) and number of them (L,)."""
+    link_of, local, radii, count, mids, reach = [], [], [], [], [], []
+    first, parts = np.zeros(len(PARTS), dtype=int), np.zeros(len(PARTS), dtype=int)
+    for link, name in enumerate(PARTS):
+        centres, r = spheres[name]
+        first[link], parts[link] = len(link_of), -(-len(r) // size)  # ceil
+        spread = centres - centres.mean(0)
+        axis = np.linalg.svd(spread, full_matrices=False)[2][0] if len(r) > 1 else np.eye(3)[0]
+        for chunk in np.array_split(np.argsort(spread @ axis, kind="stable"), parts[link]):
+            rows = np.where(np.arange(size) < chunk.size, np.arange(size), 0)
+            mid, far = _bound(centres[chunk], r[chunk])
+            link_of.append(link)
+            local.append(centres[chunk][rows])
+            radii.append(r[chunk][rows])
+            count.append(chunk.size)
+            mids.append(mid)
+            reach.append(far)
+    return (
+        np.array(link_of),
+        np.array(local),
+        np.array(radii),
+        np.array(count),
+        np.array(mids),
+        np.array(reach),
+        first,
+        parts,
+    )
+
+
+def _turn(yaw: np.ndarray) -> np.ndarray:
+    """Rotations (..., 3, 3) about z by ``yaw`` (...)."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    z, o = np.zeros_like(yaw), np.ones_like(yaw)
+    return np.stack([c, -s, z, s, c, z, z, z, o], -1).reshape(*yaw.shape, 3, 3)
+
+
+def _obb_gap(r_a, t_a, half_a, r_b, c_b, h_b) -> np.ndarray:
+    """Separating-axis test of M pairs of boxes: A (rotations (M, 3, 3), centres (M, 3), half
+    extents (3,)) against B (rotations (M, 3, 3), centres (M, 3), half extents (M, 3)); the
+    largest separation (M,) over the 15 axes (< 0: the boxes overlap)."""
+    a_axes, b_axes = np.swapaxes(r_a, 1, 2), np.swapaxes(r_b, 1, 2)  # (M, 3, 3): rows are axes
+    cross = np.cross(a_axes[:, :, None], b_axes[:, None, :]).reshape(-1, 9, 3)  # (M, 9, 3)
+    norm = np.linalg.norm(cross, axis=-1, keepdims=True)
+    cross = np.where(norm > 1e-6, cross / np.maximum(norm, 1e-6), 0.0)
+    axes = np.concatenate([a_axes, b_axes, cross], axis=1)  # (M, 15, 3)
+    along = np.abs(np.einsum("mki,mi->mk", axes, c_b - t_a))  # (M, 15)
+    rad_a = np.abs(np.einsum("mki,mji->mkj", axes, a_axes)) @ half_a  # (M, 15)
+    rad_b = (np.abs(np.einsum("mki,mji->mkj", axes, b_axes)) * h_b[:, None]).sum(-1)
+    sep = along - rad_a - rad_b  # (M, 15); a zero axis never separates
+    sep = np.where(np.linalg.norm(axes, axis=-1) > 0.5, sep, -np.inf)
+    return sep.max(-1)
 
 
 def _links(
