@@ -16,7 +16,8 @@ fingers on the way can stay wedged between the open pads (PyBullet: a pad's edge
 millimetre into it; the retreat then carries it off and drops it anywhere, once on a post's
 top), so the hand closes on it again and reopens, at most ``release_tries`` times, before
 it retreats; the run's evidence says how often (``regrasped``), or that it stayed stuck
-(``not_released``). Nothing here reads ground truth.
+(``not_released``). The back-off after a missed grasp frees the object the same way (the
+fingers had closed on it askew) before it backs up. Nothing here reads ground truth.
 
 Where the place is tight, a held object that slipped a few millimetres in the fingers (the
 friction grasp, most in MuJoCo) would land out of its cell. Given a ``sense`` of the held
@@ -165,17 +166,18 @@ def run_move(
         expected = expected_contacts(phase.name, move.obj, rests)
         worst = sim.run(phase.trajectory, phase.gripper, release, on_frame, expected)
         if worst > config.max_tracking:
-            _back_off(sim, check.motion, on_frame, handling)
-            return done("tracking_error", phase=phase.name, error_rad=round(worst, 3))
+            freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
+            return done("tracking_error", phase=phase.name, error_rad=round(worst, 3), **freed)
         if phase.name == "close":
             missed = holding(sim, width, config, fresh=True)
             if missed is None and sim.grasp == "weld" and not sim.attach():
                 missed = {"weld": "no object between the fingers"}
             if missed is not None:
-                _back_off(sim, check.motion, on_frame, handling)
-                return done("missed_grasp", **missed)
+                freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
+                return done("missed_grasp", **missed, **freed)
         elif phase.name == "open":
-            evidence |= _release(sim, move.obj, rests, phase, config, on_frame)
+            closing = expected_contacts("lower", move.obj, rests)
+            evidence |= _release(sim, config, on_frame, closing, phase.trajectory.duration)
         elif phase.name in ("lift", "transit"):
             gone = holding(sim, width, config, fresh=False)
             if gone is not None:
@@ -228,9 +230,10 @@ def opened(sim: Simulator, config: RunConfig) -> dict | None:
     }
 
 
-def _release(sim, obj: str, rests, open_phase: Phase, config: RunConfig, on_frame) -> dict:
-    """After the ``open`` phase: while the fingers do not stand open (`opened`), the object
-    wedged between them, close on it and open again (the hand where it stands), at most
+def _release(sim, config: RunConfig, on_frame, closing: Expected, open_s: float) -> dict:
+    """After the hand opened on an object (``closing.handled``): while the fingers do not
+    stand open (`opened`), the object wedged between them, close on it (the contacts
+    ``closing`` expects) and open again for ``open_s`` s, the hand where it stands, at most
     ``config.release_tries`` times. The evidence: ``regrasped`` (closings), and
     ``not_released`` (the last reading) when the fingers never opened."""
     stuck, tries = opened(sim, config), 0
@@ -238,22 +241,30 @@ def _release(sim, obj: str, rests, open_phase: Phase, config: RunConfig, on_fram
         tries += 1
         q = sim.arm_q()
         close = JointTrajectory.hold(q, config.reclose_s, sim.dt)
-        sim.run(close, "closed", on_frame=on_frame, expected=expected_contacts("lower", obj, rests))
-        reopen = JointTrajectory.hold(q, open_phase.trajectory.duration, sim.dt)
-        sim.run(reopen, "open", on_frame=on_frame, expected=Expected(obj))
+        sim.run(close, "closed", on_frame=on_frame, expected=closing)
+        reopen = JointTrajectory.hold(q, open_s, sim.dt)
+        sim.run(reopen, "open", on_frame=on_frame, expected=Expected(closing.handled))
         stuck = opened(sim, config)
     out = {"regrasped": tries} if tries else {}
     return out if stuck is None else {**out, "not_released": stuck}
 
 
-def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Expected) -> None:
-    """After a failure at the object: open the gripper and undo the descent."""
+def _back_off(
+    sim: Simulator, phases: tuple[Phase, ...], on_frame, obj: str, rests, config: RunConfig
+) -> dict:
+    """After a failure at the object ``obj``: open the gripper, free the object where it
+    stays wedged between the fingers (`_release`: a grasp that missed had closed on it
+    askew), and undo the descent. Returns `_release`'s evidence."""
     sim.detach()
     q = sim.arm_q()
+    expected = Expected(obj)
     sim.run(JointTrajectory.hold(q, 0.3, sim.dt), "open", on_frame=on_frame, expected=expected)
+    closing = Expected(obj, obj, frozenset(rests))
+    freed = _release(sim, config, on_frame, closing, 0.3)
     down = next(ph for ph in phases if ph.name == "descend").trajectory
     back = JointTrajectory(
         down.times, down.positions[::-1].copy(), -down.velocities[::-1], down.accelerations[::-1]
     )
     if np.abs(back.positions[0] - q).max() < 0.05:
         sim.run(back, "open", on_frame=on_frame, expected=expected)
+    return freed

@@ -28,8 +28,8 @@ class _Hand:
     grasp = "friction"
     dt = 0.002
 
-    def __init__(self, stuck: int) -> None:
-        self.stuck, self.time = stuck, 0.0
+    def __init__(self, stuck: int, closes: float = WIDTH) -> None:
+        self.stuck, self.closes, self.time = stuck, closes, 0.0  # closes: the first closing
         self.commands: list[tuple[str, int]] = []  # (gripper, samples) per run
         self._reading = GripperReading(2 * PANDA.finger_open, 0.0, 0.0)
 
@@ -37,7 +37,8 @@ class _Hand:
         self.commands.append((gripper, len(trajectory.positions)))
         self.time += trajectory.duration
         if gripper == "closed":
-            self._reading = GripperReading(WIDTH, 40.0, 40.0)
+            self._reading = GripperReading(self.closes, 40.0, 40.0)
+            self.closes = WIDTH
         elif self._reading.width < 2 * PANDA.finger_open - 1e-9:  # opening on the object
             wedged = self.stuck > 0
             self.stuck -= wedged
@@ -88,3 +89,16 @@ def test_fingers_that_never_open_are_evidence_of_the_move_after_the_tries():
     ran = run_move(hand, move, check, ("table", "table"), config)
     assert ran.evidence["regrasped"] == config.release_tries
     assert ran.evidence["not_released"]["finger_width"] == pytest.approx(WEDGED.width)
+
+
+def test_a_missed_grasp_frees_an_object_wedged_askew_between_the_fingers_before_backing_off():
+    move, check = _move()
+    hand = _Hand(stuck=1, closes=0.045)  # closed askew: 4.5 cm where the object is 5.7
+    ran = run_move(hand, move, check, ("table", "table"), RunConfig())
+    assert ran.failure == "missed_grasp"
+    assert ran.evidence["regrasped"] == 1 and "not_released" not in ran.evidence
+    descend = len(check.motion[1].trajectory.positions)
+    after_close = hand.commands[3:]  # the back-off: open, close on it again, open, back up
+    assert [g for g, _ in after_close] == ["open", "closed", "open", "open"]
+    assert after_close[-1] == ("open", descend)  # ... along the descent, last
+    assert hand.gripper().width == pytest.approx(2 * PANDA.finger_open)
