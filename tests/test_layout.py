@@ -151,3 +151,19 @@ def test_no_flat_folder_of_many_modules():
         for folder in [ROOT / package, *(p for p in (ROOT / package).rglob("*") if p.is_dir())]:
             modules = [p for p in folder.glob("*.py") if p.name != "__init__.py"]
             assert len(modules) <= 11, f"{folder.relative_to(ROOT)}: {len(modules)} modules"
+
+
+def test_the_installed_packages_are_every_package_of_the_source_tree():
+    """pyproject.toml lists its packages by name: a package missing there works in an editable
+    install (the source tree is on the path) and is absent from a wheel."""
+    import tomllib
+
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    found = {
+        ".".join(init.parent.relative_to(ROOT).parts)
+        for top in PACKAGES
+        for init in (ROOT / top).rglob("__init__.py")
+    }
+    assert sorted(found - listed) == [] and sorted(listed - found) == []
