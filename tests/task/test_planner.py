@@ -330,36 +330,15 @@ def test_a_window_reaching_the_goal_in_the_bound_stops_at_the_first_read(monkeyp
         PlannerConfig(proof_every=-1)
 
 
-class _FlatCosts:
-    """A move-cost source pricing every move 1.0 except ``banned`` (IMPOSSIBLE)."""
+def _flat_costs(problem, banned=()):
+    """Every move priced 1.0, ``banned`` (entity, target) pairs IMPOSSIBLE."""
+    from task.costs import IMPOSSIBLE
+    from tests.task.test_costs import FixedCosts
 
-    def __init__(self, banned=()):
-        self.banned = set(banned)
-
-    def __call__(self, indices, states, restarts):
-        from task.costs import IMPOSSIBLE
-
-        problem = self.problem
-        c = torch.ones(len(states), problem.n, len(problem.targets), dtype=torch.float64)
-        for x, y in self.banned:
-            c[:, problem.entities.index(x), problem.index(y)] = IMPOSSIBLE
-        return _Fixed(c)
-
-
-class _Fixed:
-    lr = 0.0
-
-    def __init__(self, matrix):
-        self.matrix = matrix
-
-    def compute(self):
-        return self.matrix
-
-    def parameters(self):
-        return []
-
-    def commit(self, rows, moves):
-        pass
+    c = torch.ones(1, problem.n, len(problem.targets), dtype=torch.float64)
+    for x, y in banned:
+        c[:, problem.entities.index(x), problem.index(y)] = IMPOSSIBLE
+    return FixedCosts(c)
 
 
 def test_with_move_costs_a_window_stops_early_only_with_proof_costs_and_never_on_a_refused_move(
@@ -368,8 +347,7 @@ def test_with_move_costs_a_window_stops_early_only_with_proof_costs_and_never_on
     """`PlannerConfig.proof_costs`: with move costs a window is read early only when asked;
     the early read refuses a move the costs rule out as the final decode does."""
     problem = Problem("one-move", "blocksworld", ("a", "b"), ("table", "table"), (("a", "b"),))
-    costs = _FlatCosts()
-    costs.problem = problem
+    costs = _flat_costs(problem)
     config = replace(FAST, proof_every=3, lambda_motion=0.05)
     steps = _adam_steps(monkeypatch)
     plan(problem, config, costs=costs)
@@ -377,7 +355,6 @@ def test_with_move_costs_a_window_stops_early_only_with_proof_costs_and_never_on
     steps.clear()
     early = plan(problem, replace(config, proof_costs=True), costs=costs)
     assert [str(m) for m in early.plan.moves] == ["move(a -> b)"] and len(steps) == 3
-    banned = _FlatCosts({("a", "b")})
-    banned.problem = problem
+    banned = _flat_costs(problem, {("a", "b")})
     refused = plan(problem, replace(config, proof_costs=True, max_windows=2), costs=banned)
     assert "move(a -> b)" not in [str(m) for m in refused.plan.moves]
