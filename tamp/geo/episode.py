@@ -364,6 +364,10 @@ def _act(
         return MoveRecord(move.text(), "", False, verdict.failure, verdict.evidence), world, home
     support = dict(read_facts(world, OBSERVED).supports).get(move.obj, TABLE)
     rests = rests_of(world, move, support)
+    # the prior of the camera's estimates: where the objects should be, the moved one at its
+    # place (objects of one colour are told apart by nearness to it); motion capture replaces
+    # every pose alike
+    expected = moved(world, move.obj, move.place.pose)
     ran = run_move(
         sim,
         move,
@@ -372,12 +376,12 @@ def _act(
         RunConfig(),
         on_frame,
         0.5 if drop else None,
-        sense=lambda: np.asarray(_sensed(sim, world, camera)[move.obj].xyz),
+        sense=lambda: np.asarray(_sensed(sim, expected, camera)[move.obj].xyz),
         solver=runner.solver,
         screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
     )
     _settle(sim, on_frame)
-    seen = observe(sim, world, camera)
+    seen = observe(sim, expected, camera)
     name = verdict.grasp.name
     path = home + ran.path_rad
     if not ran.ok:
