@@ -21,11 +21,11 @@ good.
   then make constructive moves until the goal holds. Each misplaced block moves at most twice,
   so US is at most twice the optimum.
 - **GN1** (Gupta & Nau's algorithm as Slaney & Thiébaux state it): make a constructive move
-  whenever one exists; otherwise move a clear misplaced block to the table, preferring one whose
-  move makes a constructive move possible (it frees a goal support that is in position, or the
-  block under it can then go in position: the move breaks a deadlock). GN1 moves a block to
-  the table only when it is misplaced, off the table, and its goal support is not ready, and
-  every block it moves goes in position by its next move, so it is never longer than US.
+  whenever one exists; otherwise move a clear *deadlocked* block to the table (`deadlocked`:
+  misplaced a and b stand in N(a, b) when b is above some block x now and the goal puts a
+  above x; a deadlock is a cycle of N). GN1 moves a block to the table only when it is
+  misplaced, off the table, and no constructive move exists, and every block it moves goes in
+  position by its next move, so it is never longer than US.
 
 The paper's versions run in linear time with incremental bookkeeping; these recompute the
 positions after each move (quadratic, a few milliseconds at 100 blocks), which changes the
@@ -151,11 +151,75 @@ def gn1(problem: Problem) -> tuple[Move, ...]:
         table = _to_table(problem, state)
         if not table:
             raise ProblemError(f"{problem.name}: GN1 found no move; a bug")
-        helps = [
-            m for m in table if constructive(problem, blocksworld.apply_move(problem, state, m))
-        ]
-        state = _apply(problem, state, (helps or table)[0], moves)
+        stuck = deadlocked(problem, state)
+        chosen = [m for m in table if m.entity in stuck]
+        state = _apply(problem, state, (chosen or table)[0], moves)
     return tuple(moves)
+
+
+def deadlocked(problem: Problem, state: State) -> set[str]:
+    """The blocks in a deadlock in ``state`` (Gupta & Nau; Slaney & Thiébaux's form): misplaced
+    blocks a, b stand in N(a, b) when b is above some block x now and the goal puts a above x
+    (so b must move before a can go in position); a deadlock is a cycle of N, and a block is
+    deadlocked when it lies on one (a strongly connected component of N with an edge inside)."""
+    placed = in_position(problem, state)
+    on = dict(zip(problem.entities, state, strict=True))
+    goal = dict(problem.goal)
+    misplaced = [x for x in problem.entities if not placed[x]]
+
+    def above(support: dict, x: str) -> set[str]:
+        out, y = set(), support.get(x, TABLE)
+        while y != TABLE and y not in out:
+            out.add(y)
+            y = support.get(y, TABLE)
+        return out
+
+    now = {b: above(on, b) for b in misplaced}
+    wanted = {a: above(goal, a) for a in misplaced}
+    edges = {a: [b for b in misplaced if now[b] & wanted[a]] for a in misplaced}
+    return _on_cycles(misplaced, edges)
+
+
+def _on_cycles(nodes: Sequence[str], edges: dict[str, list[str]]) -> set[str]:
+    """The nodes on a cycle of the directed graph (Tarjan's strongly connected components,
+    iterative: a component of two or more nodes, or one node with an edge to itself)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    out: set[str] = set()
+    for root in nodes:
+        if root in index:
+            continue
+        work = [(root, 0)]
+        while work:
+            v, i = work.pop()
+            if i == 0:
+                index[v] = low[v] = len(index)
+                stack.append(v)
+                on_stack.add(v)
+            if i < len(edges[v]):
+                work.append((v, i + 1))
+                w = edges[v][i]
+                if w not in index:
+                    work.append((w, 0))
+                elif w in on_stack:
+                    low[v] = min(low[v], index[w])
+                continue
+            if low[v] == index[v]:
+                component = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    component.append(w)
+                    if w == v:
+                        break
+                if len(component) > 1 or v in edges[v]:
+                    out.update(component)
+            if work:
+                parent = work[-1][0]
+                low[parent] = min(low[parent], low[v])
+    return out
 
 
 BASELINES: dict[str, Callable[[Problem], tuple[Move, ...]]] = {"us": us, "gn1": gn1}

@@ -124,3 +124,24 @@ def test_bench_planbench_takes_the_baselines_for_blocksworld_only(capsys, planbe
     assert main([*argv, "--baselines", "gn1", "--no-progress", "--json"]) == 0
     body = json.loads(capsys.readouterr().out)
     assert body["config"]["baselines"] == ["gn1"] and body["summary"][0]["gn1"] == 2
+
+
+def test_two_towers_each_wanting_the_others_base_are_a_deadlock_gn1_breaks():
+    """a on b and c on d, the goal a on d and c on b: c is above d, which a must go above, and
+    a above b, which c must go above: N(a, c) and N(c, a), a deadlock of two."""
+    blocks, init = ("a", "b", "c", "d"), ("b", TABLE, "d", TABLE)
+    problem = Problem("swap", "blocksworld", blocks, init, (("a", "d"), ("c", "b")))
+    state = blocksworld.initial_state(problem)
+    assert slaney.constructive(problem, state) == []
+    assert slaney.deadlocked(problem, state) == {"a", "c"}
+    plan = slaney.gn1(problem)
+    assert _reaches_goal(problem, plan) and len(plan) == len(optimal_moves(problem)) == 3
+
+
+def test_blocks_on_no_cycle_are_not_deadlocked():
+    # a above b must go above c; nothing needs a block above a to move first: no cycle
+    problem = Problem("chain", "blocksworld", ("a", "b", "c"), ("b", TABLE, TABLE), (("a", "c"),))
+    state = blocksworld.initial_state(problem)
+    assert slaney.deadlocked(problem, state) == set()
+    assert slaney._on_cycles(["x", "y", "z"], {"x": ["y"], "y": ["z"], "z": ["y"]}) == {"y", "z"}
+    assert slaney._on_cycles(["x"], {"x": ["x"]}) == {"x"}
