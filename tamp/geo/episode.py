@@ -391,7 +391,7 @@ def _act(
     if want != got:
         evidence = {"missing": sorted(want - got), "extra": sorted(got - want)}
         return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, path
-    return MoveRecord(move.text(), name, True), seen, path
+    return MoveRecord(move.text(), name, True, None, ran.evidence), seen, path
 
 
 def _free(world: Scene, move: GeoMove, grasp, support: str, runner: Tools, phases) -> bool:

@@ -52,6 +52,7 @@ ROW_COLUMNS = (
     "collisions",
     "touched",
     "failures",
+    "run_notes",
     "planning_time_s",
     "execution_time_s",
     "arm_path_rad",
@@ -145,7 +146,10 @@ def play(item: Item) -> dict:
         "collisions": report.collisions,
         # what was touched (physics steps in contact) and each failed move's failure, in order
         "touched": ";".join(f"{k}:{v}" for k, v in sorted(report.touched.items())),
-        "failures": ";".join(m.failure for m in report.moves if m.failure),
+        "failures": ";".join(_failure(m) for m in report.moves if m.failure),
+        # what the run of each move that succeeded had to do beyond the plan (`run_move`'s
+        # evidence: regrasped on release, corrected above the place), in order
+        "run_notes": ";".join(n for n in (_notes(m) for m in report.moves if m.ok) if n),
         "planning_time_s": report.planning_time_s,
         "execution_time_s": report.execution_time_s,
         "arm_path_rad": report.arm_path_rad,
@@ -229,3 +233,33 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
             }
         )
     return out
+
+
+def _failure(record) -> str:
+    """A failed move's failure, with where it happened and what it hit when the check or the
+    run said so: ``failure[@phase][:other]``."""
+    ev = record.evidence or {}
+    where = ev.get("phase", ev.get("waypoint", ""))
+    out = record.failure
+    if where:
+        out += f"@{where}"
+    if ev.get("other"):
+        out += f":{ev['other']}"
+    return out
+
+
+NOTES = (
+    "regrasped",
+    "not_released",
+    "corrected_mm",
+    "corrected_low_mm",
+    "uncorrected_mm",
+    "uncorrected_low_mm",
+)  # the run evidence kept
+
+
+def _notes(record) -> str:
+    """A successful move's run evidence worth a line (`NOTES`), ``move{key=value,...}``."""
+    ev = record.evidence or {}
+    kept = [f"{k}={ev[k]}" for k in NOTES if ev.get(k)]
+    return f"{record.move}{{{','.join(kept)}}}" if kept else ""

@@ -102,3 +102,16 @@ def test_one_episode_writes_results_and_rows(tmp_path):
     assert summary["episodes"] == 1 and summary["planner"] == "soft"
     rows = list(csv.DictReader((out / "episodes.csv").open()))
     assert len(rows) == 1 and rows[0]["problem"] == "blocked" and rows[0]["note"]
+
+
+def test_a_failed_moves_place_and_a_successful_moves_run_notes_reach_the_row():
+    from tamp.geo.episode import MoveRecord
+
+    hit = MoveRecord("move(a -> b)", "top0", False, "collision", {"phase": "lift", "other": "p1"})
+    ik = MoveRecord("move(a -> c)", "", False, "ik_infeasible", {})
+    done = MoveRecord("move(a -> d)", "top0", True, None, {"regrasped": 1, "corrected_mm": 2.5})
+    plain = MoveRecord("move(b -> d)", "top0", True, None, {})
+    assert bench._failure(hit) == "collision@lift:p1" and bench._failure(ik) == "ik_infeasible"
+    assert bench._notes(done) == "move(a -> d){regrasped=1,corrected_mm=2.5}"
+    assert bench._notes(plain) == ""
+    assert "run_notes" in bench.ROW_COLUMNS
