@@ -157,16 +157,30 @@ def test_a_scripted_disturbance_during_a_move_counts_against_the_plan(script, un
 
 # --- the motion planner's count ------------------------------------------------------------
 def test_a_planner_run_that_finds_no_way_is_not_a_reroute(solver):
-    """A 30 cm post 1.5 cm beside block a: the hand above a, where every approach ends, is in
-    it, so each grasp tried runs the motion planner, which finds no way; the move fails and was
-    rerouted nowhere."""
+    """A 30 cm post 1.5 cm beside block a: the hand above a, where every top-down approach
+    ends, is in it, so each grasp tried runs the motion planner, which finds no way; the move
+    fails and was rerouted nowhere. The executor's geometric fallback (on by default) then
+    makes the move with a grasp that is not top-down, its planner runs counted the same."""
     post = Obstacle("post", (0.4, -0.26, 0.15), (0.02, 0.02, 0.15))
     scene = replace(SceneConfig(), obstacles=(post,))
     poses = layout(("a", "b"), (TABLE, TABLE), scene, seed=0, slots=[0, 4])  # a at (0.4, -0.32)
-    with make_simulator("pybullet", ("a", "b"), poses, scene) as sim, PandaCollision() as model:
-        done = execute_move(
-            sim, solver, Move("a", "b"), sim.truth.block_poses, scene=scene, collision=model
-        )
+    outcomes = []
+    for fallback in (False, True):
+        with make_simulator("pybullet", ("a", "b"), poses, scene) as sim, PandaCollision() as model:
+            outcomes.append(
+                execute_move(
+                    sim,
+                    solver,
+                    Move("a", "b"),
+                    sim.truth.block_poses,
+                    ExecConfig(geo_fallback=fallback),
+                    scene=scene,
+                    collision=model,
+                )
+            )
+    done, geo = outcomes
     assert done.failure is Failure.COLLISION and done.evidence["other"] == "post"
     assert done.path_time_s > 0  # the planner ran ...
     assert done.rerouted == () and done.planner_runs == done.planner_failures == 2  # ... in vain
+    assert geo.ok and not geo.evidence["grasp"].startswith("top")
+    assert geo.rerouted == () and geo.planner_runs == geo.planner_failures == 2
