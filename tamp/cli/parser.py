@@ -10,6 +10,13 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.official import DEFAULT_DATA
+from tamp.cli.bench.options import (
+    executability_options,
+    perception_bench_options,
+    suite_options,
+    sweep_options,
+    tamp_bench_options,
+)
 from tamp.cli.options import (
     IMAGE_SCENES,
     SCENES,
@@ -17,17 +24,12 @@ from tamp.cli.options import (
     data_option,
     device_option,
     episode_options,
-    executability_options,
     output_options,
     peers_option,
-    perception_bench_options,
     planner_options,
     progress_option,
     rules_option,
     run_options,
-    suite_options,
-    sweep_options,
-    tamp_bench_options,
     workcell_options,
 )
 from tamp.cli.types import (

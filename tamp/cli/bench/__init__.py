@@ -1,6 +1,8 @@
 """``tamp bench ...``: options in, `tamp.bench` runs, tables out. One module per kind of
 benchmark: `planning` (planbench, pddl, random), `vision` (perception, latplan, poses,
-segmentation), `arm` (motion, executability) and `record` (BENCHMARKS.md's current table).
+segmentation), `arm` (motion, executability), `geo` (tamp), `checker` (the sphere collision
+checker) and `record` (BENCHMARKS.md's current table); `options` holds the option groups of the
+benchmarks that sweep episodes or images (the parser's, imported without torch).
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
 bar on stderr, prints its table (``--json``: ``results.json``'s content), and with ``--out DIR``
@@ -15,12 +17,12 @@ from __future__ import annotations
 import sys
 from contextlib import contextmanager
 
-from tqdm import tqdm
-
 
 @contextmanager
 def bar(total: int, desc: str, enabled: bool, unit: str = "plan"):
     """A tqdm bar on stderr; yields ``update(k)``, the `plan_batch` progress callback."""
+    from tqdm import tqdm  # when a benchmark runs: the parser imports `tamp.cli.bench.options`
+
     with tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, disable=not enabled) as progress:
         yield progress.update
 

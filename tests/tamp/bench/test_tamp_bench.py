@@ -10,7 +10,7 @@ import pytest
 from tamp.bench.geo import run as bench
 from tamp.bench.tables import tamp_table
 from tamp.cli import main
-from tamp.cli.options import TAMP_PLANNERS, TAMP_PROBLEMS
+from tamp.cli.bench.options import TAMP_PLANNERS, TAMP_PROBLEMS
 
 
 def test_the_parser_names_what_the_library_has():
