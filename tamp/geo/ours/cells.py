@@ -65,7 +65,6 @@ class _Region:
     body: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
-    walled: bool
 
 
 def _shapes(bridged: Bridged, pack: PackConfig) -> list[_Region]:
@@ -87,8 +86,7 @@ def _shapes(bridged: Bridged, pack: PackConfig) -> list[_Region]:
         body = np.where(turned[:, None], half[:, ::-1], half)
         along = np.eye(2, dtype=bool)[np.asarray(result.axes, dtype=int)]
         grown = np.where(along, np.maximum(body, pack.fingers), np.maximum(body, pack.side))
-        walled = r.wall_height > 0
-        edge = grown if walled else body
+        edge = grown if r.wall_height > 0 else body  # walls: the hand stays inside too
         (x0, y0), (x1, y1) = r.inner()
         xy = np.array([bridged.site(n).xy for n in names])
         inset = np.minimum(
@@ -96,7 +94,7 @@ def _shapes(bridged: Bridged, pack: PackConfig) -> list[_Region]:
         )  # (C,) how far inside the packer put each footprint, at most the margin
         inset = np.maximum(inset, 0.0)[:, None]
         lo, hi = np.array([x0, y0]) + edge + inset, np.array([x1, y1]) - edge - inset
-        out.append(_Region(region, names, grown, body, lo, hi, walled))
+        out.append(_Region(region, names, grown, body, lo, hi))
     return out
 
 
@@ -110,7 +108,7 @@ class Cells:
         self.moved: dict[str, tuple[float, float]] = {}  # cell -> the place it was settled at
         self.kept = 0  # committed places refused by the exact test
 
-    def empty(self, bridged: Bridged, state: State) -> list[tuple[_Region, list[int]]]:
+    def empty(self, state: State) -> list[tuple[_Region, list[int]]]:
         """Per region, the indices of its cells nothing stands on in ``state`` and that no
         committed move has fixed yet."""
         taken = set(state)
@@ -204,35 +202,47 @@ def _occupants(bridged: Bridged, region: _Region):
     )
 
 
+@dataclass(frozen=True)
+class _Term:
+    """One problem's region with empty cells in a window: the problem's index, the region,
+    its empty cells' indices and cost columns, every cell's place now (C, 2), the fixed
+    occupants (centres, half extents), the objects' positions (N, 2) and the first of its
+    cells' entries in ``u``."""
+
+    problem: int
+    region: _Region
+    free: list[int]
+    columns: list[int]
+    xy: torch.Tensor
+    fixed: tuple[torch.Tensor, torch.Tensor]
+    picks: torch.Tensor
+    first: int
+
+
 class CellWindow:
     """The costs of one window with empty cells (`task.costs.WindowCosts`, module docstring):
     (P * R, N, Y), one matrix per restart row."""
 
-    def __init__(
-        self,
-        owner,
-        matrices: torch.Tensor,
-        bridged: Bridged,
-        states: Sequence[State],
-        restarts: int,
-    ) -> None:
+    def __init__(self, owner, matrices: torch.Tensor, states: Sequence[State], restarts: int):
         self.owner, self.restarts = owner, restarts
         cells: Cells = owner.cells
+        bridged: Bridged = owner.bridged
         self.lr = cells.config.lr
         p, r = matrices.shape[0], restarts
         self.base = matrices.repeat_interleave(r, dim=0)  # (B, N, Y)
         problem = bridged.problem
-        self.terms = []  # per (problem, region): what its cells' costs need
+        self.terms = []  # per (problem, region): what its cells' costs need, as tensors
         count = 0
         for i, state in enumerate(states):
             world = bridged.predict(state)
             picks = torch.tensor(
                 [world.object(x).pose.xyz[:2] for x in problem.entities], dtype=torch.float64
             )  # (N, 2)
-            for region, free in cells.empty(bridged, state):
-                xy = np.array([bridged.site(c).xy for c in region.cells])
-                fxy, fh = _occupants(bridged, region)
-                self.terms.append((i, region, free, xy, fxy, fh, picks, count))
+            for region, free in cells.empty(state):
+                xy = torch.tensor([bridged.site(c).xy for c in region.cells], dtype=torch.float64)
+                fixed = tuple(torch.from_numpy(a) for a in _occupants(bridged, region))
+                columns = [problem.index(region.cells[k]) for k in free]
+                self.terms.append(_Term(i, region, free, columns, xy, fixed, picks, count))
                 count += len(free)
         self.u = torch.zeros(p * r, max(count, 1), 2, dtype=torch.float64, requires_grad=True)
 
@@ -243,29 +253,25 @@ class CellWindow:
     def compute(self) -> torch.Tensor:
         config: CellConfig = self.owner.cells.config
         pack: PackConfig = self.owner.cells.pack
-        problem = self.owner.bridged.problem
         out = self.base.clone()
         shift = self.shifts()
         r = self.restarts
-        for i, region, free, xy, fxy, fh, picks, first in self.terms:
-            rows = slice(i * r, (i + 1) * r)
-            mine = shift[rows, first : first + len(free)]  # (R, F, 2)
-            centres = torch.tensor(xy, dtype=torch.float64).expand(r, -1, -1).clone()
-            centres[:, free] = centres[:, free] + mine  # (R, C, 2)
-            grown = torch.tensor(region.grown).expand(r, -1, -1)
-            body = torch.tensor(region.body).expand(r, -1, -1)
-            fixed_xy, fixed_half = torch.tensor(fxy), torch.tensor(fh)
-            crowd = _per_cell_overlap(centres, grown, body, fixed_xy, fixed_half, pack, config)
-            lo, hi = torch.tensor(region.lo), torch.tensor(region.hi)
+        for t in self.terms:
+            rows = slice(t.problem * r, (t.problem + 1) * r)
+            centres = t.xy.expand(r, -1, -1).clone()  # (R, C, 2)
+            centres[:, t.free] = centres[:, t.free] + shift[rows, t.first : t.first + len(t.free)]
+            grown = torch.from_numpy(t.region.grown).expand(r, -1, -1)
+            body = torch.from_numpy(t.region.body).expand(r, -1, -1)
+            crowd = _per_cell_overlap(centres, grown, body, *t.fixed, pack, config)
+            lo, hi = torch.from_numpy(t.region.lo), torch.from_numpy(t.region.hi)
             out_of_room = (torch.relu(lo - centres) + torch.relu(centres - hi)).sum(-1)  # (R, C)
-            area = torch.tensor(4 * region.body.prod(-1))  # (C,)
-            lost = (
-                config.crowd * (crowd + out_of_room * 2 * torch.tensor(region.body).sum(-1)) / area
-            )
-            for k in free:
-                col = problem.index(region.cells[k])
-                base = torch.tensor(xy[k])
-                carry = (picks - centres[:, k, None]).norm(dim=-1) - (picks - base).norm(dim=-1)
+            side = torch.from_numpy(2 * t.region.body.sum(-1))  # (C,) the footprint's width sums
+            area = torch.from_numpy(4 * t.region.body.prod(-1))  # (C,)
+            lost = config.crowd * (crowd + out_of_room * side) / area  # (R, C)
+            for k, col in zip(t.free, t.columns, strict=True):
+                carry = (t.picks - centres[:, k, None]).norm(dim=-1) - (t.picks - t.xy[k]).norm(
+                    dim=-1
+                )  # (R, N)
                 priced = self.base[rows, :, col] < IMPOSSIBLE  # (R, N) only moves still open
                 extra = config.carry * carry + lost[:, k, None]  # (R, N)
                 out[rows, :, col] = torch.where(
@@ -281,20 +287,18 @@ class CellWindow:
         (`Cells.settle`); a move planned without these costs (row None) fixes its cell where
         it is."""
         shift = self.shifts().detach()
-        for i, region, free, xy, _, _, _, first in self.terms:
-            row = rows[i]
-            for move in moves[i]:
-                if move.target not in region.cells:
+        for t in self.terms:
+            row = rows[t.problem]
+            for move in moves[t.problem]:
+                if move.target not in t.region.cells:
                     continue
-                k = region.cells.index(move.target)
-                if k not in free:
+                k = t.region.cells.index(move.target)
+                if k not in t.free:
                     continue
-                offset = (
-                    np.zeros(2)
-                    if row is None
-                    else shift[i * self.restarts + row, first + free.index(k)].numpy()
-                )
-                self.owner.settle(move.target, xy[k] + offset)
+                offset = torch.zeros(2, dtype=torch.float64)
+                if row is not None:
+                    offset = shift[t.problem * self.restarts + row, t.first + t.free.index(k)]
+                self.owner.settle(move.target, (t.xy[k] + offset).numpy())
 
 
 def _per_cell_overlap(centres, grown, body, fixed_xy, fixed_half, pack: PackConfig, config):

@@ -221,8 +221,8 @@ class GeoCosts:
         with empty cells (`tamp.geo.ours.cells`) one per restart row, their places optimised
         with the logits."""
         rows = torch.stack([torch.from_numpy(self.price(s)) for s in states])
-        if self.cells is not None and any(self.cells.empty(self.bridged, s) for s in states):
-            return CellWindow(self, rows, self.bridged, states, restarts)
+        if self.cells is not None and any(self.cells.empty(s) for s in states):
+            return CellWindow(self, rows, states, restarts)
         return _Window(rows)
 
     def settle(self, cell: str, xy) -> None:

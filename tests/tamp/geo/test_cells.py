@@ -52,7 +52,7 @@ def test_a_gradient_step_moves_a_rows_cell_towards_the_object_carried_there(room
     window.compute()[0, i, j].backward()  # row 0 prices a -> its cell only
     grad = window.u.grad
     assert grad[1].abs().max() == 0  # row 1's places do not move for row 0's cost
-    k = window.terms[0][2].index(int(cell.split(".c")[1]))
+    k = window.terms[0].free.index(int(cell.split(".c")[1]))
     towards = np.asarray(b.scene.object("a").pose.xyz[:2]) - np.asarray(b.site(cell).xy)
     assert float(-grad[0, k] @ torch.tensor(towards)) > 0  # descent carries it nearer to a
 
