@@ -96,6 +96,7 @@ __all__ = [
     "planbench_suite",
     "random_suite",
     "run_episode",
+    "run_geometric",
     "run_scene",
     "validate",
 ]
@@ -422,6 +423,39 @@ def run_scene(
     found = scene_task(path, goal)
     chosen = replace(_loop_config(config, sim), scene=found.config)
     return Episode(found.problem, chosen, seed, poses=dict(found.poses)).run()
+
+
+def run_geometric(
+    scene: str | Path,
+    goal: str | Path | None = None,
+    *,
+    planner: str = "motion-aware",
+    sim: str = "pybullet",
+    seed: int = 0,
+    video: str | Path | None = None,
+    observation: str = "state",
+):
+    """A geometric TAMP episode of a scene file (``tamp run --scene FILE --goal GOAL`` where the
+    Blocksworld loop cannot run it, or with ``--geo-planner``): objects of any shape, regions
+    as targets (``(in a tray)``), grasps and placements chosen, each move checked before it
+    runs. ``scene``: a path, a shipped scene's name or a canonical problem's (``"packed"``, its
+    goal file the default ``goal``); ``planner``: one of `tamp.geo.episode.PLANNERS` (the
+    motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
+    Returns a `tamp.geo.episode.GeoReport`."""
+    from tamp.geo.episode import run_geo_episode
+    from tamp.geo.scene_file import scene_episode
+
+    task = scene_episode(str(scene), goal, planner)
+    return run_geo_episode(
+        task.scene,
+        task.goal,
+        task.planner,
+        sim,
+        seed=seed,
+        video=video,
+        domain=task.domain,
+        observation=observation,
+    )
 
 
 # ------------------------------------------------------------------------------- images

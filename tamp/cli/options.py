@@ -30,6 +30,8 @@ from task.domains import names
 from task.errors import TampError
 
 SCENES = ("tabletop", "shelf", "clutter", "cramped")  # `tamp.obstacles` (no simulator import)
+# `tamp.geo.episode.PLANNERS`, ours first (the parser imports no planner; a test keeps them equal)
+GEO_PLANNERS = ("motion-aware", "search-then-check", "search", "soft", "motion-aware-sampled")
 IMAGE_SCENES = ("cubes", "latplan")  # whose blocks an image shows (`tamp.camera.image_pair`)
 
 # every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
@@ -325,9 +327,10 @@ def workcell_options(p: argparse.ArgumentParser, files: bool = False) -> None:
             "--scene",
             default="tabletop",
             metavar="NAME|FILE.json",
-            help=f"the workcell ({', '.join(SCENES)}; tabletop: no obstacles), or a scene "
+            help=f"the workcell ({', '.join(SCENES)}; tabletop: no obstacles), a scene "
             "file whose objects start where it puts them, their state read from the geometry "
-            "(with --goal)",
+            "(with --goal), or a canonical problem's name (blocked, packed, nonmonotonic, "
+            "sorting, tall, hanoi: its shipped scene and goal)",
         )
     else:
         p.add_argument(
@@ -387,7 +390,15 @@ def run_options(p: argparse.ArgumentParser) -> None:
         "--goal",
         metavar="PDDL|FILE",
         help="--scene FILE.json: the goal over its objects, inline such as '(and (on a b) "
-        "(on b c))' or a file (a PDDL goal or problem); on and ontable atoms",
+        "(in c tray))' or a file (a PDDL goal or problem): on, ontable and in atoms (a "
+        "canonical problem's name: its shipped goal)",
+    )
+    p.add_argument(
+        "--geo-planner",
+        choices=GEO_PLANNERS,
+        help="--scene FILE.json or a canonical problem: run the geometric TAMP episode with "
+        "this planner (motion-aware where the Blocksworld loop cannot run the scene: regions, "
+        "shapes, parking rules; else the loop)",
     )
     p.add_argument(
         "--plan",

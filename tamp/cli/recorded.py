@@ -86,13 +86,15 @@ def loop_config(args: argparse.Namespace):
 
 
 def scene_run(args: argparse.Namespace):
-    """``run`` and ``demo`` with ``--scene FILE.json --goal GOAL``: the scene file's episode
-    (`tamp.world.blocks.SceneTask`), None with a named workcell. Refused in one line before any
-    work: ``--goal`` without a scene file or with a PDDL problem, a scene file without
-    ``--goal``, with ``--plan`` or with the camera, and what `scene_task` refuses. A shipped
-    scene (`tamp.world.named_scenes`) other than the workcells is a scene file by its name."""
+    """``run`` and ``demo`` with ``--scene FILE.json [--goal GOAL]``: the scene file's episode
+    (`tamp.geo.scene_file.scene_episode`: a `tamp.world.blocks.SceneTask` for the Blocksworld
+    loop or a `tamp.geo.scene_file.GeoRun` for the geometric episode), None with a named
+    workcell. Refused in one line before any work: ``--goal`` without a scene file or with a
+    PDDL problem, ``--geo-planner`` with a workcell, a scene file with ``--plan``, the loop's
+    scene file with the camera, and what `scene_episode` refuses."""
     goal = getattr(args, "goal", None)
     name = getattr(args, "scene", "tabletop")
+    geo = getattr(args, "geo_planner", None)
     if goal is not None and getattr(args, "problem", None) is not None:
         raise TampError("--goal with PROBLEM.pddl: the goal is the scene file's or the problem's")
     if name in SCENES:
@@ -101,27 +103,91 @@ def scene_run(args: argparse.Namespace):
                 f"--goal needs --scene FILE.json (the objects it names); --scene {name} is a "
                 "named workcell, whose problem is PROBLEM.pddl"
             )
+        if geo is not None:
+            raise TampError(
+                f"--geo-planner needs --scene FILE.json or a canonical problem's name; --scene "
+                f"{name} is a named workcell"
+            )
         return None
-    from tamp.world import named_scenes
-    from tamp.world.blocks import scene_task
-    from tamp.world.load import SCENES_DIR
+    from tamp.geo.scene_file import GeoRun, scene_episode
 
-    path = SCENES_DIR / f"{name}.json" if name in named_scenes() else Path(name)
-    if not name.endswith(".json") and not path.is_file():
-        raise TampError(
-            f"--scene {name}: neither a named scene ({', '.join(named_scenes())}) nor a scene "
-            "file (FILE.json)"
-        )
-    if goal is None:
-        raise TampError(f"--scene {name} needs --goal: the goal over the scene file's objects")
+    task = scene_episode(name, goal, geo)
     if getattr(args, "plan", None) is not None:
         raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
-    if getattr(args, "observe", "state") == "camera":
+    if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == "camera":
         raise TampError(
-            "--observe camera with a scene file: the camera's goal image is laid out from a "
-            "PDDL problem (yet); use --observe state"
+            "--observe camera with a Blocksworld scene file: the camera's goal image is "
+            "laid out from a PDDL problem (yet); use --observe state, or --geo-planner "
+            "(the geometric episode's cameras estimate the objects' poses)"
         )
-    return scene_task(path, goal)
+    return task
+
+
+GEO_PLANNER_FLAGS = ("time_limit_s", "lambda_motion")  # the planner flags a GeoRun reads
+GEO_DEFAULTS = {"max_replans": 3, "max_moves": 40, "time_limit_s": 120.0}  # as bench tamp's
+
+
+def geo_config(args: argparse.Namespace, task) -> dict:
+    """``run`` and ``demo`` of a `tamp.geo.scene_file.GeoRun`: what the geometric episode
+    runs with. Options of the Blocksworld loop that it has no counterpart for are refused in
+    one line: the loop's
+    planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
+    ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
+    rerouted), ``--crisp``, the perception network's options, faults other than drops, and
+    ``--record``."""
+    from tamp.loop.faults import KINDS, Injection
+
+    given = [
+        "--" + n.replace("_", "-")
+        for n in _PLANNER_FLAGS
+        if n not in GEO_PLANNER_FLAGS and getattr(args, n, None) is not None
+    ]
+    if args.device not in (None, "cpu"):
+        given.append("--device")
+    for flag, value, default in (
+        ("--placements", args.placements, 0.0),
+        ("--collision", args.collision, "plan"),
+        ("--crisp", args.crisp, "perceived"),
+        ("--perception", args.perception, "frozen"),
+        ("--blur", args.blur, 0),
+        ("--checkpoint", args.checkpoint, None),
+        ("--record", args.record, None),
+    ):
+        if value != default:
+            given.append(flag)
+    if given:
+        raise TampError(
+            f"{', '.join(given)}: the Blocksworld loop's; the geometric episode that runs "
+            f"{task.path} ({task.why}) has no such setting"
+        )
+    if args.lambda_motion and task.planner not in ("motion-aware", "motion-aware-sampled"):
+        raise TampError(f"--motion-aware with --geo-planner {task.planner}: they differ")
+    inject = Injection.parse(args.inject)
+    other = [k for k in KINDS if k != "drop" and getattr(inject, k) > 0]
+    if other:
+        raise TampError(
+            f"--inject {','.join(other)}: the geometric episode injects drops only (drop:P)"
+        )
+    limit = args.time_limit_s if args.time_limit_s is not None else GEO_DEFAULTS["time_limit_s"]
+    return {
+        "executor": "geometric",
+        "why": task.why,
+        "scene_file": task.path,
+        "goal": task.goal.text(),
+        "planner": task.planner,
+        "domain": None if task.domain is None else "hanoi-pick-place",
+        "sim": args.sim,
+        "grasp": args.grasp,
+        "observe": args.observe,
+        "inject": str(inject),
+        "max_replans": GEO_DEFAULTS["max_replans"]
+        if args.max_replans is None
+        else args.max_replans,
+        "max_moves": GEO_DEFAULTS["max_moves"],
+        "time_limit_s": limit,
+        "seed": args.seed,
+        "video": None if args.no_video or args.out is None else args.video_format,
+    }
 
 
 def _loop_dict(config) -> dict:
@@ -154,8 +220,14 @@ def run_config(args: argparse.Namespace) -> dict:
         raise TampError("--video-format with --no-video: there is no video to format")
     if args.out is None and (args.no_video or args.video_format != "mp4"):
         raise TampError("--no-video and --video-format apply with --out DIR (the video's folder)")
-    config = loop_config(args)
     task = scene_run(args)
+    if task is not None:
+        from tamp.geo.scene_file import GeoRun
+
+        if isinstance(task, GeoRun):  # the geometric episode
+            check_workcell(args, executes=True)
+            return geo_config(args, task)
+    config = loop_config(args)
     return {
         **_loop_dict(config),
         "scene_file": None if task is None else args.scene,

@@ -7,11 +7,13 @@ the entities, the supports read from their poses the initial state, the goal's `
 obstacles (and its regions' walls and floors), on its slot grid (`scene_config`), with each
 object's colour.
 
-What the loop cannot do yet is one `SceneFileError` line, before any work: an object the
-geometry cannot explain, an object that is not a cube of the loop's block size, an object
-resting in a region, a goal atom other than ``on`` / ``ontable`` (``in``: regions are not
-planning targets yet), and poses the loop's own state reader (`tamp.scene.read_state`, whose
-tolerances are looser than the scene file's) would read as another state.
+A scene the geometry cannot explain is one `SceneFileError` line, before any work. What is
+beyond the Blocksworld loop is a `BeyondLoop` (a `SceneFileError`) instead: an object that is not
+a cube of the loop's block size, an object resting in a region, a scene where nothing may be
+parked on the bare table, a goal atom other than ``on`` / ``ontable`` (``in``: regions are not
+the loop's targets), and poses the loop's own state reader (`tamp.scene.read_state`, whose
+tolerances are looser than the scene file's) would read as another state. ``tamp run`` runs such
+a scene through the geometric TAMP episode (`tamp.geo.episode`) instead.
 """
 
 from __future__ import annotations
@@ -27,6 +29,11 @@ from tamp.world.schema import Scene, SceneFileError
 from task.problem import TABLE, Problem
 
 GOAL_PREDICATES = ("on", "ontable")  # what a Blocksworld goal names: supports
+
+
+class BeyondLoop(SceneFileError):
+    """A well-formed scene file, or its goal, that the Blocksworld loop cannot run (regions,
+    shapes, parking rules): the geometric episode can."""
 
 
 @dataclass(frozen=True)
@@ -50,28 +57,33 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
     label = str(path)
     if not scene.objects:
         raise SceneFileError(f"{label}: objects: the scene has no movable object to plan for")
-    _check_blocks(scene, base.block_size, label)
     facts = read_facts(scene)
     if facts.unexplained:
         raise SceneFileError(
             f"{label}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
             + "; ".join(facts.issues)
         )
+    _check_blocks(scene, base.block_size, label)
+    if not scene.parking:
+        raise BeyondLoop(
+            f"{label}: parking: false: the loop parks blocks on the bare table, which this "
+            "scene forbids"
+        )
     in_regions = [f"{x} in {s}" for x, s in facts.supports if s in {r.name for r in scene.regions}]
     if in_regions:
-        raise SceneFileError(
-            f"{label}: {', '.join(in_regions)}: objects in regions cannot be planned yet "
-            "(regions are not planning targets); put them on the table or on an object"
+        raise BeyondLoop(
+            f"{label}: {', '.join(in_regions)}: objects in regions are beyond the Blocksworld "
+            "loop (its supports are the table and blocks)"
         )
     wanted = load_goal(goal, scene)
     for atom in wanted.atoms:
         if atom[0] not in GOAL_PREDICATES:
             why = (
-                "regions are not planning targets yet"
+                "regions are the geometric episode's targets"
                 if atom[0] == "in"
                 else "a Blocksworld goal names supports"
             )
-            raise SceneFileError(
+            raise BeyondLoop(
                 f"goal: ({' '.join(atom)}): the loop plans goals of "
                 f"{' and '.join(GOAL_PREDICATES)} atoms only ({why})"
             )
@@ -94,7 +106,7 @@ def _check_blocks(scene: Scene, size: float, label: str) -> None:
     for i, o in enumerate(scene.objects):
         if o.kind != "cube" or abs(o.size[0] - size) > 1e-9:
             shape = o.kind if o.kind == "cube" else f"a {o.kind}"
-            raise SceneFileError(
+            raise BeyondLoop(
                 f"{label}: objects[{i}] ({o.name}): {shape} of size "
                 f"{', '.join(f'{v:g}' for v in o.size)} m; the loop moves cubes of "
                 f"{size:g} m only (yet)"
@@ -115,7 +127,7 @@ def _check_reader(problem: Problem, poses: dict, config: SceneConfig, label: str
             for x, r, g in zip(problem.entities, reading.state, problem.init, strict=True)
             if r != g
         )
-    raise SceneFileError(
+    raise BeyondLoop(
         f"{label}: the loop's state reader (centres within {config.tol_xy * 1000:.0f} mm, "
         f"heights within {config.tol_z * 1000:.0f} mm of a block) reads the poses otherwise: "
         f"{detail}"

@@ -11,6 +11,7 @@ from tamp.bench.geo import run as bench
 from tamp.bench.tables import tamp_table
 from tamp.cli import main
 from tamp.cli.bench.options import TAMP_PLANNERS, TAMP_PROBLEMS
+from tamp.cli.options import GEO_PLANNERS
 
 
 def test_the_parser_names_what_the_library_has():
@@ -20,6 +21,12 @@ def test_the_parser_names_what_the_library_has():
     assert TAMP_PROBLEMS == PROBLEMS
     assert TAMP_PLANNERS == PLANNERS
     assert set(bench.PLANNERS) <= set(PLANNERS)
+    assert set(GEO_PLANNERS) == set(PLANNERS)  # tamp run --geo-planner
+    from tamp.cli import build_parser
+
+    run = build_parser()._subparsers._group_actions[0].choices["run"]
+    scene = next(a for a in run._actions if a.dest == "scene")
+    assert all(name in scene.help for name in PROBLEMS)  # tamp run --scene NAME
 
 
 def test_items_give_every_planner_and_simulator_the_same_variants(tmp_path):

@@ -89,6 +89,8 @@ NEEDS = {
     "--peers": [["--time-limit", "5"]],  # the same limit for every planner
     # a scene file (the shipped example's name), another goal, and the state observed
     "--goal": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
+    # a scene file the loop could run, run by the geometric episode's planner instead
+    "--geo-planner": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
 }
 # commands with no run configuration: what they write is named by their options
 NOT_RUNS = {"bench record"}
@@ -228,7 +230,10 @@ def test_presentation_options_are_only_these():
         (["run", "p.pddl", "--scene", "tower", "--goal", "(on a b)"], "--goal with PROBLEM.pddl"),
         (["run", "--scene", "tower"], "needs --goal"),
         (["run", "--scene", "attic"], "neither a named scene"),
-        (["demo", "--scene", "tower", "--goal", "(on b c)"], "--observe camera with a scene"),
+        (
+            ["demo", "--scene", "tower", "--goal", "(on b c)"],
+            "--observe camera with a Blocksworld scene",
+        ),
         (["run", "--scene", "tower", "--goal", "(on b c)", "--plan", "x"], "--plan with a scene"),
     ],
 )

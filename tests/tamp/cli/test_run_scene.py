@@ -1,6 +1,8 @@
 """``tamp run --scene FILE.json --goal GOAL``: the episode starts where the scene file puts the
-objects, from the state read from their geometry, and reaches the goal; what the loop cannot
-run yet is a one-line usage error before any work."""
+objects, from the state read from their geometry, and reaches the goal. A scene the Blocksworld
+loop can run runs there; one it cannot (regions as targets, other shapes), a canonical problem by
+its name, or any scene with ``--geo-planner`` runs as the geometric TAMP episode; what neither
+can run is a one-line usage error before any work."""
 
 from __future__ import annotations
 
@@ -8,7 +10,7 @@ import json
 
 import pytest
 
-from tamp.cli import main
+from tamp.cli import build_parser, main
 from tests.tamp.world.test_load import TRAY, cube, scene
 
 
@@ -40,9 +42,21 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
 @pytest.mark.parametrize(
     ("extra", "expected"),
     [
-        (["--goal", "(in a tray)"], "regions are not planning targets yet"),
         (["--goal", "(on a zz)"], "unknown object 'zz'"),
-        (["--goal", "(on a b)", "--observe", "camera"], "--observe camera with a scene file"),
+        (["--goal", "(in a zz)"], "unknown region 'zz'"),
+        (["--goal", "(in a tray)", "--horizon", "2"], "--horizon: the Blocksworld loop's"),
+        (["--goal", "(in a tray)", "--collision", "off"], "--collision: the Blocksworld loop's"),
+        (["--goal", "(in a tray)", "--inject", "nudge:0.1"], "injects drops only"),
+        (["--goal", "(in a tray)", "--record", "x.rrd"], "--record: the Blocksworld loop's"),
+        (["--goal", "(in a tray)", "--plan", "x"], "--plan with a scene file"),
+        (
+            ["--goal", "(on a b)", "--geo-planner", "soft", "--motion-aware"],
+            "--motion-aware with --geo-planner soft",
+        ),
+        (
+            ["--goal", "(on a b)", "--observe", "camera"],
+            "--observe camera with a Blocksworld scene file",
+        ),
         ([], "needs --goal"),
     ],
 )
@@ -56,19 +70,79 @@ def test_what_a_scene_file_run_cannot_do_is_refused_in_one_line(tmp_path, capsys
     assert not (tmp_path / "out").exists()  # refused before any work
 
 
-def test_a_cylinder_in_the_scene_is_refused_naming_it(tmp_path, capsys):
-    can = {
-        "name": "can",
-        "kind": "cylinder",
-        "size": [0.05, 0.06],
-        "colour": "red",
-        "pose": {"xyz": [0.4, 0.0, 0.03]},
-    }
+def recorded(argv):
+    """What ``tamp run ARGV`` records as its config (its refusals raise), without running it."""
+    args = build_parser().parse_args(["run", *argv])
+    return args.recorded(args)
+
+
+CAN = {
+    "name": "can",
+    "kind": "cylinder",
+    "size": [0.05, 0.06],
+    "colour": "red",
+    "pose": {"xyz": [0.4, 0.0, 0.03]},
+}
+
+
+@pytest.mark.parametrize(
+    ("objects", "goal", "why"),
+    [
+        ([cube("a", 0.4, -0.16, 0.025)], "(in a tray)", "regions are the geometric episode's"),
+        ([cube("a", 0.4, 0.16, 0.025), CAN], "(on a can)", "objects[1] (can): a cylinder"),
+        ([cube("a", 0.55, 0.25, 0.025)], "(ontable a)", "a in tray: objects in regions"),
+    ],
+)
+def test_what_the_loop_cannot_run_runs_as_the_geometric_episode(tmp_path, objects, goal, why):
     path = tmp_path / "s.json"
-    path.write_text(json.dumps(scene(cube("a", 0.4, 0.16, 0.025), can)))
-    assert main(["run", "--scene", str(path), "--goal", "(on a can)"]) == 2
+    path.write_text(json.dumps(scene(*objects, regions=[TRAY])))
+    config = recorded(["--scene", str(path), "--goal", goal, "--sim", "mujoco", "--seed", "4"])
+    assert config["executor"] == "geometric" and why in config["why"], config["why"]
+    assert config["planner"] == "motion-aware" and config["sim"] == "mujoco"
+    assert config["seed"] == 4 and config["domain"] is None
+    assert config["scene_file"] == str(path) and config["goal"] == f"(and {goal})"
+
+
+def test_a_loop_scene_runs_geometrically_with_geo_planner(tmp_path):
+    path = tower_file(tmp_path)
+    assert "executor" not in recorded(["--scene", str(path), "--goal", "(on b c)"])
+    config = recorded(["--scene", str(path), "--goal", "(on b c)", "--geo-planner", "search"])
+    assert config["executor"] == "geometric" and config["planner"] == "search"
+    assert config["why"] == "--geo-planner search"
+
+
+def test_a_canonical_problem_runs_by_name_with_its_shipped_goal():
+    from tamp.world.canonical import shipped
+
+    config = recorded(["--scene", "packed", "--time-limit", "30", "--inject", "drop:0.5"])
+    assert config["executor"] == "geometric" and config["goal"] == shipped("packed")[1].text()
+    assert config["time_limit_s"] == 30.0 and config["inject"] == "drop:0.5"
+    hanoi = recorded(["--scene", "hanoi"])
+    assert hanoi["domain"] == "hanoi-pick-place"  # ours plans it by its rules, as bench tamp
+    assert recorded(["--scene", "hanoi", "--geo-planner", "search"])["domain"] is None
+    own = recorded(["--scene", "sorting", "--goal", "(in o1 green_zone)"])
+    assert own["goal"] == "(and (in o1 green_zone))"
+
+
+def test_geo_planner_with_a_workcell_is_refused(capsys):
+    assert main(["run", "--geo-planner", "search"]) == 2
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "objects[1] (can): a cylinder" in err, err
+    assert "\n" not in err and "--geo-planner needs --scene FILE.json" in err, err
+
+
+@pytest.mark.sim
+def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
+    """The smallest region goal end to end: one move, checked and run in PyBullet."""
+    path, out = tmp_path / "s.json", tmp_path / "out"
+    path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
+    argv = ["run", "--scene", str(path), "--goal", "(in a tray)", "--out", str(out), "--no-video"]
+    assert main(argv) == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["report"]["reached"] and report["report"]["collisions"] == 0
+    assert [m["move"].split(" at ")[0] for m in report["report"]["moves"]] == ["move a -> tray"]
+    assert report["config"]["executor"] == "geometric"
+    printed = capsys.readouterr().out
+    assert "goal reached (ground truth): yes" in printed and "wrote report.json" in printed
 
 
 @pytest.mark.sim
@@ -92,3 +166,15 @@ def test_the_episode_starts_where_the_scene_file_puts_the_objects(tmp_path):
         episode.close()
     for name, pose in task.poses:
         assert seen[name].xyz == pytest.approx(pose.xyz, abs=0.003), name
+
+
+@pytest.mark.sim
+def test_the_python_api_runs_the_same_geometric_episode(tmp_path):
+    from tamp import api
+
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
+    report = api.run_geometric(path, "(in a tray)", sim="mujoco")
+    assert report.reached and report.backend == "mujoco" and report.planner == "motion-aware"
+    with pytest.raises(api.TampError, match="needs --goal"):
+        api.run_geometric(path)

@@ -81,9 +81,9 @@ def test_the_scene_s_obstacles_slots_and_region_walls_are_the_table(tmp_path):
             "(ontable a)",
             "a cylinder of size 0.05, 0.05 m; the loop moves cubes of 0.05 m",
         ),
-        ([cube("a", 0.5, 0.0, 0.025)], "(in a tray)", "regions are not planning targets"),
+        ([cube("a", 0.5, 0.0, 0.025)], "(in a tray)", "regions are the geometric episode's"),
         ([cube("a", 0.5, 0.0, 0.025)], "(clear a)", "on and ontable atoms only"),
-        ([cube("a", 0.55, 0.25, 0.025)], "(ontable a)", "a in tray: objects in regions"),
+        ([cube("a", 0.55, 0.25, 0.025)], "(ontable a)", "a in tray: objects in regions are beyond"),
         (  # the file's 5 mm allows what the loop's reader (20 mm in xy) reads otherwise
             [cube("a", 0.5, 0.0, 0.025), cube("b", 0.5, 0.022, 0.075)],
             "(ontable b)",

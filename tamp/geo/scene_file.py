@@ -1,0 +1,104 @@
+"""Which episode runs a scene file: the Blocksworld loop or the geometric TAMP episode.
+
+`scene_episode` resolves what ``tamp run --scene NAME|FILE.json [--goal GOAL] [--geo-planner
+P]`` and `tamp.api.run_geometric` are given. A scene of 5 cm cubes with ``on`` / ``ontable``
+goals is a `tamp.world.blocks.SceneTask` for the closed Blocksworld loop (`tamp.loop`). What the
+loop cannot run (`tamp.world.blocks.BeyondLoop`: regions as targets, other shapes, no parking on
+the bare table), a canonical problem by its name (`tamp.world.canonical.PROBLEMS`: its shipped
+scene, its goal file the default goal) and any scene with a planner named is a `GeoRun` for the
+geometric episode (`tamp.geo.episode.run_geo_episode`). Parsing-level: nothing here plans,
+simulates or imports a simulator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from tamp.world.goal import Goal
+from tamp.world.schema import Scene, SceneFileError
+
+DEFAULT_PLANNER = "motion-aware"  # ours, where the loop cannot run the scene
+
+
+@dataclass(frozen=True)
+class GeoRun:
+    """A scene file for the geometric TAMP episode with ``planner`` (one of
+    `tamp.geo.episode.PLANNERS`). ``why``: why not the loop (the loop's `BeyondLoop` line, a
+    canonical problem, or the planner named); ``domain``: the PDDL domain and binding the
+    motion-aware planner plans through (the shipped Tower of Hanoi's, as ``tamp bench tamp``
+    does), else None."""
+
+    path: str
+    scene: Scene
+    goal: Goal
+    planner: str
+    why: str
+    domain: tuple[str, str] | None = None
+
+
+def scene_path(name: str) -> tuple[Path, bool]:
+    """The file of scene ``name`` (a shipped scene's or canonical problem's name, or a path)
+    and whether it is a canonical problem; SceneFileError when it is none of them."""
+    from tamp.world.canonical import PROBLEMS
+    from tamp.world.canonical import SCENES_DIR as CANONICAL_DIR
+    from tamp.world.load import SCENES_DIR, named_scenes
+
+    if name in PROBLEMS:
+        return CANONICAL_DIR / f"{name}.json", True
+    path = SCENES_DIR / f"{name}.json" if name in named_scenes() else Path(name)
+    if not name.endswith(".json") and not path.is_file():
+        raise SceneFileError(
+            f"--scene {name}: neither a named scene ({', '.join(named_scenes())}), a canonical "
+            f"problem ({', '.join(PROBLEMS)}) nor a scene file (FILE.json)"
+        )
+    return path, False
+
+
+def scene_episode(name: str, goal: str | Path | None, planner: str | None = None):
+    """The episode of scene ``name`` toward ``goal`` (inline PDDL or a file; None: a canonical
+    problem's goal file): a `tamp.world.blocks.SceneTask` when the loop can run it and no
+    ``planner`` is named, else a `GeoRun` (``planner`` or `DEFAULT_PLANNER`). One-line
+    SceneFileError for a scene or goal neither can run (see `tamp.world.blocks`)."""
+    from tamp.world.blocks import BeyondLoop, scene_task
+    from tamp.world.canonical import SCENES_DIR as CANONICAL_DIR
+
+    path, canonical = scene_path(name)
+    if goal is None:
+        if not canonical:
+            raise SceneFileError(
+                f"--scene {name} needs --goal: the goal over the scene file's objects"
+            )
+        goal = str(CANONICAL_DIR / f"{name}.goal.pddl")
+    why = f"--geo-planner {planner}" if planner is not None else f"{name}: a canonical problem"
+    if planner is None and not canonical:
+        try:
+            return scene_task(path, goal)
+        except BeyondLoop as exc:
+            why = str(exc)
+    return geo_run(path, goal, planner or DEFAULT_PLANNER, why, canonical and name == "hanoi")
+
+
+def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -> GeoRun:
+    """The `GeoRun` of the scene file at ``path`` (its geometry must explain every object);
+    ``hanoi``: the canonical Tower of Hanoi, which the motion-aware planner plans through its
+    PDDL domain."""
+    from tamp.world.goal import load_goal
+    from tamp.world.load import load_scene
+    from tamp.world.relations import read_facts
+
+    scene = load_scene(path)
+    if not scene.objects:
+        raise SceneFileError(f"{path}: objects: the scene has no movable object to plan for")
+    facts = read_facts(scene)
+    if facts.unexplained:
+        raise SceneFileError(
+            f"{path}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
+            + "; ".join(facts.issues)
+        )
+    domain = None
+    if hanoi and planner == DEFAULT_PLANNER:
+        from task.symbolic.pickplace import hanoi as rules
+
+        domain = (rules.domain_text(), rules.BINDING)
+    return GeoRun(str(path), scene, load_goal(goal, scene), planner, why, domain)
