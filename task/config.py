@@ -49,6 +49,9 @@ class PlannerConfig:
     batched: bool = True  # one tensor program for all problems; False: one problem at a time
     rank_prefixes: bool = True  # rank (and cut) each window by its best prefix (`task.decode`)
     park_free: bool = False  # count parking moves (to the table) as free in that ranking
+    park_from: int | None = None  # park_free for the problems of at least this many entities
+    # (None: only park_free); Blocksworld's `planner_defaults` set 30: beyond the sizes whose
+    # plan length the issue holds to the optimum, where the time budget binds instead
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
     fallback: bool | None = None  # when the windows revisit a state or run out, search on from
     # the world state, complete over the moves the cost source allows (`task.symbolic.lazy_search`);
@@ -77,6 +80,11 @@ class PlannerConfig:
         tuned = getattr(get_domain(name), "planner_defaults", {})
         return cls(**{**tuned, **given})
 
+    def parks(self, problem) -> bool:
+        """Whether ``problem``'s windows are ranked with parking moves free (`park_free`, or
+        at least `park_from` entities)."""
+        return self.park_free or (self.park_from is not None and problem.n >= self.park_from)
+
     def horizons(self) -> tuple[int, ...]:
         """Window length of each restart: the long-lookahead restarts come last."""
         n_long = round(self.restarts * self.lookahead_share)
@@ -85,6 +93,8 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         from task.errors import TampError
 
+        if self.park_from is not None and self.park_from < 1:
+            raise TampError(f"PlannerConfig.park_from must be >= 1 or None, got {self.park_from}")
         for name in ("horizon", "iters", "restarts", "max_windows", "fallback_nodes"):
             if getattr(self, name) < 1:
                 raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")

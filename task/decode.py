@@ -197,9 +197,10 @@ def decode_best(
     visited: Sequence[Collection[State]] | None = None,
     costs: Tensor | None = None,
     prefix: bool = False,
-    park: bool = False,
+    park: bool | Sequence[bool] = False,
 ) -> list[DecodedWindow]:
     """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
+    ``park``: for every problem, or one per problem (`PlannerConfig.parks`).
 
     ``visited``: per problem, the states its plan has passed through (a window that ends in
     one ranks below every window that does not). ``check=False``: illegal moves are kept and
@@ -211,11 +212,22 @@ def decode_best(
     for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
         rows = range(i * restarts, (i + 1) * restarts)
         seen = () if visited is None else visited[i]
+        parks = park if isinstance(park, bool) else park[i]
         windows = []
         for k, r in enumerate(rows):
             c = None if costs is None else costs[r]
             window = decode_row(
-                domain, problem, state, gates[r], threshold, losses[r], check, seen, c, prefix, park
+                domain,
+                problem,
+                state,
+                gates[r],
+                threshold,
+                losses[r],
+                check,
+                seen,
+                c,
+                prefix,
+                parks,
             )
             windows.append(replace(window, row=k))
         out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))

@@ -85,7 +85,7 @@ def _window(
         visited,
         roll.costs,
         config.rank_prefixes,
-        config.park_free,
+        [config.parks(p) for p in problems],
     )
     return [proven.get(i, window) for i, window in enumerate(decoded)]
 
@@ -136,7 +136,7 @@ def _proofs(
                     visited[i],
                     None if priced is None else priced[row],
                     config.rank_prefixes,
-                    config.park_free,
+                    config.parks(problems[i]),
                 )
                 windows.append(replace(window, row=k))
             best = min(windows, key=DecodedWindow.key)

@@ -121,9 +121,9 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         "--park-free",
         action="store_const",
         const=True,
-        help="rank windows with "
-        "moves to the table free (faster on big Blocksworld problems, plans a little "
-        "longer; off)",
+        help="rank windows with moves to the table free (faster on big Blocksworld "
+        "problems, plans a little longer; off, but on for Blocksworld problems of 30 blocks "
+        "or more)",
     )
     g.add_argument(
         "--time-limit",

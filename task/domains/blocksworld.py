@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
+from types import MappingProxyType
 
 import torch
 from torch import Tensor
@@ -280,6 +281,9 @@ class Blocksworld:
     name = NAME
     size_name = "blocks"
     goal_losses = GOAL_LOSSES
+    # from 30 blocks the windows are ranked with moves to the table free (as Slaney and
+    # Thiebaux's US), which finds the long plans of big problems faster (`PlannerConfig.parks`)
+    planner_defaults = MappingProxyType({"park_from": 30})
     distributions = True
     encode = staticmethod(encode)
     soft_legality = staticmethod(soft_legality)

@@ -56,3 +56,16 @@ def test_parking_is_free_only_when_asked():
     assert decode_row(BW, TOWER, state, park, 0.3, 0.0, prefix=True).estimated == 2
     free = decode_row(BW, TOWER, state, park, 0.3, 0.0, prefix=True, park=True)
     assert (free.remaining, free.estimated) == (2, 1)  # the bound, less one parking move
+
+
+def test_parking_is_free_per_problem_when_asked_per_problem():
+    state = BW.initial_state(TOWER)
+    gates = torch.stack([_gates(Move("a", "table"))] * 2)  # one problem, two restarts
+    kwargs = {"prefix": True}
+    (kept,) = decode_best(
+        BW, [TOWER], [state], gates, torch.zeros(2), 2, 0.3, park=[False], **kwargs
+    )
+    (free,) = decode_best(
+        BW, [TOWER], [state], gates, torch.zeros(2), 2, 0.3, park=[True], **kwargs
+    )
+    assert (kept.estimated, free.estimated) == (2, 1)

@@ -194,7 +194,13 @@ def test_a_window_back_to_a_visited_state_ranks_below_progress_elsewhere():
 
 
 def test_domain_planner_defaults_and_overrides():
-    assert PlannerConfig.for_domain("blocksworld") == PlannerConfig()
+    blocks = PlannerConfig.for_domain("blocksworld")
+    assert blocks == PlannerConfig(park_from=30)
+    assert not blocks.parks(random_problem(29, 0)) and blocks.parks(random_problem(30, 0))
+    assert not PlannerConfig().parks(random_problem(50, 0))  # other domains: asked for only
+    assert PlannerConfig(park_free=True).parks(random_problem(3, 0))
+    with pytest.raises(TampError, match="park_from"):
+        PlannerConfig(park_from=0)
     sokoban = PlannerConfig.for_domain("sokoban")
     assert (sokoban.lookahead, sokoban.max_windows) == (8, 100)
     assert PlannerConfig.for_domain("sokoban", max_windows=7, horizon=2).max_windows == 7
