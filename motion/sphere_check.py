@@ -29,17 +29,19 @@ Its contacts' distances are lower bounds, so the mesh model stays the final word
 pairs the two: the mesh model answers ``valid`` and ``check_path``, the spheres
 ``valid_batch``, which `motion.rrt.plan_path` uses to search).
 
-Speed. Forward kinematics batch-last (`motion.sphere_fk`). A bounding sphere per link (L = 11)
-is tested first: against the table, and against each box's world bounds axis by axis,
-(B, L, O); the flagged (configuration, link) pairs go to the narrow phase in three `BUCKETS` of
-links by sphere count (each link's spheres padded to its bucket's widest, placed in one batched
-product per bucket). Self pairs go through the bounding spheres (the pairs `APART` always keeps
-apart never), then the link's bounding sphere against the other link's box, then clusters of at
-most `CLUSTER` spheres of the link (their bounding spheres against that box first), then each
-sphere against the DOP's box and, where near, its 26 planes. A configuration with a contact
-found is not tested further (``valid_batch``). Without square roots where only the sign of a
-clearance matters. tests/motion/test_sphere_check.py checks the verdicts against a check that
-tests every sphere against everything.
+Speed. `CHUNK` configurations at a time; forward kinematics and the broad phases batch-last
+(`motion.sphere_fk`). A bounding sphere per link (L = 11) is tested first: against the table,
+and against each box's world bounds axis by axis, (L, O, B); the flagged (configuration, link)
+pairs go to the narrow phase in three `BUCKETS` of links by sphere count (each link's spheres
+padded to its bucket's widest, placed in one batched product per bucket). Self pairs go
+through the bounding spheres (the pairs `APART` always keeps apart never), then the link's
+bounding sphere against the other link's box, then clusters of at most `CLUSTER` spheres of
+the link (their bounding spheres against that box first), then each sphere against the DOP's
+box and, where near, its 26 planes. A configuration with a contact found is not tested
+further (``valid_batch``). Without square roots where only the sign of a clearance matters,
+nor BLAS (numpy's OpenBLAS spreads a large product over a second thread): one thread.
+tests/motion/test_sphere_check.py checks the verdicts against a check that tests every
+sphere against everything.
 """
 
 from __future__ import annotations
@@ -54,12 +56,17 @@ from motion.errors import MotionError
 from motion.sphere_fk import (
     _FLOAT,
     PARTS,
+    _batch_first,
     _bound,
+    _box_gap,
+    _box_sdf,
     _chain,
     _clusters,
+    _dop_gap,
     _dops,
+    _frames,
     _link_spheres,
-    _links,
+    _near_box,
     _obb_gap,
     _onehot,
     _turn,
@@ -94,13 +101,7 @@ APART_CLEARANCE = 0.003  # m
 # 46), each link's spheres padded to its bucket's widest: few groups, little padding
 BUCKETS = (10, 30)
 CLUSTER = 10  # spheres per cluster of a link in the self-collision narrow phase
-
-
-def _box_sdf(points: np.ndarray, half: np.ndarray) -> np.ndarray:
-    """Signed distances (...) of points (..., 3) in a box's frame to it, half extents (..., 3)."""
-    d = np.abs(points) - half
-    outside = np.sqrt(np.square(np.maximum(d, 0.0)).sum(-1))
-    return outside + np.minimum(d.max(-1), 0.0)
+CHUNK = 2048  # configurations per pass of valid_batch: ~2x faster than 100,000 at once
 
 
 class SphereCollision:
@@ -190,6 +191,8 @@ class SphereCollision:
         minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
         high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
         self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
+        # (L, 26) the supports from the box's centre: d . (p - c) - (s - d . c) = d . p - s
+        self._dop_c = self._dop - self._aabb_c @ self._directions.T
 
     def _clusters(self, spheres) -> None:
         """The self-collision narrow phase's clusters (`sphere_fk._clusters`), as float32."""
@@ -298,7 +301,11 @@ class SphereCollision:
 
     def _links(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
         """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk._links`."""
-        return _links(q, fingers, self._off, self._swaps, self._hand, self._tcp)
+        return _batch_first(*self._frames(q, fingers))
+
+    def _frames(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
+        """The same batch-last, (L + 1, 3, 3, B) and (L + 1, 3, B): see `sphere_fk._frames`."""
+        return _frames(q, fingers, self._off, self._swaps, self._hand, self._tcp)
 
     def _place(self, rot: np.ndarray, pos: np.ndarray, bucket: int, link: np.ndarray):
         """World centres (M, S, 3) and grown radii (M, S) of the spheres of links ``link``
@@ -322,8 +329,13 @@ class SphereCollision:
     # ---- queries -----------------------------------------------------------------------------
 
     def valid_batch(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()):
-        """(B,) bool: True where configuration q (B, J) rad has no contact below the margins."""
-        return self._clearance(self._configs(q), fingers, ignore, detail=False)
+        """(B,) bool: True where configuration q (B, J) rad has no contact below the margins;
+        checked `CHUNK` configurations at a time (the working arrays stay in cache)."""
+        q = self._configs(q)
+        out = np.empty(len(q), dtype=bool)
+        for s in range(0, len(q), CHUNK):  # (CHUNK, J) each
+            out[s : s + CHUNK] = self._clearance(q[s : s + CHUNK], fingers, ignore, False)
+        return out
 
     def valid(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()) -> bool:
         """True when ``q`` (J,) has no contact below the margins."""
@@ -384,14 +396,14 @@ class SphereCollision:
         """(B,) bool validity, or (detail, B = 1) the list of contacts."""
         scene, own, held_arm = self._mask(ignore)
         n, links = q.shape[0], len(PARTS)
-        rot, pos = self._links(q, float(fingers))  # (B, L + 1, 3, 3), (B, L + 1, 3)
-        r = rot[:, :links]  # (B, L, 3, 3)
-        b = self._bounds  # (L, 3) the bounding spheres' centres, each in its link's frame
-        mid = pos[:, :links] + r[..., 0] * b[:, None, 0] + r[..., 1] * b[:, None, 1]
-        mid += r[..., 2] * b[:, None, 2]  # (B, L, 3)
+        rot_t, pos_t = self._frames(q, float(fingers))  # (F, 3, 3, B), (F, 3, B)
+        b = self._bounds[:, :, None]  # (L, 3, 1) the bounding spheres' centres, link frames
+        mid_t = pos_t[:links] + rot_t[:links, :, 0] * b[:, None, 0]  # (L, 3, B)
+        mid_t += rot_t[:links, :, 1] * b[:, None, 1]
+        mid_t += rot_t[:links, :, 2] * b[:, None, 2]
+        rot, pos = _batch_first(rot_t, pos_t)  # (B, F, 3, 3), (B, F, 3)
         reach = self._reach + self.gap  # (L,)
-        hit = np.zeros(n, dtype=bool)
-        found: list[Contact] = []
+        hit, found = np.zeros(n, dtype=bool), []  # found: [Contact]
 
         def record(b, part, other, clearance, limit: float) -> None:
             """Mark the rows b (M,) whose clearance (M,), or any of whose spheres' (M, S), is
@@ -416,17 +428,23 @@ class SphereCollision:
 
         m = self.margin
         # the table: a plane at z = 0
-        near_b, near_l = np.nonzero((mid[..., 2] - reach < m) & scene[None, :links, 0])
+        low = mid_t[:, 2] < (reach + m)[:, None]  # (L, B)
+        near_l, near_b = np.nonzero(low & scene[:links, 0, None])
         for k, _, rows, link in self._by_bucket(near_b, near_l):
             x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
             record(rows, link, np.zeros_like(rows), x[..., 2] - grown, m)
         # the boxes, each in its own frame (turned about z only)
         if len(self._names) > 1:  # the bounding spheres against the boxes' world bounds
-            near = scene[None, :links, 1:]  # (1, L, O)
-            for axis in range(3):
+            near = np.empty((links, len(self._names) - 1, n), dtype=bool)  # (L, O, B)
+            near[:] = scene[:links, 1:, None]
+            d = np.empty(near.shape, dtype=_FLOAT)
+            for axis in range(3):  # batch-last: every operation runs over rows of B
                 room = self._world_half[axis] + (reach[:, None] + m)  # (L, O)
-                near = near & (np.abs(mid[:, :, axis, None] - self._box_c[:, axis]) < room)
-            near_b, near_l, near_o = pending(*np.nonzero(near))  # (B, L, O) -> (M,) each
+                np.subtract(mid_t[:, axis, None], self._box_c[:, axis, None], out=d)
+                np.abs(d, out=d)
+                near &= d < room[..., None]
+            near_l, near_o, near_b = np.nonzero(near)  # (M,) each
+            near_b, near_l, near_o = pending(near_b, near_l, near_o)
             for k, group, rows, link in self._by_bucket(near_b, near_l):
                 x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
                 box = near_o[group]  # (M,)
@@ -437,20 +455,22 @@ class SphereCollision:
             own = own & (self._apart_from > -math.inf)
         a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
         apart = reach[a] + reach[c] + self.self_margin  # (K',)
-        close = np.square(mid[:, a] - mid[:, c]).sum(-1) < np.square(apart)  # (B, K')
+        gap = mid_t[a] - mid_t[c]  # (K', 3, B)
+        gap *= gap
+        close = gap.sum(1) < np.square(apart)[:, None]  # (K', B)
         if self.self_margin < APART_CLEARANCE:  # ... and those it keeps apart at these angles
-            close &= q[:, self._apart_joint[own]] < self._apart_from[own]
-        near_b, near_k = pending(*np.nonzero(close))
+            close &= q.T[self._apart_joint[own]] < self._apart_from[own, None]
+        near_b, near_k = pending(*np.nonzero(close)[::-1])
         la, lc = a[near_k], c[near_k]
         if near_b.size:  # link a's bounding sphere against link c's box, in c's frame
-            centre = np.einsum("mji,mj->mi", rot[near_b, lc], mid[near_b, la] - pos[near_b, lc])
-            gap = _box_sdf(centre - self._aabb_c[lc], self._aabb_h[lc]) - reach[la]  # (M,)
-            keep = gap < self.self_margin
+            d = mid_t[la, :, near_b] - pos[near_b, lc]  # (M, 3)
+            d = np.einsum("mji,mj->mi", rot[near_b, lc], d) - self._aabb_c[lc]  # from its middle
+            keep = _near_box(d, self._aabb_h[lc], reach[la] + self.self_margin)
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
         if near_b.size:
             self._self_pairs(rot, pos, near_b, la, lc, record)
         if self._held_half is not None:
-            self._check_held(rot, pos, mid, scene, held_arm, record)
+            self._check_held(rot, pos, mid_t.transpose(2, 0, 1), scene, held_arm, record)
         return found if detail else ~hit
 
     def _self_pairs(self, rot, pos, b, link, other, record) -> None:
@@ -467,42 +487,27 @@ class SphereCollision:
         frame = other[pair]  # (N,)
         box_c, box_h = self._aabb_c[frame], self._aabb_h[frame]  # (N, 3) each
         centre = np.einsum("nij,nj->ni", r_rel[pair], self._cluster_mid[cluster]) + t_rel[pair]
-        reach = self._cluster_reach[cluster] + self.gap  # (N,)
-        keep = _box_sdf(centre - box_c, box_h) - reach < self.self_margin
+        reach = self._cluster_reach[cluster] + (self.gap + self.self_margin)  # (N,)
+        keep = _near_box(centre - box_c, box_h, reach)
         pair, cluster, frame = pair[keep], cluster[keep], frame[keep]
         box_c, box_h = box_c[keep, None], box_h[keep, None]  # (N', 1, 3) each
-        local = self._cluster_local[cluster]  # (N', S, 3)
-        inner = np.matmul(local, np.swapaxes(r_rel[pair], 1, 2)) + t_rel[pair, None]
+        local = self._cluster_local[cluster]  # (N', S, 3), padded with repeats of the first
+        # (N', S, 3) in the other link's frame, from the centre of its DOP's box
+        inner = np.matmul(local, np.swapaxes(r_rel[pair], 1, 2)) + (t_rel[pair, None] - box_c)
         grown = self._cluster_radii[cluster] + self.gap  # (N', S)
         # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
-        gap = _box_sdf(inner - box_c, box_h) - grown  # (N', S)
-        gap[np.arange(CLUSTER) >= self._cluster_count[cluster][:, None]] = np.inf  # repeats
-        near_n, near_s = np.nonzero(gap < self.self_margin)
-        if near_n.size:
-            dop = inner[near_n, near_s] @ self._directions.T - self._dop[frame[near_n]]
-            gap[near_n, near_s] = dop.max(-1) - grown[near_n, near_s]  # the 26-DOP's bound
-        least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its clusters
-        np.minimum.at(least, pair, gap.min(1))
+        near_n, near_s = np.nonzero(_near_box(inner, box_h, grown + self.self_margin))
+        gap = _dop_gap(inner[near_n, near_s], self._directions, self._dop_c[frame[near_n]])
+        gap -= grown[near_n, near_s]  # (K,) the 26-DOP's bound
+        least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its spheres
+        np.minimum.at(least, pair[near_n], gap)
         record(b, link, ~other, least, self.self_margin)
 
     def _box_gap(self, points: np.ndarray, box, reach, exact: bool) -> np.ndarray:
-        """Clearance of points (..., 3) to the boxes ``box`` (indices broadcasting with the
-        points' leading axes, or a slice) less ``reach`` (...): < 0 where a ball of radius
-        ``reach`` there meets the box. ``exact``: the signed distance less ``reach``; else
-        only its sign is right (the squared distance outside the box less ``reach``^2, which
-        skips the square root)."""
+        """`sphere_fk._box_gap` of points (..., 3) to the boxes ``box`` (indices broadcasting
+        with the points' leading axes, or a slice) less ``reach`` (...)."""
         d = points - self._box_c[box]  # (..., 3)
-        cos, sin, half = self._cos[box], self._sin[box], self._halves[box]
-        u = np.abs(cos * d[..., 0] + sin * d[..., 1]) - half[..., 0]
-        v = np.abs(cos * d[..., 1] - sin * d[..., 0]) - half[..., 1]
-        w = np.abs(d[..., 2]) - half[..., 2]
-        outside = np.square(np.maximum(u, 0.0))
-        outside += np.square(np.maximum(v, 0.0))
-        outside += np.square(np.maximum(w, 0.0))
-        if not exact:
-            return outside - np.square(reach)
-        inside = np.minimum(np.maximum(np.maximum(u, v), w), 0.0)
-        return np.sqrt(outside) + inside - reach
+        return _box_gap(d, self._cos[box], self._sin[box], self._halves[box], reach, exact)
 
     def _check_held(self, rot, pos, mid, scene, held_arm, record) -> None:
         """The held box at the TCP against the table, the boxes and the arm's links."""

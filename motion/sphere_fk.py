@@ -3,10 +3,13 @@
 The URDF's joint origins (parsed once by `_chain`, revolute joints as quarter-turn rotations and
 offsets), the link frames `PARTS` in the order `SphereCollision` uses, and the spheres of
 `robots.panda_spheres` (cuRobo's SPHERES plus the COVER rows) per link in its own frame, and
-`_links`: the world frames of every link and the TCP for B configurations at once (float32);
-and the model's fixed geometry: bounding spheres (`_bound`), each link's 26-DOP (`_dops`), its
-spheres in clusters (`_clusters`), turns about z (`_turn`) and the separating-axis test of two
-boxes (`_obb_gap`).
+`_links`: the world frames of every link and the TCP for B configurations at once (float32;
+`_frames` batch-last); the model's fixed geometry: bounding spheres (`_bound`), each link's
+26-DOP (`_dops`), its spheres in clusters (`_clusters`), turns about z (`_turn`); and the
+checks' distance tests: the separating-axis test of two boxes (`_obb_gap`), points against
+turned boxes (`_box_gap`) and axis-aligned ones (`_box_sdf`, `_near_box`), and the 26-DOP's
+bound (`_dop_gap`), the last four without BLAS (OpenBLAS spreads a large product over more
+threads).
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ _ARM = tuple(f"panda_link{i}" for i in range(1, 8))
 _HAND = "panda_hand"
 PARTS = ("panda_link0", *_ARM, _HAND, *FINGERS)  # (L,) the links, as PandaCollision.parts
 _FLOAT = np.float32  # the checks' precision: 0.1 um at 1 m, against the 1.5 cm cover gap
+SLACK = 1e-5  # m added to a culling test's reach (`_near_box`): far above float32 rounding
 
 
 def _onehot(rows: np.ndarray) -> np.ndarray:
@@ -187,7 +191,24 @@ def _links(
     `PARTS` (fingers at ``fingers`` m each), then of the TCP, from `_chain`'s offsets ``off``
     (J, 3), the joint origins' axis ``swaps`` and the hand and TCP transforms (4, 4).
 
-    Computed batch-last (every quantity a contiguous row of B numbers), then transposed once."""
+    Computed batch-last (`_frames`), then transposed once."""
+    rot, pos = _frames(q, fingers, off, swaps, hand_t, tcp_t)
+    return _batch_first(rot, pos)
+
+
+def _batch_first(rot: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """`_frames`' (F, 3, 3, B) and (F, 3, B) as contiguous (B, F, 3, 3) and (B, F, 3): the
+    checks gather frames by configuration."""
+    return np.ascontiguousarray(rot.transpose(3, 0, 1, 2)), np.ascontiguousarray(
+        pos.transpose(2, 0, 1)
+    )
+
+
+def _frames(
+    q: np.ndarray, fingers: float, off, swaps, hand_t, tcp_t
+) -> tuple[np.ndarray, np.ndarray]:
+    """`_links`' frames batch-last: rotations (F, 3, 3, B) and origins (F, 3, B), F = L + 1,
+    every quantity a contiguous row of B numbers."""
     n = q.shape[0]
     rot = np.empty((len(PARTS) + 1, 3, 3, n), dtype=_FLOAT)  # (F, 3, 3, B)
     pos = np.empty((len(PARTS) + 1, 3, n), dtype=_FLOAT)  # (F, 3, B)
@@ -213,10 +234,7 @@ def _links(
         rot[k] = rot[hand]
         pos[k] = pos[hand] + (sign * fingers) * rot[hand, :, 1] + FINGER_ORIGIN * rot[hand, :, 2]
     _compose(rot[hand], pos[hand], tcp_t, rot[-1], pos[-1])
-    # (B, F, 3, 3) and (B, F, 3), contiguous: the checks gather frames by configuration
-    return np.ascontiguousarray(rot.transpose(3, 0, 1, 2)), np.ascontiguousarray(
-        pos.transpose(2, 0, 1)
-    )
+    return rot, pos
 
 
 def _compose(r: np.ndarray, t: np.ndarray, transform: np.ndarray, r_out, t_out) -> None:
@@ -229,3 +247,56 @@ def _compose(r: np.ndarray, t: np.ndarray, transform: np.ndarray, r_out, t_out) 
         for k, w in terms:
             value += w * r[:, k] if w != 1.0 else r[:, k]
         out[:] = value
+
+
+def _box_gap(d: np.ndarray, cos, sin, half, reach, exact: bool) -> np.ndarray:
+    """Clearance of points at offsets d (..., 3) from the centres of boxes turned by yaws of
+    cosine ``cos`` and sine ``sin`` (...) about z, half extents ``half`` (..., 3), less
+    ``reach`` (...): < 0 where a ball of radius ``reach`` there meets the box. ``exact``: the
+    signed distance less ``reach``; else only its sign is right (the squared distance outside
+    the box less ``reach``^2, which skips the square root)."""
+    u = np.abs(cos * d[..., 0] + sin * d[..., 1]) - half[..., 0]
+    v = np.abs(cos * d[..., 1] - sin * d[..., 0]) - half[..., 1]
+    w = np.abs(d[..., 2]) - half[..., 2]
+    outside = np.square(np.maximum(u, 0.0))
+    outside += np.square(np.maximum(v, 0.0))
+    outside += np.square(np.maximum(w, 0.0))
+    if not exact:
+        return outside - np.square(reach)
+    inside = np.minimum(np.maximum(np.maximum(u, v), w), 0.0)
+    return np.sqrt(outside) + inside - reach
+
+
+def _box_sdf(points: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Signed distances (...) of points (..., 3) in a box's frame to it, half extents (..., 3)."""
+    d = np.abs(points) - half
+    outside = np.sqrt(np.square(np.maximum(d, 0.0)).sum(-1))
+    return outside + np.minimum(d.max(-1), 0.0)
+
+
+def _near_box(d: np.ndarray, half: np.ndarray, reach) -> np.ndarray:
+    """(...) bool: whether points at offsets d (..., 3) from an axis-aligned box's centre, half
+    extents ``half`` (..., 3), lie closer than ``reach`` (...) > 0 to it (inside counts):
+    `_box_sdf` < reach, axis by axis and squared (no square root, no reduction over the
+    short last axis). ``reach`` is widened by `SLACK`, so float rounding never drops a point
+    the exact test keeps (this only decides what a finer test sees)."""
+    total = None
+    for axis in range(3):
+        e = np.abs(d[..., axis])  # (...)
+        e -= half[..., axis]
+        np.maximum(e, 0.0, out=e)
+        e *= e
+        total = e if total is None else np.add(total, e, out=total)
+    limit = np.asarray(reach, dtype=total.dtype) + SLACK
+    return total < limit * limit
+
+
+def _dop_gap(points: np.ndarray, directions: np.ndarray, support: np.ndarray) -> np.ndarray:
+    """(K,) the 26-DOP bound max_k (d_k . p - support_k) of points p (K, 3) in their DOP's
+    frame, supports (K, 26): three products broadcast over the directions (26, 3), not a
+    matrix product, which OpenBLAS would spread over a second thread."""
+    out = points[:, 0, None] * directions[:, 0]  # (K, 26)
+    out += points[:, 1, None] * directions[:, 1]
+    out += points[:, 2, None] * directions[:, 2]
+    out -= support
+    return out.max(-1)

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from motion.errors import MotionError
-from motion.sphere_check import APART, APART_CLEARANCE, PARTS, Screened, SphereCollision
+from motion.sphere_check import APART, APART_CLEARANCE, CHUNK, PARTS, Screened, SphereCollision
+from motion.sphere_fk import _dop_gap
 from robots.collision import Box
 from robots.panda import PANDA, data_dir
 from robots.panda_spheres import COVER, COVER_GAP, FINGERS, SPHERES
@@ -377,3 +378,35 @@ def test_valid_batch_agrees_with_a_check_without_culling(self_margin):
     if self_margin < APART_CLEARANCE:
         assert 0.1 * total < free < 0.9 * total
     model.set_boxes([])
+
+
+def test_a_batch_of_several_chunks_gets_the_reference_verdicts():
+    """valid_batch checks CHUNK configurations at a time: a batch of a little over two chunks
+    (beside boxes, about q_home and across the joint box) gets the verdicts of the check
+    without culling, configuration by configuration."""
+    model = SphereCollision(margin=0.01)
+    boxes, _, q = next(near_arm_scenes(model, 1, 40, seed=8))
+    model.set_boxes(boxes)
+    rng = np.random.default_rng(9)
+    q = np.concatenate(
+        [
+            q,
+            np.clip(HOME + rng.normal(0.0, 0.5, (CHUNK, 7)), LO, HI),
+            rng.uniform(LO, HI, (CHUNK + 3, 7)),
+        ]
+    )
+    fast = model.valid_batch(q, 0.02)
+    assert len(fast) == len(q) > 2 * CHUNK
+    assert 0 < fast.sum() < len(q)
+    assert np.array_equal(fast, _reference_valid(model, q, 0.02))
+    model.set_boxes([])
+
+
+def test_the_26_dop_bound_equals_the_matrix_product():
+    """`sphere_fk._dop_gap` (three broadcast products, no BLAS) against the matrix product."""
+    rng = np.random.default_rng(3)
+    model = SphereCollision()
+    p = rng.normal(0.0, 0.2, (500, 3)).astype(np.float32)
+    support = model._dop_c[rng.integers(0, len(PARTS), 500)]  # (500, 26)
+    want = (p.astype(float) @ model._directions.T.astype(float) - support).max(-1)
+    assert np.allclose(_dop_gap(p, model._directions, support), want, atol=1e-6)

@@ -7,6 +7,8 @@
   core, its verdicts against the mesh model's (`robots.collision.PandaCollision`, PyBullet's
   closest points) near obstacles, and rerouted moves planned by `motion.rrt.plan_path` with the
   guard's settings, beside OMPL's RRT-Connect on the mesh model alone.
+- ``threads``: one core for the throughput (every thread of the process on one CPU, OpenBLAS's
+  and torch's pools at one thread) and a count of the threads that worked.
 
 The table printer is `tamp.bench.tables.checker_table`; the results writer `tamp.bench.results`.
 """

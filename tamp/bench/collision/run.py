@@ -3,10 +3,11 @@
 Per scene (`tamp.bench.collision.scenes`):
 
 - **throughput**: `SphereCollision.valid_batch` on batches of each size, ``repeats`` calls per
-  batch, the process pinned to one CPU (`one_core`); configurations per second of the median
+  batch, on one core (`tamp.bench.collision.threads.one_core`: every thread of the process on
+  one CPU, OpenBLAS's and torch's pools at one thread); configurations per second of the median
   call, by the wall clock and by the process's CPU time (its own work, which other
   processes on a loaded machine do not inflate as much), on the ``uniform`` sample and on the
-  ``near`` one (tiled to the batch size);
+  ``near`` one (tiled to the batch size), and how many threads worked during the timed calls;
 - **validation**: the sphere model's verdicts on the ``near`` sample against the mesh model's
   (`robots.collision.PandaCollision.valid`, PyBullet's closest points, the guard's final word),
   both at the loop's margin: false "free" (must be 0), false "collision", the mesh model's cost
@@ -21,16 +22,15 @@ Per scene (`tamp.bench.collision.scenes`):
 
 from __future__ import annotations
 
-import os
 import time
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from tamp.bench.collision import scenes
+from tamp.bench.collision.threads import busy_threads, one_core, thread_times
 
 PROBE = 0.05  # m beyond the margin up to which a false collision's mesh clearance is measured
 MOVE_COLUMNS = (
@@ -58,6 +58,7 @@ THROUGHPUT_COLUMNS = (
     "configs_per_s",
     "median_cpu_s",
     "configs_per_cpu_s",
+    "threads",
 )
 
 
@@ -75,37 +76,25 @@ class CheckerBenchConfig:
     margin: float = 0.01  # m, the loop's (`tamp.loop.execute.ExecutionConfig.margin`)
 
 
-@contextmanager
-def one_core() -> Iterator[int | None]:
-    """The process pinned to one of its CPUs for the block (the lowest it may use); yields that
-    CPU, or None where the platform cannot pin (then nothing changes)."""
-    if not hasattr(os, "sched_setaffinity"):
-        yield None
-        return
-    before = os.sched_getaffinity(0)
-    cpu = min(before)
-    os.sched_setaffinity(0, {cpu})
-    try:
-        yield cpu
-    finally:
-        os.sched_setaffinity(0, before)
-
-
 def throughput(spheres, samples: dict[str, np.ndarray], batches: Sequence[int], repeats: int):
-    """Rows (sample, batch, calls, median_s, configs_per_s): ``repeats`` timed calls of
-    ``spheres.valid_batch`` on the first ``batch`` configurations of each sample (tiled when it
-    is shorter), after one untimed call."""
+    """Rows (sample, batch, calls, median_s, configs_per_s, median_cpu_s, configs_per_cpu_s,
+    threads): ``repeats`` timed calls of ``spheres.valid_batch`` on the first ``batch``
+    configurations of each sample (tiled when it is shorter), after one untimed call;
+    ``threads``: how many of the process's threads worked during them (`busy_threads`, None
+    without ``/proc``)."""
     rows = []
     for name, q in samples.items():
         for batch in batches:
             qs = np.resize(q, (batch, q.shape[1]))  # (batch, J)
             spheres.valid_batch(qs)
             wall, cpu = [], []
+            before = thread_times()
             for _ in range(repeats):
                 t0, c0 = time.perf_counter(), time.process_time()
                 spheres.valid_batch(qs)
                 wall.append(time.perf_counter() - t0)
                 cpu.append(time.process_time() - c0)
+            threads = busy_threads(before, thread_times())
             median, median_cpu = float(np.median(wall)), float(np.median(cpu))
             rows.append(
                 {
@@ -116,6 +105,7 @@ def throughput(spheres, samples: dict[str, np.ndarray], batches: Sequence[int], 
                     "configs_per_s": batch / median,
                     "median_cpu_s": median_cpu,
                     "configs_per_cpu_s": batch / max(median_cpu, 1e-9),
+                    "threads": threads,
                 }
             )
     return rows
@@ -271,8 +261,8 @@ def run_scene(name: str, config: CheckerBenchConfig, progress=None) -> tuple[dic
 
 
 def run(config: CheckerBenchConfig, progress=None) -> dict:
-    """Every scene of ``config``, the process on one CPU: {"cpu", "scenes": [summary],
-    "moves": [row]}; ``progress(text)`` after each stage of each scene."""
+    """Every scene of ``config``, the process on one core (`one_core`): {"cpu", "scenes":
+    [summary], "moves": [row]}; ``progress(text)`` after each stage of each scene."""
     summaries, moves = [], []
     with one_core() as cpu:
         for name in config.scenes:

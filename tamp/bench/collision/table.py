@@ -20,7 +20,7 @@ def checker_table(result: dict) -> str:
     """Three tables over the scenes of `tamp.bench.collision.run.run`'s result."""
     scenes = result["scenes"]
     rates = table(
-        ("scene", "sample", "batch", "configs/s", "configs/CPU-s"),
+        ("scene", "sample", "batch", "configs/s", "configs/CPU-s", "threads"),
         [
             (
                 s["scene"],
@@ -28,6 +28,7 @@ def checker_table(result: dict) -> str:
                 r["batch"],
                 f"{r['configs_per_s']:,.0f}",
                 f"{r['configs_per_cpu_s']:,.0f}",
+                "-" if r.get("threads") is None else r["threads"],
             )
             for s in scenes
             for r in s["throughput"]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import sys
 
 import numpy as np
 import pytest
@@ -50,11 +51,15 @@ def test_a_tiny_run_writes_its_tables_and_finds_no_false_free(tmp_path, capsys):
     (scene,) = body["scenes"]
     assert scene["validation"]["n"] == 40 and scene["validation"]["false_free"] == 0
     assert [r["batch"] for r in scene["throughput"]] == [20, 50, 20, 50]
+    for row in scene["throughput"]:  # both rates, and the one thread that worked
+        assert row["configs_per_s"] > 0 and row["configs_per_cpu_s"] > 0
+        assert row["threads"] == (1 if sys.platform.startswith("linux") else None)
     with (out / "moves.csv").open() as f:
         moves = list(csv.DictReader(f))
     assert [m["planner"] for m in moves] == ["spheres", "ompl_mesh"]
     with (out / "throughput.csv").open() as f:
-        assert len(list(csv.DictReader(f))) == 4
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 4 and "threads" in rows[0]
 
 
 def test_an_unknown_scene_is_refused_in_one_line(capsys):
