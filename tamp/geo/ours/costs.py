@@ -31,8 +31,11 @@ row, the cells' places optimised with the logits, and the row whose moves are co
 them (`GeoCosts.settle`; a moved cell forgets the prices seen so far).
 
 Every state is priced once (cached); the IK solutions are cached by target position (to the
-mm) across states, so later windows solve only the targets they have not seen. ``stats``
-records states priced and the time spent (ms per state).
+mm) across states, so later windows solve only the targets they have not seen. Binding a plan
+asks for one move in each state it passes (`GeoCosts.price_of`, `GeoCosts.grasps_left`): that
+move alone is priced there, as the whole state's pricing would price it, unless the state was
+priced whole already. ``stats`` records states priced, single moves priced and the time spent
+(ms per state).
 """
 
 from __future__ import annotations
@@ -164,6 +167,19 @@ def _stands(world: Scene, x: str) -> tuple[int, ...]:
     return (*(round(float(v) * 1000) for v in pose.xyz), round(float(pose.yaw) * 1000))
 
 
+@dataclass
+class _Seen:
+    """A state's predicted world, its fixed solids and each object's body as oriented boxes
+    (`solid_obbs`), and what pricing found there: each object's grasps free where it stands
+    (``picks``) and the solids its hand must clear (``solids``: all but the object)."""
+
+    world: Scene
+    fixed: tuple
+    bodies: dict
+    picks: dict = field(default_factory=dict)
+    solids: dict = field(default_factory=dict)
+
+
 class _Window:
     """The costs of one window: a fixed (P, N, Y) matrix, alike for every restart row."""
 
@@ -206,13 +222,16 @@ class GeoCosts:
             grasps = {o.name: candidate_grasps(o, config.choices) for o in bridged.scene.objects}
         self.grasps: dict[str, tuple[Grasp, ...]] = dict(grasps)
         self._base: dict[State, tuple[np.ndarray, dict]] = {}
+        # moves priced one at a time (`price_of`): (state, move) -> (price, grasp names)
+        self._single: dict[tuple[State, Move], tuple[float, tuple[str, ...]]] = {}
+        self._seen: dict[State, _Seen] = {}  # the predicted world of a state, its solids
         self._ik: dict[tuple[int, int, int], tuple[np.ndarray, bool]] = {}
         self._hands: dict[str, tuple] = {}  # object -> `hand_obbs` of its grasps
         self.failed: dict[tuple[State, Move, str], set] = {}
         # failures no movable object caused (IK, a post, the table, a wall): (move, where the
         # object stands, place) -> grasps, whatever the other objects do
         self.failed_fixed: dict[tuple[Move, tuple, str], set] = {}
-        self.stats = {"states": 0, "price_s": 0.0, "ik_targets": 0}
+        self.stats = {"states": 0, "moves": 0, "price_s": 0.0, "ik_targets": 0}
 
     # ---- the planner's interface
 
@@ -233,6 +252,8 @@ class GeoCosts:
         if settled is not self.bridged:
             self.bridged = settled
             self._base.clear()
+            self._single.clear()
+            self._seen.clear()
 
     def price(self, state: State) -> np.ndarray:
         """(N, Y) the price of every move x -> y in crisp ``state`` (0 where illegal)."""
@@ -244,6 +265,24 @@ class GeoCosts:
             if legal(problem, state, move) is None and not self.grasps_left(state, move, world):
                 out[problem.entities.index(move.entity), problem.index(move.target)] = IMPOSSIBLE
         return out
+
+    def price_of(self, state: State, move: Move) -> float:
+        """The price of ``move`` in crisp ``state``, as `price` gives it (0 where illegal),
+        the move alone priced where the state was not priced whole."""
+        if tuple(state) in self._base:
+            p = self.bridged.problem
+            return float(self.price(state)[p.entities.index(move.entity), p.index(move.target)])
+        if legal(self.bridged.problem, state, move) is not None:
+            return 0.0
+        price, _ = self._move(state, move)
+        if price >= IMPOSSIBLE or not self._remembers(move):
+            return price
+        return price if self.grasps_left(state, move) else float(IMPOSSIBLE)
+
+    def _remembers(self, move: Move) -> bool:
+        return any(m == move for _, m, _ in self.failed) or any(
+            m == move for m, _, _ in self.failed_fixed
+        )
 
     # ---- failure memory
 
@@ -264,9 +303,8 @@ class GeoCosts:
         """The names of ``move``'s grasps free at both ends in ``state`` (best first: the
         order of `tamp.geo.check.candidate_grasps`) that no failure ruled out. ``world``: the
         predicted world of ``state`` when the caller has it."""
-        _, allowed = self._priced(state)
-        names = allowed.get(move, ())
-        world = world or self.bridged.predict(state)
+        _, names = self._move(state, move)
+        world = world or self._world(state)
         place = self.bridged.geo_move(world, move).place.name
         gone = self.failed.get((tuple(state), move, place), set())
         gone = gone | self.failed_fixed.get((move, _stands(world, move.entity), place), set())
@@ -285,40 +323,91 @@ class GeoCosts:
             self.stats["price_s"] += time.perf_counter() - t0
         return self._base[state]
 
+    def _move(self, state: State, move: Move) -> tuple[float, tuple[str, ...]]:
+        """The price of one move in ``state`` (before failure memory) and the names of its
+        grasps free at both ends: from the whole state's pricing where it was done, else
+        that move alone, priced as `_price` prices it."""
+        state = tuple(state)
+        if state in self._base:
+            out, allowed = self._base[state]
+            p = self.bridged.problem
+            return float(out[p.entities.index(move.entity), p.index(move.target)]), allowed.get(
+                move, ()
+            )
+        key = (state, move)
+        if key not in self._single:
+            t0 = time.perf_counter()
+            self._single[key] = self._price_move(state, move)
+            self.stats["moves"] += 1
+            self.stats["price_s"] += time.perf_counter() - t0
+        return self._single[key]
+
+    def _price_move(self, state: State, move: Move) -> tuple[float, tuple[str, ...]]:
+        if legal(self.bridged.problem, state, move) is not None:
+            return 0.0, ()
+        names, ends = self._judge(state, move)
+        if not names:
+            return float(IMPOSSIBLE), names
+        if self.solver is None:
+            return 0.0, names
+        q, reach = self._solve(list(ends))  # (2, J), (2,)
+        if self.config.ik and not (reach[0] and reach[1]):
+            return float(IMPOSSIBLE), names
+        dist = float(np.linalg.norm(q[1] - q[0]))
+        return min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0), names
+
+    def _world(self, state: State) -> Scene:
+        return self._context(state).world
+
+    def _context(self, state: State) -> _Seen:
+        state = tuple(state)
+        if state not in self._seen:
+            world = self.bridged.predict(state)
+            fixed = solid_obbs(fixed_solids(world))
+            bodies = {o.name: solid_obbs([of_movable(o)]) for o in world.objects}
+            self._seen[state] = _Seen(world, fixed, bodies)
+        return self._seen[state]
+
+    def _judge(self, state: State, move: Move) -> tuple[tuple[str, ...], tuple | None]:
+        """The names of a legal ``move``'s grasps free at both ends in ``state`` (best
+        first: the order of `tamp.geo.check.candidate_grasps`; none where the goal rules the
+        move out or the object does not fit there), and the object's position and the place's
+        (m) the arm's price is measured between."""
+        b, seen = self.bridged, self._context(state)
+        world, x = seen.world, move.entity
+        geo = b.geo_move(world, move)
+        ok = (x, move.target) not in b.banned and free(world, x, geo.place)
+        if ok and move.target in b.problem.entities:
+            ok = supported_on(world.object(x), world.object(move.target), geo.place.yaw)
+        if not ok:
+            return (), None
+        if x not in seen.picks:
+            o = world.object(x)
+            seen.picks[x] = self._free_grasps(world, x, o.pose.xyz, o.pose.yaw, seen)
+        at = self._free_grasps(world, x, geo.place.xyz, geo.place.yaw, seen)
+        # best first, in `candidate_grasps`' order (a set's order changes with the process's
+        # string hashing, and with it which grasp binding tries first)
+        names = tuple(g.name for g in self.grasps[x] if g.name in seen.picks[x] & at)
+        return names, (world.object(x).pose.xyz, geo.place.xyz)
+
     def _price(self, state: State) -> tuple[np.ndarray, dict]:
-        b, problem = self.bridged, self.bridged.problem
-        world = b.predict(state)
+        problem = self.bridged.problem
         n, y = problem.n, len(problem.targets)
         out = np.zeros((n, y))
         allowed: dict[Move, tuple[str, ...]] = {}
-        fixed = solid_obbs(fixed_solids(world))
-        bodies = {o.name: solid_obbs([of_movable(o)]) for o in world.objects}
-        picks = {
-            o.name: self._free_grasps(world, o.name, o.pose.xyz, o.pose.yaw, fixed, bodies)
-            for o in world.objects
-        }
         moves, ends = [], []
         for i, x in enumerate(problem.entities):
             for j, target in enumerate(problem.targets):
                 move = Move(x, target)
                 if legal(problem, state, move) is not None:
                     continue
-                geo = b.geo_move(world, move)
-                ok = (x, target) not in b.banned and free(world, x, geo.place)
-                if ok and target in problem.entities:
-                    ok = supported_on(world.object(x), world.object(target), geo.place.yaw)
-                names = ()
-                if ok:
-                    at = self._free_grasps(world, x, geo.place.xyz, geo.place.yaw, fixed, bodies)
-                    # best first, in `candidate_grasps`' order (a set's order changes with
-                    # the process's string hashing, and with it which grasp binding tries first)
-                    names = tuple(g.name for g in self.grasps[x] if g.name in picks[x] & at)
+                names, where = self._judge(state, move)
                 allowed[move] = names
                 if not names:
                     out[i, j] = IMPOSSIBLE
                     continue
                 moves.append((i, j))
-                ends.append((world.object(x).pose.xyz, geo.place.xyz))
+                ends.append(where)
         if moves and self.solver is not None:
             q, reach = self._solve([p for e in ends for p in e])  # (2M, J), (2M,)
             for k, (i, j) in enumerate(moves):
@@ -329,12 +418,16 @@ class GeoCosts:
                 out[i, j] = min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0)
         return out, allowed
 
-    def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, fixed, bodies) -> set[str]:
+    def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, seen: _Seen) -> set[str]:
         """Names of x's grasps whose open hand, x centred at ``xyz`` turned ``yaw``, overlaps
         nothing but x (the other objects where ``world`` has them, the fixed solids: oriented
-        boxes, `solid_obbs`); all of x's grasps at once (`obb_overlap`)."""
-        others = [bodies[o.name] for o in world.objects if o.name != x]
-        solids = tuple(np.concatenate(parts) for parts in zip(fixed, *others, strict=True))
+        boxes, `solid_obbs`, of ``seen``); all of x's grasps at once (`obb_overlap`)."""
+        if x not in seen.solids:
+            others = [seen.bodies[o.name] for o in world.objects if o.name != x]
+            seen.solids[x] = tuple(
+                np.concatenate(parts) for parts in zip(seen.fixed, *others, strict=True)
+            )
+        solids = seen.solids[x]
         if x not in self._hands:
             self._hands[x] = hand_obbs(self.grasps[x], self.config.margin)
         count = len(self._hands[x][0])  # G grasps

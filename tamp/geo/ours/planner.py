@@ -79,6 +79,11 @@ WINDOWS_PER_BOUND_MOVE = 1.5
 # check failures no movable object takes part in: ruled out wherever the object stands as it
 # stood (`GeoCosts.avoid`'s ``fixed``), not only in the state they happened in
 FIXED_FAILURES = ("ik_infeasible", "no_clearance")
+# grasps a planned move's full check takes at a time, the grasps the prices found free at both
+# ends first (`_check_in_turn`): the first of them passes for most moves, and the check's
+# batched IK and collision tests then cover four grasps, not all twenty of a cuboid
+CHECK_CHUNK = 4
+BEFORE_GRASPS = ("not_clear", "unsupported")  # check failures whatever the grasp
 
 
 @dataclass(frozen=True)
@@ -282,7 +287,8 @@ def reorder(bridged: Bridged, costs: GeoCosts, state, moves, budget: int = 200):
     (`GeoCosts.price`), the moves of each object kept in their order (so the plan ends in the
     same state), the planned order tried first; None when no such order is found within
     ``budget`` states. A window prices all its moves in its start state: placing o5 then o4
-    may look free there though o4's hand no longer fits beside o5; this repairs the order."""
+    may look free there though o4's hand no longer fits beside o5; this repairs the order.
+    Only the moves tried are priced in each state (`GeoCosts.price_of`)."""
     p = bridged.problem
     dead: set[frozenset] = set()
     seen = 0
@@ -295,14 +301,13 @@ def reorder(bridged: Bridged, costs: GeoCosts, state, moves, budget: int = 200):
         if key in dead or seen >= budget:
             return None
         seen += 1
-        prices = costs.price(state)
         for k, i in enumerate(left):
             move = moves[i]
             if any(moves[j].entity == move.entity for j in left[:k]):
                 continue  # an earlier move of the same object comes first
             if legal(p, state, move) is not None:
                 continue
-            if prices[p.entities.index(move.entity), p.index(move.target)] >= IMPOSSIBLE:
+            if costs.price_of(state, move) >= IMPOSSIBLE:
                 continue
             rest = search(apply_move(p, state, move), left[:k] + left[k + 1 :])
             if rest is not None:
@@ -324,16 +329,15 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
 
     p, bound = bridged.problem, []
     for move in moves:
-        price = costs.price(state)[p.entities.index(move.entity), p.index(move.target)]
-        if price >= IMPOSSIBLE:
+        if costs.price_of(state, move) >= IMPOSSIBLE:
             return state, world, tuple(bound), {"move": str(move), "failure": "priced"}
         geo = bridged.geo_move(world, move)
         o = world.object(move.entity)
         first = costs.grasps_left(state, move)
-        rest = [g for g in candidate_grasps(o, costs.config.choices) if g.name not in first]
-        by_name = {g.name: g for g in candidate_grasps(o, costs.config.choices)}
-        order = tuple(by_name[n] for n in first) + tuple(rest)
-        verdict = check(world, geo, tools, grasps=order)
+        grasps = candidate_grasps(o, costs.config.choices)
+        by_name = {g.name: g for g in grasps}
+        order = tuple(by_name[n] for n in first) + tuple(g for g in grasps if g.name not in first)
+        verdict = _check_in_turn(check, world, geo, tools, order)
         if not verdict.ok:
             tried = getattr(verdict, "tried", ())
             movable = {x.name for x in world.objects}
@@ -350,6 +354,26 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
         world = moved(world, geo.obj, geo.place.pose)
         state = apply_move(p, state, move)
     return state, world, tuple(bound), None
+
+
+def _check_in_turn(check, world, geo: GeoMove, tools, order, chunk: int = CHECK_CHUNK):
+    """The full check of ``geo`` with the grasps of ``order`` (best first), ``chunk`` at a
+    time: the first that passes wins, as one call with them all would give (`check_move`
+    tries its grasps in order), but the batched IK and the arm's collision tests of its cheap
+    half (`tamp.geo.check.quick_check`) cover only the grasps up to the chunk that passes.
+    A refusal is the last chunk's that tried a grasp, listing every grasp tried."""
+    tried, verdict, last = [], None, None
+    for k in range(0, max(len(order), 1), chunk):
+        verdict = check(world, geo, tools, grasps=order[k : k + chunk])
+        if verdict.ok or verdict.failure in BEFORE_GRASPS:
+            return verdict
+        if not getattr(verdict, "tried", ()):
+            if verdict.failure == "no_grasp":
+                continue  # every grasp of this chunk too wide for the hand
+            break  # refused before any grasp: the others would be too
+        tried += verdict.tried
+        last = verdict
+    return verdict if last is None else replace(last, tried=tuple(tried))
 
 
 def _packs(bridged: Bridged) -> dict:
