@@ -231,6 +231,7 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         grasp=args.grasp,
         domain=task.domain,
         observation=args.observe,
+        on_event=None if args.json else _say,
     )
     body = {"report": _jsonable(asdict(report)), "config": recorded}
     written = []
@@ -246,6 +247,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         if written:
             print(f"wrote {', '.join(written)} to {out}")
     return 0 if report.reached else 1
+
+
+def _say(text: str) -> None:
+    print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
 
 def geo_lines(report) -> list[str]:

@@ -221,6 +221,7 @@ def run_geo_episode(
     grasp: str = "friction",
     domain: tuple[str, ...] | None = None,
     observation: str = "state",
+    on_event: Callable[[str], None] | None = None,
 ) -> GeoReport:
     """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
@@ -230,7 +231,10 @@ def run_geo_episode(
     closed here); ``domain``: ``(pddl_domain_text, binding_text)`` the motion-aware planner
     plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules); refused for the
     other planners, which plan over the moves the geometry allows. ``observation``: the pose
-    sensor, one of `OBSERVATIONS` (``"camera"``: `tamp.camera.scene_poses.ScenePoses`)."""
+    sensor, one of `OBSERVATIONS` (``"camera"``: `tamp.camera.scene_poses.ScenePoses`).
+    ``on_event``: called with a line after each plan and each move (progress, e.g. for
+    ``tamp run``); what it is told is also in the report."""
+    say = on_event or (lambda line: None)
     if observation not in OBSERVATIONS:
         raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
     plan_fn = planner_by_name(planner)
@@ -282,6 +286,10 @@ def run_geo_episode(
                 plan = plan_fn(world, goal, tools, config)
                 plan_times.append(time.perf_counter() - t0)
                 plan_stats.append(dict(plan.stats))
+                say(
+                    f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
+                    f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
+                )
                 if not plan.solved:
                     status, reason = "no_plan", f"{plan.status.value}: {plan.reason}"
                     break
@@ -297,6 +305,10 @@ def run_geo_episode(
                         sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
                     )
                     records.append(record)
+                    say(
+                        f"move {k + 1}: {record.move}: "
+                        f"{'ok' if record.ok else 'failed: ' + str(record.failure)}"
+                    )
                     path += ran
                     failures += record.failure not in (None, "unexpected")
                     if not record.ok:

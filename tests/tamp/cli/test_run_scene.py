@@ -141,8 +141,10 @@ def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
     assert report["report"]["reached"] and report["report"]["collisions"] == 0
     assert [m["move"].split(" at ")[0] for m in report["report"]["moves"]] == ["move a -> tray"]
     assert report["config"]["executor"] == "geometric"
-    printed = capsys.readouterr().out
-    assert "goal reached (ground truth): yes" in printed and "wrote report.json" in printed
+    printed = capsys.readouterr()
+    assert "goal reached (ground truth): yes" in printed.out and "wrote report.json" in printed.out
+    assert "plan 1: solved, 1 moves" in printed.err  # progress as the episode goes
+    assert "move 1: move a -> tray" in printed.err and ": ok" in printed.err
 
 
 @pytest.mark.sim
