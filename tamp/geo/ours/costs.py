@@ -345,7 +345,7 @@ class GeoCosts:
     def _price_move(self, state: State, move: Move) -> tuple[float, tuple[str, ...]]:
         if legal(self.bridged.problem, state, move) is not None:
             return 0.0, ()
-        names, ends = self._judge(state, move)
+        ((names, ends),) = self._judge(state, [move])
         if not names:
             return float(IMPOSSIBLE), names
         if self.solver is None:
@@ -368,46 +368,72 @@ class GeoCosts:
             self._seen[state] = _Seen(world, fixed, bodies)
         return self._seen[state]
 
-    def _judge(self, state: State, move: Move) -> tuple[tuple[str, ...], tuple | None]:
-        """The names of a legal ``move``'s grasps free at both ends in ``state`` (best
-        first: the order of `tamp.geo.check.candidate_grasps`; none where the goal rules the
-        move out or the object does not fit there), and the object's position and the place's
-        (m) the arm's price is measured between."""
-        b, seen = self.bridged, self._context(state)
-        world, x = seen.world, move.entity
+    def _fits(self, state: State, move: Move):
+        """Where a legal ``move`` puts its object in ``state``'s predicted world (a `Place`),
+        or None where the goal rules the move out or the object does not fit there."""
+        b, world, x = self.bridged, self._world(state), move.entity
         geo = b.geo_move(world, move)
         ok = (x, move.target) not in b.banned and free(world, x, geo.place)
         if ok and move.target in b.problem.entities:
             ok = supported_on(world.object(x), world.object(move.target), geo.place.yaw)
-        if not ok:
-            return (), None
-        if x not in seen.picks:
+        return geo.place if ok else None
+
+    def _judge(self, state: State, moves: Sequence[Move]) -> list[tuple]:
+        """For each legal move of ``moves`` (of any objects) in ``state``: the names of its
+        grasps free at both ends (best first: the order of
+        `tamp.geo.check.candidate_grasps`; none where `_fits` finds no place), and the
+        object's position and the place's (m) the arm's price is measured between. The hand
+        is tested at all the places of one object at once (`_free_grasps`)."""
+        seen = self._context(state)
+        world = seen.world
+        places = [self._fits(state, move) for move in moves]
+        by_object: dict[str, list[int]] = {}
+        for k, (move, place) in enumerate(zip(moves, places, strict=True)):
+            if place is not None:
+                by_object.setdefault(move.entity, []).append(k)
+        free_at: dict[int, set[str]] = {}
+        for x, ks in by_object.items():
             o = world.object(x)
-            seen.picks[x] = self._free_grasps(world, x, o.pose.xyz, o.pose.yaw, seen)
-        at = self._free_grasps(world, x, geo.place.xyz, geo.place.yaw, seen)
-        # best first, in `candidate_grasps`' order (a set's order changes with the process's
-        # string hashing, and with it which grasp binding tries first)
-        names = tuple(g.name for g in self.grasps[x] if g.name in seen.picks[x] & at)
-        return names, (world.object(x).pose.xyz, geo.place.xyz)
+            poses = [(places[k].xyz, places[k].yaw) for k in ks]
+            if x in seen.picks:
+                found = self._free_grasps(world, x, poses, seen)
+            else:  # where x stands too
+                *found, seen.picks[x] = self._free_grasps(
+                    world, x, [*poses, (o.pose.xyz, o.pose.yaw)], seen
+                )
+            free_at.update(zip(ks, found, strict=True))
+        out = []
+        for k, (move, place) in enumerate(zip(moves, places, strict=True)):
+            if place is None:
+                out.append(((), None))
+                continue
+            x = move.entity
+            # best first, in `candidate_grasps`' order (a set's order changes with the
+            # process's string hashing, and with it which grasp binding tries first)
+            ok = seen.picks[x] & free_at[k]
+            names = tuple(g.name for g in self.grasps[x] if g.name in ok)
+            out.append((names, (world.object(x).pose.xyz, place.xyz)))
+        return out
 
     def _price(self, state: State) -> tuple[np.ndarray, dict]:
         problem = self.bridged.problem
-        n, y = problem.n, len(problem.targets)
-        out = np.zeros((n, y))
+        out = np.zeros((problem.n, len(problem.targets)))
+        cells = [
+            (i, j, Move(x, target))
+            for i, x in enumerate(problem.entities)
+            for j, target in enumerate(problem.targets)
+            if legal(problem, state, Move(x, target)) is None
+        ]
+        judged = self._judge(state, [move for _, _, move in cells])
         allowed: dict[Move, tuple[str, ...]] = {}
         moves, ends = [], []
-        for i, x in enumerate(problem.entities):
-            for j, target in enumerate(problem.targets):
-                move = Move(x, target)
-                if legal(problem, state, move) is not None:
-                    continue
-                names, where = self._judge(state, move)
-                allowed[move] = names
-                if not names:
-                    out[i, j] = IMPOSSIBLE
-                    continue
-                moves.append((i, j))
-                ends.append(where)
+        for (i, j, move), (names, where) in zip(cells, judged, strict=True):
+            allowed[move] = names
+            if not names:
+                out[i, j] = IMPOSSIBLE
+                continue
+            moves.append((i, j))
+            ends.append(where)
         if moves and self.solver is not None:
             q, reach = self._solve([p for e in ends for p in e])  # (2M, J), (2M,)
             for k, (i, j) in enumerate(moves):
@@ -418,10 +444,11 @@ class GeoCosts:
                 out[i, j] = min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0)
         return out, allowed
 
-    def _free_grasps(self, world: Scene, x: str, xyz, yaw: float, seen: _Seen) -> set[str]:
-        """Names of x's grasps whose open hand, x centred at ``xyz`` turned ``yaw``, overlaps
-        nothing but x (the other objects where ``world`` has them, the fixed solids: oriented
-        boxes, `solid_obbs`, of ``seen``); all of x's grasps at once (`obb_overlap`)."""
+    def _free_grasps(self, world: Scene, x: str, poses, seen: _Seen) -> list[set[str]]:
+        """For each of ``poses`` ((xyz, yaw): x centred at xyz (m) turned yaw (rad)), the
+        names of x's grasps whose open hand overlaps nothing but x (the other objects where
+        ``world`` has them, the fixed solids: oriented boxes, `solid_obbs`, of ``seen``); all
+        of x's grasps at all the poses at once (`obb_overlap`)."""
         if x not in seen.solids:
             others = [seen.bodies[o.name] for o in world.objects if o.name != x]
             seen.solids[x] = tuple(
@@ -431,11 +458,12 @@ class GeoCosts:
         if x not in self._hands:
             self._hands[x] = hand_obbs(self.grasps[x], self.config.margin)
         count = len(self._hands[x][0])  # G grasps
-        if not count or not len(solids[0]):
-            return {g.name for g in self.grasps[x]}
-        hand = hand_in_world(self._hands[x], xyz, yaw)
-        hit = obb_overlap(hand, solids).reshape(count, -1).any(-1)  # (G,)
-        return {g.name for g, h in zip(self.grasps[x], hit, strict=True) if not h}
+        if not count or not len(solids[0]) or not poses:
+            return [{g.name for g in self.grasps[x]} for _ in poses]
+        hands = [hand_in_world(self._hands[x], xyz, yaw) for xyz, yaw in poses]
+        hand = tuple(np.concatenate(parts) for parts in zip(*hands, strict=True))
+        hit = obb_overlap(hand, solids).reshape(len(poses), count, -1).any(-1)  # (P, G)
+        return [{g.name for g, h in zip(self.grasps[x], row, strict=True) if not h} for row in hit]
 
     def _solve(self, points: list) -> tuple[np.ndarray, np.ndarray]:
         """Top-down IK (yaw 0) of every point (m), cached to the mm: (M, J), (M,)."""
