@@ -41,7 +41,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -205,47 +205,113 @@ def pack(
     ``turnable[m]``: whether footprint m may turn a quarter turn (default: when it is not
     square); ``walled``: the hand must stay inside the region too (walls stand on its edges;
     a marked area lets the fingers reach beyond it)."""
+    (result,) = pack_tries(
+        inner, footprints, fixed_xy, fixed_half, ((config, seed),), turnable, walled
+    )
+    return result
+
+
+@dataclass(frozen=True)
+class _Try:
+    """One packing's rows in a batch of tries: its rectangle's corner ``lo`` and ``span``, what
+    must stay inside (``edge``) and the room its centres may use, each row's yaw turn and
+    closing axis, grown and body half extents, and its rows' place in the batch."""
+
+    config: PackConfig
+    lo: torch.Tensor
+    edge: torch.Tensor
+    room: torch.Tensor
+    turn: torch.Tensor
+    axis: torch.Tensor
+    half: torch.Tensor
+    body: torch.Tensor
+    rows: slice
+
+
+def pack_tries(
+    inner: Rect,
+    footprints: Sequence,
+    fixed_xy: Sequence = (),
+    fixed_half: Sequence = (),
+    tries: Sequence[tuple[PackConfig, int]] = ((PackConfig(), 0),),
+    turnable: Sequence[bool] | None = None,
+    walled: bool = True,
+) -> list[PackResult]:
+    """`pack` of the same footprints with each ``(config, seed)`` of ``tries``, all their
+    restart rows optimised in one tensor program: each result is the one `pack` gives alone
+    (a row's loss and its Adam step depend on that row only), and a batch of a few tries
+    costs about what one does (a step's cost is mostly its fixed overhead). The tries may
+    differ in their ``margin`` and ``restarts`` only. ``time``: the batch's, in each."""
     t0 = time.perf_counter()
+    first = tries[0][0]
+    for config, _ in tries:
+        if replace(config, margin=first.margin, restarts=first.restarts) != first:
+            raise PackError("tries packed together may differ in margin and restarts only")
     (x0, y0), (x1, y1) = inner
-    inner = ((x0 + config.margin, y0 + config.margin), (x1 - config.margin, y1 - config.margin))
-    half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
-    m, r = len(half_np), config.restarts
+    half_np = fxy_np = fh_np = None
+    made, u0, start = [], [], 0
+    for config, seed in tries:
+        inside = (
+            (x0 + config.margin, y0 + config.margin),
+            (x1 - config.margin, y1 - config.margin),
+        )
+        half_np, fxy_np, fh_np = _check(inside, footprints, fixed_xy, fixed_half)
+        m, r = len(half_np), config.restarts
+        gen = torch.Generator().manual_seed(seed)
+        square = np.isclose(half_np[:, 0], half_np[:, 1])
+        may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
+        turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
+        axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
+        h = torch.where(
+            turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np)
+        )
+        wide = 2 * h.gather(-1, axis[..., None])[..., 0] > config.stroke  # (R, M): not between
+        axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
+        body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
+        lo = torch.tensor(inside[0], dtype=torch.float64)
+        span = torch.tensor(inside[1], dtype=torch.float64) - lo
+        edge = half if walled else body  # what must stay inside: the hand too where walls stand
+        room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
+        u0.append(torch.randn(r, m, 2, generator=gen, dtype=torch.float64))
+        made.append(_Try(config, lo, edge, room, turn, axis, half, body, slice(start, start + r)))
+        start += r
+    m = len(half_np)
     if m == 0:
         empty = np.zeros((0, 2))
-        return PackResult(empty, np.zeros(0), np.zeros(0, int), True, -math.inf, 0.0, 0)
-    gen = torch.Generator().manual_seed(seed)
-    square = np.isclose(half_np[:, 0], half_np[:, 1])
-    may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
-    turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
-    axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
-    h = torch.where(turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np))
-    wide = 2 * h.gather(-1, axis[..., None])[..., 0] > config.stroke  # (R, M): not between
-    axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
-    body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
-    lo = torch.tensor(inner[0], dtype=torch.float64)
-    span = torch.tensor(inner[1], dtype=torch.float64) - lo
-    edge = half if walled else body  # what must stay inside: the hand too where walls stand
-    room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
-    u = torch.randn(r, m, 2, generator=gen, dtype=torch.float64).requires_grad_(True)
-    opt = Adam([{"params": [u], "lr": config.lr}])  # the planner's (no torch._dynamo import)
+        return [
+            PackResult(empty, np.zeros(0), np.zeros(0, int), True, -math.inf, 0.0, 0) for _ in tries
+        ]
+    u = torch.cat(u0).requires_grad_(True)  # (sum R, M, 2)
+    opt = Adam([{"params": [u], "lr": first.lr}])  # the planner's (no torch._dynamo import)
     fxy, fh = torch.from_numpy(fxy_np), torch.from_numpy(fh_np)
-    steps = config.steps
+    lo = torch.cat([t.lo.expand(t.rows.stop - t.rows.start, 1, 2) for t in made])  # (sum R, 1, 2)
+    edge, room = torch.cat([t.edge for t in made]), torch.cat([t.room for t in made])
+    half, body = torch.cat([t.half for t in made]), torch.cat([t.body for t in made])
+    steps = first.steps
 
     def centres() -> torch.Tensor:
-        return lo + edge + room * torch.sigmoid(u)  # (R, M, 2)
+        return lo + edge + room * torch.sigmoid(u)  # (sum R, M, 2)
 
     for k in range(steps):
-        beta = config.beta * (config.beta_end / config.beta) ** (k / max(steps - 1, 1))
+        beta = first.beta * (first.beta_end / first.beta) ** (k / max(steps - 1, 1))
         loss = overlap_loss(
-            centres(), half, body, fxy, fh, beta, config.eps, config.gap, config.ordered
+            centres(), half, body, fxy, fh, beta, first.eps, first.gap, first.ordered
         )
         opt.zero_grad()
         loss.sum().backward()
         opt.step()
     with torch.no_grad():
-        xy = centres().numpy()  # (R, M, 2)
-    fits = (room > 0).all(-1).all(-1).numpy()  # (R,) every grown footprint fits the region
-    grown_np, body_np = half.numpy(), body.numpy()
+        xy = centres().numpy()  # (sum R, M, 2)
+    took = time.perf_counter() - t0
+    return [_best(t, xy[t.rows], fxy_np, fh_np, took) for t in made]
+
+
+def _best(t: _Try, xy: np.ndarray, fxy_np, fh_np, took: float) -> PackResult:
+    """The winning row of one try (module docstring): the free row of least overlap that
+    admits a placing order, else the row of least overlap."""
+    config, m = t.config, xy.shape[1]
+    fits = (t.room > 0).all(-1).all(-1).numpy()  # (R,) every grown footprint fits the region
+    grown_np, body_np = t.half.numpy(), t.body.numpy()
     worst = _depths(xy, grown_np, body_np, fxy_np, fh_np, config.gap, config.ordered)  # (R,)
     worst = np.where(fits, worst, np.inf)
     best = int(np.argmin(worst))
@@ -261,15 +327,15 @@ def pack(
                 break
         if len(order) != m:
             order = placing_order(xy[best], grown_np[best], body_np[best], config.gap, config.tol)
-    yaws = np.where(turn[best].numpy(), math.pi / 2, 0.0)
+    yaws = np.where(t.turn[best].numpy(), math.pi / 2, 0.0)
     return PackResult(
         positions=xy[best],
         yaws=yaws,
-        axes=axis[best].numpy(),
+        axes=t.axis[best].numpy(),
         ok=bool(worst[best] <= config.tol) and len(order) == m,
         overlap=float(worst[best]),
-        time=time.perf_counter() - t0,
-        tries=r * steps,
+        time=took,
+        tries=config.restarts * config.steps,
         order=order,
     )
 

@@ -5,12 +5,20 @@ gradient matches finite differences, and the sampled baseline gives the same kin
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 import torch
 
-from tamp.geo.ours.pack import PackConfig, PackError, overlap_loss, pack, pack_sampled
+from tamp.geo.ours.pack import (
+    PackConfig,
+    PackError,
+    overlap_loss,
+    pack,
+    pack_sampled,
+    pack_tries,
+)
 
 TIGHT = ((0.0, 0.0), (0.17, 0.105))  # five 5 cm squares fill 70 % of it: 3 + 2 in two rows
 SQUARES = [(0.025, 0.025)] * 5
@@ -33,6 +41,20 @@ def test_pack_places_five_squares_in_a_region_that_holds_them_only_tightly(seed)
     result = pack(TIGHT, SQUARES, seed=seed)
     assert result.ok and result.positions.shape == (5, 2)
     assert _free_and_inside(TIGHT, SQUARES, result.positions)  # checked independently
+
+
+def test_tries_packed_together_give_each_the_packing_it_gets_alone():
+    config = PackConfig(fingers=0.07, side=0.033)
+    tries = [(replace(config, margin=margin), seed) for margin in (0.01, 0.0) for seed in (0, 3)]
+    fixed = ([(0.05, 0.05)], [(0.02, 0.02)])
+    together = pack_tries(TIGHT, SQUARES[:3], *fixed, tries, walled=False)
+    for (at, seed), got in zip(tries, together, strict=True):
+        alone = pack(TIGHT, SQUARES[:3], *fixed, at, seed, walled=False)
+        assert np.array_equal(got.positions, alone.positions)
+        assert (got.ok, got.overlap, got.order) == (alone.ok, alone.overlap, alone.order)
+        assert np.array_equal(got.yaws, alone.yaws) and np.array_equal(got.axes, alone.axes)
+    with pytest.raises(PackError, match="margin and restarts only"):
+        pack_tries(TIGHT, SQUARES, tries=[(config, 0), (replace(config, steps=10), 0)])
 
 
 def test_pack_says_when_the_region_cannot_hold_them():
