@@ -191,8 +191,8 @@ class SphereCollision:
         minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
         high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
         self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
-        # (L, 26) the supports from the box's centre: d . (p - c) - (s - d . c) = d . p - s
-        self._dop_c = self._dop - self._aabb_c @ self._directions.T
+        # (26, L) the supports from the box's centre: d . (p - c) - (s - d . c) = d . p - s
+        self._dop_c = np.ascontiguousarray((self._dop - self._aabb_c @ self._directions.T).T)
 
     def _clusters(self, spheres) -> None:
         """The self-collision narrow phase's clusters (`sphere_fk._clusters`), as float32."""
@@ -437,12 +437,11 @@ class SphereCollision:
         if len(self._names) > 1:  # the bounding spheres against the boxes' world bounds
             near = np.empty((links, len(self._names) - 1, n), dtype=bool)  # (L, O, B)
             near[:] = scene[:links, 1:, None]
-            d = np.empty(near.shape, dtype=_FLOAT)
-            for axis in range(3):  # batch-last: every operation runs over rows of B
+            d, inside = np.empty(near.shape, dtype=_FLOAT), np.empty_like(near)
+            for axis in range(3):  # batch-last, in place: every operation over rows of B
                 room = self._world_half[axis] + (reach[:, None] + m)  # (L, O)
                 np.subtract(mid_t[:, axis, None], self._box_c[:, axis, None], out=d)
-                np.abs(d, out=d)
-                near &= d < room[..., None]
+                near &= np.less(np.abs(d, out=d), room[..., None], out=inside)
             near_l, near_o, near_b = np.nonzero(near)  # (M,) each
             near_b, near_l, near_o = pending(near_b, near_l, near_o)
             for k, group, rows, link in self._by_bucket(near_b, near_l):
@@ -455,7 +454,8 @@ class SphereCollision:
             own = own & (self._apart_from > -math.inf)
         a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
         apart = reach[a] + reach[c] + self.self_margin  # (K',)
-        gap = mid_t[a] - mid_t[c]  # (K', 3, B)
+        gap = mid_t[a]  # (K', 3, B)
+        gap -= mid_t[c]
         gap *= gap
         close = gap.sum(1) < np.square(apart)[:, None]  # (K', B)
         if self.self_margin < APART_CLEARANCE:  # ... and those it keeps apart at these angles
@@ -497,7 +497,7 @@ class SphereCollision:
         grown = self._cluster_radii[cluster] + self.gap  # (N', S)
         # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
         near_n, near_s = np.nonzero(_near_box(inner, box_h, grown + self.self_margin))
-        gap = _dop_gap(inner[near_n, near_s], self._directions, self._dop_c[frame[near_n]])
+        gap = _dop_gap(inner[near_n, near_s], self._directions, self._dop_c[:, frame[near_n]])
         gap -= grown[near_n, near_s]  # (K,) the 26-DOP's bound
         least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its spheres
         np.minimum.at(least, pair[near_n], gap)

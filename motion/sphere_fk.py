@@ -293,10 +293,12 @@ def _near_box(d: np.ndarray, half: np.ndarray, reach) -> np.ndarray:
 
 def _dop_gap(points: np.ndarray, directions: np.ndarray, support: np.ndarray) -> np.ndarray:
     """(K,) the 26-DOP bound max_k (d_k . p - support_k) of points p (K, 3) in their DOP's
-    frame, supports (K, 26): three products broadcast over the directions (26, 3), not a
-    matrix product, which OpenBLAS would spread over a second thread."""
-    out = points[:, 0, None] * directions[:, 0]  # (K, 26)
-    out += points[:, 1, None] * directions[:, 1]
-    out += points[:, 2, None] * directions[:, 2]
+    frame, supports (26, K): three products over rows of K, the directions (26, 3) down the
+    side, in place (a fresh large array costs its page faults), not a matrix product, which
+    OpenBLAS would spread over a second thread."""
+    out = np.multiply(directions[:, 0, None], points[:, 0])  # (26, K)
+    term = np.multiply(directions[:, 1, None], points[:, 1])  # (26, K)
+    out += term
+    out += np.multiply(directions[:, 2, None], points[:, 2], out=term)
     out -= support
-    return out.max(-1)
+    return out.max(0)

@@ -407,6 +407,6 @@ def test_the_26_dop_bound_equals_the_matrix_product():
     rng = np.random.default_rng(3)
     model = SphereCollision()
     p = rng.normal(0.0, 0.2, (500, 3)).astype(np.float32)
-    support = model._dop_c[rng.integers(0, len(PARTS), 500)]  # (500, 26)
-    want = (p.astype(float) @ model._directions.T.astype(float) - support).max(-1)
+    support = model._dop_c[:, rng.integers(0, len(PARTS), 500)]  # (26, 500)
+    want = (p.astype(float) @ model._directions.T.astype(float) - support.T).max(-1)
     assert np.allclose(_dop_gap(p, model._directions, support), want, atol=1e-6)
