@@ -286,13 +286,16 @@ def check_move(
     q_now=None,
     seed: int = 0,
     full: bool = True,
+    quick: bool | None = None,
 ) -> MoveCheck:
     """Decide ``move`` in ``scene`` (see the module docstring). ``grasps``: the candidates to
     try (default: ``move.grasp`` when set, else `candidate_grasps` in `grasp_order`);
     ``q_now`` (J,): where the arm starts (default ``tools.q``); ``seed`` seeds the motion
     planner when ``tools.guard.plan`` reroutes blocked phases. ``full`` False: the verdict of
     `quick_check` alone (ok with the first grasp it passes, no phases), the cheap test a search
-    expands with before the full check has the final word."""
+    expands with before the full check has the final word. ``quick``: whether the full check
+    runs `quick_check` first (None: ``tools.quick``); for one grasp it only repeats what the
+    full plan decides anyway."""
     t0 = time.perf_counter()
     tools.checks += 1
 
@@ -320,7 +323,8 @@ def check_move(
         return verdict(ok=False, failure="no_grasp", evidence={"object": o.name, "kind": o.kind})
     q = tools.q if q_now is None else np.asarray(q_now, dtype=np.float64)
     support = support_box(scene, dict(facts.supports).get(o.name, TABLE))
-    quick = quick_check(scene, move, tools, grasps, q) if tools.quick or not full else {}
+    quick = tools.quick if quick is None else quick
+    quick = quick_check(scene, move, tools, grasps, q) if quick or not full else {}
     tried, last = [], ("collision", {})
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
     for g in grasps:

@@ -361,11 +361,15 @@ def _check_in_turn(check, world, geo: GeoMove, tools, order, chunk: int = CHECK_
     """The full check of ``geo`` with the grasps of ``order`` (best first), ``chunk`` at a
     time: the first that passes wins, as one call with them all would give (`check_move`
     tries its grasps in order), but the batched IK and the arm's collision tests of its cheap
-    half (`tamp.geo.check.quick_check`) cover only the grasps up to the chunk that passes.
+    half (`tamp.geo.check.quick_check`) cover only the grasps up to the chunk that passes;
+    a chunk of one grasp goes straight to its full plan (the cheap half would only repeat
+    the poses and collision tests the full plan decides).
     A refusal is the last chunk's that tried a grasp, listing every grasp tried."""
     tried, verdict, last = [], None, None
     for k in range(0, max(len(order), 1), chunk):
-        verdict = check(world, geo, tools, grasps=order[k : k + chunk])
+        grasps = order[k : k + chunk]
+        # one grasp: no cheap half first (`check_move`'s ``quick``), its full plan decides
+        verdict = check(world, geo, tools, grasps=grasps, quick=None if len(grasps) > 1 else False)
         if verdict.ok or verdict.failure in BEFORE_GRASPS:
             return verdict
         if not getattr(verdict, "tried", ()):

@@ -73,7 +73,7 @@ class _Refuse:
     def __init__(self, n: int) -> None:
         self.n, self.seen = n, []
 
-    def __call__(self, world, move, tools, grasps=()):
+    def __call__(self, world, move, tools, grasps=(), quick=None):
         self.seen.append((move.obj, move.place.name))
         if len(self.seen) <= self.n:
             return MoveCheck(ok=False, failure="collision", evidence={"fake": True})
