@@ -64,6 +64,12 @@ class PlannerConfig:
     fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans);
     # "greedy": lazy greedy best-first on its `estimate` and `helpful` moves (far larger
     # problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
+    improve_s: float = 0.0  # anytime improvement: after the windows (and `shorten`) give a
+    # plan of L moves, A* on the domain's lower bound looks for one of fewer than L moves for
+    # at most this many seconds (within ``time_limit_s`` when set) and ``improve_nodes``
+    # expansions; a plan found replaces it and is a shortest one (`task.planner._improve`).
+    # Only without beliefs and a cost source; 0: off
+    improve_nodes: int = 20_000  # state expansions the improvement may spend per problem
     window_share: float = 1.0  # with a time limit and the fallback on, the windows stop at
     # this share of the limit and the fallback searches in the rest (1: the windows may use all
     # of it, leaving the complete search none; the STRIPS lift's defaults: 0.5)
@@ -95,7 +101,8 @@ class PlannerConfig:
 
         if self.park_from is not None and self.park_from < 1:
             raise TampError(f"PlannerConfig.park_from must be >= 1 or None, got {self.park_from}")
-        for name in ("horizon", "iters", "restarts", "max_windows", "fallback_nodes"):
+        names = ("horizon", "iters", "restarts", "max_windows", "fallback_nodes", "improve_nodes")
+        for name in names:
             if getattr(self, name) < 1:
                 raise TampError(f"PlannerConfig.{name} must be >= 1, got {getattr(self, name)}")
         if self.proof_every < 0:
@@ -121,6 +128,8 @@ class PlannerConfig:
         if not 0.0 < self.window_share <= 1.0:
             share = self.window_share
             raise TampError(f"PlannerConfig.window_share must be in (0, 1], got {share}")
+        if not self.improve_s >= 0:
+            raise TampError(f"PlannerConfig.improve_s must be >= 0, got {self.improve_s}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:
             raise TampError(f"PlannerConfig.time_limit_s must be > 0, got {self.time_limit_s}")
         sharp = self.decode_tau if self.decode_tau is not None else self.tau_end

@@ -13,6 +13,10 @@ kept last so that `task.symbolic.validate` names it); with the crisp check on an
 protocol that never happens. Under the perceived protocol a window that predicts the goal is
 confirmed by one more reading (a new image, no optimisation), so a perfect reading gives
 exactly the true protocol's plans.
+
+With ``PlannerConfig(improve_s=...)`` a plan found (without beliefs and move costs) is handed to
+an anytime improvement (`_improve`): A* on the domain's lower bound, cut at the plan's length,
+returns a shorter plan when one exists within its budget, a shortest one.
 """
 
 from __future__ import annotations
@@ -294,6 +298,43 @@ def _fall_back(
     return found
 
 
+def _improve(
+    domain: Domain,
+    problem: Problem,
+    moves: Sequence[Move],
+    config: PlannerConfig,
+    deadline: float | None,
+) -> tuple[tuple[Move, ...], dict]:
+    """The anytime improvement (`PlannerConfig.improve_s`) of a plan of ``moves`` that reaches
+    the goal: A* on the domain's lower bound from the initial state, cutting every state whose
+    moves so far plus bound reach ``len(moves)`` (`lazy_best_first`'s ``below``), within
+    ``config.improve_nodes`` expansions and ``config.improve_s`` seconds (at most until
+    ``deadline``, the time limit). Returns the plan (the one found, a shortest one, or
+    ``moves`` unchanged) and its stats: ``improved_from`` (the length before, None when
+    unchanged), ``proved_optimal`` (the bound from the initial state equals the length, or the
+    search completed), the search's status, expansions and seconds."""
+    t0 = time.perf_counter()
+    length = len(moves)
+    start = domain.initial_state(problem)
+    stats = {"improved_from": None, "moves": length, "proved_optimal": False, "expanded": 0}
+    if domain.lower_bound(problem, start) >= length:
+        stats.update(proved_optimal=True, status="bound", time_s=time.perf_counter() - t0)
+        return tuple(moves), stats
+    end = t0 + config.improve_s if deadline is None else min(deadline, t0 + config.improve_s)
+    found = lazy_best_first(domain, problem, start, None, config.improve_nodes, end, below=length)
+    better = found.status is SearchStatus.SOLVED and len(found.moves) < length
+    if better:
+        moves = found.moves
+        stats.update(improved_from=length, moves=len(moves))
+    stats.update(
+        proved_optimal=found.status in (SearchStatus.SOLVED, SearchStatus.UNSOLVABLE),
+        status=found.status.value,
+        expanded=found.expanded,
+        time_s=time.perf_counter() - t0,
+    )
+    return tuple(moves), stats
+
+
 def _next_window(
     domain: Domain,
     problems: Sequence[Problem],
@@ -429,6 +470,12 @@ def _run(
         for i, p in enumerate(problems):
             if solved[i] and illegal[i] is None:
                 moves[i] = list(shorten(domain, p, moves[i]))
+    improved: dict[int, dict] = {}
+    if config.improve_s > 0 and source is None and costs is None:
+        for i, p in enumerate(problems):
+            if solved[i] and illegal[i] is None:
+                better, improved[i] = _improve(domain, p, moves[i], config, deadline)
+                moves[i] = list(better)
     on_done(len(active))
     elapsed = time.perf_counter() - start
     results = []
@@ -448,6 +495,8 @@ def _run(
             )
         if illegal[i] is not None:
             status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
+        if i in improved:
+            stats["improve"] = improved[i]
         if i in searched:
             stats["fallback"] = {"trigger": trigger[i], **searched[i].stats()}
             if searched[i].status is SearchStatus.UNSOLVABLE:

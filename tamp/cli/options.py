@@ -20,6 +20,7 @@ from tamp.cli.types import (
     positive_float,
     radius,
     seconds,
+    seconds_or_off,
     share,
     window,
     window_list,
@@ -52,6 +53,7 @@ _OVERRIDES = (
     "time_limit_s",
     "lambda_motion",
     "park_free",
+    "improve_s",
     "device",
 )
 
@@ -131,6 +133,16 @@ def planner_options(horizon_list: bool) -> argparse.ArgumentParser:
         type=seconds,
         metavar="SECONDS",
         help="stop planning at this wall-clock limit with the moves so far, and say so (none)",
+    )
+    g.add_argument(
+        "--improve",
+        dest="improve_s",
+        type=seconds_or_off,
+        metavar="SECONDS",
+        help="anytime improvement: after a plan of L moves is found, A* on the domain's lower "
+        f"bound looks for one shorter than L for up to this long and {d.improve_nodes} "
+        "expansions (within --time-limit), proving it optimal when it completes; 0 = off "
+        f"({d.improve_s:g}; without a cost source and perception only)",
     )
     g.add_argument(
         "--device",

@@ -277,6 +277,7 @@ _PLANNER_FLAGS = (
     "lookahead",
     "max_windows",
     "park_free",
+    "improve_s",
     "time_limit_s",
     "tau_end",
     "lambda_motion",

@@ -84,6 +84,10 @@ def seconds(text: str) -> float:  # a positive number of seconds
     return value
 
 
+def seconds_or_off(text: str) -> float:  # seconds >= 0; 0 turns a phase off
+    return 0.0 if text.strip() in ("0", "0.0") else seconds(text)
+
+
 def nonnegative(text: str) -> int:
     return 0 if text.strip() == "0" else positive(text)
 

@@ -17,6 +17,11 @@ rules out, states the lower bound calls dead ends cut): it ends ``SOLVED`` with 
 within these choices), or ``BUDGET`` when ``max_nodes`` expansions or the deadline run out.
 With ``weight`` 1 a plan is a shortest one among the feasible moves.
 
+``below`` bounds the plans sought (the planner's anytime improvement, `task.planner`): a
+successor whose moves so far plus lower bound reach ``below`` is cut, so only plans of fewer
+than ``below`` moves are found, and UNSOLVABLE then says that none exists within these choices
+(with ``weight`` 1: a plan of ``below`` moves in hand is a shortest one).
+
 `lazy_greedy` is the same search made greedy, for problems far beyond A*'s reach (the generic
 STRIPS lift's fallback, `PlannerConfig.fallback_search`): Fast Downward's lazy greedy
 best-first search on the domain's inadmissible ``estimate`` (h_FF for the lift), with deferred
@@ -93,10 +98,12 @@ def lazy_best_first(
     max_nodes: int = 20_000,
     deadline: float | None = None,
     weight: float = 1.0,
+    below: float = math.inf,
 ) -> LazyResult:
     """Plan from crisp ``start`` to ``problem``'s goal over ``domain``'s moves that ``feasible``
     allows (None: all), checked lazily (see the module docstring). ``deadline``: a
-    ``time.perf_counter()`` value after which the search stops with BUDGET."""
+    ``time.perf_counter()`` value after which the search stops with BUDGET. ``below``: only
+    plans of fewer moves (states with moves so far + lower bound >= ``below`` are cut)."""
     t0 = time.perf_counter()
     allowed: dict[tuple[Hashable, Move], bool] = {}
     checked = 0
@@ -124,6 +131,9 @@ def lazy_best_first(
     h0 = domain.lower_bound(problem, start)
     if math.isinf(h0):
         return done(SearchStatus.UNSOLVABLE, (), "the start is a dead end (lower bound INF)")
+    if h0 >= below:
+        why = f"no plan of fewer than {below:g} moves: the lower bound from the start is {h0:g}"
+        return done(SearchStatus.UNSOLVABLE, (), why)
     heapq.heappush(frontier, (weight * h0, 0, next(tie), start))
     pending[start] = {0: []}
     while frontier:
@@ -157,19 +167,20 @@ def lazy_best_first(
             if nxt in parent:
                 continue
             h = domain.lower_bound(problem, nxt)
-            if math.isinf(h):
-                continue  # a dead end: no plan passes through it
+            if math.isinf(h) or g + 1 + h >= below:
+                continue  # a dead end, or no plan through it is shorter than ``below``
             at = pending.setdefault(nxt, {})
             if g + 1 not in at:
                 at[g + 1] = []
                 heapq.heappush(frontier, (g + 1 + weight * h, -(g + 1), next(tie), nxt))
             at[g + 1].append((state, move))
     ruled = sum(not v for v in allowed.values())
+    shorter = "" if math.isinf(below) else f" of fewer than {below:g} moves"
     return done(
         SearchStatus.UNSOLVABLE,
         (),
-        f"no plan exists within these choices: {len(parent)} reachable states expanded, "
-        f"{ruled} moves ruled out",
+        f"no plan{shorter} exists within these choices: {len(parent)} reachable states "
+        f"expanded, {ruled} moves ruled out",
     )
 
 
