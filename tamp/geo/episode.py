@@ -401,7 +401,8 @@ def _act(
     want = read_facts(moved(world, move.obj, move.place.pose), OBSERVED).atoms
     got = read_facts(seen, OBSERVED).atoms
     if want != got:
-        evidence = {"missing": sorted(want - got), "extra": sorted(got - want)}
+        # what the run itself noticed (re-grasps on release, corrections) stays beside it
+        evidence = {**ran.evidence, "missing": sorted(want - got), "extra": sorted(got - want)}
         return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, path
     return MoveRecord(move.text(), name, True, None, ran.evidence), seen, path
 

@@ -14,8 +14,10 @@ the hand opens and backs out along its descent. After the release the fingers mu
 (their opening within ``width_tol`` of the stroke): an object that turned a little in the
 fingers on the way can stay wedged between the open pads (PyBullet: a pad's edge sunk a
 millimetre into it; the retreat then carries it off and drops it anywhere, once on a post's
-top), so the hand closes on it again and reopens, at most ``release_tries`` times, before
-it retreats; the run's evidence says how often (``regrasped``), or that it stayed stuck
+top), so the hand closes on it again and reopens, at most ``release_tries`` times, and then
+turns the wrist a little each way and back with the fingers open (``wiggles``: twice in
+PyBullet a pad stayed sunk after both re-grasps, sorting variant 11), before it retreats; the
+run's evidence says how often (``regrasped``, ``wiggled``), or that it stayed stuck
 (``not_released``). The back-off after a missed grasp frees the object the same way (the
 fingers had closed on it askew) before it backs up. Nothing here reads ground truth.
 
@@ -42,7 +44,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from motion.pick_place import Phase, corrected_place, split_lower
-from motion.trajectory import JointTrajectory
+from motion.trajectory import JointTrajectory, straight_segment
 from robots.panda import PANDA
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
@@ -63,6 +65,9 @@ class RunConfig:
     low_look: float = 0.02  # m: ... and again this far above the release, before the last bit
     release_tries: int = 2  # closings on an object still between the opened fingers
     reclose_s: float = 0.25  # s: the gripper's closing time (`PickPlaceConfig.close_time`)
+    # ... then turns of the wrist (the last joint, rad, each and back) with the fingers open:
+    # a pad's edge sunk into an object that turned in the fingers comes out sideways
+    wiggles: tuple[float, ...] = (0.03, -0.03, 0.06, -0.06)
 
 
 @dataclass(frozen=True)
@@ -234,8 +239,9 @@ def _release(sim, config: RunConfig, on_frame, closing: Expected, open_s: float)
     """After the hand opened on an object (``closing.handled``): while the fingers do not
     stand open (`opened`), the object wedged between them, close on it (the contacts
     ``closing`` expects) and open again for ``open_s`` s, the hand where it stands, at most
-    ``config.release_tries`` times. The evidence: ``regrasped`` (closings), and
-    ``not_released`` (the last reading) when the fingers never opened."""
+    ``config.release_tries`` times; then turn the wrist a little each way and back
+    (``config.wiggles``) until they do. The evidence: ``regrasped`` (closings), ``wiggled``
+    (turns), and ``not_released`` (the last reading) when the fingers never opened."""
     stuck, tries = opened(sim, config), 0
     while stuck is not None and tries < config.release_tries:
         tries += 1
@@ -246,6 +252,20 @@ def _release(sim, config: RunConfig, on_frame, closing: Expected, open_s: float)
         sim.run(reopen, "open", on_frame=on_frame, expected=Expected(closing.handled))
         stuck = opened(sim, config)
     out = {"regrasped": tries} if tries else {}
+    wiggled = 0
+    for turn in config.wiggles if stuck is not None else ():
+        wiggled += 1
+        q = sim.arm_q()
+        turned = q.copy()
+        turned[-1] += turn
+        touching = Expected(closing.handled)
+        for a, b in ((q, turned), (turned, q)):  # turn, open there, turn back
+            sim.run(straight_segment(a, b, sim.dt), "open", on_frame=on_frame, expected=touching)
+        stuck = opened(sim, config)
+        if stuck is None:
+            break
+    if wiggled:
+        out["wiggled"] = wiggled
     return out if stuck is None else {**out, "not_released": stuck}
 
 

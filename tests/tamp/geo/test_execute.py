@@ -84,11 +84,26 @@ def test_an_object_wedged_between_the_opened_fingers_is_gripped_again_and_let_go
 
 def test_fingers_that_never_open_are_evidence_of_the_move_after_the_tries():
     move, check = _move()
-    hand = _Hand(stuck=5)
+    hand = _Hand(stuck=50)
     config = RunConfig()
     ran = run_move(hand, move, check, ("table", "table"), config)
     assert ran.evidence["regrasped"] == config.release_tries
+    assert ran.evidence["wiggled"] == len(config.wiggles)
     assert ran.evidence["not_released"]["finger_width"] == pytest.approx(WEDGED.width)
+
+
+def test_an_object_the_regrasps_leave_wedged_is_freed_by_turning_the_wrist():
+    """Sorting variant 11 in PyBullet: two re-grasps left the fingers at 5.1 cm pushing 30 N;
+    turning the wrist a little each way with the fingers open let the object go."""
+    move, check = _move()
+    hand = _Hand(stuck=5)  # the open phase and two reopenings, then one turn and back
+    config = RunConfig()
+    ran = run_move(hand, move, check, ("table", "table"), config)
+    assert ran.ok and ran.evidence["regrasped"] == config.release_tries
+    assert ran.evidence["wiggled"] == 2 and "not_released" not in ran.evidence
+    assert hand.gripper().width == pytest.approx(2 * PANDA.finger_open)
+    after_open = [g for g, _ in hand.commands[7:-1]]  # re-grasps, then turns with it open
+    assert after_open == ["closed", "open"] * config.release_tries + ["open"] * 4
 
 
 def test_a_missed_grasp_frees_an_object_wedged_askew_between_the_fingers_before_backing_off():
