@@ -94,6 +94,18 @@ def _given_steps(path: str | None, problem: Problem):
     return read_given(path, problem)
 
 
+def _out_dir(out: str | None) -> Path | None:
+    """``--out`` created (None without it); one line when it cannot be."""
+    if not out:
+        return None
+    path = Path(out)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise TampError(f"cannot create {path} ({exc.strerror or exc})") from None
+    return path
+
+
 def run_command(args: argparse.Namespace) -> int:
     recorded = run_config(args)  # refused combinations: before any work
     out_folder(args.out)
@@ -108,12 +120,7 @@ def run_command(args: argparse.Namespace) -> int:
     if config.observe == "camera":
         checkpoint(config.checkpoint)
     steps = _given_steps(args.plan, problem)
-    out = Path(args.out) if args.out else None
-    if out is not None:
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise TampError(f"cannot create {out} ({exc.strerror or exc})") from None
+    out = _out_dir(args.out)
     video = None
     if out is not None and not args.no_video:  # its renderer process starts now
         video = EpisodeVideo(out / f"episode.{args.video_format}", VIDEO_FPS)
@@ -194,12 +201,7 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     from tamp.geo.search import SearchConfig
     from tamp.loop.faults import Injection
 
-    out = Path(args.out) if args.out else None
-    if out is not None:
-        try:
-            out.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise TampError(f"cannot create {out} ({exc.strerror or exc})") from None
+    out = _out_dir(args.out)
     video = None
     if recorded["video"] is not None:
         video = out / f"episode.{recorded['video']}"

@@ -83,19 +83,10 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
     """The `GeoRun` of the scene file at ``path`` (its geometry must explain every object);
     ``hanoi``: the canonical Tower of Hanoi, which the motion-aware planner plans through its
     PDDL domain."""
+    from tamp.world.blocks import explained_scene
     from tamp.world.goal import load_goal
-    from tamp.world.load import load_scene
-    from tamp.world.relations import read_facts
 
-    scene = load_scene(path)
-    if not scene.objects:
-        raise SceneFileError(f"{path}: objects: the scene has no movable object to plan for")
-    facts = read_facts(scene)
-    if facts.unexplained:
-        raise SceneFileError(
-            f"{path}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
-            + "; ".join(facts.issues)
-        )
+    scene, _ = explained_scene(path)
     domain = None
     if hanoi and planner == DEFAULT_PLANNER:
         from task.symbolic.pickplace import hanoi as rules

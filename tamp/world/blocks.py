@@ -53,16 +53,8 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
     """The Blocksworld episode of the scene file at ``path`` and the goal ``goal`` (inline PDDL
     or a file, `load_goal`), on ``base``'s block size; SceneFileError, one line, when the loop
     cannot run it (see the module docstring)."""
-    scene = load_scene(path)
+    scene, facts = explained_scene(path)
     label = str(path)
-    if not scene.objects:
-        raise SceneFileError(f"{label}: objects: the scene has no movable object to plan for")
-    facts = read_facts(scene)
-    if facts.unexplained:
-        raise SceneFileError(
-            f"{label}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
-            + "; ".join(facts.issues)
-        )
     _check_blocks(scene, base.block_size, label)
     if not scene.parking:
         raise BeyondLoop(
@@ -100,6 +92,21 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
     poses = tuple((o.name, o.pose) for o in scene.objects)
     _check_reader(problem, dict(poses), config, label)
     return SceneTask(scene, wanted, facts, problem, poses, config)
+
+
+def explained_scene(path: str | Path) -> tuple[Scene, Facts]:
+    """The scene file at ``path`` and the facts read from its geometry; SceneFileError when it
+    has no movable object or the geometry cannot explain one (any episode needs both)."""
+    scene = load_scene(path)
+    if not scene.objects:
+        raise SceneFileError(f"{path}: objects: the scene has no movable object to plan for")
+    facts = read_facts(scene)
+    if facts.unexplained:
+        raise SceneFileError(
+            f"{path}: the geometry cannot explain object(s) {', '.join(facts.unexplained)}: "
+            + "; ".join(facts.issues)
+        )
+    return scene, facts
 
 
 def _check_blocks(scene: Scene, size: float, label: str) -> None:
