@@ -12,6 +12,7 @@ independent of the blocksworld code so tests can cross-check the two on small pr
 
 from __future__ import annotations
 
+import functools
 import heapq
 import itertools
 from collections import deque
@@ -62,12 +63,20 @@ def moves_lower_bound(problem: Problem, state: tuple[str, ...]) -> int:
     the table (the bound ignores their capacity: a relaxation, so it stays admissible); a
     block whose goal is one slot must move while it stands anywhere else (the geometric
     planner's region cells: without this the bound was blind to every cell goal)."""
+    names, goal, claimed = _bound_codes(problem)
+    return _heuristic(tuple(names[s] for s in state), goal, claimed)
+
+
+@functools.lru_cache(maxsize=256)
+def _bound_codes(problem: Problem) -> tuple[dict[str, int], dict[int, int], dict[int, int]]:
+    """`moves_lower_bound`'s codes of ``problem``, built once per problem (a search calls the
+    bound for every state it generates): each name's code, the goal and the claimed targets.
+    Read only."""
     n = problem.n
     names = {name: i if i < n else n + 1 + i for i, name in enumerate(problem.targets)}
     names[TABLE] = n
-    code = tuple(names[s] for s in state)
     goal = {names[x]: names[y] for x, y in problem.goal}
-    return _heuristic(code, goal, {y: x for x, y in goal.items() if y < len(code)})
+    return names, goal, {y: x for x, y in goal.items() if y < n}
 
 
 def _successors(state: _Code) -> list[tuple[int, int]]:
