@@ -70,6 +70,9 @@ class PlannerConfig:
     # expansions; a plan found replaces it and is a shortest one (`task.planner._improve`).
     # Only without beliefs and a cost source; 0: off
     improve_nodes: int = 20_000  # state expansions the improvement may spend per problem
+    improve_up_to: int | None = None  # improve only problems of at most this many entities
+    # (None: any size); Blocksworld's `planner_defaults` turn the improvement on up to 15
+    # blocks, where its A* proved the optimum within seconds (at 20 it never finished)
     window_share: float = 1.0  # with a time limit and the fallback on, the windows stop at
     # this share of the limit and the fallback searches in the rest (1: the windows may use all
     # of it, leaving the complete search none; the STRIPS lift's defaults: 0.5)
@@ -128,6 +131,10 @@ class PlannerConfig:
         if not 0.0 < self.window_share <= 1.0:
             share = self.window_share
             raise TampError(f"PlannerConfig.window_share must be in (0, 1], got {share}")
+        if self.improve_up_to is not None and self.improve_up_to < 1:
+            raise TampError(
+                f"PlannerConfig.improve_up_to must be >= 1 or None, got {self.improve_up_to}"
+            )
         if not self.improve_s >= 0:
             raise TampError(f"PlannerConfig.improve_s must be >= 0, got {self.improve_s}")
         if self.time_limit_s is not None and not self.time_limit_s > 0:

@@ -472,8 +472,9 @@ def _run(
                 moves[i] = list(shorten(domain, p, moves[i]))
     improved: dict[int, dict] = {}
     if config.improve_s > 0 and source is None and costs is None:
+        small = config.improve_up_to
         for i, p in enumerate(problems):
-            if solved[i] and illegal[i] is None:
+            if solved[i] and illegal[i] is None and (small is None or p.n <= small):
                 better, improved[i] = _improve(domain, p, moves[i], config, deadline)
                 moves[i] = list(better)
     on_done(len(active))

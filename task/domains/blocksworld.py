@@ -286,8 +286,11 @@ class Blocksworld:
     size_name = "blocks"
     goal_losses = GOAL_LOSSES
     # from 30 blocks the windows are ranked with moves to the table free (as Slaney and
-    # Thiebaux's US), which finds the long plans of big problems faster (`PlannerConfig.parks`)
-    planner_defaults = MappingProxyType({"park_from": 30})
+    # Thiebaux's US), which finds the long plans of big problems faster (`PlannerConfig.parks`);
+    # up to 15 blocks a plan is handed to the anytime improvement, A* below its length for at
+    # most 30 s (`PlannerConfig.improve_s`): every plan of the long set optimal, PlanBench at
+    # no measurable cost, 1.7x the time on 10-14-block problems (BENCHMARKS.md)
+    planner_defaults = MappingProxyType({"park_from": 30, "improve_s": 30.0, "improve_up_to": 15})
     distributions = True
     encode = staticmethod(encode)
     soft_legality = staticmethod(soft_legality)

@@ -102,7 +102,33 @@ def test_on_never_longer_nor_invalid_and_off_unchanged():
 def test_off_by_default_and_bad_settings_refused():
     problem = random_problem(5, 0)
     assert "improve" not in plan(problem, CHEAP).stats
+    with pytest.raises(TampError, match="improve_up_to"):
+        PlannerConfig(improve_up_to=0)
     with pytest.raises(TampError, match="improve_s"):
         PlannerConfig(improve_s=-1.0)
     with pytest.raises(TampError, match="improve_nodes"):
         PlannerConfig(improve_nodes=0)
+
+
+def test_blocksworld_improves_its_plans_up_to_its_size_cap():
+    """On by the domain's defaults (`PlannerConfig.for_domain`) up to ``improve_up_to`` blocks:
+    a 6-block plan is handed to the improvement, a bigger one is not."""
+    blocks = replace(PlannerConfig.for_domain("blocksworld"), restarts=2, iters=15, max_windows=10)
+    problem = random_problem(6, 1)
+    done = plan(problem, blocks)
+    assert done.solved and done.stats["improve"]["proved_optimal"]
+    assert len(done.plan.moves) == len(optimal_moves(problem))
+    capped = plan(problem, replace(blocks, improve_up_to=5))
+    assert "improve" not in capped.stats
+
+
+def test_the_improve_option_lifts_the_domain_s_size_cap():
+    """``--improve`` takes effect at any size: the domain's cap belongs to its default."""
+    from tamp.cli import build_parser
+    from tamp.cli.options import planner_config
+
+    parser = build_parser()
+    default = planner_config(parser.parse_args(["plan", "d.pddl", "p.pddl"]), "blocksworld")
+    assert (default.improve_s, default.improve_up_to) == (30.0, 15)
+    given = planner_config(parser.parse_args(["plan", "d", "p", "--improve", "5"]), "blocksworld")
+    assert (given.improve_s, given.improve_up_to) == (5.0, None)
