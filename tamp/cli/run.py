@@ -240,10 +240,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     if video is not None and video.is_file():
         written.append(video.name)
     if out is not None:
-        (out / "report.json").write_text(json.dumps(body, indent=2, allow_nan=False))
+        (out / "report.json").write_text(json.dumps(body, indent=2, allow_nan=False, default=str))
         written.append("report.json")
     if args.json:
-        print(json.dumps(body, indent=2, allow_nan=False))
+        print(json.dumps(body, indent=2, allow_nan=False, default=str))
     else:
         print("\n".join(geo_lines(report)))
         if written:
