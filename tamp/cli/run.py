@@ -95,15 +95,11 @@ def _given_steps(path: str | None, problem: Problem):
 
 
 def _out_dir(out: str | None) -> Path | None:
-    """``--out`` created (None without it); one line when it cannot be."""
-    if not out:
-        return None
-    path = Path(out)
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise TampError(f"cannot create {path} ({exc.strerror or exc})") from None
-    return path
+    """``--out`` created (None without it); one line when it cannot be
+    (`tamp.bench.results.out_folder`)."""
+    from tamp.bench.results import out_folder
+
+    return out_folder(out) if out else None
 
 
 def run_command(args: argparse.Namespace) -> int:
