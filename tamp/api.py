@@ -442,8 +442,10 @@ def run_geometric(
     goal file the default ``goal``); ``planner``: one of `tamp.geo.episode.PLANNERS` (the
     motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
     Returns a `tamp.geo.episode.GeoReport`."""
+    from tamp.bench.geo.run import LIMITS  # tamp run's and bench tamp's limits
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.scene_file import scene_episode
+    from tamp.geo.search import SearchConfig
 
     task = scene_episode(str(scene), goal, planner)
     return run_geo_episode(
@@ -452,7 +454,10 @@ def run_geometric(
         task.planner,
         sim,
         seed=seed,
+        planner_config=SearchConfig(seed=seed, max_time_s=LIMITS["planning_s"]),
         video=video,
+        max_moves=LIMITS["max_moves"],
+        max_replans=LIMITS["max_replans"],
         domain=task.domain,
         observation=observation,
     )

@@ -109,6 +109,10 @@ def scene_run(args: argparse.Namespace):
                 f"{name} is a named workcell"
             )
         return None
+    if getattr(args, "problem", None) is not None:
+        raise TampError(
+            f"PROBLEM.pddl with --scene {name}: a scene file's problem is read from its geometry"
+        )
     from tamp.geo.scene_file import GeoRun, scene_episode
 
     task = scene_episode(name, goal, geo)
@@ -123,8 +127,7 @@ def scene_run(args: argparse.Namespace):
     return task
 
 
-GEO_PLANNER_FLAGS = ("time_limit_s", "lambda_motion")  # the planner flags a GeoRun reads
-GEO_DEFAULTS = {"max_replans": 3, "max_moves": 40, "time_limit_s": 120.0}  # as bench tamp's
+GEO_PLANNER_FLAGS = ("time_limit_s",)  # the planner flags a GeoRun reads
 
 
 def geo_config(args: argparse.Namespace, task) -> dict:
@@ -134,11 +137,13 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
     ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
     rerouted), ``--crisp``, the perception network's options, faults other than drops, and
-    ``--record``."""
+    ``--record``; ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
+    default). The limits not given are `tamp bench tamp`'s (`tamp.bench.geo.run.LIMITS`)."""
+    from tamp.bench.geo.run import LIMITS
     from tamp.loop.faults import KINDS, Injection
 
     given = [
-        "--" + n.replace("_", "-")
+        _flag(n)
         for n in _PLANNER_FLAGS
         if n not in GEO_PLANNER_FLAGS and getattr(args, n, None) is not None
     ]
@@ -160,15 +165,13 @@ def geo_config(args: argparse.Namespace, task) -> dict:
             f"{', '.join(given)}: the Blocksworld loop's; the geometric episode that runs "
             f"{task.path} ({task.why}) has no such setting"
         )
-    if args.lambda_motion and task.planner not in ("motion-aware", "motion-aware-sampled"):
-        raise TampError(f"--motion-aware with --geo-planner {task.planner}: they differ")
     inject = Injection.parse(args.inject)
     other = [k for k in KINDS if k != "drop" and getattr(inject, k) > 0]
     if other:
         raise TampError(
             f"--inject {','.join(other)}: the geometric episode injects drops only (drop:P)"
         )
-    limit = args.time_limit_s if args.time_limit_s is not None else GEO_DEFAULTS["time_limit_s"]
+    limit = args.time_limit_s if args.time_limit_s is not None else LIMITS["planning_s"]
     return {
         "executor": "geometric",
         "why": task.why,
@@ -180,10 +183,8 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         "grasp": args.grasp,
         "observe": args.observe,
         "inject": str(inject),
-        "max_replans": GEO_DEFAULTS["max_replans"]
-        if args.max_replans is None
-        else args.max_replans,
-        "max_moves": GEO_DEFAULTS["max_moves"],
+        "max_replans": LIMITS["max_replans"] if args.max_replans is None else args.max_replans,
+        "max_moves": LIMITS["max_moves"],
         "time_limit_s": limit,
         "seed": args.seed,
         "video": None if args.no_video or args.out is None else args.video_format,
@@ -255,7 +256,7 @@ def given_config(args: argparse.Namespace):
     if not args.ours:
         given = [name for name in _PLANNER_FLAGS if getattr(args, name, None) is not None]
         if given:
-            flags = ", ".join("--" + n.replace("_", "-") for n in given)
+            flags = ", ".join(_flag(n) for n in given)
             raise TampError(
                 f"{flags} set(s) our planner, whose row --no-ours leaves out; drop one of them"
             )
@@ -267,6 +268,18 @@ def given_config(args: argparse.Namespace):
         placements=args.placements,
     )
 
+
+def _flag(dest: str) -> str:
+    """The option of a `_PLANNER_FLAGS` destination as the user types it."""
+    return _FLAG_NAMES.get(dest, "--" + dest.replace("_", "-"))
+
+
+# the planner options whose names are not their destinations (`tamp.cli.options`)
+_FLAG_NAMES = {
+    "lambda_motion": "--motion-aware",
+    "time_limit_s": "--time-limit",
+    "improve_s": "--improve",
+}
 
 _PLANNER_FLAGS = (
     "horizon",

@@ -51,8 +51,10 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
         (["--goal", "(in a tray)", "--plan", "x"], "--plan with a scene file"),
         (
             ["--goal", "(on a b)", "--geo-planner", "soft", "--motion-aware"],
-            "--motion-aware with --geo-planner soft",
+            "--motion-aware: the Blocksworld loop's",
         ),
+        (["--goal", "(in a tray)", "--motion-aware"], "--motion-aware: the Blocksworld loop's"),
+        (["p.pddl"], "PROBLEM.pddl with --scene"),
         (
             ["--goal", "(on a b)", "--observe", "camera"],
             "--observe camera with a Blocksworld scene file",
@@ -122,6 +124,13 @@ def test_a_canonical_problem_runs_by_name_with_its_shipped_goal():
     assert recorded(["--scene", "hanoi", "--geo-planner", "search"])["domain"] is None
     own = recorded(["--scene", "sorting", "--goal", "(in o1 green_zone)"])
     assert own["goal"] == "(and (in o1 green_zone))"
+
+
+def test_a_problem_file_with_a_canonical_problem_is_refused(capsys):
+    """Its problem is read from the scene's geometry: a PDDL problem would be ignored."""
+    assert main(["run", "p.pddl", "--scene", "packed"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "PROBLEM.pddl with --scene packed" in err, err
 
 
 def test_geo_planner_with_a_workcell_is_refused(capsys):
