@@ -52,6 +52,10 @@ class PlannerConfig:
     park_from: int | None = None  # park_free for the problems of at least this many entities
     # (None: only park_free); Blocksworld's `planner_defaults` set 30: beyond the sizes whose
     # plan length the issue holds to the optimum, where the time budget binds instead
+    safe_from: int | None = None  # problems of at least this many entities take the domain's
+    # safe moves (`safe_moves`: Blocksworld's constructive moves, which some shortest plan
+    # starts with) without a window; windows plan only from states that have none. None: off;
+    # Blocksworld's `planner_defaults` set 16. Only without beliefs and a cost source
     crisp_check: bool = True  # decode only legal moves; False keeps an illegal strongest move
     fallback: bool | None = None  # when the windows revisit a state or run out, search on from
     # the world state, complete over the moves the cost source allows (`task.symbolic.lazy_search`);
@@ -94,6 +98,10 @@ class PlannerConfig:
         at least `park_from` entities)."""
         return self.park_free or (self.park_from is not None and problem.n >= self.park_from)
 
+    def takes_safe(self, problem) -> bool:
+        """Whether ``problem`` takes its domain's safe moves without a window (`safe_from`)."""
+        return self.safe_from is not None and problem.n >= self.safe_from
+
     def horizons(self) -> tuple[int, ...]:
         """Window length of each restart: the long-lookahead restarts come last."""
         n_long = round(self.restarts * self.lookahead_share)
@@ -104,6 +112,8 @@ class PlannerConfig:
 
         if self.park_from is not None and self.park_from < 1:
             raise TampError(f"PlannerConfig.park_from must be >= 1 or None, got {self.park_from}")
+        if self.safe_from is not None and self.safe_from < 1:
+            raise TampError(f"PlannerConfig.safe_from must be >= 1 or None, got {self.safe_from}")
         names = ("horizon", "iters", "restarts", "max_windows", "fallback_nodes", "improve_nodes")
         for name in names:
             if getattr(self, name) < 1:

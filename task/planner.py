@@ -59,9 +59,13 @@ def _window(
     visited: Sequence[set] | None = None,
     costs: WindowCosts | None = None,
     deadline: float | None = None,
+    parks: Sequence[bool] | None = None,
 ):
     """The decoded window of each problem (`decode_best`); a window of one problem
-    (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early (`_proofs`)."""
+    (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early (`_proofs`).
+    ``parks``: per problem, whether parking moves rank free (default `PlannerConfig.parks`
+    of the problems given; a part of a problem (`_unfinished`) keeps its whole problem's)."""
+    parks = [config.parks(p) for p in problems] if parks is None else list(parks)
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
     batch = batch.repeat(config.restarts)
@@ -71,7 +75,7 @@ def _window(
     stop = None
     priced_ok = costs is None or config.proof_costs
     if len(problems) <= PROOF_PROBLEMS and beliefs is None and priced_ok and visited:
-        stop = _proofs(domain, problems, states, config, visited, proven)
+        stop = _proofs(domain, problems, states, config, visited, proven, parks)
     _, roll = optimise_window(
         domain, batch, steps, config, generator, beliefs, costs, deadline, stop
     )
@@ -89,7 +93,7 @@ def _window(
         visited,
         roll.costs,
         config.rank_prefixes,
-        [config.parks(p) for p in problems],
+        parks,
     )
     return [proven.get(i, window) for i, window in enumerate(decoded)]
 
@@ -101,6 +105,7 @@ def _proofs(
     config: PlannerConfig,
     visited: Sequence[set],
     proven: dict[int, DecodedWindow],
+    parks: Sequence[bool],
 ) -> Callable[[Rollout], bool] | None:
     """The early stop of a window (`PlannerConfig.proof_every`): the rollout is read as the
     decoder reads it, and a problem whose best window reaches the goal in as many moves as the
@@ -140,7 +145,7 @@ def _proofs(
                     visited[i],
                     None if priced is None else priced[row],
                     config.rank_prefixes,
-                    config.parks(problems[i]),
+                    parks[i],
                 )
                 windows.append(replace(window, row=k))
             best = min(windows, key=DecodedWindow.key)
@@ -335,6 +340,62 @@ def _improve(
     return tuple(moves), stats
 
 
+def _take_safe(
+    domain: Domain,
+    problems: Sequence[Problem],
+    active: Sequence[int],
+    states: list[State],
+    moves: list[list],
+    visited: Sequence[set],
+    solved: list[bool],
+    safe: list[int],
+    config: PlannerConfig,
+) -> list[int]:
+    """The ``active`` problems that `PlannerConfig.takes_safe` take their domain's safe moves
+    (`Domain.safe_moves`) in the world, as executed moves; returns those still active (not
+    at the goal). Only without beliefs and a cost source (the caller's check)."""
+    take = getattr(domain, "safe_moves", None)
+    if take is None:
+        return list(active)
+    still = []
+    for i in active:
+        if config.takes_safe(problems[i]):
+            for move in take(problems[i], states[i]):
+                states[i] = domain.apply_move(problems[i], states[i], move)
+                visited[i].add(states[i])
+                moves[i].append(move)
+                safe[i] += 1
+            solved[i] = domain.is_goal(problems[i], states[i])
+        if not solved[i]:
+            still.append(i)
+    return still
+
+
+def _unfinished(
+    domain: Domain,
+    problems: list[Problem],
+    states: list[State],
+    visited: list[set],
+    config: PlannerConfig,
+) -> tuple[list[Problem], list[State], list[set]]:
+    """The problems a window plans: for those that `PlannerConfig.takes_safe`, the part still
+    to be planned (`Domain.unfinished`: without the towers no shortest plan touches again), its
+    state and the visited states seen on its blocks; the others as they are. The window's
+    moves are moves of the whole problem and its goal is reached exactly when the whole one's
+    is. Only without beliefs and a cost source (the caller's check)."""
+    shrink = getattr(domain, "unfinished", None)
+    if shrink is None:
+        return problems, states, visited
+    problems, states, visited = list(problems), list(states), list(visited)
+    for k, problem in enumerate(problems):
+        part = shrink(problem, states[k]) if config.takes_safe(problem) else None
+        if part is not None and part[0].goal:
+            problems[k], keep = part
+            states[k] = problems[k].init
+            visited[k] = {tuple(state[i] for i in keep) for state in visited[k]}
+    return problems, states, visited
+
+
 def _next_window(
     domain: Domain,
     problems: Sequence[Problem],
@@ -360,16 +421,12 @@ def _next_window(
     if costs is not None:
         priced = costs([indices[i] for i in active], crisp, config.restarts)
     check_deadline(deadline)
+    views = [problems[i] for i in active], list(crisp), [visited[i] for i in active]
+    parks = [config.parks(p) for p in views[0]]
+    if source is None and costs is None:
+        views = _unfinished(domain, *views, config)
     decoded = _window(
-        domain,
-        [problems[i] for i in active],
-        crisp,
-        config,
-        generator,
-        beliefs,
-        [visited[i] for i in active],
-        priced,
-        deadline,
+        domain, views[0], views[1], config, generator, beliefs, views[2], priced, deadline, parks
     )
     retried = _retry_frozen(
         domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
@@ -410,7 +467,12 @@ def _run(
     on_done(len(problems) - len(active))
     timed_out = False
     trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
+    safe = [0] * len(problems)  # moves taken without a window (`PlannerConfig.safe_from`)
     for _ in range(config.max_windows):
+        if source is None and costs is None:
+            active = _take_safe(
+                domain, problems, active, states, moves, visited, solved, safe, config
+            )
         if not active:
             break
         try:
@@ -496,6 +558,8 @@ def _run(
             )
         if illegal[i] is not None:
             status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
+        if safe[i]:
+            stats["safe_moves"] = safe[i]
         if i in improved:
             stats["improve"] = improved[i]
         if i in searched:

@@ -105,6 +105,93 @@ def is_goal(problem: Problem, state: State) -> bool:
     return not unsatisfied_goals(problem, state)
 
 
+def in_position(problem: Problem, state: State) -> frozenset[str]:
+    """The blocks that never have to move again (Slaney & Thiebaux's "in position", partial
+    goals included): a goal block on its goal support, that support in position or the table;
+    a block the goal leaves free on the table, or on a block in position that no goal block
+    must stand on. (Supports form no cycle in a state, so the recursion ends.)"""
+    goal = dict(problem.goal)
+    wanted = {y for y in goal.values() if y != TABLE}
+    on = dict(zip(problem.entities, state, strict=True))
+    known: dict[str, bool] = {}
+
+    def placed(x: str) -> bool:
+        if x not in known:
+            below = on[x]
+            if x in goal:
+                known[x] = _on(problem, below, goal[x]) and (below not in on or placed(below))
+            else:
+                known[x] = below not in on or (below not in wanted and placed(below))
+        return known[x]
+
+    return frozenset(x for x in problem.entities if placed(x))
+
+
+def constructive_moves(problem: Problem, state: State) -> list[Move]:
+    """The legal moves that put a clear block not in position into position (`in_position`):
+    onto its goal block when that block is in position and clear, onto the table when the
+    goal wants it there or leaves it free. Gupta & Nau's result, which Slaney & Thiebaux's
+    GN1 builds on: where such a move exists, some shortest plan starts with it, so taking it
+    without a window loses no plan length. Only on the unlimited table (a slotted problem's
+    table is a resource: none are returned there)."""
+    if slotted(problem):
+        return []
+    placed = in_position(problem, state)
+    goal = dict(problem.goal)
+    covered = set(state)
+    out = []
+    for x in problem.entities:
+        if x in covered or x in placed:
+            continue
+        y = goal.get(x, TABLE)
+        if y == TABLE or (y in placed and y not in covered):
+            out.append(Move(x, y))
+    return [m for m in out if check_move(problem, state, m) is None]
+
+
+def safe_moves(problem: Problem, state: State) -> tuple[Move, ...]:
+    """Constructive moves taken one after another from ``state`` until none is left (each
+    may make the next possible): the moves the planner takes without a window
+    (`PlannerConfig.safe_from`)."""
+    out = []
+    while moves := constructive_moves(problem, state):
+        out.append(moves[0])
+        state = apply_move(problem, state, moves[0])
+    return tuple(out)
+
+
+def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]] | None:
+    """The part of ``problem`` still to be planned from ``state``. Blocks in position
+    (`in_position`) never move again in some shortest plan, so of each tower's in-position
+    segment only its top is kept, as a block standing on the table (its goal, if any, the
+    table): the rest of the segment can receive nothing more (the block on it is the one the
+    goal wants there, or no goal wants it). A top with nothing on it that no goal block still
+    has to come onto is dropped too. No kept block rests on a dropped one and no goal atom of
+    a kept block names one, so the part is a problem of its own, with the same moves and
+    shortest plans as ``problem`` from ``state`` (a window's soft problem shrinks as towers
+    are built). Returns it and the indices of its blocks in ``problem.entities``, or None when
+    nothing is dropped or on a slotted table."""
+    if slotted(problem):
+        return None
+    placed = in_position(problem, state)
+    above = {y: x for x, y in zip(problem.entities, state, strict=True) if y != TABLE}
+    wanted = {y for _, y in problem.goal if y != TABLE}
+
+    def dropped(x: str) -> bool:
+        top = above.get(x)
+        return x in placed and (top in placed or (top is None and x not in wanted))
+
+    keep = tuple(i for i, x in enumerate(problem.entities) if not dropped(x))
+    if len(keep) == problem.n:
+        return None
+    goal = dict(problem.goal)
+    rooted = {problem.entities[i] for i in keep} & placed  # the kept tops of the segments
+    init = tuple(TABLE if problem.entities[i] in rooted else state[i] for i in keep)
+    entities = tuple(problem.entities[i] for i in keep)
+    atoms = tuple((x, TABLE if x in rooted else goal[x]) for x in entities if x in goal)
+    return replace(problem, entities=entities, init=init, goal=atoms), keep
+
+
 # ---------------------------------------------------------------------------- moves <-> actions
 
 
@@ -289,8 +376,12 @@ class Blocksworld:
     # Thiebaux's US), which finds the long plans of big problems faster (`PlannerConfig.parks`);
     # up to 15 blocks a plan is handed to the anytime improvement, A* below its length for at
     # most 30 s (`PlannerConfig.improve_s`): every plan of the long set optimal, PlanBench at
-    # no measurable cost, 1.7x the time on 10-14-block problems (BENCHMARKS.md)
-    planner_defaults = MappingProxyType({"park_from": 30, "improve_s": 30.0, "improve_up_to": 15})
+    # no measurable cost, 1.7x the time on 10-14-block problems (BENCHMARKS.md); from 16
+    # blocks, beyond the improvement, constructive moves are taken without a window
+    # (`safe_moves`), the windows deciding only which blocks to move out of the way
+    planner_defaults = MappingProxyType(
+        {"park_from": 30, "safe_from": 16, "improve_s": 30.0, "improve_up_to": 15}
+    )
     distributions = True
     encode = staticmethod(encode)
     soft_legality = staticmethod(soft_legality)
@@ -306,6 +397,8 @@ class Blocksworld:
     to_actions = staticmethod(user_actions(moves_to_actions))  # the user's names
     lower_bound = staticmethod(moves_lower_bound)
     legal_moves = staticmethod(legal_moves)
+    safe_moves = staticmethod(safe_moves)
+    unfinished = staticmethod(unfinished)
     to_atoms = staticmethod(user_atoms(to_atoms))
     to_pddl = staticmethod(to_pddl)
     from_pddl = staticmethod(from_pddl)
