@@ -434,6 +434,8 @@ def run_geometric(
     seed: int = 0,
     video: str | Path | None = None,
     observation: str = "state",
+    domain: str | Path | None = None,
+    binding: str | Path | None = None,
 ):
     """A geometric TAMP episode of a scene file (``tamp run --scene FILE --goal GOAL`` where the
     Blocksworld loop cannot run it, or with ``--geo-planner``): objects of any shape, regions
@@ -441,13 +443,19 @@ def run_geometric(
     runs. ``scene``: a path, a shipped scene's name or a canonical problem's (``"packed"``, its
     goal file the default ``goal``); ``planner``: one of `tamp.geo.episode.PLANNERS` (the
     motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
-    Returns a `tamp.geo.episode.GeoReport`."""
+    ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
+    (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through
+    by the motion-aware planner. Returns a `tamp.geo.episode.GeoReport`."""
     from tamp.bench.geo.run import LIMITS  # tamp run's and bench tamp's limits
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.scene_file import scene_episode
     from tamp.geo.search import SearchConfig
 
-    task = scene_episode(str(scene), goal, planner)
+    if (domain is None) != (binding is None):
+        raise TampError("run_geometric: domain and binding go together (a bound domain)")
+    rules = None if domain is None else (domain, binding)
+    named = None if rules is not None and planner == "motion-aware" else planner
+    task = scene_episode(str(scene), goal, named, rules)
     return run_geo_episode(
         task.scene,
         task.goal,

@@ -253,7 +253,10 @@ def episode_options(
     else:
         p.add_argument("--sim", choices=SIMULATORS, default="pybullet", help="(pybullet)")
         p.add_argument(
-            "--domain", metavar="DOMAIN.pddl", help="domain file (the embedded 4-op blocksworld)"
+            "--domain",
+            metavar="DOMAIN.pddl",
+            help="domain file of PROBLEM.pddl (the embedded 4-op blocksworld), or with --scene "
+            "FILE.json and --binding a pick-and-place domain of your own",
         )
     p.add_argument(
         "--grasp",
@@ -414,6 +417,14 @@ def run_options(p: argparse.ArgumentParser) -> None:
         help="--scene FILE.json or a canonical problem: run the geometric TAMP episode with "
         "this planner (motion-aware where the Blocksworld loop cannot run the scene: regions, "
         "shapes, parking rules; else the loop)",
+    )
+    p.add_argument(
+        "--binding",
+        metavar="FILE.json|toml",
+        help="--scene FILE.json with --domain DOMAIN.pddl: plan through your own "
+        "pick-and-place domain, this file binding its actions to the arm (which picks, "
+        "which places what) and saying how the scene reads as its state (see "
+        "examples/domains/tray.binding.json)",
     )
     p.add_argument(
         "--plan",

@@ -108,6 +108,11 @@ def scene_run(args: argparse.Namespace):
                 f"--geo-planner needs --scene FILE.json or a canonical problem's name; --scene "
                 f"{name} is a named workcell"
             )
+        if getattr(args, "binding", None) is not None:
+            raise TampError(
+                f"--binding needs --scene FILE.json (the objects its domain moves); --scene "
+                f"{name} is a named workcell"
+            )
         return None
     if getattr(args, "problem", None) is not None:
         raise TampError(
@@ -115,7 +120,9 @@ def scene_run(args: argparse.Namespace):
         )
     from tamp.geo.scene_file import GeoRun, scene_episode
 
-    task = scene_episode(name, goal, geo)
+    binding = getattr(args, "binding", None)
+    rules = None if binding is None else (args.domain, binding)
+    task = scene_episode(name, goal, geo, rules)
     if getattr(args, "plan", None) is not None:
         raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
     if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == "camera":
@@ -178,7 +185,9 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         "scene_file": task.path,
         "goal": task.goal.text(),
         "planner": task.planner,
-        "domain": None if task.domain is None else "hanoi-pick-place",
+        "domain": task.domain_name,
+        "domain_file": getattr(args, "domain", None),
+        "binding": getattr(args, "binding", None),
         "sim": args.sim,
         "grasp": args.grasp,
         "observe": args.observe,
@@ -213,8 +222,19 @@ def _loop_dict(config) -> dict:
 
 def run_config(args: argparse.Namespace) -> dict:
     """``run`` and ``demo``."""
-    if args.domain is not None and args.problem is None:
-        raise TampError("--domain needs PROBLEM.pddl (the embedded example has its own domain)")
+    binding = getattr(args, "binding", None)
+    if binding is not None and args.domain is None:
+        raise TampError("--binding needs --domain DOMAIN.pddl (the domain whose actions it binds)")
+    if binding is not None and args.problem is not None:
+        raise TampError(
+            "--binding with PROBLEM.pddl: a bound domain's problem is read from the scene "
+            "file's geometry (--scene FILE.json --goal GOAL)"
+        )
+    if args.domain is not None and args.problem is None and binding is None:
+        raise TampError(
+            "--domain needs PROBLEM.pddl (the embedded example has its own domain), or "
+            "--scene FILE.json with --binding (a pick-and-place domain bound to the arm)"
+        )
     if args.plan is None and (args.replan or args.stop_at_invalid):
         raise TampError("--replan and --stop-at-invalid apply to a given plan (--plan PLAN)")
     if args.no_video and args.video_format != "mp4":

@@ -210,7 +210,8 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         print(
             f"running {task.scene.name} ({len(task.scene.objects)} objects) in {args.sim} "
             f"with the geometric episode ({task.why}): planner {task.planner}"
-            f"{' through the Hanoi domain' if task.domain else ''}, goal {task.goal.text()}, "
+            f"{f' through the {task.domain_name} domain' if task.domain else ''}, "
+            f"goal {task.goal.text()}, "
             f"observe {args.observe}, grasp {args.grasp}, faults {recorded['inject']}, "
             f"seed {args.seed}",
             file=sys.stderr,

@@ -35,6 +35,7 @@ class GeoRun:
     planner: str
     why: str
     domain: tuple[str, str] | None = None
+    domain_name: str | None = None  # the PDDL domain ``domain`` plans through
 
 
 def scene_path(name: str) -> tuple[Path, bool]:
@@ -55,11 +56,18 @@ def scene_path(name: str) -> tuple[Path, bool]:
     return path, False
 
 
-def scene_episode(name: str, goal: str | Path | None, planner: str | None = None):
+def scene_episode(
+    name: str,
+    goal: str | Path | None,
+    planner: str | None = None,
+    rules: tuple[str | Path, str | Path] | None = None,
+):
     """The episode of scene ``name`` toward ``goal`` (inline PDDL or a file; None: a canonical
     problem's goal file): a `tamp.world.blocks.SceneTask` when the loop can run it and no
-    ``planner`` is named, else a `GeoRun` (``planner`` or `DEFAULT_PLANNER`). One-line
-    SceneFileError for a scene or goal neither can run (see `tamp.world.blocks`)."""
+    ``planner`` is named, else a `GeoRun` (``planner`` or `DEFAULT_PLANNER`). ``rules``: a
+    user's ``(DOMAIN.pddl, BINDING.json|toml)``, planned through by the motion-aware planner
+    (`user_domain`). One-line SceneFileError (or the domain's or binding's error) for a scene,
+    goal or domain neither can run (see `tamp.world.blocks`)."""
     from tamp.world.blocks import BeyondLoop, scene_task
     from tamp.world.canonical import SCENES_DIR as CANONICAL_DIR
 
@@ -70,6 +78,13 @@ def scene_episode(name: str, goal: str | Path | None, planner: str | None = None
                 f"--scene {name} needs --goal: the goal over the scene file's objects"
             )
         goal = str(CANONICAL_DIR / f"{name}.goal.pddl")
+    if rules is not None:
+        if planner not in (None, DEFAULT_PLANNER):
+            raise SceneFileError(
+                f"--geo-planner {planner} with --binding: a user's domain is planned by the "
+                f"{DEFAULT_PLANNER} planner (the lift of its PDDL rules)"
+            )
+        return user_domain(path, goal, *rules)
     why = f"--geo-planner {planner}" if planner is not None else f"{name}: a canonical problem"
     if planner is None and not canonical:
         try:
@@ -92,4 +107,44 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
         from task.symbolic.pickplace import hanoi as rules
 
         domain = (rules.domain_text(), rules.BINDING)
-    return GeoRun(str(path), scene, load_goal(goal, scene), planner, why, domain)
+    name = None if domain is None else rules.DOMAIN
+    return GeoRun(str(path), scene, load_goal(goal, scene), planner, why, domain, name)
+
+
+def _binding_json(path: Path) -> str:
+    """The binding file at ``path`` as JSON text (a TOML file converted); BindingError (one
+    line) for a missing or malformed file."""
+    import json
+    import tomllib
+
+    from task.symbolic.pickplace import binding as binder
+
+    binder.load(path)  # one line for a wrong suffix, a missing file or bad JSON / TOML
+    text = path.read_text(encoding="utf-8")
+    return text if path.suffix.lower() == ".json" else json.dumps(tomllib.loads(text))
+
+
+def user_domain(path: Path, goal: str | Path, domain: str | Path, binding: str | Path) -> GeoRun:
+    """The `GeoRun` of the scene file at ``path`` through a user's pick-and-place PDDL
+    ``domain`` and its ``binding`` (`task.symbolic.pickplace.binding`, with a ``scene``
+    section: how the geometry reads as the domain's state). Everything is checked here, before
+    any planning: the domain, the binding against its actions and predicates, and the problem
+    `tamp.world.scene_pddl` writes from the scene and ``goal`` (one line for each)."""
+    from tamp.world.blocks import explained_scene
+    from tamp.world.goal import load_goal
+    from tamp.world.scene_pddl import problem_text
+    from task.domains.strips import problem_from_text
+    from task.symbolic import pddl_io
+    from task.symbolic.pickplace import binding as binder
+
+    scene, _ = explained_scene(path)
+    target = load_goal(goal, scene)
+    domain_text = pddl_io.read_text(domain)
+    parsed = pddl_io.parse_domain(domain_text, str(domain))
+    binding_text = _binding_json(Path(binding))
+    bound = binder.bind_text(binding_text, parsed, source=str(binding))
+    problem_from_text(domain_text, problem_text(scene, target, bound), scene.name)
+    why = f"--domain {Path(domain).name}: a user's pick-and-place domain ({bound.domain})"
+    return GeoRun(
+        str(path), scene, target, DEFAULT_PLANNER, why, (domain_text, binding_text), bound.domain
+    )

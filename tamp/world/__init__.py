@@ -13,6 +13,9 @@ and movable objects; the symbolic state is read from that geometry, never given.
   read from the poses, and the objects the geometry cannot explain;
 - ``tamp.world.goal``: `load_goal` / `parse_goal`, a PDDL goal over the scene's objects and
   regions, checked against the scene.
+- ``tamp.world.scene_pddl``: `problem_text`, a scene and a goal as the PDDL problem of a
+  user's pick-and-place domain, its state read from the geometry through the binding's scene
+  section (``tamp run --scene FILE --domain D.pddl --binding B.json``);
 - ``tamp.world.blocks``: `scene_task`, a scene file and a goal as the closed loop's Blocksworld
   episode (``tamp run --scene FILE.json --goal GOAL``), or one line saying what it cannot run.
 

@@ -408,7 +408,11 @@ def _done(status, moves, reason, stats, t0, plans, failures) -> GeoPlan:
     return GeoPlan(status, tuple(moves), reason, stats)
 
 
-# ---- a pick-and-place PDDL domain (Hanoi) ------------------------------------------------------
+# ---- a pick-and-place PDDL domain (Hanoi, a user's) ---------------------------------------------
+
+PDDL_PLACES = 32  # region places `plan_pddl` tries per move, in `candidate_places`' order
+# (nearest the walls and neighbours first, for packing): 8 were all too tight for the fingers
+# when a cube goes into the tray scene's tray beside another object
 
 
 def pddl_problem_text(scene: Scene, goal: Goal) -> str:
@@ -430,12 +434,15 @@ def plan_pddl(
     check: Callable | None = None,
 ) -> GeoPlan:
     """Plan through a pick-and-place PDDL domain (module docstring). ``domain``:
-    ``(domain_text, binding_text)`` (the problem written by `pddl_problem_text`, Hanoi's) or
-    ``(domain_text, binding_text, problem_text)``. The lift plans with its fallback on; each
-    paired move goes onto a disc (centred on its top) or into a region at the first of
-    `candidate_places` (``config.table_places`` of them, default 8) that the full check passes.
-    A move none passes ends planning with BUDGET (the lift gets no failure memory)."""
+    ``(domain_text, binding_text)`` (the problem written by `tamp.world.scene_pddl` when the
+    binding has a scene section, else by `pddl_problem_text`, Hanoi's) or ``(domain_text,
+    binding_text, problem_text)``. The lift plans with its fallback on; each paired move goes
+    onto an object (centred on its top), or into a region or onto the table at the first of
+    `candidate_places` (``config.table_places`` of them, default `PDDL_PLACES`) that the full
+    check passes. A move none passes ends planning with BUDGET (the lift gets no failure
+    memory)."""
     from tamp.geo.places import candidate_places
+    from tamp.world import scene_pddl
     from task.domains.strips import problem_from_text
     from task.symbolic import pddl_io
     from task.symbolic.pickplace import binding as binder
@@ -444,9 +451,14 @@ def plan_pddl(
     config = as_ours(config)
     check = check or _check()
     domain_text, binding_text = domain[0], domain[1]
-    problem_text = domain[2] if len(domain) > 2 else pddl_problem_text(scene, goal)
-    lifted = problem_from_text(domain_text, problem_text, scene.name)
     bound = binder.bind_text(binding_text, pddl_io.parse_domain(domain_text, "domain"))
+    if len(domain) > 2:
+        problem_text = domain[2]
+    elif bound.scene is not None:  # the binding says how the scene reads as its state
+        problem_text = scene_pddl.problem_text(scene, goal, bound)
+    else:
+        problem_text = pddl_problem_text(scene, goal)
+    lifted = problem_from_text(domain_text, problem_text, scene.name)
     planner = replace(
         PlannerConfig.for_domain("strips"),
         fallback=True,
@@ -469,7 +481,7 @@ def plan_pddl(
         if move.target in objects:
             places = (bridge_on(world, move.entity, move.target),)
         else:
-            n = config.table_places or 8
+            n = config.table_places or PDDL_PLACES
             places = candidate_places(world, move.entity, move.target, n, config.seed)
         verdict, place = None, None
         for place in places:

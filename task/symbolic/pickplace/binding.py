@@ -25,6 +25,19 @@ hold and adds an atom of its object (with its target, when the target is a param
 deletes an atom of its object and adds one of object and target. `to_moves` pairs a plan's
 actions into `task.problem.Move`s (object -> target): a pick must be followed by the place of
 the same object; anything else is a one-line error naming the plan step.
+
+An optional ``scene`` section says how a scene's geometry reads as the domain's initial state
+(``tamp run --scene FILE --domain D.pddl --binding B.json``; the robot reads the state, it is
+never given): the PDDL types of the scene's movable objects and regions, and which predicate
+holds each geometric relation (`RELATIONS`)::
+
+    "scene": {"objects": "disc", "regions": "peg",
+              "facts": {"on": "on", "in": "on", "clear": "clear", "empty": "clear",
+                        "narrower": "smaller", "fits": "smaller"}}
+
+Each predicate must exist in the domain with the relation's arity; a relation left out is not
+written, and an object whose support is such a relation is refused when the problem is written
+(`tamp.world.scene_pddl`).
 """
 
 from __future__ import annotations
@@ -55,6 +68,22 @@ class Role(enum.Enum):
 
 ROLES = tuple(r.value for r in Role)
 KEYS = ("role", "object", "target")
+TOP_KEYS = ("domain", "actions", "scene")
+SCENE_KEYS = ("objects", "regions", "facts")
+# the geometric relations a scene is read as (`tamp.world.scene_pddl`) and their arities:
+# object x on object y, x in region r, x on the bare table, nothing on object x, nothing in
+# region r, x's footprint narrower than object y's, x's footprint fits inside region r, the
+# hand empty (true when a problem starts)
+RELATIONS = {
+    "on": 2,
+    "in": 2,
+    "ontable": 1,
+    "clear": 1,
+    "empty": 1,
+    "narrower": 2,
+    "fits": 2,
+    "handempty": 0,
+}
 
 # the embedded 4-op blocksworld (`task/data/blocksworld-4ops.pddl`): put-down places on the table
 BLOCKSWORLD = """{
@@ -79,12 +108,28 @@ class ActionSpec:
 
 
 @dataclass(frozen=True)
+class SceneFacts:
+    """The declared reading of a scene as the domain's state: the PDDL types of its objects
+    and regions (None: untyped) and the predicate of each geometric relation
+    (`RELATIONS`) written."""
+
+    objects: str | None = None
+    regions: str | None = None
+    facts: tuple[tuple[str, str], ...] = ()
+
+    def predicate(self, relation: str) -> str | None:
+        """The domain's predicate holding ``relation``, None when it is not written."""
+        return dict(self.facts).get(relation)
+
+
+@dataclass(frozen=True)
 class BindingSpec:
     """A binding as declared, before it is checked against a domain (``domain``: the PDDL
-    domain name it is for, None: any)."""
+    domain name it is for, None: any; ``scene``: how a scene reads as its state, if said)."""
 
     actions: tuple[tuple[str, ActionSpec], ...]
     domain: str | None = None
+    scene: SceneFacts | None = None
 
 
 @dataclass(frozen=True)
@@ -100,10 +145,12 @@ class BoundAction:
 
 @dataclass(frozen=True)
 class Binding:
-    """A binding checked against the action schemas of domain ``domain``."""
+    """A binding checked against the action schemas of domain ``domain`` (``scene``: its
+    checked `SceneFacts`, None when the binding says none)."""
 
     domain: str
     actions: tuple[BoundAction, ...]
+    scene: SceneFacts | None = None
 
     def get(self, name: str) -> BoundAction | None:
         return next((a for a in self.actions if a.name == name.lower()), None)
@@ -145,8 +192,8 @@ def from_mapping(data: object, source: str = "<binding>") -> BindingSpec:
     if not isinstance(data, Mapping):
         raise BindingError(f"{source}: expected a table with 'actions', got {type(data).__name__}")
     for key in data:
-        if key not in ("domain", "actions"):
-            raise BindingError(f"{source}: unknown key {one_of(key, ('domain', 'actions'))}")
+        if key not in TOP_KEYS:
+            raise BindingError(f"{source}: unknown key {one_of(key, TOP_KEYS)}")
     actions = data.get("actions")
     if not isinstance(actions, Mapping) or not actions:
         raise BindingError(f"{source}: 'actions' must map at least one action to its role")
@@ -154,7 +201,36 @@ def from_mapping(data: object, source: str = "<binding>") -> BindingSpec:
     if domain is not None and not isinstance(domain, str):
         raise BindingError(f"{source}: 'domain' must be a name, got {domain!r}")
     specs = tuple((str(n).lower(), _action_spec(str(n), e, source)) for n, e in actions.items())
-    return BindingSpec(specs, domain and domain.lower())
+    scene = None if data.get("scene") is None else _scene_facts(data["scene"], source)
+    return BindingSpec(specs, domain and domain.lower(), scene)
+
+
+def _scene_facts(entry: object, source: str) -> SceneFacts:
+    where = f"{source}: scene"
+    if not isinstance(entry, Mapping):
+        raise BindingError(f"{where}: expected a table of {', '.join(SCENE_KEYS)}, got {entry!r}")
+    for key in entry:
+        if key not in SCENE_KEYS:
+            raise BindingError(f"{where}: unknown key {one_of(key, SCENE_KEYS)}")
+    for key in ("objects", "regions"):
+        value = entry.get(key)
+        if value is not None and (not isinstance(value, str) or not value):
+            raise BindingError(f"{where}: {key} must be a PDDL type name, got {value!r}")
+    facts = entry.get("facts")
+    if not isinstance(facts, Mapping) or not facts:
+        raise BindingError(
+            f"{where}: 'facts' must map geometric relations ({', '.join(RELATIONS)}) to the "
+            "domain's predicates"
+        )
+    pairs = []
+    for relation, predicate in facts.items():
+        if relation not in RELATIONS:
+            raise BindingError(f"{where}: unknown relation {one_of(relation, tuple(RELATIONS))}")
+        if not isinstance(predicate, str) or not predicate:
+            raise BindingError(f"{where}: {relation} must name a predicate, got {predicate!r}")
+        pairs.append((relation, predicate.lower()))
+    objects, regions = entry.get("objects"), entry.get("regions")
+    return SceneFacts(objects and objects.lower(), regions and regions.lower(), tuple(pairs))
 
 
 def load_text(text: str, fmt: str = "json", source: str = "<binding>") -> BindingSpec:
@@ -239,9 +315,31 @@ def bind(spec: BindingSpec, domain: Domain) -> Binding:
             target = params.index(entry.target)
         atoms[name] = _schema_atoms(domain, name)
         bound.append(BoundAction(name, entry.role, params.index(entry.object), target))
-    binding = Binding(dname, tuple(bound))
+    if spec.scene is not None:
+        _check_scene(spec.scene, domain)
+    binding = Binding(dname, tuple(bound), spec.scene)
     _check_roles(binding, spec, atoms)
     return binding
+
+
+def _check_scene(scene: SceneFacts, domain: Domain) -> None:
+    """BindingError for a scene section naming a type or predicate the domain lacks, or a
+    predicate of another arity than its relation's."""
+    types = sorted(str(t).lower() for t in domain.types)
+    for key in ("objects", "regions"):
+        name = getattr(scene, key)
+        if name is not None and name != "object" and name not in types:
+            raise BindingError(f"binding: scene {key}: unknown type {one_of(name, types)}")
+    arity = {str(p.name).lower(): p.arity for p in domain.predicates}
+    for relation, predicate in scene.facts:
+        if predicate not in arity:
+            what = one_of(predicate, sorted(arity))
+            raise BindingError(f"binding: scene fact {relation}: unknown predicate {what}")
+        if arity[predicate] != RELATIONS[relation]:
+            raise BindingError(
+                f"binding: scene fact {relation}: ({predicate}) takes {arity[predicate]} "
+                f"argument(s), {relation} gives {RELATIONS[relation]}"
+            )
 
 
 def _check_roles(binding: Binding, spec: BindingSpec, atoms: dict) -> None:

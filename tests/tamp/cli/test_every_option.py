@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,6 +23,8 @@ from tamp.cli import build_parser, main
 from tamp.cli.recorded import PRESENTATION
 from task.config import check_device_name
 from task.errors import TampError
+
+EXAMPLES = Path(__file__).resolve().parents[3] / "examples" / "domains"
 
 # the positional arguments and required options of each command (never read by `recorded`)
 BASE = {
@@ -39,6 +42,7 @@ SAMPLES = {
     "--inject": "drop:0.2",
     "--sim": "mujoco",
     "--domain": "domain.pddl",
+    "--binding": str(EXAMPLES / "tray.binding.json"),
     "--checkpoint": "other.pt",
     "--plan": "plan.txt",
     "--data": "elsewhere",
@@ -91,6 +95,14 @@ NEEDS = {
     "--goal": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
     # a scene file the loop could run, run by the geometric episode's planner instead
     "--geo-planner": [["--scene", "tower", "--goal", "(on a c)", "--observe", "state"]],
+    # a user's domain on a scene file, bound by the TOML binding before the JSON one
+    "--binding": [
+        [
+            *("--scene", "tray", "--goal", "(in a tray)", "--observe", "state"),
+            *("--domain", str(EXAMPLES / "tray.pddl")),
+            *("--binding", str(EXAMPLES / "tray.binding.toml")),
+        ]
+    ],
 }
 # commands with no run configuration: what they write is named by their options
 NOT_RUNS = {"bench record"}

@@ -118,7 +118,7 @@ def test_binding_file_by_suffix(tmp_path):
         ("{}", "yaml", r"unknown binding format 'yaml' \(valid: json, toml\)"),
         ("[]", "json", r"expected a table with 'actions'"),
         ('{"actions": {}}', "json", r"'actions' must map at least one action"),
-        ('{"action": {}}', "json", r"unknown key 'action' \(valid: domain, actions\)"),
+        ('{"action": {}}', "json", r"unknown key 'action' \(valid: domain, actions, scene\)"),
         ('{"actions": {"stack": 3}}', "json", r"action stack: expected a table of role, object"),
         (
             '{"actions": {"stack": {"role": "place", "obj": "?x"}}}',
