@@ -169,8 +169,10 @@ def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]
     has to come onto is dropped too. No kept block rests on a dropped one and no goal atom of
     a kept block names one, so the part is a problem of its own, with the same moves and
     shortest plans as ``problem`` from ``state`` (a window's soft problem shrinks as towers
-    are built). Returns it and the indices of its blocks in ``problem.entities``, or None when
-    nothing is dropped or on a slotted table."""
+    are built). The part is marked `GOAL_OR_TABLE`: its windows move a block only onto its
+    goal block or the table, which keeps some shortest plan (`_goal_or_table`). Returns it and
+    the indices of its blocks in ``problem.entities`` (all of them when nothing is dropped),
+    or None on a slotted table."""
     if slotted(problem):
         return None
     placed = in_position(problem, state)
@@ -182,14 +184,13 @@ def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]
         return x in placed and (top in placed or (top is None and x not in wanted))
 
     keep = tuple(i for i, x in enumerate(problem.entities) if not dropped(x))
-    if len(keep) == problem.n:
-        return None
     goal = dict(problem.goal)
     rooted = {problem.entities[i] for i in keep} & placed  # the kept tops of the segments
     init = tuple(TABLE if problem.entities[i] in rooted else state[i] for i in keep)
     entities = tuple(problem.entities[i] for i in keep)
     atoms = tuple((x, TABLE if x in rooted else goal[x]) for x in entities if x in goal)
-    return replace(problem, entities=entities, init=init, goal=atoms), keep
+    part = replace(problem, entities=entities, init=init, goal=atoms, data=GOAL_OR_TABLE)
+    return part, keep
 
 
 # ---------------------------------------------------------------------------- moves <-> actions
@@ -297,13 +298,39 @@ def goal_loss(F: Tensor, batch: SoftBatch, kind: str) -> Tensor:
     raise ProblemError(f"unknown goal loss {one_of(kind, GOAL_LOSSES)}")
 
 
+GOAL_OR_TABLE = "goal-or-table"  # ``Problem.data`` of a window's part (`unfinished`)
+
+
+def _goal_or_table(batch: SoftBatch, problems: Sequence[Problem]) -> SoftBatch:
+    """``batch`` with the moves of the `GOAL_OR_TABLE` rows narrowed to onto the block's goal
+    block or the table: Gupta & Nau, some shortest plan makes only constructive moves and
+    moves to the table, and a block's constructive move goes to its goal support (the table
+    for a block the goal leaves free)."""
+    rows = [i for i, p in enumerate(problems) if p.data == GOAL_OR_TABLE]
+    if not rows:
+        return batch
+    n = batch.n
+    keep = torch.zeros_like(batch.action_mask)
+    keep[..., n:] = True  # the table and STAY
+    for i in rows:
+        p = problems[i]
+        for x, y in p.goal:
+            if y != TABLE:
+                keep[i, p.entities.index(x), p.entities.index(y)] = True
+    for i in set(range(len(problems))) - set(rows):
+        keep[i] = True
+    return replace(batch, action_mask=batch.action_mask & keep)
+
+
 def encode(
     problems: Sequence[Problem], states: Sequence[State], dtype: torch.dtype = torch.float32
 ) -> SoftBatch:
     """`encode_supports`; with table slots (`slotted`), a goal on the table marks every slot
-    of the row and ``static["one"]`` (B, Y) marks the capacity-one columns."""
+    of the row and ``static["one"]`` (B, Y) marks the capacity-one columns. A window's part of
+    a big problem (`GOAL_OR_TABLE`, `unfinished`) moves each block only onto its goal block or
+    the table (`_goal_or_table`)."""
     if not any(slotted(p) for p in problems):
-        return encode_supports(problems, states, dtype)
+        return _goal_or_table(encode_supports(problems, states, dtype), problems)
     free = [replace(p, goal=tuple(g for g in p.goal if g[1] != TABLE)) for p in problems]
     batch = encode_supports(free, states, dtype)
     n, y = batch.n, batch.F0.shape[-1]

@@ -5,11 +5,15 @@ window from `PlannerConfig.safe_from` blocks, with plans as short as the windows
 from dataclasses import replace
 
 import pytest
+import torch
 
 from task.config import PlannerConfig
 from task.domains.blocksworld import (
+    GOAL_OR_TABLE,
     apply_move,
+    check_move,
     constructive_moves,
+    encode,
     in_position,
     is_goal,
     safe_moves,
@@ -74,7 +78,9 @@ def test_finished_towers_leave_the_problem():
     rest, keep = unfinished(p, p.init)
     assert rest.entities == ("c", "d", "e") and keep == (2, 3, 4)
     assert rest.init == (TABLE, TABLE, "c") and rest.goal == (("c", "d"),)
-    assert unfinished(rest, rest.init) is None  # nothing more is finished
+    again, kept = unfinished(rest, rest.init)  # nothing more is finished
+    assert again.entities == rest.entities and kept == (0, 1, 2)
+    assert again.data == GOAL_OR_TABLE  # its windows move blocks onto goal blocks or the table
     # a segment in position keeps only its top, standing on the table: f on g on h (all
     # in position), i must come onto f; g and h leave, f stays with the table as its goal
     tower = Problem(
@@ -140,3 +146,43 @@ def test_safe_from_is_checked():
 
     with pytest.raises(TampError, match="safe_from must be >= 1"):
         PlannerConfig(safe_from=0)
+
+
+def _goal_or_table_optimum(problem: Problem) -> int:
+    """Breadth-first search over moves onto a block's goal block or the table only."""
+    goal = dict(problem.goal)
+    frontier, seen, depth = [tuple(problem.init)], {tuple(problem.init)}, 0
+    while frontier:
+        if any(is_goal(problem, s) for s in frontier):
+            return depth
+        step = []
+        for state in frontier:
+            for x in problem.entities:
+                for y in {goal.get(x, TABLE), TABLE}:
+                    if check_move(problem, state, Move(x, y)) is None:
+                        nxt = apply_move(problem, state, Move(x, y))
+                        if nxt not in seen:
+                            seen.add(nxt)
+                            step.append(nxt)
+        frontier, depth = step, depth + 1
+    raise AssertionError("no plan of goal-or-table moves")
+
+
+@pytest.mark.parametrize("problem", list(_problems())[:18], ids=lambda p: p.name)
+def test_moves_onto_the_goal_block_or_the_table_keep_a_shortest_plan(problem):
+    assert _goal_or_table_optimum(problem) == _optimum(problem, problem.init)
+
+
+def test_the_window_part_narrows_its_moves_to_goal_block_or_table():
+    problem = random_problem(6, 5)
+    part, _ = unfinished(problem, problem.init)
+    whole, narrow = encode([problem], [problem.init]), encode([part], [part.init])
+    goal = dict(part.goal)
+    n = narrow.n
+    for x, name in enumerate(part.entities):
+        allowed = {n} | (
+            {part.entities.index(goal[name])} if goal.get(name, TABLE) != TABLE else set()
+        )
+        moves = set(torch.nonzero(narrow.action_mask[0, x, :-1]).flatten().tolist())
+        assert moves <= allowed and n in moves
+    assert whole.action_mask.sum() > narrow.action_mask.sum()
