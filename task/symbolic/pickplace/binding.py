@@ -163,13 +163,18 @@ class Binding:
 # ------------------------------------------------------------------------------ declaration
 
 
+def _table(entry: object, keys: tuple[str, ...], where: str) -> None:
+    """BindingError unless ``entry`` is a table whose keys are among ``keys``."""
+    if not isinstance(entry, Mapping):
+        raise BindingError(f"{where}: expected a table of {', '.join(keys)}, got {entry!r}")
+    for key in entry:
+        if key not in keys:
+            raise BindingError(f"{where}: unknown key {one_of(key, keys)}")
+
+
 def _action_spec(name: str, entry: object, source: str) -> ActionSpec:
     where = f"{source}: action {name}"
-    if not isinstance(entry, Mapping):
-        raise BindingError(f"{where}: expected a table of {', '.join(KEYS)}, got {entry!r}")
-    for key in entry:
-        if key not in KEYS:
-            raise BindingError(f"{where}: unknown key {one_of(key, KEYS)}")
+    _table(entry, KEYS, where)
     for key in KEYS:
         value = entry.get(key)
         if key != "target" and value is None:
@@ -207,11 +212,7 @@ def from_mapping(data: object, source: str = "<binding>") -> BindingSpec:
 
 def _scene_facts(entry: object, source: str) -> SceneFacts:
     where = f"{source}: scene"
-    if not isinstance(entry, Mapping):
-        raise BindingError(f"{where}: expected a table of {', '.join(SCENE_KEYS)}, got {entry!r}")
-    for key in entry:
-        if key not in SCENE_KEYS:
-            raise BindingError(f"{where}: unknown key {one_of(key, SCENE_KEYS)}")
+    _table(entry, SCENE_KEYS, where)
     for key in ("objects", "regions"):
         value = entry.get(key)
         if value is not None and (not isinstance(value, str) or not value):
