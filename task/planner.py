@@ -390,9 +390,16 @@ def _unfinished(
     for k, problem in enumerate(problems):
         part = shrink(problem, states[k]) if config.takes_safe(problem) else None
         if part is not None and part[0].goal:
-            problems[k], keep = part
+            (problems[k], keep), now = part, states[k]
             states[k] = problems[k].init
-            visited[k] = {tuple(state[i] for i in keep) for state in visited[k]}
+            # the part's supports where they differ from the world's (tops of segments in
+            # position, which stand on the table in the part), read the same in the past
+            moved = {
+                j: s for j, (i, s) in enumerate(zip(keep, states[k], strict=True)) if now[i] != s
+            }
+            visited[k] = {
+                tuple(moved.get(j, state[i]) for j, i in enumerate(keep)) for state in visited[k]
+            }
     return problems, states, visited
 
 
