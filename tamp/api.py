@@ -454,8 +454,7 @@ def run_geometric(
     if (domain is None) != (binding is None):
         raise TampError("run_geometric: domain and binding go together (a bound domain)")
     rules = None if domain is None else (domain, binding)
-    named = None if rules is not None and planner == "motion-aware" else planner
-    task = scene_episode(str(scene), goal, named, rules)
+    task = scene_episode(str(scene), goal, planner, rules)
     return run_geo_episode(
         task.scene,
         task.goal,

@@ -71,7 +71,8 @@ class PlannerConfig:
     improve_s: float = 0.0  # anytime improvement: after the windows (and `shorten`) give a
     # plan of L moves, A* on the domain's lower bound looks for one of fewer than L moves for
     # at most this many seconds (within ``time_limit_s`` when set) and ``improve_nodes``
-    # expansions; a plan found replaces it and is a shortest one (`task.planner._improve`).
+    # expansions; a plan found replaces it and is a shortest one
+    # (`task.symbolic.lazy_search.improve`).
     # Only without beliefs and a cost source; 0: off
     improve_nodes: int = 20_000  # state expansions the improvement may spend per problem
     improve_up_to: int | None = None  # improve only problems of at most this many entities

@@ -15,8 +15,9 @@ confirmed by one more reading (a new image, no optimisation), so a perfect readi
 exactly the true protocol's plans.
 
 With ``PlannerConfig(improve_s=...)`` a plan found (without beliefs and move costs) is handed to
-an anytime improvement (`_improve`): A* on the domain's lower bound, cut at the plan's length,
-returns a shorter plan when one exists within its budget, a shortest one.
+an anytime improvement (`task.symbolic.lazy_search.improve`): A* on the domain's lower bound,
+cut at the plan's length, returns a shorter plan when one exists within its budget, a shortest
+one.
 """
 
 from __future__ import annotations
@@ -32,12 +33,18 @@ from task.config import PlannerConfig, torch_device
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
 from task.decode import DecodedWindow, decode_best, decode_row
 from task.domains import get_domain
-from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss
+from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss, window_part
 from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 from task.rollout import OutOfTime, Rollout, check_deadline
-from task.symbolic.lazy_search import LazyResult, SearchStatus, lazy_best_first, lazy_greedy
+from task.symbolic.lazy_search import (
+    LazyResult,
+    SearchStatus,
+    improve,
+    lazy_best_first,
+    lazy_greedy,
+)
 from task.symbolic.shorten import shorten
 
 NEAR_GOAL = 10.0  # `_proofs` decodes a restart early only when its soft goal cross-entropy at
@@ -64,7 +71,7 @@ def _window(
     """The decoded window of each problem (`decode_best`); a window of one problem
     (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early (`_proofs`).
     ``parks``: per problem, whether parking moves rank free (default `PlannerConfig.parks`
-    of the problems given; a part of a problem (`_unfinished`) keeps its whole problem's)."""
+    of the problems given; a part of a problem (`_window_parts`) keeps its whole problem's)."""
     parks = [config.parks(p) for p in problems] if parks is None else list(parks)
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
@@ -303,43 +310,6 @@ def _fall_back(
     return found
 
 
-def _improve(
-    domain: Domain,
-    problem: Problem,
-    moves: Sequence[Move],
-    config: PlannerConfig,
-    deadline: float | None,
-) -> tuple[tuple[Move, ...], dict]:
-    """The anytime improvement (`PlannerConfig.improve_s`) of a plan of ``moves`` that reaches
-    the goal: A* on the domain's lower bound from the initial state, cutting every state whose
-    moves so far plus bound reach ``len(moves)`` (`lazy_best_first`'s ``below``), within
-    ``config.improve_nodes`` expansions and ``config.improve_s`` seconds (at most until
-    ``deadline``, the time limit). Returns the plan (the one found, a shortest one, or
-    ``moves`` unchanged) and its stats: ``improved_from`` (the length before, None when
-    unchanged), ``proved_optimal`` (the bound from the initial state equals the length, or the
-    search completed), the search's status, expansions and seconds."""
-    t0 = time.perf_counter()
-    length = len(moves)
-    start = domain.initial_state(problem)
-    stats = {"improved_from": None, "moves": length, "proved_optimal": False, "expanded": 0}
-    if domain.lower_bound(problem, start) >= length:
-        stats.update(proved_optimal=True, status="bound", time_s=time.perf_counter() - t0)
-        return tuple(moves), stats
-    end = t0 + config.improve_s if deadline is None else min(deadline, t0 + config.improve_s)
-    found = lazy_best_first(domain, problem, start, None, config.improve_nodes, end, below=length)
-    better = found.status is SearchStatus.SOLVED and len(found.moves) < length
-    if better:
-        moves = found.moves
-        stats.update(improved_from=length, moves=len(moves))
-    stats.update(
-        proved_optimal=found.status in (SearchStatus.SOLVED, SearchStatus.UNSOLVABLE),
-        status=found.status.value,
-        expanded=found.expanded,
-        time_s=time.perf_counter() - t0,
-    )
-    return tuple(moves), stats
-
-
 def _take_safe(
     domain: Domain,
     problems: Sequence[Problem],
@@ -371,7 +341,7 @@ def _take_safe(
     return still
 
 
-def _unfinished(
+def _window_parts(
     domain: Domain,
     problems: list[Problem],
     states: list[State],
@@ -379,27 +349,12 @@ def _unfinished(
     config: PlannerConfig,
 ) -> tuple[list[Problem], list[State], list[set]]:
     """The problems a window plans: for those that `PlannerConfig.takes_safe`, the part still
-    to be planned (`Domain.unfinished`: without the towers no shortest plan touches again), its
-    state and the visited states seen on its blocks; the others as they are. The window's
-    moves are moves of the whole problem and its goal is reached exactly when the whole one's
-    is. Only without beliefs and a cost source (the caller's check)."""
-    shrink = getattr(domain, "unfinished", None)
-    if shrink is None:
-        return problems, states, visited
+    to be planned (`task.domains.base.window_part`); the others as they are. Only without
+    beliefs and a cost source (the caller's check)."""
     problems, states, visited = list(problems), list(states), list(visited)
     for k, problem in enumerate(problems):
-        part = shrink(problem, states[k]) if config.takes_safe(problem) else None
-        if part is not None and part[0].goal:
-            (problems[k], keep), now = part, states[k]
-            states[k] = problems[k].init
-            # the part's supports where they differ from the world's (tops of segments in
-            # position, which stand on the table in the part), read the same in the past
-            moved = {
-                j: s for j, (i, s) in enumerate(zip(keep, states[k], strict=True)) if now[i] != s
-            }
-            visited[k] = {
-                tuple(moved.get(j, state[i]) for j, i in enumerate(keep)) for state in visited[k]
-            }
+        if config.takes_safe(problem):
+            problems[k], states[k], visited[k] = window_part(domain, problem, states[k], visited[k])
     return problems, states, visited
 
 
@@ -431,7 +386,7 @@ def _next_window(
     views = [problems[i] for i in active], list(crisp), [visited[i] for i in active]
     parks = [config.parks(p) for p in views[0]]
     if source is None and costs is None:
-        views = _unfinished(domain, *views, config)
+        views = _window_parts(domain, *views, config)
     decoded = _window(
         domain, views[0], views[1], config, generator, beliefs, views[2], priced, deadline, parks
     )
@@ -544,7 +499,9 @@ def _run(
         small = config.improve_up_to
         for i, p in enumerate(problems):
             if solved[i] and illegal[i] is None and (small is None or p.n <= small):
-                better, improved[i] = _improve(domain, p, moves[i], config, deadline)
+                better, improved[i] = improve(
+                    domain, p, moves[i], config.improve_nodes, config.improve_s, deadline
+                )
                 moves[i] = list(better)
     on_done(len(active))
     elapsed = time.perf_counter() - start

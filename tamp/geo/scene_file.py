@@ -112,16 +112,15 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
 
 
 def _binding_json(path: Path) -> str:
-    """The binding file at ``path`` as JSON text (a TOML file converted); BindingError (one
-    line) for a missing or malformed file."""
+    """The binding file at ``path`` as JSON text (a TOML file converted), read once; one-line
+    BindingError for a wrong suffix, a missing file or bad JSON / TOML."""
     import json
-    import tomllib
 
     from task.symbolic.pickplace import binding as binder
 
-    binder.load(path)  # one line for a wrong suffix, a missing file or bad JSON / TOML
-    text = path.read_text(encoding="utf-8")
-    return text if path.suffix.lower() == ".json" else json.dumps(tomllib.loads(text))
+    text, fmt = binder.read(path)
+    data = binder.decode(text, fmt, str(path))
+    return text if fmt == "json" else json.dumps(data)
 
 
 def user_domain(path: Path, goal: str | Path, domain: str | Path, binding: str | Path) -> GeoRun:

@@ -230,7 +230,7 @@ def hanoi_pddl(problem: CanonicalProblem) -> str:
     facts = read_facts(scene)
     if facts.unexplained:
         raise ProblemError(f"hanoi: {facts.issues[0]}")
-    width = {o.name: 2 * max(o.half[0], o.half[1]) for o in scene.objects}
+    width = {o.name: o.width for o in scene.objects}
     discs = sorted(width, key=lambda d: (width[d], d))
     pegs = [r.name for r in scene.regions]
     init = sorted(_hanoi_atom(a, "initial state") for a in facts.atoms if a[0] != "clear")

@@ -23,14 +23,9 @@ from task.problem import TABLE
 from task.symbolic.pickplace.binding import Binding
 
 
-def _width(scene: Scene, name: str) -> float:
-    half = scene.object(name).half
-    return 2.0 * max(half[0], half[1])
-
-
 def _fits(scene: Scene, name: str, region) -> bool:
     """Whether object ``name``'s footprint, turned any way, fits inside ``region``'s walls."""
-    width = _width(scene, name)
+    width = scene.object(name).width
     lo, hi = region.inner()
     return all(b - a >= width for a, b in zip(lo, hi, strict=True))
 
@@ -46,7 +41,10 @@ def _atoms(scene: Scene, binding: Binding) -> list[tuple[str, ...]]:
     atoms = sorted(facts.atoms)
     atoms += [("empty", r) for r in regions if r not in holding]
     atoms += [
-        ("narrower", x, y) for x in objects for y in objects if _width(scene, x) < _width(scene, y)
+        ("narrower", x, y)
+        for x in objects
+        for y in objects
+        if scene.object(x).width < scene.object(y).width
     ]
     atoms += [("fits", x, r.name) for x in objects for r in scene.regions if _fits(scene, x, r)]
     atoms.append(("handempty",))

@@ -157,6 +157,11 @@ class Movable:
         return (self.size[0] / 2, self.size[1] / 2, self.size[2] / 2)
 
     @property
+    def width(self) -> float:
+        """The footprint's larger side (m): how wide the object is however it is turned."""
+        return 2.0 * max(self.half[0], self.half[1])
+
+    @property
     def bottom(self) -> float:
         return self.pose.xyz[2] - self.half[2]
 

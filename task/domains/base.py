@@ -127,8 +127,11 @@ class Domain(Protocol):
     """What a domain file provides. Tensors are batch first; see the glossary in ``task``.
 
     Optional: ``estimate(problem, state) -> float``, an inadmissible cost-to-go the decoder
-    ranks restarts by instead of ``lower_bound`` (which still marks dead ends), and
-    ``planner_defaults``, a dict of `PlannerConfig` fields (`PlannerConfig.for_domain`)."""
+    ranks restarts by instead of ``lower_bound`` (which still marks dead ends);
+    ``planner_defaults``, a dict of `PlannerConfig` fields (`PlannerConfig.for_domain`); for
+    big problems (`PlannerConfig.safe_from`), ``safe_moves(problem, state)``, moves some
+    shortest plan starts with, taken without a window, and ``unfinished(problem, state)``, the
+    part of the problem a window plans (`window_part`)."""
 
     name: str
     size_name: str  # what `size` counts, a table's column head ("blocks", "packages", ...)
@@ -223,6 +226,26 @@ class Domain(Protocol):
     def samples(self, seed: int) -> Iterator[Problem]:
         """Small random problems of this domain of several sizes, for the contract tests."""
         ...
+
+
+def window_part(
+    domain: Domain, problem: Problem, state: State, visited: set
+) -> tuple[Problem, State, set]:
+    """The problem a window plans from ``state``: the domain's part still to be planned
+    (its optional ``unfinished(problem, state) -> (part, kept indices) | None``), the part's
+    state and ``visited`` read in the part's blocks and supports (where the part's support of
+    a block differs from the world's now, it reads the same in every visited state). The
+    window's moves are moves of the whole problem, and its goal is reached exactly when the
+    whole one's is. ``problem``, ``state`` and ``visited`` as they are without such a part or
+    when it has no goal left."""
+    shrink = getattr(domain, "unfinished", None)
+    part = None if shrink is None else shrink(problem, state)
+    if part is None or not part[0].goal:
+        return problem, state, visited
+    part, keep = part
+    moved = {j: s for j, (i, s) in enumerate(zip(keep, part.init, strict=True)) if state[i] != s}
+    seen = {tuple(moved.get(j, past[i]) for j, i in enumerate(keep)) for past in visited}
+    return part, part.init, seen
 
 
 def resolve_goal_loss(domain: Domain, kind: str) -> str:

@@ -309,16 +309,13 @@ def _goal_or_table(batch: SoftBatch, problems: Sequence[Problem]) -> SoftBatch:
     rows = [i for i, p in enumerate(problems) if p.data == GOAL_OR_TABLE]
     if not rows:
         return batch
-    n = batch.n
-    keep = torch.zeros_like(batch.action_mask)
-    keep[..., n:] = True  # the table and STAY
+    keep = torch.ones_like(batch.action_mask)
     for i in rows:
         p = problems[i]
+        keep[i, :, : batch.n] = False  # block targets; the table and STAY stay
         for x, y in p.goal:
             if y != TABLE:
                 keep[i, p.entities.index(x), p.entities.index(y)] = True
-    for i in set(range(len(problems))) - set(rows):
-        keep[i] = True
     return replace(batch, action_mask=batch.action_mask & keep)
 
 

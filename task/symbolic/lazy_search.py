@@ -17,7 +17,7 @@ rules out, states the lower bound calls dead ends cut): it ends ``SOLVED`` with 
 within these choices), or ``BUDGET`` when ``max_nodes`` expansions or the deadline run out.
 With ``weight`` 1 a plan is a shortest one among the feasible moves.
 
-``below`` bounds the plans sought (the planner's anytime improvement, `task.planner`): a
+``below`` bounds the plans sought (`improve`, the planner's anytime improvement): a
 successor whose moves so far plus lower bound reach ``below`` is cut, so only plans of fewer
 than ``below`` moves are found, and UNSOLVABLE then says that none exists within these choices
 (with ``weight`` 1: a plan of ``below`` moves in hand is a shortest one).
@@ -36,7 +36,7 @@ import heapq
 import itertools
 import math
 import time
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -274,3 +274,40 @@ def lazy_greedy(
                 f"{ruled} moves ruled out",
             )
         h = domain.estimate(problem, state)
+
+
+def improve(
+    domain: CrispDomain,
+    problem,
+    moves: Sequence,
+    max_nodes: int,
+    seconds: float,
+    deadline: float | None = None,
+) -> tuple[tuple, dict]:
+    """The anytime improvement (`PlannerConfig.improve_s`) of a plan of ``moves`` that reaches
+    the goal: A* on the domain's lower bound from the initial state, cutting every state whose
+    moves so far plus bound reach ``len(moves)`` (`lazy_best_first`'s ``below``), within
+    ``max_nodes`` expansions and ``seconds`` (at most until ``deadline``, the planner's time
+    limit). Returns the plan (the one found, a shortest one, or ``moves`` unchanged) and its
+    stats: ``improved_from`` (the length before, None when unchanged), ``proved_optimal`` (the
+    bound from the initial state equals the length, or the search completed), the search's
+    status, expansions and seconds."""
+    t0 = time.perf_counter()
+    length = len(moves)
+    start = domain.initial_state(problem)
+    stats = {"improved_from": None, "moves": length, "proved_optimal": False, "expanded": 0}
+    if domain.lower_bound(problem, start) >= length:
+        stats.update(proved_optimal=True, status="bound", time_s=time.perf_counter() - t0)
+        return tuple(moves), stats
+    end = t0 + seconds if deadline is None else min(deadline, t0 + seconds)
+    found = lazy_best_first(domain, problem, start, None, max_nodes, end, below=length)
+    if found.status is SearchStatus.SOLVED and len(found.moves) < length:
+        moves = found.moves
+        stats.update(improved_from=length, moves=len(moves))
+    stats.update(
+        proved_optimal=found.status in (SearchStatus.SOLVED, SearchStatus.UNSOLVABLE),
+        status=found.status.value,
+        expanded=found.expanded,
+        time_s=time.perf_counter() - t0,
+    )
+    return tuple(moves), stats

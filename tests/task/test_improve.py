@@ -1,6 +1,6 @@
-"""The anytime improvement (`PlannerConfig.improve_s`, `task.planner._improve`): A* bounded by
-the plan in hand finds a shortest plan, never returns a longer or invalid one, and off leaves
-the plans as they were."""
+"""The anytime improvement (`PlannerConfig.improve_s`, `task.symbolic.lazy_search.improve`):
+A* bounded by the plan in hand finds a shortest plan, never returns a longer or invalid one, and
+off leaves the plans as they were."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import pytest
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.errors import TampError
-from task.planner import _improve, plan, plan_batch
+from task.planner import plan, plan_batch
 from task.problem import Move
 from task.symbolic.generate import random_problem
-from task.symbolic.lazy_search import SearchStatus, lazy_best_first
+from task.symbolic.lazy_search import SearchStatus, improve, lazy_best_first
 from task.symbolic.search import optimal_moves
 from tests.pddl_check import assert_valid
 
@@ -37,7 +37,7 @@ def test_the_improvement_finds_the_optimum_below_a_longer_plan(seed):
     problem = random_problem(6, seed)
     longer = detour(problem)
     assert_valid(problem, longer)
-    better, stats = _improve(BW, problem, longer, ON, None)
+    better, stats = improve(BW, problem, longer, ON.improve_nodes, ON.improve_s)
     assert len(better) == len(optimal_moves(problem)) == len(longer) - 2
     assert_valid(problem, better)
     assert stats["improved_from"] == len(longer) and stats["moves"] == len(better)
@@ -50,7 +50,7 @@ def test_an_optimal_plan_is_kept_and_proved_so():
     for seed in range(4):
         problem = random_problem(6, seed)
         best = optimal_moves(problem)
-        kept, stats = _improve(BW, problem, best, ON, None)
+        kept, stats = improve(BW, problem, best, ON.improve_nodes, ON.improve_s)
         assert kept == best and stats["improved_from"] is None
         assert stats["proved_optimal"] and stats["status"] in ("unsolvable", "bound")
 
@@ -58,10 +58,12 @@ def test_an_optimal_plan_is_kept_and_proved_so():
 def test_out_of_budget_the_plan_is_unchanged_and_not_called_optimal():
     problem = random_problem(8, 3)
     longer = detour(problem)
-    kept, stats = _improve(BW, problem, longer, replace(ON, improve_nodes=1), None)
+    kept, stats = improve(BW, problem, longer, 1, ON.improve_s)
     assert kept == longer and stats["status"] == "budget"
     assert not stats["proved_optimal"] and stats["improved_from"] is None
-    kept, stats = _improve(BW, problem, longer, ON, deadline=0.0)  # a time limit long past
+    kept, stats = improve(
+        BW, problem, longer, ON.improve_nodes, ON.improve_s, deadline=0.0
+    )  # a time limit long past
     assert kept == longer and stats["status"] == "budget"
 
 

@@ -234,20 +234,26 @@ def _scene_facts(entry: object, source: str) -> SceneFacts:
     return SceneFacts(objects and objects.lower(), regions and regions.lower(), tuple(pairs))
 
 
-def load_text(text: str, fmt: str = "json", source: str = "<binding>") -> BindingSpec:
-    """Read a binding from JSON (``fmt="json"``) or TOML (``fmt="toml"``) text."""
+def decode(text: str, fmt: str = "json", source: str = "<binding>") -> object:
+    """The document of JSON (``fmt="json"``) or TOML (``fmt="toml"``) binding text, before
+    its declarations are checked (`from_mapping`)."""
     if fmt not in ("json", "toml"):
         raise BindingError(f"{source}: unknown binding format {one_of(fmt, ('json', 'toml'))}")
     try:
-        data = json.loads(text) if fmt == "json" else tomllib.loads(text)
+        return json.loads(text) if fmt == "json" else tomllib.loads(text)
     except (json.JSONDecodeError, tomllib.TOMLDecodeError) as exc:
         first = str(exc).splitlines()[0]
         raise BindingError(f"{source}: not valid {fmt.upper()}: {first}") from None
-    return from_mapping(data, source)
 
 
-def load(path: str | Path) -> BindingSpec:
-    """Read a binding file: ``.json`` or ``.toml``."""
+def load_text(text: str, fmt: str = "json", source: str = "<binding>") -> BindingSpec:
+    """Read a binding from JSON (``fmt="json"``) or TOML (``fmt="toml"``) text."""
+    return from_mapping(decode(text, fmt, source), source)
+
+
+def read(path: str | Path) -> tuple[str, str]:
+    """The text of binding file ``path`` and its format, ``json`` or ``toml`` by its suffix;
+    BindingError for another suffix or a file that cannot be read."""
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in ("json", "toml"):
@@ -255,9 +261,14 @@ def load(path: str | Path) -> BindingSpec:
             f"{path}: a binding file ends in {one_of(path.suffix, ('.json', '.toml'))}"
         )
     try:
-        text = path.read_text(encoding="utf-8")
+        return path.read_text(encoding="utf-8"), fmt
     except OSError as exc:
         raise BindingError(f"{path}: cannot read the binding ({exc.strerror})") from None
+
+
+def load(path: str | Path) -> BindingSpec:
+    """Read a binding file: ``.json`` or ``.toml``."""
+    text, fmt = read(path)
     return load_text(text, fmt, str(path))
 
 
