@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 # moves per window (horizon, lookahead): far beyond any plan the windows decode, and the window's
 # (B, T, N, A) logits and T-step rollout graph grow with it (1_000_000 hung before planning)
 MAX_HORIZON = 1000
 FALLBACK_SEARCHES = ("astar", "greedy")  # `PlannerConfig.fallback_search`
+PART_WINDOW = ("horizon", "lookahead", "lookahead_share", "restarts", "iters", "lr", "init_noise")
 DEVICES = ("cpu", "cuda", "cuda:N")  # `PlannerConfig.device`: torch devices planning runs on
 _DEVICE = re.compile(r"cpu|cuda(:\d+)?")
 
@@ -40,7 +41,7 @@ class PlannerConfig:
     # every problem's decoded window reaches it in as few moves as the domain's lower bound
     # from the window's start allows, no later step could decode a shorter window and the
     # window stops (0: never, all ``iters`` steps; only windows of one problem, without
-    # beliefs, and without move costs unless ``proof_costs``; `task.planner._proofs`)
+    # beliefs, and without move costs unless ``proof_costs``; `task.decode.proof_stop`)
     proof_costs: bool = False  # stop early with move costs too: a window reaching the goal in
     # as few moves as the bound wins over a cheaper one of that length a later step might decode
     time_limit_s: float | None = None  # wall-clock planning limit (problems planned together
@@ -81,6 +82,10 @@ class PlannerConfig:
     window_share: float = 1.0  # with a time limit and the fallback on, the windows stop at
     # this share of the limit and the fallback searches in the rest (1: the windows may use all
     # of it, leaving the complete search none; the STRIPS lift's defaults: 0.5)
+    part_window: tuple[tuple[str, object], ...] = ()  # window settings (field, value) for the
+    # problems that take safe moves (`safe_from`), whose windows plan a part cut to what their
+    # moves reach (`task.domains.base.window_part`); Blocksworld's `planner_defaults` set longer
+    # windows with fewer restarts and Adam steps there (`for_parts`). (): the same as the others
     device: str = "cpu"  # torch device of the window tensors (and of a perception model read
     # alongside): "cpu", "cuda" or "cuda:N"; never falls back (`torch_device` refuses one that
     # this machine lacks). Decoding and the crisp checks stay on the CPU
@@ -88,10 +93,14 @@ class PlannerConfig:
     @classmethod
     def for_domain(cls, name: str, **given) -> PlannerConfig:
         """The defaults with domain ``name``'s own (its ``planner_defaults``, e.g. Sokoban's
-        longer lookahead and window budget), then the fields ``given``."""
+        longer lookahead and window budget), then the fields ``given``. A field given also
+        holds in the windows over a part of a problem: the domain's `part_window` setting
+        of it is left out."""
         from task.domains import get_domain
 
-        tuned = getattr(get_domain(name), "planner_defaults", {})
+        tuned = dict(getattr(get_domain(name), "planner_defaults", {}))
+        parts = tuned.get("part_window", ())
+        tuned["part_window"] = tuple((k, v) for k, v in parts if k not in given)
         return cls(**{**tuned, **given})
 
     def parks(self, problem) -> bool:
@@ -102,6 +111,10 @@ class PlannerConfig:
     def takes_safe(self, problem) -> bool:
         """Whether ``problem`` takes its domain's safe moves without a window (`safe_from`)."""
         return self.safe_from is not None and problem.n >= self.safe_from
+
+    def for_parts(self) -> PlannerConfig:
+        """The settings of the windows over a part of a problem (`part_window`)."""
+        return replace(self, part_window=(), **dict(self.part_window)) if self.part_window else self
 
     def horizons(self) -> tuple[int, ...]:
         """Window length of each restart: the long-lookahead restarts come last."""
@@ -127,6 +140,14 @@ class PlannerConfig:
                     f"PlannerConfig.{name} must be in 1..{MAX_HORIZON}, got {getattr(self, name)}"
                 )
         check_device_name(self.device)
+        for name, _ in self.part_window:
+            if name not in PART_WINDOW:
+                from task.errors import one_of
+
+                raise TampError(
+                    f"PlannerConfig.part_window: unknown setting {one_of(name, PART_WINDOW)}"
+                )
+        self.for_parts()  # its values checked as settings of their own
         if self.fallback_search not in FALLBACK_SEARCHES:
             from task.errors import one_of
 

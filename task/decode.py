@@ -21,19 +21,24 @@ Without the crisp check (``check=False``, `task.config.PlannerConfig.crisp_check
 illegal move is kept as the window's last move, and the restart with the lowest soft objective
 wins (ranking restarts by their crisp replay would be the check again); the planner then finds
 the move illegal in the world and the plan is inexecutable.
+
+`proof_stop` reads a window while Adam optimises it and ends it early once its decode is
+provably a shortest way to the goal.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass, replace
 
 from torch import Tensor
 
+from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE
 from task.domains.base import Domain, State
 from task.problem import Problem
+from task.rollout import Rollout
 
 
 @dataclass(frozen=True)
@@ -237,3 +242,67 @@ def decode_best(
 def _soft_objective(window: DecodedWindow) -> float:
     """Restart ranking without the crisp check: the soft objective alone."""
     return window.loss
+
+
+NEAR_GOAL = 10.0  # `proof_stop` decodes a restart early only when its soft goal cross-entropy at
+# the decode temperature is below this (a cheap filter: it can delay a stop,
+# never make one wrong; far rows read 30 to 1000, rows that reach it about 0)
+
+
+def proof_stop(
+    domain: Domain,
+    problems: Sequence[Problem],
+    states: Sequence[State],
+    config: PlannerConfig,
+    visited: Sequence[set],
+    proven: dict[int, DecodedWindow],
+    parks: Sequence[bool],
+) -> Callable[[Rollout], bool] | None:
+    """The early stop of a window (`PlannerConfig.proof_every`; `task.planner` passes it to
+    the window's optimisation): the rollout is read as the decoder reads it, and a problem
+    whose best window reaches the goal in as many moves as the domain's admissible lower
+    bound from the window's start state is done: no further Adam step could decode a shorter
+    way to the goal. That window is kept in ``proven`` (later reads and the final decode are
+    not used for it: a problem's plan does not depend on whether the others of its batch are
+    proven too). The stop is True once every problem is proven. None (no reads) when no
+    problem can be (its bound exceeds the longest window) or without the crisp check. Only the
+    restarts near the goal in the rollout (`NEAR_GOAL`) are decoded, the best of them by the
+    decoder's ranking (`DecodedWindow.key`)."""
+    longest = max(config.horizons())
+    bounds = [domain.lower_bound(p, s) for p, s in zip(problems, states, strict=True)]
+    hopeful = [i for i, bound in enumerate(bounds) if bound <= longest]
+    if not hopeful or not config.crisp_check or not config.proof_every:
+        return None
+    r = config.restarts
+
+    def stop(roll: Rollout) -> bool:
+        near = (roll.goal < NEAR_GOAL).view(len(problems), r).tolist()  # (P, R)
+        todo = [i for i in hopeful if i not in proven and any(near[i])]
+        if not todo:
+            return False
+        gates, losses = roll.gates.cpu(), roll.loss.cpu().tolist()
+        priced = None if roll.costs is None else roll.costs.detach().cpu()  # (B, N, Y)
+        for i in todo:
+            windows = []
+            for k in (k for k in range(r) if near[i][k]):
+                row = i * r + k
+                window = decode_row(
+                    domain,
+                    problems[i],
+                    states[i],
+                    gates[row],
+                    config.threshold,
+                    losses[row],
+                    True,
+                    visited[i],
+                    None if priced is None else priced[row],
+                    config.rank_prefixes,
+                    parks[i],
+                )
+                windows.append(replace(window, row=k))
+            best = min(windows, key=DecodedWindow.key)
+            if best.reached and len(best.moves) <= bounds[i]:
+                proven[i] = best
+        return len(proven) == len(problems)
+
+    return stop

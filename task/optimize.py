@@ -16,7 +16,7 @@ from torch import Tensor
 from task.beliefs import WindowBeliefs
 from task.config import PlannerConfig
 from task.costs import WindowCosts
-from task.domains.base import Domain, SoftBatch
+from task.domains.base import STAY_PRIOR, Domain, SoftBatch
 from task.errors import TampError
 from task.rollout import Rollout, check_deadline, rollout
 
@@ -25,11 +25,16 @@ def initial_logits(
     batch: SoftBatch, horizon: int, config: PlannerConfig, generator: torch.Generator
 ) -> Tensor:
     """Gaussian logits, (B, T, N, A), on the batch's device; each restart row draws its own
-    noise. ``generator`` is a CPU generator, so every device starts from the same logits."""
+    noise. ``generator`` is a CPU generator, so every device starts from the same logits.
+    A domain's `task.domains.base.STAY_PRIOR` raises the rows' STAY logits."""
     b, n, a = batch.action_mask.shape
     shape = (b, horizon, n, a)
     noise = torch.randn(shape, generator=generator, dtype=torch.float64)
-    return (config.init_noise * noise).to(batch.F0.dtype).to(batch.F0.device)
+    logits = (config.init_noise * noise).to(batch.F0.dtype).to(batch.F0.device)
+    prior = batch.static.get(STAY_PRIOR)
+    if prior is not None:  # STAY e^prior times more likely at the first temperature
+        logits[..., -1] += config.tau * prior.to(logits.device)[:, None, None]
+    return logits
 
 
 def optimise_window(

@@ -31,13 +31,13 @@ import torch
 from task.beliefs import BeliefSource, WindowBeliefs
 from task.config import PlannerConfig, torch_device
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
-from task.decode import DecodedWindow, decode_best, decode_row
+from task.decode import DecodedWindow, decode_best, proof_stop
 from task.domains import get_domain
 from task.domains.base import Domain, SoftBatch, State, resolve_goal_loss, window_part
 from task.errors import ProblemError, TampError, one_of
 from task.optimize import optimise_window
 from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
-from task.rollout import OutOfTime, Rollout, check_deadline
+from task.rollout import OutOfTime, check_deadline
 from task.symbolic.lazy_search import (
     LazyResult,
     SearchStatus,
@@ -47,9 +47,6 @@ from task.symbolic.lazy_search import (
 )
 from task.symbolic.shorten import shorten
 
-NEAR_GOAL = 10.0  # `_proofs` decodes a restart early only when its soft goal cross-entropy at
-# the decode temperature is below this (a cheap filter: it can delay a stop,
-# never make one wrong; far rows read 30 to 1000, rows that reach it about 0)
 PROOF_PROBLEMS = 1  # windows of at most this many problems are read early (`_proofs`): a read
 # costs about a third of an Adam step, and a window stops only once all its problems are proven,
 # which in a batch of many rarely happens (PlanBench's 150 4-block problems in one batch: 8%
@@ -69,9 +66,10 @@ def _window(
     parks: Sequence[bool] | None = None,
 ):
     """The decoded window of each problem (`decode_best`); a window of one problem
-    (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early (`_proofs`).
+    (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early
+    (`task.decode.proof_stop`).
     ``parks``: per problem, whether parking moves rank free (default `PlannerConfig.parks`
-    of the problems given; a part of a problem (`_window_parts`) keeps its whole problem's)."""
+    of the problems given; a part of a problem (`_part_windows`) keeps its whole problem's)."""
     parks = [config.parks(p) for p in problems] if parks is None else list(parks)
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
@@ -82,7 +80,7 @@ def _window(
     stop = None
     priced_ok = costs is None or config.proof_costs
     if len(problems) <= PROOF_PROBLEMS and beliefs is None and priced_ok and visited:
-        stop = _proofs(domain, problems, states, config, visited, proven, parks)
+        stop = proof_stop(domain, problems, states, config, visited, proven, parks)
     _, roll = optimise_window(
         domain, batch, steps, config, generator, beliefs, costs, deadline, stop
     )
@@ -103,64 +101,6 @@ def _window(
         parks,
     )
     return [proven.get(i, window) for i, window in enumerate(decoded)]
-
-
-def _proofs(
-    domain: Domain,
-    problems: Sequence[Problem],
-    states: Sequence[State],
-    config: PlannerConfig,
-    visited: Sequence[set],
-    proven: dict[int, DecodedWindow],
-    parks: Sequence[bool],
-) -> Callable[[Rollout], bool] | None:
-    """The early stop of a window (`PlannerConfig.proof_every`): the rollout is read as the
-    decoder reads it, and a problem whose best window reaches the goal in as many moves as the
-    domain's admissible lower bound from the window's start state is done: no further Adam
-    step could decode a shorter way to the goal. That window is kept in ``proven`` (later reads
-    and the final decode are not used for it: a problem's plan does not depend on whether the
-    others of its batch are proven too). The stop is True once every problem is proven. None
-    (no reads) when no problem can be (its bound exceeds the longest window) or without the
-    crisp check. Only the restarts near the goal in the rollout (`NEAR_GOAL`) are decoded, the
-    best of them by the decoder's ranking (`DecodedWindow.key`)."""
-    longest = max(config.horizons())
-    bounds = [domain.lower_bound(p, s) for p, s in zip(problems, states, strict=True)]
-    hopeful = [i for i, bound in enumerate(bounds) if bound <= longest]
-    if not hopeful or not config.crisp_check or not config.proof_every:
-        return None
-    r = config.restarts
-
-    def stop(roll: Rollout) -> bool:
-        near = (roll.goal < NEAR_GOAL).view(len(problems), r).tolist()  # (P, R)
-        todo = [i for i in hopeful if i not in proven and any(near[i])]
-        if not todo:
-            return False
-        gates, losses = roll.gates.cpu(), roll.loss.cpu().tolist()
-        priced = None if roll.costs is None else roll.costs.detach().cpu()  # (B, N, Y)
-        for i in todo:
-            windows = []
-            for k in (k for k in range(r) if near[i][k]):
-                row = i * r + k
-                window = decode_row(
-                    domain,
-                    problems[i],
-                    states[i],
-                    gates[row],
-                    config.threshold,
-                    losses[row],
-                    True,
-                    visited[i],
-                    None if priced is None else priced[row],
-                    config.rank_prefixes,
-                    parks[i],
-                )
-                windows.append(replace(window, row=k))
-            best = min(windows, key=DecodedWindow.key)
-            if best.reached and len(best.moves) <= bounds[i]:
-                proven[i] = best
-        return len(proven) == len(problems)
-
-    return stop
 
 
 def on_device(batch: SoftBatch, device: torch.device) -> SoftBatch:
@@ -341,21 +281,39 @@ def _take_safe(
     return still
 
 
-def _window_parts(
+def _part_windows(
     domain: Domain,
     problems: list[Problem],
     states: list[State],
     visited: list[set],
     config: PlannerConfig,
-) -> tuple[list[Problem], list[State], list[set]]:
-    """The problems a window plans: for those that `PlannerConfig.takes_safe`, the part still
-    to be planned (`task.domains.base.window_part`); the others as they are. Only without
-    beliefs and a cost source (the caller's check)."""
-    problems, states, visited = list(problems), list(states), list(visited)
+    generator: torch.Generator,
+    deadline: float | None,
+    parks: Sequence[bool],
+) -> list[DecodedWindow]:
+    """The decoded windows of ``problems`` without beliefs and move costs: those that
+    `PlannerConfig.takes_safe` plan the part still to be planned, cut to what their windows'
+    moves reach (`task.domains.base.window_part`), with the part's settings
+    (`PlannerConfig.for_parts`); the others plan as they are. One `_window` per settings."""
+    part_config = config.for_parts()
+    groups: dict[PlannerConfig, list[int]] = {}
+    views = list(problems), list(states), list(visited)
     for k, problem in enumerate(problems):
+        here = part_config if config.takes_safe(problem) else config
         if config.takes_safe(problem):
-            problems[k], states[k], visited[k] = window_part(domain, problem, states[k], visited[k])
-    return problems, states, visited
+            depth = max(here.horizons())
+            views[0][k], views[1][k], views[2][k] = window_part(
+                domain, problem, states[k], visited[k], depth
+            )
+        groups.setdefault(here, []).append(k)
+    decoded: list[DecodedWindow | None] = [None] * len(problems)
+    for here, ks in groups.items():
+        pick = [[view[k] for k in ks] for view in views]
+        parked = [parks[k] for k in ks]
+        windows = _window(domain, *pick[:2], here, generator, None, pick[2], None, deadline, parked)
+        for k, window in zip(ks, windows, strict=True):
+            decoded[k] = window
+    return decoded
 
 
 def _next_window(
@@ -386,10 +344,11 @@ def _next_window(
     views = [problems[i] for i in active], list(crisp), [visited[i] for i in active]
     parks = [config.parks(p) for p in views[0]]
     if source is None and costs is None:
-        views = _window_parts(domain, *views, config)
-    decoded = _window(
-        domain, views[0], views[1], config, generator, beliefs, views[2], priced, deadline, parks
-    )
+        decoded = _part_windows(domain, *views, config, generator, deadline, parks)
+    else:
+        decoded = _window(
+            domain, *views[:2], config, generator, beliefs, views[2], priced, deadline, parks
+        )
     retried = _retry_frozen(
         domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
     )

@@ -84,6 +84,15 @@ def _ref(cells: list[str], s: Summary | None, refs: bool) -> list[str]:
     return [*cells[:5], *extra, *cells[5:]]
 
 
+def _part_settings(config, size_name: str) -> str:
+    """The windows' own settings on the problems that take safe moves, for the report's head
+    (`PlannerConfig.part_window`); empty when there are none."""
+    if config.safe_from is None or not config.part_window:
+        return ""
+    settings = ", ".join(f"{k} {v}" for k, v in config.part_window)
+    return f"; from {config.safe_from} {size_name}: {settings}"
+
+
 def planning_report(bench: Bench) -> str:
     """The paper-style tables of a benchmark: by (horizon, seed), then by block count."""
     c = bench.config
@@ -93,6 +102,7 @@ def planning_report(bench: Bench) -> str:
         f"seeds {seeds}; restarts {c.restarts}, iters {c.iters}, goal loss {c.goal_loss}, "
         f"lookahead {c.lookahead} x {c.lookahead_share:g} of restarts, "
         f"tau {c.tau:g}->{c.tau_end:g}, max windows {c.max_windows}"
+        + _part_settings(c, bench.size_name)
         + ("" if c.crisp_check else "; NO crisp check (illegal moves kept, restarts by loss)"),
         "",
     ]

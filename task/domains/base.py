@@ -30,6 +30,8 @@ from task.problem import Action, Move, Problem
 from task.soft import transition
 
 State = tuple | frozenset  # crisp: supports per entity (relational), or a set of atoms
+STAY_PRIOR = "stay-prior"  # ``SoftBatch.static`` key, (B,): a row's STAY logit offset at the
+# start of a window (`task.optimize.initial_logits`), as a log-odds factor; absent: none
 INF = math.inf  # the lower bound of a dead end: no sequence of moves reaches the goal
 
 
@@ -130,8 +132,9 @@ class Domain(Protocol):
     ranks restarts by instead of ``lower_bound`` (which still marks dead ends);
     ``planner_defaults``, a dict of `PlannerConfig` fields (`PlannerConfig.for_domain`); for
     big problems (`PlannerConfig.safe_from`), ``safe_moves(problem, state)``, moves some
-    shortest plan starts with, taken without a window, and ``unfinished(problem, state)``, the
-    part of the problem a window plans (`window_part`)."""
+    shortest plan starts with, taken without a window, and ``unfinished(problem, state,
+    depth)``, the part of the problem a window of at most ``depth`` moves plans
+    (`window_part`)."""
 
     name: str
     size_name: str  # what `size` counts, a table's column head ("blocks", "packages", ...)
@@ -229,22 +232,31 @@ class Domain(Protocol):
 
 
 def window_part(
-    domain: Domain, problem: Problem, state: State, visited: set
+    domain: Domain, problem: Problem, state: State, visited: set, depth: int | None = None
 ) -> tuple[Problem, State, set]:
-    """The problem a window plans from ``state``: the domain's part still to be planned
-    (its optional ``unfinished(problem, state) -> (part, kept indices) | None``), the part's
-    state and ``visited`` read in the part's blocks and supports (where the part's support of
-    a block differs from the world's now, it reads the same in every visited state). The
-    window's moves are moves of the whole problem, and its goal is reached exactly when the
-    whole one's is. ``problem``, ``state`` and ``visited`` as they are without such a part or
-    when it has no goal left."""
+    """The problem a window of at most ``depth`` moves plans from ``state``: the domain's part
+    still to be planned (its optional ``unfinished(problem, state, depth) -> (part, kept
+    indices) | None``; the part may have entities of its own after the kept ones, and keep
+    only what ``depth`` moves can change), the part's state and ``visited`` read in the part's
+    blocks and supports. Of the visited states only those a window could reach again are
+    read: the same as now in every block the part drops or stands elsewhere (the window moves
+    neither), each then read in the part as it stands now. The window's moves are moves of the
+    whole problem, and its goal is reached exactly when the whole one's is. ``problem``,
+    ``state`` and ``visited`` as they are without such a part or when it has no goal left."""
     shrink = getattr(domain, "unfinished", None)
-    part = None if shrink is None else shrink(problem, state)
+    part = None if shrink is None else shrink(problem, state, depth)
     if part is None or not part[0].goal:
         return problem, state, visited
     part, keep = part
-    moved = {j: s for j, (i, s) in enumerate(zip(keep, part.init, strict=True)) if state[i] != s}
-    seen = {tuple(moved.get(j, past[i]) for j, i in enumerate(keep)) for past in visited}
+    fixed = [i for j, i in enumerate(keep) if state[i] != part.init[j]]  # stands elsewhere
+    fixed += sorted(set(range(len(state))) - set(keep))  # dropped
+    own = part.init[len(keep) :]  # the part's own entities stand still
+    seen = {
+        tuple(part.init[j] if state[i] != part.init[j] else past[i] for j, i in enumerate(keep))
+        + own
+        for past in visited
+        if all(past[i] == state[i] for i in fixed)
+    }
     return part, part.init, seen
 
 

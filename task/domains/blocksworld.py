@@ -11,6 +11,7 @@ unstack), where each move is two actions: ``(unstack x s)`` or ``(pick-up x)``, 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import replace
 from types import MappingProxyType
@@ -19,7 +20,13 @@ import torch
 from torch import Tensor
 
 from task.domains import blocksworld_pddl as _pddl
-from task.domains.base import SoftBatch, encode_supports, relational_decode, relational_step
+from task.domains.base import (
+    STAY_PRIOR,
+    SoftBatch,
+    encode_supports,
+    relational_decode,
+    relational_step,
+)
 from task.domains.match.renaming import user_actions, user_atoms
 from task.errors import ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
@@ -160,7 +167,9 @@ def safe_moves(problem: Problem, state: State) -> tuple[Move, ...]:
     return tuple(out)
 
 
-def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]] | None:
+def unfinished(
+    problem: Problem, state: State, depth: int | None = None
+) -> tuple[Problem, tuple[int, ...]] | None:
     """The part of ``problem`` still to be planned from ``state``. Blocks in position
     (`in_position`) never move again in some shortest plan, so of each tower's in-position
     segment only its top is kept, as a block standing on the table (its goal, if any, the
@@ -170,9 +179,15 @@ def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]
     a kept block names one, so the part is a problem of its own, with the same moves and
     shortest plans as ``problem`` from ``state`` (a window's soft problem shrinks as towers
     are built). The part is marked `GOAL_OR_TABLE`: its windows move a block only onto its
-    goal block or the table, which keeps some shortest plan (`_goal_or_table`). Returns it and
-    the indices of its blocks in ``problem.entities`` (all of them when nothing is dropped),
-    or None on a slotted table."""
+    goal block or the table, which keeps some shortest plan (`_goal_or_table`).
+
+    With ``depth`` (the longest window's moves), only what a window of ``depth`` moves can
+    change is kept (`_within_reach`): the part is then exact for every plan of at most
+    ``depth`` moves but no longer a problem of its own (its goal is out of reach).
+
+    Returns the part and the indices of its blocks in ``problem.entities`` (all of them when
+    nothing is dropped; a part cut at ``depth`` has entities of its own after them), or None
+    on a slotted table."""
     if slotted(problem):
         return None
     placed = in_position(problem, state)
@@ -190,7 +205,76 @@ def unfinished(problem: Problem, state: State) -> tuple[Problem, tuple[int, ...]
     entities = tuple(problem.entities[i] for i in keep)
     atoms = tuple((x, TABLE if x in rooted else goal[x]) for x in entities if x in goal)
     part = replace(problem, entities=entities, init=init, goal=atoms, data=GOAL_OR_TABLE)
-    return part, keep
+    if depth is None:
+        return part, keep
+    part, near = _within_reach(part, depth)
+    return part, tuple(keep[j] for j in near)
+
+
+PEDESTAL = "_pedestal-{}"  # a `_within_reach` part's own entities (no PDDL name starts so)
+
+
+def _within_reach(part: Problem, depth: int) -> tuple[Problem, tuple[int, ...]]:
+    """``part`` (standing in its ``init``) cut to what ``depth`` moves can change, and the
+    indices of the blocks kept in ``part.entities``.
+
+    A block with ``depth`` or more blocks above it can neither move nor receive a block
+    within ``depth`` moves (clearing it takes that many). Of each tower the blocks above
+    that level are kept as they are; the first one at it, the *root*, is kept with the table
+    as its goal, standing on the table where it is in position in ``part`` and otherwise on a
+    *pedestal*, an entity of the cut part's own that nothing reaches (the root never leaves
+    it within ``depth`` moves). Blocks deeper down are dropped. A kept block whose goal block
+    is dropped can reach it in no plan of ``depth`` moves: its goal becomes the pedestal of
+    that tower, a goal never met (that tower's root is not in position, as a block in
+    position stands on that goal block, and it is not the kept one). A block the goal leaves
+    free that stands on a block a root or a dropped block must stand on gets the table as its
+    goal (it is in position only there). For every plan of at most ``depth`` moves from
+    ``part.init`` that moves each block only onto its goal block or the table (the part's
+    moves, `GOAL_OR_TABLE`), the cut part has the same legal moves (but after the last), each
+    kept block the same in-position truth and, but for the roots, the same support, and the
+    cut's goal holds exactly when ``part``'s does. ``part`` itself when no tower reaches the
+    level."""
+    support = dict(zip(part.entities, part.init, strict=True))
+    covered = set(part.init)
+    level: dict[str, int] = {}  # blocks above each block, for the blocks near the top
+    for top in (x for x in part.entities if x not in covered):
+        x, k = top, 0
+        while x != TABLE and k <= depth:
+            level[x], x, k = k, support[x], k + 1
+    if len(level) == part.n:
+        return part, tuple(range(part.n))
+    placed = in_position(part, part.init)
+    roots = [x for x in part.entities if level.get(x) == depth]
+    stands = {r: PEDESTAL.format(i) for i, r in enumerate(r for r in roots if r not in placed)}
+    tower: dict[str, str] = {}  # each dropped block's root
+    for root in roots:
+        x = support[root]
+        while x != TABLE:
+            tower[x], x = root, support[x]
+    goal = dict(part.goal)
+    claimed = {goal[z] for z in (*tower, *roots) if z in goal}  # by a block that stays
+    near = tuple(j for j, x in enumerate(part.entities) if x in level)
+    entities = tuple(part.entities[j] for j in near)
+    atoms = []
+    for x in entities:
+        if level[x] == depth:
+            atoms.append((x, TABLE))
+        elif goal.get(x) in tower:  # a dropped goal block; its root is not in position
+            if tower[goal[x]] in stands:  # (always, for a goal one state can meet)
+                atoms.append((x, stands[tower[goal[x]]]))
+        elif x in goal:
+            atoms.append((x, goal[x]))
+        elif support[x] in claimed:
+            atoms.append((x, TABLE))
+    init = tuple(stands.get(x, TABLE) if level[x] == depth else support[x] for x in entities)
+    pedestals = tuple(stands.values())
+    cut = replace(
+        part,
+        entities=entities + pedestals,
+        init=init + (TABLE,) * len(pedestals),
+        goal=tuple(atoms),
+    )
+    return cut, near
 
 
 # ---------------------------------------------------------------------------- moves <-> actions
@@ -305,18 +389,24 @@ def _goal_or_table(batch: SoftBatch, problems: Sequence[Problem]) -> SoftBatch:
     """``batch`` with the moves of the `GOAL_OR_TABLE` rows narrowed to onto the block's goal
     block or the table: Gupta & Nau, some shortest plan makes only constructive moves and
     moves to the table, and a block's constructive move goes to its goal support (the table
-    for a block the goal leaves free)."""
+    for a block the goal leaves free). Those rows also start with STAY log(n) more likely for
+    each of their n blocks (`STAY_PRIOR`): with at most three choices a block, random logits
+    would have about n/1.5 blocks move at once in a step meant for one, and the step's
+    competition between them (`soft_legality`) would leave each a gate near (1/3)^n."""
     rows = [i for i, p in enumerate(problems) if p.data == GOAL_OR_TABLE]
     if not rows:
         return batch
     keep = torch.ones_like(batch.action_mask)
+    prior = torch.zeros(len(problems), dtype=batch.F0.dtype)
     for i in rows:
         p = problems[i]
         keep[i, :, : batch.n] = False  # block targets; the table and STAY stay
         for x, y in p.goal:
             if y != TABLE:
                 keep[i, p.entities.index(x), p.entities.index(y)] = True
-    return replace(batch, action_mask=batch.action_mask & keep)
+        prior[i] = math.log(p.n)
+    static = {**batch.static, STAY_PRIOR: prior}
+    return replace(batch, action_mask=batch.action_mask & keep, static=static)
 
 
 def encode(
@@ -404,7 +494,17 @@ class Blocksworld:
     # blocks, beyond the improvement, constructive moves are taken without a window
     # (`safe_moves`), the windows deciding only which blocks to move out of the way
     planner_defaults = MappingProxyType(
-        {"park_from": 30, "safe_from": 16, "improve_s": 30.0, "improve_up_to": 15}
+        {
+            "park_from": 30,
+            "safe_from": 16,
+            "improve_s": 30.0,
+            "improve_up_to": 15,
+            # a window from a deadlock (no constructive move left) must look far enough ahead
+            # to see a parked block's gain: at 100 blocks 3- and 5-move windows mostly decoded
+            # no move; 5 and 8 moves with half the restarts and a third of the Adam steps
+            # decode 2-3 moves a window at about the same cost
+            "part_window": (("horizon", 5), ("lookahead", 8), ("restarts", 8), ("iters", 20)),
+        }
     )
     distributions = True
     encode = staticmethod(encode)

@@ -195,7 +195,10 @@ def test_a_window_back_to_a_visited_state_ranks_below_progress_elsewhere():
 
 def test_domain_planner_defaults_and_overrides():
     blocks = PlannerConfig.for_domain("blocksworld")
-    assert blocks == PlannerConfig(park_from=30, safe_from=16, improve_s=30.0, improve_up_to=15)
+    parts = (("horizon", 5), ("lookahead", 8), ("restarts", 8), ("iters", 20))
+    assert blocks == PlannerConfig(
+        park_from=30, safe_from=16, improve_s=30.0, improve_up_to=15, part_window=parts
+    )
     assert not blocks.takes_safe(random_problem(15, 0)) and blocks.takes_safe(random_problem(16, 0))
     assert not blocks.parks(random_problem(29, 0)) and blocks.parks(random_problem(30, 0))
     assert not PlannerConfig().parks(random_problem(50, 0))  # other domains: asked for only
