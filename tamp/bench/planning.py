@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, fields, replace
 
 from pddl.core import Domain
 
@@ -48,6 +48,28 @@ class Row:
     us_s: float | None = None  # US's seconds (None: US did not run)
     gn1_length: int | None = None  # their GN1, PDDL actions (None: not run, or invalid)
     gn1_s: float | None = None  # GN1's seconds
+
+
+def best_known(row: Row) -> int | None:
+    """The shortest plan known for ``row``'s instance, in PDDL actions: the least of its
+    optimum, our valid plan and the peers' plans that ran (LAMA, US, GN1); None when none is
+    known."""
+    ours = row.length if row.status == "valid" else None
+    found = (row.optimal, ours, row.lama_length, row.us_length, row.gn1_length)
+    lengths = [k for k in found if k is not None]
+    return min(lengths) if lengths else None
+
+
+def beside_best(row: Row) -> dict:
+    """``row``'s fields with `best_known` and ``x_best`` (our valid plan's length over it;
+    None without a valid plan): `INSTANCE_COLUMNS`, one instances.csv row."""
+    best = best_known(row)
+    ours = row.length if row.status == "valid" else None
+    ratio = None if ours is None or not best else ours / best
+    return asdict(row) | {"best_known": best, "x_best": ratio}
+
+
+INSTANCE_COLUMNS = (*(f.name for f in fields(Row)), "best_known", "x_best")
 
 
 @dataclass(frozen=True)

@@ -20,10 +20,10 @@ import shlex
 import subprocess
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, fields
+from dataclasses import asdict
 from pathlib import Path
 
-from tamp.bench.planning import Bench, Row
+from tamp.bench.planning import INSTANCE_COLUMNS, Bench, beside_best
 from tamp.bench.summary import latency_rows, main_rows, size_rows
 from task.errors import TampError
 
@@ -194,7 +194,12 @@ def write(bench: Bench, out_dir: str | Path, report: dict | None = None) -> tupl
     """A planning benchmark's three artefacts in ``out_dir`` (created); returns their paths."""
     out = out_folder(out_dir)
     return (
-        write_csv(out / "instances.csv", bench.rows(), [f.name for f in fields(Row)], digits=4),
+        write_csv(
+            out / "instances.csv",
+            [beside_best(r) for r in bench.rows()],
+            INSTANCE_COLUMNS,
+            digits=4,
+        ),
         write_json(out / "results.json", report if report is not None else results(bench)),
         plot_steps(bench, out / "steps.png"),
     )

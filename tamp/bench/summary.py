@@ -16,7 +16,7 @@ import statistics
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, fields
 
-from tamp.bench.planning import STATUSES, Bench, Row, percentiles
+from tamp.bench.planning import STATUSES, Bench, Row, best_known, percentiles
 from task.errors import TampError
 
 
@@ -57,6 +57,9 @@ class Summary:
     gn1_ratio: float | None = None
     gn1_s: float | None = None
     vs_gn1: float | None = None
+    best: float | None = None  # valid plans as short as the best known (`best_known`; None:
+    # nothing to compare with: no optimum known and no peer ran)
+    vs_best: float | None = None  # mean our length / the best known, over valid plans
 
     def asdict(self) -> dict:
         return asdict(self)
@@ -123,7 +126,25 @@ def summarise(
         vs_lama=_mean([r.length / r.lama_length for r in valid if r.lama_length]),
         **_baseline("us", rows, valid),
         **_baseline("gn1", rows, valid),
+        **_beside_best(rows, valid),
     )
+
+
+def _beside_best(rows: Sequence[Row], valid: Sequence[Row]) -> dict:
+    """``best`` and ``vs_best``: our valid plans against the shortest plan known for each
+    instance (`tamp.bench.planning.best_known`); None when no peer ran and no optimum is
+    known (the best known would be our own plan)."""
+    peers = any(
+        r.optimal is not None or r.lama_s is not None or r.us_s is not None or r.gn1_s is not None
+        for r in rows
+    )
+    if not peers or not valid:
+        return {"best": None, "vs_best": None}
+    best = [best_known(r) for r in valid]
+    return {
+        "best": sum(r.length == b for r, b in zip(valid, best, strict=True)),
+        "vs_best": _mean([r.length / b for r, b in zip(valid, best, strict=True)]),
+    }
 
 
 def _baseline(name: str, rows: Sequence[Row], valid: Sequence[Row]) -> dict:

@@ -3,12 +3,13 @@ the optimum, GN1 never longer than US, and ``tamp bench random --baselines`` bes
 
 from __future__ import annotations
 
+import csv
 import json
 
 import pytest
 
 from tamp.bench.peers import slaney
-from tamp.bench.planning import Row
+from tamp.bench.planning import Row, beside_best, best_known
 from tamp.bench.summary import summarise
 from tamp.cli import main
 from task.domains import blocksworld
@@ -103,12 +104,39 @@ def test_the_summary_counts_each_baseline_against_ours_and_the_optimum():
     assert bare.us is None and bare.gn1 is None  # the baselines did not run
 
 
+def test_each_plan_is_set_beside_the_shortest_known_plan_of_its_instance():
+    """No optimum known (big problems): the best known is the shortest of ours and the peers';
+    a plan ours failed to find counts nowhere; nothing to compare without a peer."""
+
+    def row(length, lama, us, gn1, status="valid"):
+        return Row("i", 50, None, None, 3, 0, length, status, 1.0, 2, lama, 2.0, us, 0.1, gn1, 0.2)
+
+    rows = [row(70, 150, 82, 68), row(60, 140, 66, 60), row(None, 120, 90, 80, "no_plan")]
+    assert [best_known(r) for r in rows] == [68, 60, 80]
+    s = summarise(rows, 3, 0, None, None)
+    assert s.best == 1 and s.vs_best == pytest.approx((70 / 68 + 1) / 2)
+    csv_row = beside_best(rows[0])
+    assert csv_row["best_known"] == 68 and csv_row["x_best"] == pytest.approx(70 / 68)
+    assert beside_best(rows[2])["x_best"] is None and beside_best(rows[2])["best_known"] == 80
+    alone = Row("i", 50, None, None, 3, 0, 70, "valid", 1.0, 2)
+    assert summarise([alone], 3, 0, None, None).vs_best is None  # only our own plan
+    known = Row("i", 5, 8, None, 3, 0, 10, "valid", 0.5, 1)
+    assert summarise([known], 3, 0, None, None).vs_best == pytest.approx(10 / 8)
+
+
 def test_bench_random_prints_and_records_the_baselines_beside_ours(tmp_path, capsys):
     argv = ["bench", "random", "--blocks", "6", "--n", "2", "--restarts", "2", "--iters", "5"]
     argv += ["--baselines", "us,gn1", "--no-progress"]
     assert main([*argv, "--out", str(tmp_path)]) == 0
     text = capsys.readouterr().out
-    assert "US moves" in text and "ours/GN1" in text
+    assert "US moves" in text and "ours/GN1" in text and "x best" in text
+    with (tmp_path / "instances.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    for r in rows:  # our plan beside the shortest of the optimum, ours, US's and GN1's
+        found = [r[k] for k in ("optimal", "length", "us_length", "gn1_length") if r[k]]
+        best = min(int(k) for k in found)
+        assert int(r["best_known"]) == best
+        assert float(r["x_best"]) == pytest.approx(int(r["length"]) / best, abs=1e-4)
     body = json.loads((tmp_path / "results.json").read_text())
     assert body["config"]["baselines"] == ["us", "gn1"]
     sizes = body["by_size"]
