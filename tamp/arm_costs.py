@@ -202,6 +202,11 @@ class ArmCosts:
         onto a block or, without places, onto the table)."""
         return list(self._decided.get(index, ()))
 
+    def forget(self, index: int) -> None:
+        """Drop the moves committed for problem ``index`` (the planner's fallback started its
+        plan over from the initial state, `task.planner`)."""
+        self._decided.pop(index, None)
+
     def _record(self, index: int, moves: Sequence, shift: torch.Tensor | None) -> None:
         """Note the committed ``moves`` of problem ``index`` with their places' positions
         (``shift``: (K, 2) offsets from the centres, None: at the centres)."""

@@ -66,9 +66,10 @@ class PlannerConfig:
     shorten: bool = False  # cut cycles and redundant moves out of a plan that reaches the goal
     # (`task.symbolic.shorten`); only without beliefs and a cost source (their windows are
     # committed move by move)
-    fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans);
-    # "greedy": lazy greedy best-first on its `estimate` and `helpful` moves (far larger
-    # problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
+    fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans;
+    # out of budget with time left, a greedy search goes on: `task.planner._fall_back`);
+    # "greedy": lazy greedy best-first on its `estimate` (else the lower bound) and its
+    # `helpful` moves (far larger problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
     improve_s: float = 0.0  # anytime improvement: after the windows (and `shorten`) give a
     # plan of L moves, A* on the domain's lower bound looks for one of fewer than L moves for
     # at most this many seconds (within ``time_limit_s`` when set) and ``improve_nodes``

@@ -224,16 +224,49 @@ def _fall_back(
     to the cost source move by move (restart row 0 of a one-row window priced in the state
     the move starts from). When no plan exists from ``state`` but ``state`` is not the initial
     state, the initial state is searched too: UNSOLVABLE only when neither has a plan within
-    these choices (the windows may have led into a dead end). ``config.fallback_search``
-    picks the search: A* on the lower bound, or greedy on the domain's ``estimate``."""
+    these choices (the windows may have led into a dead end); when it runs out of budget
+    there, a greedy search from the initial state may find a plan that drops the windows' moves
+    (``from_start``; only without a cost source or with one that can ``forget`` the moves
+    committed to it). ``config.fallback_search``
+    picks the search: A* on the lower bound, or greedy on the domain's ``estimate`` (else its
+    lower bound). When A* spends its ``fallback_nodes`` with time left, a greedy search goes on
+    from the same state with as many again (the states priced so far stay priced): longer
+    plans, but one within the budget where A* at 15-20 slotted blocks found none."""
     feasible, windows = (
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
-    if search is lazy_greedy and getattr(domain, "estimate", None) is None:
-        raise TampError(f"PlannerConfig.fallback_search='greedy': {domain.name} has no estimate")
     found = search(domain, problem, state, feasible, config.fallback_nodes, deadline)
+    late = deadline is not None and time.perf_counter() >= deadline
+    if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late:
+        greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, deadline)
+        found = replace(
+            greedy,
+            expanded=found.expanded + greedy.expanded,
+            checked=found.checked + greedy.checked,
+            time_s=found.time_s + greedy.time_s,
+            reason=f"A* {found.reason}; then greedy: {greedy.reason}",
+        )
     start = domain.initial_state(problem)
+    forget = getattr(costs, "forget", None)  # a cost source that can drop committed moves
+    late = deadline is not None and time.perf_counter() >= deadline
+    can_forget = costs is None or forget is not None
+    if found.status is SearchStatus.BUDGET and state != start and not late and can_forget:
+        again = lazy_greedy(domain, problem, start, feasible, config.fallback_nodes, deadline)
+        if again.status is SearchStatus.SOLVED:
+            if forget is not None:
+                forget(indices[i])
+            state, found = (
+                start,
+                replace(
+                    again,
+                    expanded=found.expanded + again.expanded,
+                    checked=found.checked + again.checked,
+                    time_s=found.time_s + again.time_s,
+                    reason=f"{found.reason}; from the initial state, greedy: {again.reason}",
+                    from_start=True,
+                ),
+            )
     if found.status is SearchStatus.UNSOLVABLE and state != start:
         left = max(1, config.fallback_nodes - found.expanded)
         again = search(domain, problem, start, feasible, left, deadline)
@@ -447,6 +480,8 @@ def _run(
         if fallback and not solved[i] and illegal[i] is None:
             trigger[i] = trigger[i] or ("time_limit" if timed_out else "windows")
             searched[i] = _fall_back(domain, p, states[i], costs, indices, i, config, deadline)
+            if searched[i].from_start:  # the windows' moves led nowhere: the plan starts over
+                moves[i] = []
             moves[i].extend(searched[i].moves)
             solved[i] = searched[i].status is SearchStatus.SOLVED
     if config.shorten and source is None and costs is None:

@@ -444,6 +444,22 @@ def legal_moves(problem: Problem, state: State) -> list[Move]:
     return [m for m in moves if check_move(problem, state, m) is None]
 
 
+def helpful(problem: Problem, state: State) -> frozenset[Move]:
+    """The legal moves worth trying first (a greedy search's preferred moves,
+    `task.symbolic.lazy_search.lazy_greedy`): a block not in position onto its goal block when
+    that block is in position, or onto the table (a slot on a slotted table). Gupta & Nau: on
+    the unlimited table some shortest plan makes only such moves; on slots it may have to
+    park a block on another, so these are preferred, not the only ones."""
+    placed, goal = in_position(problem, state), dict(problem.goal)
+    slots = set(problem.fixed) if slotted(problem) else {TABLE}
+    return frozenset(
+        m
+        for m in legal_moves(problem, state)
+        if m.entity not in placed
+        and (m.target in slots or (m.target == goal.get(m.entity) and m.target in placed))
+    )
+
+
 HOP = "hop"  # ``Problem.data`` of a slotted problem whose blocks may move place to place
 
 
@@ -520,6 +536,7 @@ class Blocksworld:
     is_goal = staticmethod(is_goal)
     to_actions = staticmethod(user_actions(moves_to_actions))  # the user's names
     lower_bound = staticmethod(moves_lower_bound)
+    helpful = staticmethod(helpful)
     legal_moves = staticmethod(legal_moves)
     safe_moves = staticmethod(safe_moves)
     unfinished = staticmethod(unfinished)

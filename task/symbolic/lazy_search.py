@@ -76,6 +76,8 @@ class LazyResult:
     ruled_out: int  # distinct (state, move) pairs ``feasible`` ruled out
     time_s: float
     reason: str  # one line: what the status means here
+    from_start: bool = False  # the plan starts at the initial state, not where the search was
+    # asked to start (`task.planner`'s fallback starting over: the windows' moves are dropped)
 
     def stats(self) -> dict:
         """A JSON-ready summary for a planner result's ``stats``."""
@@ -87,6 +89,7 @@ class LazyResult:
             "ruled_out": self.ruled_out,
             "time_s": self.time_s,
             "reason": self.reason,
+            "from_start": self.from_start,
         }
 
 
@@ -185,10 +188,9 @@ def lazy_best_first(
 
 
 class GuidedDomain(CrispDomain, Protocol):
-    """A crisp domain with an inadmissible cost-to-go ``estimate`` (INF at a dead end); an
-    optional ``helpful(problem, state)`` gives the moves worth trying first."""
-
-    def estimate(self, problem: Problem, state: Hashable) -> float: ...
+    """A crisp domain with an optional inadmissible cost-to-go ``estimate`` (INF at a dead end;
+    without one the greedy search is guided by ``lower_bound``); an optional
+    ``helpful(problem, state)`` gives the moves worth trying first."""
 
 
 BOOST = 1000  # preferred-queue pops granted on each new best estimate (Fast Downward's boost)
@@ -202,7 +204,8 @@ def lazy_greedy(
     max_nodes: int = 20_000,
     deadline: float | None = None,
 ) -> LazyResult:
-    """Greedy best-first search on ``domain.estimate`` with deferred evaluation and preferred
+    """Greedy best-first search on ``domain.estimate`` (else its lower bound) with deferred
+    evaluation and preferred
     operators, as Fast Downward's lazy GBFS (Richter & Helmert 2009): a queue entry is a
     (state, move) pair ranked by its parent's estimate; the successor is made, and its estimate
     computed, only when the entry pops, and the move's feasibility is checked then (as in
@@ -216,6 +219,7 @@ def lazy_greedy(
     allowed: dict[tuple[Hashable, Move], bool] = {}
     checked = 0
     helpful = getattr(domain, "helpful", None)
+    guide = getattr(domain, "estimate", None) or domain.lower_bound
 
     def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
         ruled = sum(not v for v in allowed.values())
@@ -227,7 +231,7 @@ def lazy_greedy(
     credit = [0, 0]  # pops taken from each queue, less the boosts: the lower one pops next
     tie = itertools.count()
     expanded, best = 0, math.inf
-    state, h = start, domain.estimate(problem, start)
+    state, h = start, guide(problem, start)
     while True:
         if domain.is_goal(problem, state):
             path = []
@@ -273,7 +277,7 @@ def lazy_greedy(
                 f"no plan exists within these choices: {len(parent)} reachable states closed, "
                 f"{ruled} moves ruled out",
             )
-        h = domain.estimate(problem, state)
+        h = guide(problem, state)
 
 
 def improve(

@@ -259,7 +259,8 @@ def test_a_fallback_out_of_budget_says_so():
     result = plan(five, config, costs=RuleOut(five, rule))
     ran = result.stats["fallback"]
     assert result.status is PlanStatus.NO_PLAN and ran["status"] == "budget"
-    assert ran["expanded"] == 2 and "budget" in ran["reason"]
+    assert ran["expanded"] >= 4 and "budget" in ran["reason"]  # A*'s 2, then greedy's 2
+    assert "A* stopped after 2 expansions (budget); then greedy" in ran["reason"]
     assert _replay_allowed(five, result.plan.moves, rule)
 
 
@@ -274,3 +275,45 @@ def test_the_fallback_is_off_without_a_cost_source_and_refused_with_beliefs():
     assert_valid(problem, forced.plan.moves)
     with pytest.raises(TampError, match="cannot run with beliefs"):
         plan(problem, PlannerConfig(fallback=True), beliefs=lambda indices, states: None)
+
+
+def test_a_star_out_of_budget_hands_over_to_a_greedy_search_from_the_same_state():
+    """Eight blocks, no windows' moves, 20 expansions: A* on the lower bound runs out, the
+    greedy search on it (helpful moves first) finds a valid plan within as many again."""
+    problem = random_problem(8, 3)
+    config = PlannerConfig(restarts=1, iters=1, max_windows=1, fallback=True, fallback_nodes=20)
+    result = plan(problem, config)
+    ran = result.stats["fallback"]
+    assert result.solved and ran["status"] == "solved" and not ran["from_start"]
+    assert "A* stopped after 20 expansions (budget); then greedy: a plan of" in ran["reason"]
+    assert_valid(problem, result.plan.moves)
+
+
+@dataclass
+class Forgetful(RuleOut):
+    """`RuleOut` that can drop the moves committed to it (`ArmCosts.forget`)."""
+
+    forgot: list = field(default_factory=list)
+
+    def forget(self, index):
+        self.forgot.append(index)
+        self.committed.clear()
+
+
+def test_a_fallback_out_of_budget_where_the_windows_left_it_starts_over_from_init():
+    """The windows put d on a; one expansion finds nothing from there, but a greedy search
+    from the initial state finds a onto b: the plan starts over (``from_start``), the cost
+    source forgets the windows' moves and holds only the fallback's."""
+    from task.planner import _fall_back
+
+    source = Forgetful(FLAT, lambda state, move: False)
+    source.committed.append(Move("d", "a"))  # the windows' move
+    wandered = BW.apply_move(FLAT, BW.initial_state(FLAT), Move("d", "a"))
+    config = PlannerConfig(fallback=True, fallback_nodes=1)
+    found = _fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    assert found.status is SearchStatus.SOLVED and found.from_start
+    assert found.moves == (Move("a", "b"),) and "from the initial state, greedy" in found.reason
+    assert source.forgot == [0] and source.committed == [Move("a", "b")]
+    plain = RuleOut(FLAT, lambda state, move: False)  # cannot forget: no start over
+    kept = _fall_back(BW, FLAT, wandered, plain, [0], 0, config, None)
+    assert kept.status is SearchStatus.BUDGET and not kept.from_start

@@ -8,6 +8,7 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
+from task.domains import blocksworld
 from task.domains.blocksworld import (
     GOAL_OR_TABLE,
     apply_move,
@@ -186,3 +187,27 @@ def test_the_window_part_narrows_its_moves_to_goal_block_or_table():
         moves = set(torch.nonzero(narrow.action_mask[0, x, :-1]).flatten().tolist())
         assert moves <= allowed and n in moves
     assert whole.action_mask.sum() > narrow.action_mask.sum()
+
+
+SLOTS = ("s0", "s1", "s2", "s3", "s4", "s5")
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_helpful_moves_are_legal_and_only_onto_the_goal_block_or_the_table(seed):
+    """`blocksworld.helpful` (the greedy fallback's preferred moves): legal, each a block not in
+    position onto its in-position goal block or the table (a slot on a slotted table), and
+    every constructive move among them."""
+    slotted = blocksworld.with_slots(random_problem(5, seed), SLOTS)
+    for problem in (random_problem(7, seed), slotted):
+        state = blocksworld.initial_state(problem)
+        placed, goal = blocksworld.in_position(problem, state), dict(problem.goal)
+        helpful = blocksworld.helpful(problem, state)
+        assert helpful <= set(blocksworld.legal_moves(problem, state))
+        table = set(problem.fixed) if blocksworld.slotted(problem) else {TABLE}
+        for move in helpful:
+            assert move.entity not in placed
+            assert move.target in table or (
+                move.target == goal.get(move.entity) and move.target in placed
+            )
+        if not blocksworld.slotted(problem):
+            assert set(blocksworld.constructive_moves(problem, state)) <= helpful
