@@ -222,16 +222,17 @@ def _fall_back(
     """The complete fallback search for problem ``i`` from its world ``state``, over the moves
     the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is committed
     to the cost source move by move (restart row 0 of a one-row window priced in the state
-    the move starts from). When no plan exists from ``state`` but ``state`` is not the initial
-    state, the initial state is searched too: UNSOLVABLE only when neither has a plan within
-    these choices (the windows may have led into a dead end); when it runs out of budget
-    there, a greedy search from the initial state may find a plan that drops the windows' moves
-    (``from_start``; only without a cost source or with one that can ``forget`` the moves
-    committed to it). ``config.fallback_search``
-    picks the search: A* on the lower bound, or greedy on the domain's ``estimate`` (else its
-    lower bound). When A* spends its ``fallback_nodes`` with time left, a greedy search goes on
-    from the same state with as many again (the states priced so far stay priced): longer
-    plans, but one within the budget where A* at 15-20 slotted blocks found none."""
+    the move starts from). ``config.fallback_search`` picks the search: A* on the lower bound,
+    or greedy on the domain's ``estimate`` (else its lower bound).
+
+    When A* spends its ``fallback_nodes`` with time left, a greedy search goes on from the
+    same state with as many again (the states priced so far stay priced): longer plans, but
+    one within the budget where A* at 15-20 slotted blocks found none. When that runs out too
+    and ``state`` is not the initial state, a greedy search from the initial state may find a
+    plan that drops the windows' moves (``from_start``; only without a cost source or with
+    one that can ``forget`` the moves committed to it). When no plan exists from ``state``,
+    the initial state is searched too: UNSOLVABLE only when neither has a plan within these
+    choices (the windows may have led into a dead end)."""
     feasible, windows = (
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
@@ -240,13 +241,7 @@ def _fall_back(
     late = deadline is not None and time.perf_counter() >= deadline
     if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late:
         greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, deadline)
-        found = replace(
-            greedy,
-            expanded=found.expanded + greedy.expanded,
-            checked=found.checked + greedy.checked,
-            time_s=found.time_s + greedy.time_s,
-            reason=f"A* {found.reason}; then greedy: {greedy.reason}",
-        )
+        found = _after(found, greedy, f"A* {found.reason}; then greedy: {greedy.reason}")
     start = domain.initial_state(problem)
     forget = getattr(costs, "forget", None)  # a cost source that can drop committed moves
     late = deadline is not None and time.perf_counter() >= deadline
@@ -256,17 +251,8 @@ def _fall_back(
         if again.status is SearchStatus.SOLVED:
             if forget is not None:
                 forget(indices[i])
-            state, found = (
-                start,
-                replace(
-                    again,
-                    expanded=found.expanded + again.expanded,
-                    checked=found.checked + again.checked,
-                    time_s=found.time_s + again.time_s,
-                    reason=f"{found.reason}; from the initial state, greedy: {again.reason}",
-                    from_start=True,
-                ),
-            )
+            why = f"{found.reason}; from the initial state, greedy: {again.reason}"
+            state, found = start, _after(found, again, why, from_start=True)
     if found.status is SearchStatus.UNSOLVABLE and state != start:
         left = max(1, config.fallback_nodes - found.expanded)
         again = search(domain, problem, start, feasible, left, deadline)
@@ -281,6 +267,19 @@ def _fall_back(
         windows[state].commit([0], [(move,)])
         state = domain.apply_move(problem, state, move)
     return found
+
+
+def _after(first: LazyResult, then: LazyResult, reason: str, **changes) -> LazyResult:
+    """``then``, the search that went on after ``first`` ran out, with both searches'
+    expansions, checks and seconds, and ``reason``."""
+    return replace(
+        then,
+        expanded=first.expanded + then.expanded,
+        checked=first.checked + then.checked,
+        time_s=first.time_s + then.time_s,
+        reason=reason,
+        **changes,
+    )
 
 
 def _take_safe(
