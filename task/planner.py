@@ -237,16 +237,18 @@ def _fall_back(
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
+
+    def late() -> bool:
+        return deadline is not None and time.perf_counter() >= deadline
+
     found = search(domain, problem, state, feasible, config.fallback_nodes, deadline)
-    late = deadline is not None and time.perf_counter() >= deadline
-    if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late:
+    if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late():
         greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, deadline)
         found = _after(found, greedy, f"A* {found.reason}; then greedy: {greedy.reason}")
     start = domain.initial_state(problem)
     forget = getattr(costs, "forget", None)  # a cost source that can drop committed moves
-    late = deadline is not None and time.perf_counter() >= deadline
     can_forget = costs is None or forget is not None
-    if found.status is SearchStatus.BUDGET and state != start and not late and can_forget:
+    if found.status is SearchStatus.BUDGET and state != start and can_forget and not late():
         again = lazy_greedy(domain, problem, start, feasible, config.fallback_nodes, deadline)
         if again.status is SearchStatus.SOLVED:
             if forget is not None:

@@ -50,12 +50,16 @@ class Row:
     gn1_s: float | None = None  # GN1's seconds
 
 
+def _ours(row: Row) -> int | None:
+    """Our plan's length in PDDL actions when it is valid, else None."""
+    return row.length if row.status == "valid" else None
+
+
 def best_known(row: Row) -> int | None:
     """The shortest plan known for ``row``'s instance, in PDDL actions: the least of its
     optimum, our valid plan and the peers' plans that ran (LAMA, US, GN1); None when none is
     known."""
-    ours = row.length if row.status == "valid" else None
-    found = (row.optimal, ours, row.lama_length, row.us_length, row.gn1_length)
+    found = (row.optimal, _ours(row), row.lama_length, row.us_length, row.gn1_length)
     lengths = [k for k in found if k is not None]
     return min(lengths) if lengths else None
 
@@ -63,8 +67,7 @@ def best_known(row: Row) -> int | None:
 def beside_best(row: Row) -> dict:
     """``row``'s fields with `best_known` and ``x_best`` (our valid plan's length over it;
     None without a valid plan): `INSTANCE_COLUMNS`, one instances.csv row."""
-    best = best_known(row)
-    ours = row.length if row.status == "valid" else None
+    best, ours = best_known(row), _ours(row)
     ratio = None if ours is None or not best else ours / best
     return asdict(row) | {"best_known": best, "x_best": ratio}
 

@@ -205,11 +205,10 @@ def lazy_greedy(
     deadline: float | None = None,
 ) -> LazyResult:
     """Greedy best-first search on ``domain.estimate`` (else its lower bound) with deferred
-    evaluation and preferred
-    operators, as Fast Downward's lazy GBFS (Richter & Helmert 2009): a queue entry is a
-    (state, move) pair ranked by its parent's estimate; the successor is made, and its estimate
-    computed, only when the entry pops, and the move's feasibility is checked then (as in
-    `lazy_best_first`). The domain's optional ``helpful`` moves also enter a second queue; the
+    evaluation and preferred operators, as Fast Downward's lazy GBFS (Richter & Helmert 2009): a
+    queue entry is a (state, move) pair ranked by its parent's estimate; the successor is made, and
+    its estimate computed, only when the entry pops, and the move's feasibility is checked then (as
+    in `lazy_best_first`). The domain's optional ``helpful`` moves also enter a second queue; the
     two alternate, and every new best estimate grants the preferred queue ``BOOST`` pops.
 
     Complete over the same choices as `lazy_best_first` (every reachable state is closed once;
