@@ -22,6 +22,7 @@ one.
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import replace
@@ -191,20 +192,19 @@ def _cost_checks(domain: Domain, problem: Problem, costs: CostSource, index: int
     reaches `task.costs.IMPOSSIBLE` (as the decoder rules it out), one pricing per state, and
     the priced windows by state (their ``commit`` records the moves the fallback chose)."""
     windows: dict[State, WindowCosts] = {}
-    prices: dict[State, dict[Move, float]] = {}
+    ruled_out: dict[State, set[Move]] = {}
 
     def feasible(state: State, move: Move) -> bool:
-        if state not in prices:
+        if state not in ruled_out:
             windows[state] = costs([index], [state], 1)
             with torch.no_grad():
                 matrix = windows[state].compute()[0]  # (N, A - 1) action columns of row 0
-            rows, cols = matrix.shape
-            prices[state] = {
-                domain.decode(problem, r, c, rows): float(matrix[r, c])
-                for r in range(rows)
-                for c in range(cols)
+            rows = matrix.shape[0]
+            ruled_out[state] = {
+                domain.decode(problem, r, c, rows)
+                for r, c in (~(matrix < IMPOSSIBLE)).nonzero().tolist()  # NaN too
             }
-        return prices[state].get(move, 0.0) < IMPOSSIBLE
+        return move not in ruled_out[state]
 
     return feasible, windows
 
@@ -230,9 +230,10 @@ def _fall_back(
     one within the budget where A* at 15-20 slotted blocks found none. When that runs out too
     and ``state`` is not the initial state, a greedy search from the initial state may find a
     plan that drops the windows' moves (``from_start``; only without a cost source or with
-    one that can ``forget`` the moves committed to it). When no plan exists from ``state``,
-    the initial state is searched too: UNSOLVABLE only when neither has a plan within these
-    choices (the windows may have led into a dead end)."""
+    one that can ``forget`` the moves committed to it); the last search there is, it runs
+    until the ``deadline`` when there is one, not for ``fallback_nodes``. When no plan exists
+    from ``state``, the initial state is searched too: UNSOLVABLE only when neither has a plan
+    within these choices (the windows may have led into a dead end)."""
     feasible, windows = (
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
@@ -249,7 +250,8 @@ def _fall_back(
     forget = getattr(costs, "forget", None)  # a cost source that can drop committed moves
     can_forget = costs is None or forget is not None
     if found.status is SearchStatus.BUDGET and state != start and can_forget and not late():
-        again = lazy_greedy(domain, problem, start, feasible, config.fallback_nodes, deadline)
+        last = config.fallback_nodes if deadline is None else sys.maxsize  # the time left
+        again = lazy_greedy(domain, problem, start, feasible, last, deadline)
         if again.status is SearchStatus.SOLVED:
             if forget is not None:
                 forget(indices[i])

@@ -317,3 +317,23 @@ def test_a_fallback_out_of_budget_where_the_windows_left_it_starts_over_from_ini
     plain = RuleOut(FLAT, lambda state, move: False)  # cannot forget: no start over
     kept = _fall_back(BW, FLAT, wandered, plain, [0], 0, config, None)
     assert kept.status is SearchStatus.BUDGET and not kept.from_start
+
+
+def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
+    """Eight blocks, one block moved off the plan's way, a node budget of one: without a
+    deadline every search stops at one expansion; with one, the last search (greedy from the
+    initial state) goes on until the deadline and finds a valid plan."""
+    from task.planner import _fall_back
+
+    problem = random_problem(8, 3)
+    start = BW.initial_state(problem)
+    wandered = BW.apply_move(problem, start, BW.legal_moves(problem, start)[0])
+    config = PlannerConfig(fallback=True, fallback_nodes=1)
+    for deadline in (None, time.perf_counter() + 60):
+        source = Forgetful(problem, lambda state, move: False)
+        found = _fall_back(BW, problem, wandered, source, [0], 0, config, deadline)
+        if deadline is None:
+            assert found.status is SearchStatus.BUDGET and not found.from_start
+            continue
+        assert found.status is SearchStatus.SOLVED and found.from_start and found.expanded > 3
+        assert_valid(problem, found.moves)
