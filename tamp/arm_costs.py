@@ -10,7 +10,9 @@ model's clearance to the scene's obstacles along the move and to the other block
 their predicted places) at its grasp and release. A place onto a tower that its slot's
 clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a move to a full
 table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so
-does a move the arm failed in that state before (``avoid``, `failed_key`). With ``grasps`` (the
+does a move the arm failed in that state before (``avoid``, `failed_key`) or, in any state,
+where it failed (``failed``, `FailedMove`: picked and put among the same blocks). Each point's
+IK is solved once per source (`ArmCosts._site_solutions`). With ``grasps`` (the
 executor's geometric fallback, `tamp.blocks_geo`: tilted and side grasps, corridor transits) the
 prices agree with what that executor can do: a pick or place out of top-down reach that one of
 those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead. The
@@ -23,8 +25,10 @@ source records, for each committed move, the position the chosen row decided it 
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 
 import numpy as np
 import torch
@@ -52,6 +56,13 @@ BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refus
 # added instead to a move the top-down grasp cannot make but the executor's other grasps may
 # (`ArmCosts`' ``grasps``): about one move's joint distance, chosen, not tuned
 DETOUR = 1.0
+# m: the blocks around a pick or a place that a failed move's memory keeps (`Site`): within
+# reach of the hand and the forearm over it (the next slot, not the diagonal one); how far a
+# block may be from where it was recorded to still count as there (observation noise)
+AROUND, SAME = 0.2, 0.015
+# blocks a tower may have when the executor has other grasps and corridor transits
+# (``grasps``): where its top is out of the top-down reach, `_hover` asks those grasps
+TALLER = 9
 
 
 def predict_poses(
@@ -183,10 +194,15 @@ class ArmCosts:
         avoid: Mapping[State, set] | None = None,
         reach: float = 0.0,
         grasps: tuple[str, ...] = (),
+        failed: Sequence[FailedMove] = (),
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
+        self.failed = tuple(failed)  # moves the arm failed, by where (`FailedMove`)
+        tall = max(scene.max_height, TALLER) if grasps else scene.max_height
+        self._room = replace(scene, max_height=tall)  # the towers' capacities, `_blocked`
         self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
         self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
+        self._sites: dict[tuple, tuple[np.ndarray, bool]] = {}  # point -> `_site_solutions`
         self.places = places  # per problem: table place -> (x, y), for slotted problems
         self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
@@ -240,20 +256,40 @@ class ArmCosts:
         logits."""
         *inputs, other = self._inputs(list(zip(indices, states, strict=True)))
         picks, places, extra, blocks = inputs
-        solved = site_solutions(self.solver, self.q_now, picks, places)
+        solved = self._site_solutions(picks, places)
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return _Placed(self, indices, restarts, inputs, solved, extra)
 
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
         """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
         picks, places, extra, blocks, other = self._inputs(todo)
-        solved = site_solutions(self.solver, self.q_now, picks, places)
+        solved = self._site_solutions(picks, places)
         with torch.no_grad():
             c = move_costs_batch(
                 self.solver, self.q_now, picks, places, self.config, self.boxes, solved, blocks
             )
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return list(c + extra)  # (P, N, Y) each
+
+    def _site_solutions(self, picks, places) -> tuple[torch.Tensor, torch.Tensor]:
+        """`motion.cost.site_solutions` of picks (P, N, 3) then places (P, Y, 3) from
+        ``q_now``, each point solved once per source: a search prices thousands of states whose
+        blocks stand on the same few slots and heights, so most points repeat. One batched IK
+        call for the points (to the µm) not solved before. The batched solver stops once every
+        target of its batch has a solution, so a point's configuration can be another of its
+        seeds' than it would be in another batch; whether it is reached is the same."""
+        xyz = torch.cat([torch.as_tensor(picks), torch.as_tensor(places)], dim=1)
+        points = xyz.detach().reshape(-1, 3).to(torch.float64).numpy()  # (B, 3)
+        keys = [tuple(np.round(p, 6).tolist()) for p in points]
+        new = list(dict.fromkeys(k for k in keys if k not in self._sites))  # unseen, in order
+        if new:
+            at = torch.tensor(new, dtype=torch.float64)[None]  # (1, M, 3)
+            q, ok = site_solutions(self.solver, self.q_now, at, at[:, :0])
+            for k, qk, okk in zip(new, q.numpy(), ok.tolist(), strict=True):
+                self._sites[k] = (qk, bool(okk))
+        found = [self._sites[k] for k in keys]
+        q = torch.from_numpy(np.stack([f[0] for f in found]))  # (B, J)
+        return q, torch.tensor([f[1] for f in found], dtype=torch.bool)
 
     def _detour(self, solved, other: torch.Tensor, n: int) -> torch.Tensor:
         """(P, N, Y) ``DETOUR - config.infeasible`` per pick and per place whose top-down IK
@@ -305,6 +341,10 @@ class ArmCosts:
             extra.append(self._blocked(problem, plain, now, at is None and slot is None))
             yaws = [now[x].yaw for x in problem.entities]
             other.append(self._hover(extra[-1], xyz, places[-1], now, yaws))
+            for failed in self.failed:  # a move the arm failed where it would be the same
+                j = failed.columns(problem.entities, now, places[-1])
+                if j:
+                    extra[-1][problem.entities.index(failed.entity), j] += BLOCKED
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
                 j = _column(problem, key, at, self.reach)
                 if j is not None:
@@ -327,7 +367,7 @@ class ArmCosts:
         points = np.vstack([picks, places])  # (N + Y, 3)
         points[:, 2] = np.maximum(points[:, 2], hover)
         n = picks.shape[0]
-        ok = site_solutions(self.solver, self.q_now, points[None, :n], points[None, n:])[1]
+        ok = self._site_solutions(points[None, :n], points[None, n:])[1]
         ok = ok.numpy().copy()  # (N + Y,)
         other = np.zeros_like(ok)  # (N + Y,) out of that reach, in another grasp's
         if self.grasps and not ok.all():  # the executor's other grasps, at the block's height
@@ -345,9 +385,9 @@ class ArmCosts:
         where the executor's geometric fallback (`tamp.blocks_geo.run_geo`) may still pick or
         place it when no top-down grasp reaches over the highest stack. One batched IK call for
         the poses (to the mm and 0.01 rad) this source has not tested before."""
-        from motion.grasps import grasps, world_tcp
+        from motion.grasps import world_tcp
 
-        family = grasps("cube", (self.scene.block_size / 2,) * 3, self.grasps)
+        family = self._family
         if not family or len(points) == 0:
             return np.zeros(len(points), dtype=bool)
         keys = [
@@ -364,6 +404,14 @@ class ArmCosts:
                 self._reached[k] = bool(ok)
         return np.array([self._reached[k] for k in keys], dtype=bool)
 
+    @functools.cached_property
+    def _family(self) -> tuple:
+        """The grasps of ``self.grasps`` for a block of the scene (`motion.grasps.grasps` of a
+        cube), made once."""
+        from motion.grasps import grasps
+
+        return grasps("cube", (self.scene.block_size / 2,) * 3, self.grasps)
+
     def _blocked(self, problem: Problem, state: State, now, table_full: bool) -> np.ndarray:
         """(N, Y) BLOCKED where the place has no room: a tower at its slot's capacity, or no
         free table slot."""
@@ -374,11 +422,84 @@ class ArmCosts:
             height, below = 1, support[y]
             while below != TABLE:
                 height, below = height + 1, support[below]
-            if height + 1 > self.scene.capacity(now[y].xy):
+            if height + 1 > self._room.capacity(now[y].xy):
                 out[:, j] = BLOCKED
         if table_full:
             out[:, n:] = BLOCKED
         return out
+
+
+@dataclass(frozen=True)
+class Site:
+    """A point of a move (where the hand picks a block, or where it would put one) with the
+    blocks then within `AROUND` of it in (x, y): what a grasp or release there runs into."""
+
+    xyz: tuple[float, float, float]
+    around: tuple[tuple[str, tuple[float, float, float]], ...]  # (name, centre), by name
+
+    @classmethod
+    def at(cls, xyz, poses: Mapping[str, Pose], leave: str) -> Site:
+        """The site of point ``xyz`` among the blocks at ``poses`` (name -> `Pose`) but
+        ``leave`` (the block that moves)."""
+        point = tuple(float(v) for v in xyz)
+        around = tuple(
+            (name, tuple(float(v) for v in p.xyz))
+            for name, p in sorted(poses.items())
+            if name != leave and math.dist(p.xyz[:2], point[:2]) <= AROUND
+        )
+        return cls(point, around)
+
+    def matches(self, xyz, poses: Mapping[str, Pose], leave: str) -> bool:
+        """Whether point ``xyz`` among ``poses`` is this site again, or one at least as
+        crowded: the point and every block that was around it where they were (within
+        `SAME`); a block come near since only adds to what the hand runs into."""
+        if math.dist(xyz, self.xyz) > SAME:
+            return False
+        return all(
+            name != leave and name in poses and math.dist(poses[name].xyz, at) <= SAME
+            for name, at in self.around
+        )
+
+
+@dataclass(frozen=True)
+class FailedMove:
+    """A move the arm failed, kept by where it failed (`ArmCosts`' ``failed``): moving
+    ``entity`` from the ``pick`` site to the ``place`` site, or from the ``pick`` site to
+    anywhere (``place`` None: the pick itself failed with every grasp, whatever the place).
+    It is ruled out wherever both sites are the same again (or more crowded) and the stacks
+    as high, in any state: the memory of the move in the state it failed in (``avoid``) holds
+    in that state only."""
+
+    entity: str
+    pick: Site
+    place: Site | None
+    top: float  # m: the highest block top then (the top-down hand hovers over it)
+
+    @classmethod
+    def of(cls, entity: str, poses: Mapping[str, Pose], place, pick_only: bool) -> FailedMove:
+        """``entity`` (at ``poses[entity]``) failed to move to the point ``place`` (its
+        centre there), or to be picked at all (``pick_only``)."""
+        pick = Site.at(poses[entity].xyz, poses, entity)
+        place = None if pick_only else Site.at(place, poses, entity)
+        return cls(entity, pick, place, max(float(p.xyz[2]) for p in poses.values()))
+
+    def columns(self, entities: Sequence[str], now: Mapping[str, Pose], places) -> list[int]:
+        """The action columns this failure rules out in a state whose blocks stand at ``now``,
+        its targets' points ``places`` (Y, 3): none unless the block is picked where it
+        failed, with the highest stack as high or higher."""
+        at = now.get(self.entity)
+        if at is None or not self.pick.matches(at.xyz, now, self.entity):
+            return []
+        if max(float(p.xyz[2]) for p in now.values()) < self.top - SAME:
+            return []  # the hand hovers lower now
+        if self.place is None:
+            return list(range(len(places)))
+        e = entities.index(self.entity)
+        return [
+            j
+            for j, point in enumerate(places)
+            if j != e and self.place.matches(point, now, self.entity)
+        ]
 
 
 def failed_key(move) -> tuple[str, object]:

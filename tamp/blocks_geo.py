@@ -158,7 +158,8 @@ def run_geo(
 
     if not verdict.ok:
         tried = [f"{t.grasp}:{t.failure}" for t in verdict.tried]
-        return result(verdict.failure, tried=tried)
+        sides = sorted({t.side for t in verdict.tried if t.side})  # "pick", "place"
+        return result(verdict.failure, tried=tried, sides=sides)
     below = next((x for x, p in poses.items() if _on(p, poses[move.entity], scene)), TABLE)
     rests = rests_of(world, geo, below)
     run = run_move(sim, geo, verdict, rests, RunConfig(), on_frame, drop_at)

@@ -21,7 +21,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts
+from tamp.arm_costs import ArmCosts, FailedMove
 from tamp.scene import Pose, SceneConfig, SceneError, layout
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
@@ -111,6 +111,7 @@ def plan_on_places(
     avoid: Mapping | None = None,
     reach: float = 0.0,
     grasps: tuple[str, ...] = (),
+    failed: Sequence[FailedMove] = (),
 ) -> PlanResult:
     """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
     table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
@@ -119,7 +120,9 @@ def plan_on_places(
     with the logits, per window and restart row: every move onto a place carries the position
     that the restart row it was decoded from decided in its window (`ArmCosts.decided`).
     ``grasps``: the grasp families the executor has besides top-down over the highest stack
-    (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out)."""
+    (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out);
+    ``failed``: moves the arm failed, ruled out wherever they would be the same
+    (`FailedMove`)."""
     current, at = slotted(problem, problem.init, poses, scene)
     costs = ArmCosts(
         [current],
@@ -131,6 +134,7 @@ def plan_on_places(
         avoid=avoid,
         reach=reach,
         grasps=grasps,
+        failed=failed,
     )
     result = plan(current, config, seed=seed, costs=costs)
     decided = costs.decided(0)

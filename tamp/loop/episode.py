@@ -35,16 +35,22 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts, failed_key
+from tamp.arm_costs import ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
-from tamp.loop.execute import ExecutionResult, Failure, execute_move, obstacle_boxes
+from tamp.loop.execute import (
+    ExecutionResult,
+    Failure,
+    execute_move,
+    failed_pick,
+    obstacle_boxes,
+)
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
 from tamp.loop.score import MoveScore, Scorer
-from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout
+from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from tamp.slots import plan_on_places
@@ -119,6 +125,7 @@ class Episode:
             self.collision = Screened(PandaCollision(config.execution.margin))
         self._acts = 0  # moves attempted: each seeds its motion-planner call differently
         self._avoid: dict = {}  # state -> moves the arm failed there (`ArmCosts` avoid)
+        self._failed: list[FailedMove] = []  # the same, by where they failed (`ArmCosts`)
         self.score = Scorer(self.sim.truth, problem, config.scene)
         self.eyes = Observer(self.sim, problem, config, self.rng, self.target, perceiver)
         if self.collision is not None:
@@ -212,7 +219,26 @@ class Episode:
         done = self.execute(p, move)
         if not done.ok and done.failure in ARM_FAILURES:  # motion-aware: priced out next time
             self._avoid.setdefault(start, set()).add(failed_key(move))
+            self._remember(move, done)
         self.check(p, move, done, expected)
+
+    def _remember(self, move: Move, done: ExecutionResult) -> None:
+        """Keep the failed ``move`` by where it failed (`FailedMove`), from the poses the arm
+        sees now (it failed before it moved anything): the pick and the place it was to go
+        to; the pick alone when every grasp failed there, or when a move of the block from
+        the same spot to another place failed before."""
+        if done.path_rad > 0 or not self.config.planner.lambda_motion > 0:
+            return  # it ran and failed on the way: nothing says the same move fails again
+        poses = self._poses()
+        target = place_pose(move, poses, self.config.scene)
+        if target is None:
+            return
+        x = move.entity
+        again = any(
+            f.entity == x and f.place is not None and f.pick.matches(poses[x].xyz, poses, x)
+            for f in self._failed
+        )
+        self._failed.append(FailedMove.of(x, poses, target.xyz, again or failed_pick(done)))
 
     def _next_plan(self, p: Progress) -> bool:
         """Plan from the observed state and queue its moves; False when there is none to run
@@ -278,8 +304,17 @@ class Episode:
                     self._avoid,
                     self.config.placements,
                     self._grasps(),
+                    self._failed,
                 )
-            costs = ArmCosts([current], [poses], scene, self.solver, q, avoid=self._avoid)
+            costs = ArmCosts(
+                [current],
+                [poses],
+                scene,
+                self.solver,
+                q,
+                avoid=self._avoid,
+                failed=self._failed,
+            )
         if self.config.observe == "state":
             return plan(current, self.config.planner, seed=seed, costs=costs)
         image = self.eyes.image

@@ -239,6 +239,19 @@ def _geo(sim, solver, move, target, poses, config, scene, collision, seed, drop_
         return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
 
 
+def failed_pick(done: ExecutionResult) -> bool:
+    """Whether ``done`` failed to pick its block with every grasp, before the arm moved: the
+    top-down pick (its IK or its approach and descent) and every grasp of the geometric
+    fallback (`tamp.blocks_geo.run_geo`: each one's failure on the pick side), whatever the
+    place. False without that fallback's verdict: the top-down pick alone hovers over the
+    highest stack anywhere, which other moves change."""
+    from tamp.geo.check import PICK_PHASES, PICK_WAYPOINTS
+
+    ev, geo = done.evidence, done.evidence.get("geo")
+    top = ev.get("waypoint") in PICK_WAYPOINTS or ev.get("phase") in PICK_PHASES
+    return not done.ok and top and isinstance(geo, dict) and geo.get("sides") == ["pick"]
+
+
 def execute_move(
     sim: Simulator,
     solver: IKSolver,

@@ -204,3 +204,59 @@ def test_a_placed_window_at_zero_offsets_prices_like_a_fixed_one_blocks_included
     assert c[0, mover, far] >= BLOCKED
     (grad,) = torch.autograd.grad(c[0, mover, current.n :].sum(), window.parameters())
     assert torch.isfinite(grad).all()
+
+
+def test_each_point_is_solved_once_per_source_with_the_batched_reach(solver, monkeypatch):
+    """A search prices many states whose blocks stand on the same spots: each point's IK is
+    solved once per source. Whether it is reached is what a batched call says; a second state
+    with the same points solves nothing."""
+    import tamp.arm_costs as arm_costs
+    from motion.cost import site_solutions
+
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
+    source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)
+    picks = torch.tensor([[poses[x].xyz for x in FOUR.entities]], dtype=torch.float64)
+    places = torch.tensor([[(0.5, 0.0, 0.025), (2.0, 0.0, 0.025)]], dtype=torch.float64)
+    q, ok = source._site_solutions(picks, places)
+    ok_all = site_solutions(solver, PANDA.q_home, picks, places)[1]
+    assert torch.equal(ok, ok_all) and not ok[-1] and ok[:-1].all()  # 2 m away: out of reach
+    reached = solver.fk(q[ok].numpy())[:, :3, 3]
+    assert np.allclose(reached, torch.cat([picks, places], 1)[0][ok].numpy(), atol=2e-3)
+    calls = []
+    monkeypatch.setattr(arm_costs, "site_solutions", lambda *a: calls.append(a) or (q, ok))
+    again = source._site_solutions(picks.flip(1), places)  # the same points, another order
+    assert calls == [] and torch.equal(again[0][:4], q[:4].flip(0))
+
+
+def test_a_failed_move_is_ruled_out_wherever_it_would_be_the_same(solver):
+    """``failed``: a move the arm failed stays ruled out in any state where its block is
+    picked where it was, the blocks then around it still there, and goes where it was to go,
+    the blocks then around that still there; a pick that failed with every grasp rules out
+    every move of its block there. Once a neighbour has gone, or the block stands elsewhere,
+    it may be tried again."""
+    from tamp.arm_costs import FailedMove, Site
+    from tamp.scene import Pose
+
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])  # a-b, c, d
+    site = Site.at(poses["c"].xyz, poses, "c")
+    assert [name for name, _ in site.around] == ["a", "b"]  # d stands at the far end
+    assert site.matches(poses["c"].xyz, poses, "c")
+    nudged = {**poses, "a": Pose(tuple(np.add(poses["a"].xyz, (0.005, 0.0, 0.0))))}
+    assert site.matches(poses["c"].xyz, nudged, "c")  # observation noise
+    assert not site.matches(poses["c"].xyz, {k: v for k, v in poses.items() if k != "a"}, "c")
+    assert not site.matches(np.add(poses["c"].xyz, (0.0, 0.05, 0.0)), poses, "c")
+    crowded = {**poses, "d": Pose(tuple(np.add(poses["c"].xyz, (0.1, 0.0, 0.0))))}
+    assert site.matches(poses["c"].xyz, crowded, "c")  # another block near: no easier
+
+    onto_d = np.add(poses["d"].xyz, (0.0, 0.0, SCENE.block_size))
+    plain = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)([0], [FOUR.init]).compute()[0]
+    assert (plain[2] < BLOCKED).all()
+    for pick_only, ruled in ((False, [3]), (True, [0, 1, 2, 3, 4])):
+        failed = FailedMove.of("c", poses, onto_d, pick_only)
+        source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home, failed=[failed])
+        c = source([0], [FOUR.init]).compute()[0]
+        assert [j for j in range(5) if c[2, j] >= BLOCKED] == ruled  # columns a, b, c, d, table
+        torch.testing.assert_close(c[[0, 1, 3]], plain[[0, 1, 3]], atol=0, rtol=0)
+        # a off b onto the table: c's pick site is no longer what it was
+        after = source([0], [(TABLE, TABLE, TABLE, TABLE)]).compute()[0]
+        assert (after[2, [0, 1, 3]] < BLOCKED).all()

@@ -131,3 +131,45 @@ def test_with_other_grasps_a_top_down_release_into_a_neighbour_is_priced_not_rul
         costs[grasps] = source([0], [current.init]).compute()[0]
     assert costs[()][mover, far] >= BLOCKED
     assert DETOUR <= costs[CHOICES][mover, far] < BLOCKED
+
+
+def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solver):
+    """A block beyond the arm's reach: the top-down pick has no IK and every grasp of the
+    geometric fallback fails on the pick side, so the failure is the pick's (`failed_pick`:
+    the loop then rules out every move of the block while it stands there). A move that
+    failed on the place side, or without the fallback's verdict, is not."""
+    from robots.collision import PandaCollision
+    from tamp.loop.execute import ExecConfig, ExecutionResult, Failure, execute_move, failed_pick
+    from tamp.sim import make_simulator
+
+    poses = {"a": Pose((0.95, 0.3, 0.025)), "b": Pose((0.4, 0.0, 0.025))}
+    move = PlacedMove("a", TABLE, (0.4, -0.24), "slot0")
+    sim = make_simulator("pybullet", ("a", "b"), poses, CRAMPED)
+    with sim, PandaCollision() as model:
+        observe = sim.truth._read_poses
+        done = execute_move(sim, solver, move, observe, ExecConfig(), CRAMPED, collision=model)
+    assert done.failure is Failure.IK_INFEASIBLE and done.evidence["waypoint"] == "pre_grasp"
+    assert done.evidence["geo"]["sides"] == ["pick"] and failed_pick(done)
+    place_side = {**done.evidence, "geo": {**done.evidence["geo"], "sides": ["pick", "place"]}}
+    assert not failed_pick(replace(done, evidence=place_side))
+    alone = {k: v for k, v in done.evidence.items() if k != "geo"}
+    assert not failed_pick(replace(done, evidence=alone))
+    assert not failed_pick(ExecutionResult(move, True))
+
+
+def test_with_other_grasps_a_tower_may_grow_past_the_top_down_limit(solver):
+    """A 7-block tower on a near slot takes no 8th block from a top-down executor (the scene's
+    ``max_height``); one with other grasps and corridor transits may build it up to `TALLER`
+    blocks where some grasp reaches its top (`ArmCosts._hover`)."""
+    from tamp.arm_costs import TALLER
+
+    names = tuple("abcdefgh")
+    init = (TABLE, *names[:6], TABLE)  # a..g a tower, h on the table
+    problem = Problem("eight", "blocksworld", names, init, (("h", "g"),))
+    scene = SceneConfig()
+    poses = layout(names, init, scene, seed=0, slots=[0, 2])
+    assert scene.max_height == 7 < TALLER
+    for grasps, blocked in (((), True), (CHOICES, False)):
+        source = ArmCosts([problem], [poses], scene, solver, PANDA.q_home, grasps=grasps)
+        c = source([0], [init]).compute()[0]
+        assert bool(c[7, 6] >= BLOCKED) == blocked  # h onto g
