@@ -46,7 +46,7 @@ from task.symbolic.lazy_search import (
     lazy_best_first,
     lazy_greedy,
 )
-from task.symbolic.shorten import shorten
+from task.symbolic.shorten import merge_runs, shorten
 
 PROOF_PROBLEMS = 1  # windows of at most this many problems are read early (`_proofs`): a read
 # costs about a third of an Adam step, and a window stops only once all its problems are proven,
@@ -233,7 +233,9 @@ def _fall_back(
     one that can ``forget`` the moves committed to it); the last search there is, it runs
     until the ``deadline`` when there is one, not for ``fallback_nodes``. When no plan exists
     from ``state``, the initial state is searched too: UNSOLVABLE only when neither has a plan
-    within these choices (the windows may have led into a dead end)."""
+    within these choices (the windows may have led into a dead end). A plan found has its runs
+    of one block's moves merged (`task.symbolic.shorten.merge_runs`, each merged move checked
+    feasible) before it is committed."""
     feasible, windows = (
         (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
     )
@@ -267,6 +269,10 @@ def _fall_back(
             )
             return replace(found, status=SearchStatus.DEAD_END, reason=why)
         found = replace(found, reason=found.reason + ", from the initial state too")
+    tidy = merge_runs(domain, problem, state, found.moves, feasible)
+    if len(tidy) < len(found.moves):  # a block parked twice in a row: once
+        why = f"{found.reason}; {len(found.moves) - len(tidy)} moves of runs merged"
+        found = replace(found, moves=tidy, reason=why)
     for move in found.moves if costs is not None else ():
         windows[state].commit([0], [(move,)])
         state = domain.apply_move(problem, state, move)

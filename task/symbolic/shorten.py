@@ -12,7 +12,7 @@ replayed from the initial state to the goal, so it stays valid whenever the inpu
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 from typing import Protocol
 
 from task.problem import Move, Problem
@@ -85,3 +85,43 @@ def shorten(domain: ReplayDomain, problem: Problem, moves: Sequence[Move]) -> tu
     """``moves`` (a plan that reaches the goal) with cycles cut, then redundant moves
     eliminated; never longer, and still a plan to the goal."""
     return eliminate(domain, problem, cut_cycles(domain, problem, moves))
+
+
+def merge_runs(
+    domain: ReplayDomain,
+    problem: Problem,
+    start: Hashable,
+    moves: Sequence[Move],
+    allowed: Callable[[Hashable, Move], bool] | None = None,
+) -> tuple:
+    """``moves`` from ``start`` with every run of moves of one entity made one move where that
+    is the same: x onto a, then x onto b, becomes x onto b when that move applies where the
+    first did, is ``allowed`` there (a cost source's feasibility, None: any legal move) and
+    leads to the same state; a run that ends where it began is cut. Every state after a run
+    is the one it was, so the later moves apply as before. A greedy search's plans park a
+    block two or three times in a row; this takes that out without a replay of the rest.
+    Relational moves (`task.problem.Move`) only: other actions (the lift's) stay."""
+    plan = list(moves)
+    state, k = start, 0
+    while k < len(plan):
+        after = domain.apply_move(problem, state, plan[k])
+        if k + 1 < len(plan) and _same_entity(plan[k], plan[k + 1]):
+            end = domain.apply_move(problem, after, plan[k + 1])
+            if end == state:  # there and back
+                del plan[k : k + 2]
+                continue
+            merged = Move(plan[k].entity, plan[k + 1].target)
+            if (
+                domain.check_move(problem, state, merged) is None
+                and (allowed is None or allowed(state, merged))
+                and domain.apply_move(problem, state, merged) == end
+            ):
+                plan[k : k + 2] = [merged]
+                continue
+        state, k = after, k + 1
+    return tuple(plan)
+
+
+def _same_entity(first, then) -> bool:
+    """Whether two actions are relational moves (`Move`) of one entity."""
+    return isinstance(first, Move) and isinstance(then, Move) and first.entity == then.entity

@@ -337,3 +337,27 @@ def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
             continue
         assert found.status is SearchStatus.SOLVED and found.from_start and found.expanded > 3
         assert_valid(problem, found.moves)
+
+
+def test_a_run_of_one_blocks_moves_is_merged_where_the_merged_move_is_allowed():
+    """a to the table then onto c is one move, a onto c, unless that move is ruled out where
+    the run began; a run that comes back where it began is cut; other moves stay as they
+    were and the plan still reaches the goal."""
+    from task.symbolic.shorten import merge_runs
+
+    problem = Problem(
+        "run",
+        "blocksworld",
+        ("a", "b", "c", "d"),
+        ("b", TABLE, TABLE, TABLE),
+        (("a", "c"), ("d", "b")),
+    )
+    start = BW.initial_state(problem)
+    moves = (Move("a", TABLE), Move("a", "c"), Move("d", "a"), Move("d", TABLE), Move("d", "b"))
+    assert merge_runs(BW, problem, start, moves) == (Move("a", "c"), Move("d", "b"))
+    never = lambda state, move: move != Move("a", "c") or state != start  # noqa: E731
+    kept = merge_runs(BW, problem, start, moves, never)
+    assert kept == (Move("a", TABLE), Move("a", "c"), Move("d", "b"))
+    assert_valid(problem, kept)
+    back = (Move("c", "d"), Move("c", TABLE), Move("a", "c"), Move("d", "b"))
+    assert merge_runs(BW, problem, start, back) == back[2:]
