@@ -28,7 +28,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -60,9 +60,6 @@ DETOUR = 1.0
 # reach of the hand and the forearm over it (the next slot, not the diagonal one); how far a
 # block may be from where it was recorded to still count as there (observation noise)
 AROUND, SAME = 0.2, 0.015
-# blocks a tower may have when the executor has other grasps and corridor transits
-# (``grasps``): where its top is out of the top-down reach, `_hover` asks those grasps
-TALLER = 9
 
 
 def predict_poses(
@@ -198,8 +195,6 @@ class ArmCosts:
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
         self.failed = tuple(failed)  # moves the arm failed, by where (`FailedMove`)
-        tall = max(scene.max_height, TALLER) if grasps else scene.max_height
-        self._room = replace(scene, max_height=tall)  # the towers' capacities, `_blocked`
         self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
         self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
         self._sites: dict[tuple, tuple[np.ndarray, bool]] = {}  # point -> `_site_solutions`
@@ -422,7 +417,7 @@ class ArmCosts:
             height, below = 1, support[y]
             while below != TABLE:
                 height, below = height + 1, support[below]
-            if height + 1 > self._room.capacity(now[y].xy):
+            if height + 1 > self.scene.capacity(now[y].xy):
                 out[:, j] = BLOCKED
         if table_full:
             out[:, n:] = BLOCKED

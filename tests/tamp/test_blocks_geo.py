@@ -155,21 +155,3 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     alone = {k: v for k, v in done.evidence.items() if k != "geo"}
     assert not failed_pick(replace(done, evidence=alone))
     assert not failed_pick(ExecutionResult(move, True))
-
-
-def test_with_other_grasps_a_tower_may_grow_past_the_top_down_limit(solver):
-    """A 7-block tower on a near slot takes no 8th block from a top-down executor (the scene's
-    ``max_height``); one with other grasps and corridor transits may build it up to `TALLER`
-    blocks where some grasp reaches its top (`ArmCosts._hover`)."""
-    from tamp.arm_costs import TALLER
-
-    names = tuple("abcdefgh")
-    init = (TABLE, *names[:6], TABLE)  # a..g a tower, h on the table
-    problem = Problem("eight", "blocksworld", names, init, (("h", "g"),))
-    scene = SceneConfig()
-    poses = layout(names, init, scene, seed=0, slots=[0, 2])
-    assert scene.max_height == 7 < TALLER
-    for grasps, blocked in (((), True), (CHOICES, False)):
-        source = ArmCosts([problem], [poses], scene, solver, PANDA.q_home, grasps=grasps)
-        c = source([0], [init]).compute()[0]
-        assert bool(c[7, 6] >= BLOCKED) == blocked  # h onto g
