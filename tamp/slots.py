@@ -26,7 +26,7 @@ from tamp.scene import Pose, SceneConfig, SceneError, layout
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
 from task.planner import plan
-from task.problem import TABLE, Move, Plan, PlanResult, Problem
+from task.problem import TABLE, Move, Plan, PlanResult, PlanStatus, Problem
 
 XY = tuple[float, float]
 
@@ -122,7 +122,15 @@ def plan_on_places(
     ``grasps``: the grasp families the executor has besides top-down over the highest stack
     (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out);
     ``failed``: moves the arm failed, ruled out wherever they would be the same
-    (`FailedMove`)."""
+    (`FailedMove`). A goal tower taller than the scene's ``max_height`` is UNSOLVABLE at
+    once, its reason in ``stats["reason"]`` (the prices rule out every such tower)."""
+    tall = goal_height(problem)
+    if tall > scene.max_height:  # no tower on this table takes it: say so, do not search
+        why = (
+            f"the goal stacks {tall} blocks in one tower; this scene's towers take at most "
+            f"{scene.max_height} (SceneConfig.max_height)"
+        )
+        return PlanResult(PlanStatus.UNSOLVABLE, Plan(()), problem, stats={"reason": why})
     current, at = slotted(problem, problem.init, poses, scene)
     costs = ArmCosts(
         [current],
@@ -142,6 +150,20 @@ def plan_on_places(
         raise RuntimeError("the planner's moves differ from those committed to the cost source")
     moves = tuple(plain_move(m, at, xy) for m, xy in decided)
     return replace(result, plan=Plan(moves))
+
+
+def goal_height(problem: Problem) -> int:
+    """Blocks in the tallest tower ``problem``'s goal names: its longest chain of blocks
+    each on the next (1 when the goal puts no block on another)."""
+    below = {x: y for x, y in problem.goal if y in problem.entities}
+    tallest = 1
+    for x in problem.entities:
+        n, seen = 1, {x}
+        while x in below and below[x] not in seen:
+            x = below[x]
+            n, seen = n + 1, seen | {x}
+        tallest = max(tallest, n)
+    return tallest
 
 
 def fits(problem: Problem, scene: SceneConfig) -> bool:

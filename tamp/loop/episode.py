@@ -256,7 +256,10 @@ class Episode:
         p.stalls = 0 if window or result.solved else p.stalls + 1
         if not (result.solved or window):
             if self.config.observe == "state" or p.stalls > self.config.max_replans:
-                p.stop(EpisodeStatus.NO_PLAN, "the planner found no plan")
+                why = result.stats.get("reason")
+                p.stop(
+                    EpisodeStatus.NO_PLAN, "the planner found no plan" + (f": {why}" if why else "")
+                )
             return False
         p.queue, p.planned = list(result.plan), basis
         self.say(f"plan {len(p.plans)}: {len(p.queue)} moves")
