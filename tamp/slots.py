@@ -130,7 +130,8 @@ def plan_on_places(
             f"the goal stacks {tall} blocks in one tower; this scene's towers take at most "
             f"{scene.max_height} (SceneConfig.max_height)"
         )
-        return PlanResult(PlanStatus.UNSOLVABLE, Plan(()), problem, stats={"reason": why})
+        stats = {"reason": why, "time_s": 0.0, "windows": 0}
+        return PlanResult(PlanStatus.UNSOLVABLE, Plan(()), problem, stats=stats)
     current, at = slotted(problem, problem.init, poses, scene)
     costs = ArmCosts(
         [current],

@@ -30,7 +30,7 @@ from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.instances import Instance, example, from_files
 from task.planner import plan
-from task.problem import Move, PlanResult
+from task.problem import Move, PlanResult, PlanStatus
 from task.symbolic import pddl_io, strips
 from task.symbolic.proofs import Proof, prove_unsolvable
 from task.symbolic.search import optimal_moves
@@ -240,13 +240,17 @@ def plan_command(args: argparse.Namespace) -> int:
         print(f"note: {instance.note}", file=sys.stderr)
     recorded, config, result, actions, validation = _solve(domain, instance, args)
     valid = validation is not None and validation.valid
-    after = None if validation is not None else _proved_after(domain, instance, args)
+    said = result.stats.get("reason") if result.status is PlanStatus.UNSOLVABLE else None
+    searched = validation is not None or said is not None  # no proof needed after either
+    after = None if searched else _proved_after(domain, instance, args)
     if args.out is not None and valid:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:
         print(_plan_json(recorded, result, actions, validation, args.seed, after, instance.note))
     elif after is not None and after.unsolvable:
         print(f"unsolvable: {after.reason}")
+    elif said is not None:  # the planner's own reason (a goal the scene cannot hold)
+        print(f"unsolvable: {said}")
     else:
         if valid:
             print(pddl_io.format_plan(actions), end="")

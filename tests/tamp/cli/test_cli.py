@@ -239,3 +239,24 @@ def test_plan_with_a_time_limit_says_how_far_it_got(capsys, files):
     assert out.startswith("no plan found within the time limit: stopped at the 1e-09 s time")
     assert main(["plan", *map(str, files), "--time-limit", "0"]) == 2
     assert "expected seconds > 0" in capsys.readouterr().err
+
+
+def test_plan_motion_aware_says_a_goal_tower_too_tall_for_the_scene_is_unsolvable(capsys, tmp_path):
+    """Eight blocks stacked into one tower: the scene's towers take seven, so motion-aware
+    planning answers ``unsolvable: REASON`` (exit 1) at once; task-only planning plans it."""
+    import itertools
+
+    from task.problem import TABLE, Problem
+
+    names = tuple("abcdefgh")
+    eight = Problem("tall8", "blocksworld", names, (TABLE,) * 8, tuple(itertools.pairwise(names)))
+    domain, problem = tmp_path / "domain.pddl", tmp_path / "problem.pddl"
+    domain.write_text(data.read_text(data.DOMAIN_FILE))
+    problem.write_text(blocksworld.to_pddl(eight))
+    assert main(["plan", str(domain), str(problem), "--motion-aware"]) == 1
+    out = capsys.readouterr().out
+    assert out == (
+        "unsolvable: the goal stacks 8 blocks in one tower; this scene's towers take at most 7 "
+        "(SceneConfig.max_height)\n"
+    )
+    assert main(["plan", str(domain), str(problem), *FAST]) == 0
