@@ -451,8 +451,7 @@ class Site:
         if math.dist(xyz, self.xyz) > SAME:
             return False
         return all(
-            name != leave and name in poses and math.dist(poses[name].xyz, at) <= SAME
-            for name, at in self.around
+            name in poses and math.dist(poses[name].xyz, at) <= SAME for name, at in self.around
         )
 
 
@@ -468,7 +467,7 @@ class FailedMove:
     entity: str
     pick: Site
     place: Site | None
-    top: float  # m: the highest block top then (the top-down hand hovers over it)
+    top: float  # m: the highest block's centre then (the top-down hand hovers over it)
 
     @classmethod
     def of(cls, entity: str, poses: Mapping[str, Pose], place, pick_only: bool) -> FailedMove:

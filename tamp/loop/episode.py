@@ -227,7 +227,7 @@ class Episode:
         sees now (it failed before it moved anything): the pick and the place it was to go
         to; the pick alone when every grasp failed there, or when a move of the block from
         the same spot to another place failed before."""
-        if done.path_rad > 0 or not self.config.planner.lambda_motion > 0:
+        if done.path_rad > 0 or self.config.planner.lambda_motion <= 0:
             return  # it ran and failed on the way: nothing says the same move fails again
         poses = self._poses()
         target = place_pose(move, poses, self.config.scene)

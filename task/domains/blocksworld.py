@@ -451,13 +451,16 @@ def helpful(problem: Problem, state: State) -> frozenset[Move]:
     the unlimited table some shortest plan makes only such moves; on slots it may have to
     park a block on another, so these are preferred, not the only ones."""
     placed, goal = in_position(problem, state), dict(problem.goal)
-    slots = set(problem.fixed) if slotted(problem) else {TABLE}
-    return frozenset(
-        m
-        for m in legal_moves(problem, state)
-        if m.entity not in placed
-        and (m.target in slots or (m.target == goal.get(m.entity) and m.target in placed))
-    )
+    slots = problem.fixed if slotted(problem) else (TABLE,)
+    out = []
+    for x in problem.entities:
+        if x in placed:
+            continue
+        below = goal.get(x)
+        for target in (*slots, below) if below in placed else slots:
+            if check_move(problem, state, Move(x, target)) is None:  # only these are checked
+                out.append(Move(x, target))
+    return frozenset(out)
 
 
 HOP = "hop"  # ``Problem.data`` of a slotted problem whose blocks may move place to place

@@ -209,5 +209,12 @@ def test_helpful_moves_are_legal_and_only_onto_the_goal_block_or_the_table(seed)
             assert move.target in table or (
                 move.target == goal.get(move.entity) and move.target in placed
             )
+        every = {  # every legal move of that kind is among them
+            m
+            for m in blocksworld.legal_moves(problem, state)
+            if m.entity not in placed
+            and (m.target in table or (m.target == goal.get(m.entity) and m.target in placed))
+        }
+        assert helpful == every
         if not blocksworld.slotted(problem):
             assert set(blocksworld.constructive_moves(problem, state)) <= helpful
