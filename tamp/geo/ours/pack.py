@@ -46,6 +46,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import torch
 
+from motion.grasps import FINGER_SPARE, STROKE
 from task.errors import TampError
 from task.optimize import Adam
 
@@ -70,8 +71,10 @@ class PackConfig:
     fingers: float = 0.0  # m, the hand's reach from the object's centre along the closing axis
     # (open finger pads, with the collision model's margin); 0: no finger room
     side: float = 0.0  # m, the hand's reach from the centre across the closing axis
-    stroke: float = 0.08  # m, the widest the fingers open: a side wider than this is never
+    # m, the widest side the open fingers close across, each clearing it by `FINGER_SPARE`
+    # (`motion.grasps`: no grasp of a wider side is made); a side this wide or wider is never
     # the closing axis
+    stroke: float = STROKE - 2 * FINGER_SPARE
     tol: float = 1e-4  # m, interpenetration still counted as free
     ordered: bool = True  # finger room against the objects placed before only: a pair is free
     # when either's hand clears the other's body, and some placing order must exist (`order`)
@@ -265,7 +268,7 @@ def pack_tries(
         h = torch.where(
             turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np)
         )
-        wide = 2 * h.gather(-1, axis[..., None])[..., 0] > config.stroke  # (R, M): not between
+        wide = 2 * h.gather(-1, axis[..., None])[..., 0] >= config.stroke - 1e-6  # (R, M)
         axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
         body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
         lo = torch.tensor(inside[0], dtype=torch.float64)
@@ -372,7 +375,7 @@ def pack_sampled(
             turn = not np.isclose(*half_np[i]) and rng.random() < 0.5
             axes[i] = rng.integers(2)
             bodies[i] = half_np[i][::-1] if turn else half_np[i]
-            if 2 * bodies[i, axes[i]] > config.stroke:
+            if 2 * bodies[i, axes[i]] >= config.stroke - 1e-6:
                 axes[i] = 1 - axes[i]  # the fingers close across the other side
             grown[i] = np.maximum(bodies[i], config.side)
             grown[i, axes[i]] = max(bodies[i, axes[i]], config.fingers)

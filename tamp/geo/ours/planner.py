@@ -56,11 +56,12 @@ from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE
-from task.domains.blocksworld import apply_move
+from task.domains.blocksworld import DOMAIN, apply_move
 from task.domains.blocksworld import check_move as legal
 from task.planner import plan
 from task.problem import PlanStatus
 from task.symbolic.search import moves_lower_bound
+from task.symbolic.shorten import merge_runs
 
 SEARCH_NODES = 5_000  # the complete search's expansions at least (its time bounds it first)
 # the differentiable planner's share of the wall clock: 1 / SOFT_SHARE (a sixth left a 10-cube
@@ -267,9 +268,12 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
                 why = f"after {len(bound)} bound moves: {why}"
             stats["bound"] = tuple(bound)
             return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+        # an object moved twice in a row (one window parks it, the next moves it on, or back
+        # where it stood): once, where its prices allow the one move, or not at all
+        moves = merge_runs(DOMAIN, now, state, result.plan.moves, _allowed(costs))
         # a window prices its moves in its start state: put them in an order each move's own
         # state allows first, where one exists
-        moves = reorder(bridged, costs, state, result.plan.moves) or result.plan.moves
+        moves = reorder(bridged, costs, state, moves) or moves
         state, world, more, failed = _bind(bridged, state, world, moves, tools, costs, check)
         bound += more
         if failed is None:
@@ -281,6 +285,11 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     why = f"{len(failures)} planned moves failed the full check; the replan budget is spent"
     stats["bound"] = tuple(bound)
     return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+
+
+def _allowed(costs: GeoCosts) -> Callable:
+    """Whether a legal move is open in a crisp state under ``costs`` (not priced out)."""
+    return lambda state, move: costs.price_of(state, move) < IMPOSSIBLE
 
 
 def reorder(bridged: Bridged, costs: GeoCosts, state, moves, budget: int = 200):

@@ -6,6 +6,7 @@ planner's fallback proved it within the discretised places."""
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
 from tamp.geo.check import MoveCheck
@@ -65,6 +66,41 @@ def test_the_canonical_packed_boxes_go_into_the_tray_the_sampled_packer_cannot_f
         f"packed: gradient {result.stats['packs']['tray']}, sampled ok={sampled.ok} "
         f"in {sampled.time:.3f} s ({sampled.tries} samples); plan {result.stats['time_s']:.1f} s"
     )
+
+
+def test_packed_variant_3_is_planned_in_the_packers_order_and_no_object_moves_twice_in_a_row():
+    """Packed variant 3 (six boxes, two columns with a finger lane): the packer's placing order
+    is one the arm's prices allow move by move (it closed the fingers across a side no grasp
+    closes across, and no order of its cells was open to the planner: no plan in 120 s), and
+    the plan has no object moved twice in a row (a window parks it, the next moves it on)."""
+    from tamp.geo.ours.bridge import bridge
+    from tamp.geo.ours.costs import GeoCosts
+    from tamp.world.canonical import generate
+    from task.costs import IMPOSSIBLE
+    from task.domains.blocksworld import apply_move
+    from task.problem import Move
+
+    made = generate("packed", 3)
+    config = as_ours(SearchConfig(seed=1))
+    b = bridge(made.scene, made.goal, config.table_places, config.pack, config.seed)
+    ((_, packed),) = b.packs
+    assert packed.ok
+    costs = GeoCosts(b, tools().solver, tools().q, config.costs, pack=config.pack)
+    state = b.problem.init
+    for k in packed.order:
+        move = Move(*b.cells[k])
+        assert costs.price_of(state, move) < IMPOSSIBLE, move
+        state = apply_move(b.problem, state, move)
+    result = plan_motion_aware(made.scene, made.goal, tools(), config)
+    assert result.status is GeoStatus.SOLVED, result.reason
+    assert goal_holds(made, result.moves)
+    objects = [m.obj for m in result.moves]
+    assert all(a != b for a, b in itertools.pairwise(objects)), objects
+
+
+def goal_holds(made, moves) -> bool:
+    end = _replay(made.scene, moves)
+    return made.goal.holds(read_facts(end)) and _no_overlap(end)
 
 
 class _Refuse:

@@ -129,3 +129,23 @@ def test_a_free_row_with_a_placing_order_wins_over_a_lesser_overlap_without_one(
     for r in results:
         if r.ok:
             assert sorted(r.order) == list(range(len(feet)))
+
+
+def test_the_fingers_close_only_across_a_side_a_grasp_closes_across():
+    """The hand's room is grown along each object's closing axis: that side must be one
+    `motion.grasps` makes a grasp across (narrower than the stroke less a finger's spare on
+    each side). Packed variant 3's boxes are 5.8 cm by 6.8-7.7 cm: closing across a 7.3 cm
+    side (the stroke alone allowed it) gave cells no grasp could fill in the packer's order."""
+    from motion.grasps import FINGER_SPARE, STROKE
+    from tamp.geo.ours.bridge import PACK, own_footprint
+    from tamp.world.canonical import generate
+
+    made = generate("packed", 3)
+    tray = made.scene.regions[0]
+    feet = np.array([own_footprint(o) for o in made.scene.objects])
+    results = [pack(tray.inner(), feet, config=PACK, seed=s) for s in range(4)]
+    results.append(pack_sampled(tray.inner(), feet, config=PACK, budget=600, seed=0))
+    for r in results:
+        for half, yaw, axis in zip(feet, r.yaws, r.axes, strict=False):
+            body = half[::-1] if math.isclose(yaw, math.pi / 2) else half
+            assert 2 * body[axis] + 2 * FINGER_SPARE < STROKE
