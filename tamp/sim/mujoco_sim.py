@@ -154,6 +154,14 @@ class MuJoCoSim(Simulator):
         self._fingers = np.array([m.joint(j).qposadr[0] for j in PANDA.finger_joints])
         self._act = np.array([m.actuator(actuator_name(j)).id for j in PANDA.arm_joints])
         self._grip = m.actuator(GRIP_ACTUATOR).id
+        # s: each arm actuator's lead, (kv + joint damping) / kp. The position actuators push
+        # kp (ctrl - q) - kv qd, which at a joint velocity lags ctrl by this many seconds of it
+        # (9 mrad in a fast lift of the shoulder: 3 mm at the hand, enough to brush a block
+        # 2 mm away); commanding q + lead * qd tracks the velocity too, as PyBullet's
+        # position control does with its target velocities
+        dofs = [m.joint(j).dofadr[0] for j in PANDA.arm_joints]
+        kp = m.actuator_gainprm[self._act, 0]
+        self._lead = (-m.actuator_biasprm[self._act, 2] + m.dof_damping[dofs]) / kp
         self._finger_ids = [m.body(b).id for b in FINGER_BODIES]
         self._hand = m.body(HAND_BODY).id
         self._block_ids = {n: m.body(f"block_{n}").id for n in self.entities}
@@ -181,7 +189,7 @@ class MuJoCoSim(Simulator):
         self.set_view(self.camera, self.lighting)
 
     def _command(self, q, qd, gripper) -> None:
-        self.data.ctrl[self._act] = q
+        self.data.ctrl[self._act] = np.asarray(q) + self._lead * np.asarray(qd)
         self.data.ctrl[self._grip] = PANDA.finger_open if gripper == "open" else 0.0
 
     def _step(self) -> None:
