@@ -319,6 +319,28 @@ def test_a_fallback_out_of_budget_where_the_windows_left_it_starts_over_from_ini
     assert kept.status is SearchStatus.BUDGET and not kept.from_start
 
 
+def test_a_restart_probe_takes_a_star_from_the_initial_state_first():
+    """The windows put d on a. With ``restart_probe``, A* from the initial state looks first
+    and its one-move plan is taken (the cost source forgets the windows' move); without it the
+    search starts where the windows left off (d off a, then a onto b)."""
+    from task.planner import _fall_back
+
+    wandered = BW.apply_move(FLAT, BW.initial_state(FLAT), Move("d", "a"))
+    source = Forgetful(FLAT, lambda state, move: False)
+    source.committed.append(Move("d", "a"))  # the windows' move
+    config = PlannerConfig(fallback=True, restart_probe=5)
+    found = _fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    assert found.status is SearchStatus.SOLVED and found.from_start
+    assert found.moves == (Move("a", "b"),)
+    assert "from the initial state, A* within 5 expansions" in found.reason
+    assert source.forgot == [0] and source.committed == [Move("a", "b")]
+    source = Forgetful(FLAT, lambda state, move: False)
+    kept = _fall_back(BW, FLAT, wandered, source, [0], 0, PlannerConfig(fallback=True), None)
+    assert kept.status is SearchStatus.SOLVED and not kept.from_start and len(kept.moves) == 2
+    with pytest.raises(TampError, match="restart_probe must be >= 0"):
+        PlannerConfig(restart_probe=-1)
+
+
 def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
     """Eight blocks, one block moved off the plan's way, a node budget of one: without a
     deadline every search stops at one expansion; with one, the last search (greedy from the

@@ -244,6 +244,12 @@ class GeoCosts:
             return CellWindow(self, rows, states, restarts)
         return _Window(rows)
 
+    def forget(self, index: int) -> None:
+        """Nothing to drop when the planner's fallback starts its plan over from the initial
+        state (`task.planner`): the moves the windows committed left nothing here but the
+        cells they settled, and a settled cell keeps the region's packing free, so a plan from
+        the initial state is priced and bound with the cells where they are now."""
+
     def settle(self, cell: str, xy) -> None:
         """Fix ``cell`` at ``xy`` (m) where its region's packing stays free
         (`tamp.geo.ours.cells.Cells.settle`); the prices of the states seen so far are

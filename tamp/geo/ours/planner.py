@@ -68,8 +68,18 @@ SEARCH_NODES = 5_000  # the complete search's expansions at least (its time boun
 # tower's 20-move plan unfinished after 9 windows; with a third its 11 windows and binding took
 # 24 s of 40)
 SOFT_SHARE = 3
+# A* from the initial state first when the windows end without a plan (`restart_probe`):
+# windows that fill a region's cells in a bad order leave a state A* spent 36 s on, where from
+# the initial state it found packed variant 18's 6-move plan in 30 expansions
+RESTART_PROBE = 200
 PLANNER = PlannerConfig(
-    restarts=8, iters=40, max_windows=4, lambda_motion=0.05, fallback=True, proof_costs=True
+    restarts=8,
+    iters=40,
+    max_windows=4,
+    lambda_motion=0.05,
+    fallback=True,
+    proof_costs=True,
+    restart_probe=RESTART_PROBE,
 )
 # receding windows at least per move the bridged problem's lower bound says the goal needs
 # (`PlannerConfig.max_windows`): a window commits one to three moves, and 4 windows stopped a
