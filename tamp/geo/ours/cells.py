@@ -98,6 +98,21 @@ def _shapes(bridged: Bridged, pack: PackConfig) -> list[_Region]:
     return out
 
 
+def hand_reaches(region: _Region, xy: np.ndarray, pack: PackConfig) -> np.ndarray:
+    """(C, C) bool: with ``region``'s cells at ``xy`` (C, 2), whether cell i's hand room (its
+    grown footprint) reaches cell j's body, as `tamp.geo.ours.pack.placing_order` tests it:
+    where it does, j filled first leaves i no room."""
+    d = np.abs(xy[:, None] - xy[None])  # (C, C, 2)
+    hits = (region.grown[:, None] + region.body[None] + pack.gap - d).min(-1) > pack.tol
+    np.fill_diagonal(hits, False)
+    return hits
+
+
+def shapes(bridged: Bridged, pack: PackConfig) -> dict[str, _Region]:
+    """Each packed region's cells and footprints by region name (`_shapes`)."""
+    return {r.name: r for r in _shapes(bridged, pack)}
+
+
 class Cells:
     """The goal regions' cells of one bridged problem as planner variables (module docstring):
     which are empty in a state, their places now, and the places the committed rows gave."""

@@ -50,7 +50,7 @@ import torch
 from motion.grasps import HAND_BOXES, Grasp
 from motion.ik import IKSolver, top_down_pose
 from tamp.geo.ours.bridge import PACK, Bridged
-from tamp.geo.ours.cells import CellConfig, Cells, CellWindow
+from tamp.geo.ours.cells import CellConfig, Cells, CellWindow, hand_reaches, shapes
 from tamp.geo.ours.pack import PackConfig
 from tamp.geo.places import free, supported_on
 from tamp.world.geometry import Solid, fixed_solids, of_movable
@@ -71,6 +71,11 @@ class GeoCostConfig:
     choices: tuple[str, ...] = ("top", "side", "tilt")  # grasp families priced
     ik: bool = True  # rule out a grasp or release with no top-down IK solution (needs a solver)
     margin: float = 0.004  # m, the open hand's boxes grown by this (the collision margin)
+    # added per empty cell of its region a move into a cell closes: one whose hand room (the
+    # packer's grown footprint) reaches this cell's body, so it must be filled first
+    # (`tamp.geo.ours.pack.placing_order`'s test); a detour's price, not a rule: the arm's
+    # other grasps may still fit there
+    order: float = 1.0
     # the goal regions' empty cells as variables of the planner's Adam, per restart row
     # (`tamp.geo.ours.cells`); None: they stay where the packer put them
     cells: CellConfig | None = field(default_factory=CellConfig)
@@ -215,6 +220,8 @@ class GeoCosts:
         self.bridged, self.solver, self.config = bridged, solver, config
         # the empty cells the planner's Adam moves (`pack`: the packer's settings they keep)
         self.cells = None if config.cells is None else Cells(bridged, pack, config.cells)
+        self._pack = pack
+        self._shapes = shapes(bridged, pack)  # the goal regions' cell footprints (`_closes`)
         self.q = None if q is None else np.asarray(q, dtype=np.float64)
         if grasps is None:
             from tamp.geo.check import candidate_grasps
@@ -355,12 +362,13 @@ class GeoCosts:
         if not names:
             return float(IMPOSSIBLE), names
         if self.solver is None:
-            return 0.0, names
+            return self._order(state, move.target), names
         q, reach = self._solve(list(ends))  # (2, J), (2,)
         if self.config.ik and not (reach[0] and reach[1]):
             return float(IMPOSSIBLE), names
         dist = float(np.linalg.norm(q[1] - q[0]))
-        return min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0), names
+        price = self.config.joint_weight * dist + self._order(state, move.target)
+        return min(price, IMPOSSIBLE - 1.0), names
 
     def _world(self, state: State) -> Scene:
         return self._context(state).world
@@ -448,7 +456,34 @@ class GeoCosts:
                     continue
                 dist = float(np.linalg.norm(q[2 * k + 1] - q[2 * k]))
                 out[i, j] = min(self.config.joint_weight * dist, IMPOSSIBLE - 1.0)
+        if self.config.order and self._shapes:
+            closes = self._closes(state)
+            for i, j in moves:
+                closed = closes.get(problem.targets[j], 0)
+                if closed and out[i, j] < IMPOSSIBLE:
+                    out[i, j] = min(out[i, j] + self.config.order * closed, IMPOSSIBLE - 1.0)
         return out, allowed
+
+    def _closes(self, state: State) -> dict[str, int]:
+        """Goal cell -> how many other cells of its region, empty in ``state``, filling it
+        closes: their hand room reaches its body where the cells are now (`hand_reaches`)."""
+        b, taken = self.bridged, set(state)
+        out: dict[str, int] = {}
+        for region in self._shapes.values():
+            xy = np.array([b.site(c).xy for c in region.cells])
+            reaches = hand_reaches(region, xy, self._pack)  # (C, C): i's hand on j's body
+            empty = np.array([c not in taken for c in region.cells])
+            for k, cell in enumerate(region.cells):
+                others = empty.copy()
+                others[k] = False
+                out[cell] = int((reaches[:, k] & others).sum())
+        return out
+
+    def _order(self, state: State, target: str) -> float:
+        """``config.order`` per cell a move onto ``target`` closes in ``state`` (`_closes`)."""
+        if not self.config.order or not self._shapes:
+            return 0.0
+        return self.config.order * self._closes(state).get(target, 0)
 
     def _free_grasps(self, world: Scene, x: str, poses, seen: _Seen) -> list[set[str]]:
         """For each of ``poses`` ((xyz, yaw): x centred at xyz (m) turned yaw (rad)), the

@@ -143,3 +143,33 @@ def test_the_grasps_left_of_a_move_come_in_the_candidates_order(priced):
         assert list(names) == [n for n in order if n in names]
         seen += len(names) > 1
     assert seen  # some move has several grasps to order
+
+
+def test_a_move_into_a_cell_costs_more_per_empty_cell_of_its_region_it_closes():
+    """Packed variant 2's tray: a box put in a cell whose body another empty cell's hand room
+    reaches (the packer's placing-order test) costs ``order`` more per such cell, in the state's
+    whole pricing and a single move's alike; once that cell is filled, nothing is added."""
+    from dataclasses import replace
+
+    from tamp.geo.ours.costs import GeoCostConfig
+    from tamp.world.canonical import generate
+
+    made = generate("packed", 2)
+    b = bridge(made.scene, made.goal)
+    ((_, packed),) = b.packs
+    p = b.problem
+    plain = GeoCosts(b, config=replace(GeoCostConfig(), order=0.0))
+    ordered = GeoCosts(b)
+    closes = ordered._closes(p.init)
+    assert set(closes) == {c for _, c in b.cells} and any(closes.values())
+    for x, cell in b.cells:
+        extra = _price(ordered, p.init, Move(x, cell)) - _price(plain, p.init, Move(x, cell))
+        assert extra == pytest.approx(closes[cell])
+        single = ordered.price_of(p.init, Move(x, cell)) - plain.price_of(p.init, Move(x, cell))
+        assert single == pytest.approx(closes[cell])
+    # filling the cells in the packer's placing order (`placing_order`) closes none
+    state = p.init
+    for k in packed.order:
+        x, cell = b.cells[k]
+        assert ordered._closes(state)[cell] == 0
+        state = bw.apply_move(p, state, Move(x, cell))
