@@ -9,7 +9,8 @@
    receding windows (the empty cells' places optimised with each restart row's logits and
    fixed by the committed row, `tamp.geo.ours.cells`), then, when they revisit a state or
    run out, the planner's complete lazy fallback (`task.symbolic.lazy_search`) over the moves
-   the prices allow;
+   the prices allow, A* from the initial state first (`RESTART_PROBE` expansions); an
+   object moved twice in a row in the plan is moved once (`merge_runs`);
 3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
    full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
    no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
