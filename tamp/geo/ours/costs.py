@@ -24,7 +24,9 @@ without IK, for every grasp family at once. It is a proxy: the planner's moves a
 grasp by the full check (`tamp.geo.ours.planner`), and what fails there comes back as failure
 memory: `avoid(state, move, grasp, place)` rules the move out only under the grasp (None:
 every grasp) and place that failed, so the same move keeps its price while another of its
-grasps is left, and x -> another place is priced on its own. A failure no movable object took
+grasps is left, and x -> another place is priced on its own, unless the grasp failed on the
+pick side (reaching or closing on x, whatever the place): then it is out for x's moves to every
+place in that state. A failure no movable object took
 part in (no IK solution, a post, the table or a wall hit; ``fixed``) holds in every state where
 the object stands where it stood, so later plans do not try that grasp again from another
 order of the other moves.
@@ -241,6 +243,9 @@ class GeoCosts:
         # failures no movable object caused (IK, a post, the table, a wall): (move, where the
         # object stands, place) -> grasps, whatever the other objects do
         self.failed_fixed: dict[tuple[Move, tuple, str], set] = {}
+        # grasps that failed on the pick side (reaching or closing on the object, whatever the
+        # place): (state, object) -> grasps, for the object's moves to every place there
+        self.failed_pick: dict[tuple[State, str], set] = {}
         self.stats = {"states": 0, "moves": 0, "price_s": 0.0, "ik_targets": 0}
 
     # ---- the planner's interface
@@ -276,6 +281,9 @@ class GeoCosts:
         out = self._priced(state)[0].copy()
         problem = self.bridged.problem
         remembered = {move for _, move, _ in self.failed} | {m for m, _, _ in self.failed_fixed}
+        for s, x in self.failed_pick:  # every move of an object whose pick failed here
+            if s == tuple(state):
+                remembered |= {Move(x, y) for y in problem.targets if y != x}
         world = self.bridged.predict(state) if remembered else None
         for move in remembered:
             if legal(problem, state, move) is None and not self.grasps_left(state, move, world):
@@ -291,26 +299,38 @@ class GeoCosts:
         if legal(self.bridged.problem, state, move) is not None:
             return 0.0
         price, _ = self._move(state, move)
-        if price >= IMPOSSIBLE or not self._remembers(move):
+        if price >= IMPOSSIBLE or not self._remembers(move, state):
             return price
         return price if self.grasps_left(state, move) else float(IMPOSSIBLE)
 
-    def _remembers(self, move: Move) -> bool:
-        return any(m == move for _, m, _ in self.failed) or any(
-            m == move for m, _, _ in self.failed_fixed
+    def _remembers(self, move: Move, state: State) -> bool:
+        return (
+            any(m == move for _, m, _ in self.failed)
+            or any(m == move for m, _, _ in self.failed_fixed)
+            or (tuple(state), move.entity) in self.failed_pick
         )
 
     # ---- failure memory
 
     def avoid(
-        self, state: State, move: Move, grasp: str | None, place: str, fixed: bool = False
+        self,
+        state: State,
+        move: Move,
+        grasp: str | None,
+        place: str,
+        fixed: bool = False,
+        side: str = "",
     ) -> None:
         """Rule ``move`` out in ``state`` under ``grasp`` (a name; None: every grasp) and the
         place named ``place``, where it failed. ``fixed``: what failed involved no movable
         object (no IK solution, a fixed obstacle, the table, a region's wall hit), so the
         move is ruled out under that grasp and place in every state where its object stands
-        where it stands in ``state``."""
+        where it stands in ``state``. ``side`` "pick": the grasp failed reaching or closing on
+        the object (`tamp.geo.check.GraspTry`), so it is ruled out for the object's moves to
+        every place in ``state``, not only to ``place``."""
         self.failed.setdefault((tuple(state), move, place), set()).add(grasp)
+        if side == "pick":
+            self.failed_pick.setdefault((tuple(state), move.entity), set()).add(grasp)
         if fixed:
             key = (move, _stands(self.bridged.predict(state), move.entity), place)
             self.failed_fixed.setdefault(key, set()).add(grasp)
@@ -324,6 +344,7 @@ class GeoCosts:
         place = self.bridged.geo_move(world, move).place.name
         gone = self.failed.get((tuple(state), move, place), set())
         gone = gone | self.failed_fixed.get((move, _stands(world, move.entity), place), set())
+        gone = gone | self.failed_pick.get((tuple(state), move.entity), set())
         if None in gone:
             return ()
         return tuple(n for n in names if n not in gone)

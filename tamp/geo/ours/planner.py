@@ -14,7 +14,8 @@
 3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
    full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
    no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
-   at that place, under the grasps that failed) and the problem is planned on from the state
+   at that place, under the grasps that failed; a grasp that failed on the pick side, at
+   every place) and the problem is planned on from the state
    the moves bound so far reached, at most `OursConfig.replans` times. A window prices all
    its moves in its start state, so a later move of it may be priced out in its own state
    (the hand no longer fits once a neighbour is placed): the plan's moves are first put in
@@ -366,7 +367,7 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
                 fixed = t.failure in FIXED_FAILURES or (
                     t.failure == "collision" and bool(t.other) and t.other not in movable
                 )
-                costs.avoid(state, move, t.grasp, geo.place.name, fixed)
+                costs.avoid(state, move, t.grasp, geo.place.name, fixed, t.side)
             if not tried:  # failed before any grasp: the move, at that place, in that state
                 costs.avoid(state, move, None, geo.place.name)
             failure = {"move": str(move), "place": geo.place.name, "failure": verdict.failure}

@@ -66,6 +66,28 @@ def test_a_failure_rules_a_move_out_only_under_its_grasp_and_place(priced):
     assert _price(costs, after, other) >= IMPOSSIBLE
 
 
+def test_a_grasp_that_failed_on_the_pick_side_is_out_for_every_place_in_that_state(priced):
+    """A grasp that failed reaching or closing on the object (side "pick") fails whatever the
+    place: ruled out for the object's moves to every place in that state (nonmonotonic variant
+    2 spent its replans on one place after another); a place-side failure is not."""
+    b, _, kit = priced
+    costs = GeoCosts(b, kit.solver, kit.q)
+    p = b.problem
+    after = bw.apply_move(p, p.init, Move("n", next(x.name for x in b.sites if "table." in x.name)))
+    direct, other = Move("t", "goal.c0"), Move("t", "spot_n")
+    names = set(costs.grasps_left(after, direct)) | set(costs.grasps_left(after, other))
+    assert _price(costs, after, other) < IMPOSSIBLE
+    for name in names:
+        costs.avoid(after, direct, name, "goal.c0", side="pick")
+    assert costs.grasps_left(after, other) == ()
+    assert _price(costs, after, other) >= IMPOSSIBLE and _price(costs, after, direct) >= IMPOSSIBLE
+    assert costs.price_of(after, other) >= IMPOSSIBLE
+    fresh = GeoCosts(b, kit.solver, kit.q)
+    for name in names:
+        fresh.avoid(after, direct, name, "goal.c0", side="place")
+    assert _price(fresh, after, other) < IMPOSSIBLE  # a place-side failure stays at its place
+
+
 @pytest.mark.parametrize("fixed", [False, True])
 def test_a_failure_no_movable_object_caused_holds_wherever_the_object_still_stands(priced, fixed):
     """t fails under one grasp after n moved away; with ``fixed`` (an IK failure, a post hit)
