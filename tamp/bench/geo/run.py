@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from tamp.sweep import run_items
+from task.errors import TampError
 
 PLANNERS = ("soft", "motion-aware", "search-then-check")  # the issue's three, side by side
 OBSERVE = ("state", "camera")  # `tamp.geo.episode.OBSERVATIONS`
@@ -116,19 +117,22 @@ def play(item: Item) -> dict:
     t0 = time.perf_counter()
     # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
     domain = made.domain if item.planner == "motion-aware" else None
-    report = run_geo_episode(
-        made.scene,
-        made.goal,
-        item.planner,
-        item.sim,
-        seed=item.seed,
-        planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS["planning_s"]),
-        video=item.video,
-        max_moves=LIMITS["max_moves"],
-        max_replans=LIMITS["max_replans"],
-        domain=domain,
-        observation=item.observe,
-    )
+    try:
+        report = run_geo_episode(
+            made.scene,
+            made.goal,
+            item.planner,
+            item.sim,
+            seed=item.seed,
+            planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS["planning_s"]),
+            video=item.video,
+            max_moves=LIMITS["max_moves"],
+            max_replans=LIMITS["max_replans"],
+            domain=domain,
+            observation=item.observe,
+        )
+    except TampError as exc:  # the episode's error is its row; the other episodes go on
+        return _error_row(item, made.note, str(exc), time.perf_counter() - t0)
     errors = report.pose_errors
     return {
         "problem": item.problem,
@@ -174,6 +178,19 @@ def run(
     return run_items(play, list(todo), workers, ray_address, progress)
 
 
+def _error_row(item: Item, note: str, why: str, wall: float) -> dict:
+    """The row (`ROW_COLUMNS`) of an episode that ended in an error: not reached, nothing
+    run, the error as its reason."""
+    row = dict.fromkeys(ROW_COLUMNS)
+    row |= {"problem": item.problem, "variant": item.variant, "planner": item.planner}
+    row |= {"sim": item.sim, "observe": item.observe, "status": "error", "reason": why}
+    row |= {"reached": False, "clean": False, "note": note, "wall_s": wall}
+    row |= dict.fromkeys(("plan_length", "moves", "motion_failures", "replans", "collisions"), 0)
+    row |= dict.fromkeys(("planning_time_s", "execution_time_s", "arm_path_rad"), 0.0)
+    row |= {"touched": "", "failures": "", "run_notes": "", "unseen": ""}
+    return row
+
+
 def _median(values: Sequence[float]) -> float | None:
     return float(np.median(values)) if len(values) else None
 
@@ -211,7 +228,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
     out = []
     for (problem, planner, sim), mine in groups.items():
         solved = [r for r in mine if r["reached"]]
-        times = [r["planning_time_s"] for r in mine]
+        times = [r["planning_time_s"] for r in mine if r["status"] != "error"]
         out.append(
             {
                 "problem": problem,

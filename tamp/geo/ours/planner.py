@@ -60,6 +60,7 @@ from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE
 from task.domains.blocksworld import DOMAIN, apply_move
 from task.domains.blocksworld import check_move as legal
+from task.errors import TampError
 from task.planner import plan
 from task.problem import PlanStatus
 from task.symbolic.search import moves_lower_bound
@@ -473,13 +474,17 @@ def plan_pddl(
     check = check or _check()
     domain_text, binding_text = domain[0], domain[1]
     bound = binder.bind_text(binding_text, pddl_io.parse_domain(domain_text, "domain"))
-    if len(domain) > 2:
-        problem_text = domain[2]
-    elif bound.scene is not None:  # the binding says how the scene reads as its state
-        problem_text = scene_pddl.problem_text(scene, goal, bound)
-    else:
-        problem_text = pddl_problem_text(scene, goal)
-    lifted = problem_from_text(domain_text, problem_text, scene.name)
+    try:
+        if len(domain) > 2:
+            problem_text = domain[2]
+        elif bound.scene is not None:  # the binding says how the scene reads as its state
+            problem_text = scene_pddl.problem_text(scene, goal, bound)
+        else:
+            problem_text = pddl_problem_text(scene, goal)
+        lifted = problem_from_text(domain_text, problem_text, scene.name)
+    except TampError as exc:  # e.g. a disc that slid off its peg: no state of the domain
+        why = f"the scene is no state of the PDDL domain: {exc}"
+        return GeoPlan(GeoStatus.FAILED, reason=why, stats={"time_s": time.perf_counter() - t0})
     planner = replace(
         PlannerConfig.for_domain("strips"),
         fallback=True,

@@ -122,3 +122,23 @@ def test_a_failed_moves_place_and_a_successful_moves_run_notes_reach_the_row():
     assert bench._notes(done) == "move(a -> d){regrasped=1,corrected_mm=2.5}"
     assert bench._notes(plain) == ""
     assert "run_notes" in bench.ROW_COLUMNS
+
+
+def test_an_episode_that_errs_is_its_own_row_and_the_others_go_on(monkeypatch):
+    """One episode's error (a Hanoi disc slid off its peg: the scene is no state of the domain)
+    used to end the whole benchmark and lose every row; now it is that episode's row, status
+    "error" with the reason, and stays out of the planning-time quantiles."""
+    import tamp.geo.episode as episode
+    from task.errors import ProblemError
+
+    def fail(*args, **kwargs):
+        raise ProblemError("hanoi: initial state holds (ontable d5)")
+
+    monkeypatch.setattr(episode, "run_geo_episode", fail)
+    row = bench.play(bench.Item("blocked", 0, "soft", "pybullet", 0))
+    assert row["status"] == "error" and "ontable d5" in row["reason"] and not row["reached"]
+    assert set(row) == set(bench.ROW_COLUMNS)
+    (summary,) = bench.summarise([row, _row("blocked", "soft", "pybullet", True, t=2.0)])
+    assert summary["episodes"] == 2 and summary["solved"] == 1
+    assert summary["planning_p50_s"] == pytest.approx(2.0)
+    assert summary["statuses"]["error"] == 1

@@ -243,3 +243,18 @@ def test_the_sampled_ablation_places_cells_by_rejection_sampling_and_says_when_n
     only = replace(first, sampler="sampled", search=None)
     said = plan_motion_aware(made.scene, made.goal, tools(), only)
     assert not said.solved and "no free arrangement" in said.reason
+
+
+def test_a_hanoi_scene_that_is_no_state_of_its_domain_ends_planning_in_one_line():
+    """A disc that slid off the pegs onto the bare table: Tower of Hanoi has no such state, so
+    planning through its PDDL domain fails with that reason instead of raising (which ended a
+    whole benchmark run)."""
+    from tamp.scene import Pose
+    from tamp.world.canonical import generate
+
+    made = generate("hanoi", 0)
+    off = moved(made.scene, "d1", Pose((0.35, 0.35, 0.012)))
+    result = plan_motion_aware(off, made.goal, tools(), domain=made.domain)
+    assert result.status is GeoStatus.FAILED and not result.moves
+    assert "no state of the PDDL domain" in result.reason and "d1" in result.reason
+    assert "\n" not in result.reason
