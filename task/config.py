@@ -67,12 +67,12 @@ class PlannerConfig:
     # (`task.symbolic.shorten`); only without beliefs and a cost source (their windows are
     # committed move by move)
     restart_probe: int = 0  # A* expansions the fallback first spends from the initial state
-    # when its plan may drop the windows' moves (`task.planner._fall_back`), before searching
-    # from where the windows left off; a plan found there is taken. 0: off (each expansion
-    # prices a state: 28-38 ms at 20 cramped blocks, where A* finds no plan in 200); the
-    # motion-aware planner of scene files sets it (`tamp.geo.ours.planner.PLANNER`)
+    # when its plan may drop the windows' moves (`task.planner.fallback.fall_back`), before
+    # searching from where the windows left off; a plan found there is taken. 0: off (each
+    # expansion prices a state, 28-38 ms at 20 cramped blocks); the motion-aware planner of
+    # scene files sets it (`tamp.geo.ours.planner.PLANNER`)
     fallback_search: str = "astar"  # "astar": A* on the domain's lower bound (shortest plans;
-    # out of budget with time left, a greedy search goes on: `task.planner._fall_back`);
+    # out of budget with time left, a greedy search goes on: `task.planner.fallback.fall_back`);
     # "greedy": lazy greedy best-first on its `estimate` (else the lower bound) and its
     # `helpful` moves (far larger problems, longer plans; `task.symbolic.lazy_search.lazy_greedy`)
     improve_s: float = 0.0  # anytime improvement: after the windows (and `shorten`) give a

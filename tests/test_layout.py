@@ -44,7 +44,7 @@ ROOM_FORBIDDEN = {
 }
 ROOMS = {
     "tamp": ("bench", "camera", "cli", "loop", "sim", "world"),
-    "task": ("data", "domains", "symbolic"),
+    "task": ("data", "domains", "planner", "symbolic"),
 }
 
 

@@ -16,7 +16,8 @@ from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE
 from task.domains import get_domain, names
 from task.errors import TampError
-from task.planner import _execute, plan
+from task.planner import plan
+from task.planner.windows import execute
 from task.problem import TABLE, Move, PlanStatus, Problem
 from task.symbolic.generate import random_problem
 from task.symbolic.lazy_search import SearchStatus, lazy_best_first
@@ -204,9 +205,9 @@ def test_a_move_back_to_a_visited_state_is_a_cycle():
     visited = {start}
     there = (Move("a", "c"),)
     back = (Move("a", TABLE),)
-    _, state, _, looped = _execute(BW, FLAT, start, there, visited)
+    _, state, _, looped = execute(BW, FLAT, start, there, visited)
     assert not looped
-    _, state, _, looped = _execute(BW, FLAT, state, back, visited)
+    _, state, _, looped = execute(BW, FLAT, state, back, visited)
     assert looped and state == start
 
 
@@ -304,18 +305,18 @@ def test_a_fallback_out_of_budget_where_the_windows_left_it_starts_over_from_ini
     """The windows put d on a; one expansion finds nothing from there, but a greedy search
     from the initial state finds a onto b: the plan starts over (``from_start``), the cost
     source forgets the windows' moves and holds only the fallback's."""
-    from task.planner import _fall_back
+    from task.planner.fallback import fall_back
 
     source = Forgetful(FLAT, lambda state, move: False)
     source.committed.append(Move("d", "a"))  # the windows' move
     wandered = BW.apply_move(FLAT, BW.initial_state(FLAT), Move("d", "a"))
     config = PlannerConfig(fallback=True, fallback_nodes=1)
-    found = _fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    found = fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
     assert found.status is SearchStatus.SOLVED and found.from_start
     assert found.moves == (Move("a", "b"),) and "from the initial state, greedy" in found.reason
     assert source.forgot == [0] and source.committed == [Move("a", "b")]
     plain = RuleOut(FLAT, lambda state, move: False)  # cannot forget: no start over
-    kept = _fall_back(BW, FLAT, wandered, plain, [0], 0, config, None)
+    kept = fall_back(BW, FLAT, wandered, plain, [0], 0, config, None)
     assert kept.status is SearchStatus.BUDGET and not kept.from_start
 
 
@@ -323,19 +324,19 @@ def test_a_restart_probe_takes_a_star_from_the_initial_state_first():
     """The windows put d on a. With ``restart_probe``, A* from the initial state looks first
     and its one-move plan is taken (the cost source forgets the windows' move); without it the
     search starts where the windows left off (d off a, then a onto b)."""
-    from task.planner import _fall_back
+    from task.planner.fallback import fall_back
 
     wandered = BW.apply_move(FLAT, BW.initial_state(FLAT), Move("d", "a"))
     source = Forgetful(FLAT, lambda state, move: False)
     source.committed.append(Move("d", "a"))  # the windows' move
     config = PlannerConfig(fallback=True, restart_probe=5)
-    found = _fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    found = fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
     assert found.status is SearchStatus.SOLVED and found.from_start
     assert found.moves == (Move("a", "b"),)
     assert "from the initial state, A* within 5 expansions" in found.reason
     assert source.forgot == [0] and source.committed == [Move("a", "b")]
     source = Forgetful(FLAT, lambda state, move: False)
-    kept = _fall_back(BW, FLAT, wandered, source, [0], 0, PlannerConfig(fallback=True), None)
+    kept = fall_back(BW, FLAT, wandered, source, [0], 0, PlannerConfig(fallback=True), None)
     assert kept.status is SearchStatus.SOLVED and not kept.from_start and len(kept.moves) == 2
     with pytest.raises(TampError, match="restart_probe must be >= 0"):
         PlannerConfig(restart_probe=-1)
@@ -345,7 +346,7 @@ def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
     """Eight blocks, one block moved off the plan's way, a node budget of one: without a
     deadline every search stops at one expansion; with one, the last search (greedy from the
     initial state) goes on until the deadline and finds a valid plan."""
-    from task.planner import _fall_back
+    from task.planner.fallback import fall_back
 
     problem = random_problem(8, 3)
     start = BW.initial_state(problem)
@@ -353,7 +354,7 @@ def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
     config = PlannerConfig(fallback=True, fallback_nodes=1)
     for deadline in (None, time.perf_counter() + 60):
         source = Forgetful(problem, lambda state, move: False)
-        found = _fall_back(BW, problem, wandered, source, [0], 0, config, deadline)
+        found = fall_back(BW, problem, wandered, source, [0], 0, config, deadline)
         if deadline is None:
             assert found.status is SearchStatus.BUDGET and not found.from_start
             continue

@@ -186,21 +186,22 @@ def test_the_windows_over_a_part_have_their_own_settings():
 
 
 def test_a_big_problem_plans_its_windows_with_the_part_settings(monkeypatch):
-    import task.planner as planner
+    import task.planner.windows as windows
+    from task.planner import plan_batch
 
     seen = []
-    window = planner._window
+    window = windows.run_window
 
     def spy(domain, problems, states, config, *args):
         seen.append((tuple(p.n for p in problems), config.horizon, config.iters))
         return window(domain, problems, states, config, *args)
 
-    monkeypatch.setattr(planner, "_window", spy)
+    monkeypatch.setattr(windows, "run_window", spy)
     small, big = random_problem(5, 2), random_problem(12, 171)
     config = PlannerConfig.for_domain(
         "blocksworld", safe_from=10, improve_s=0.0, part_window=(("horizon", 4), ("iters", 7))
     )
-    results = planner.plan_batch([small, big], replace(config, restarts=4, max_windows=30))
+    results = plan_batch([small, big], replace(config, restarts=4, max_windows=30))
     assert all(r.status is PlanStatus.SOLVED for r in results)
     settings = {(h, i) for _, h, i in seen}
     assert (4, 7) in settings and (config.horizon, config.iters) in settings
