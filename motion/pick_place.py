@@ -12,7 +12,9 @@ Cartesian line through IK knots (`motion.trajectory.polyline_segment`); the free
 fraction of their speed instead of stopping at the corners (pre-grasp, lift, pre-place). The
 arm is at rest where the gripper acts (close, open) and at both ends of the move. The gripper
 phases are standstills. An unreachable waypoint is a returned failure (``ik_infeasible``) with
-evidence, never an exception.
+evidence, never an exception; so is a vertical phase that no IK branch keeps on its line
+(evidence ``straight: False``: near the arm's base the elbow's limit can part the branches of
+the two ends, and a joint segment between them bows centimetres sideways).
 
 Two ways to say how the hand holds the object (`PickPlaceRequest`):
 
@@ -58,6 +60,7 @@ from motion.trajectory import (
 
 WAYPOINTS = ("pre_grasp", "grasp", "lift", "pre_place", "place", "retreat")
 PHASES = ("approach", "descend", "close", "lift", "transit", "lower", "open", "retreat")
+KNOT_JUMP = 0.3  # rad, the most a joint may change between IK knots of a vertical phase
 
 
 @dataclass(frozen=True)
@@ -80,6 +83,7 @@ class PickPlaceConfig:
     max_joint_jump: float = 0.5  # rad, per-joint change between waypoints that triggers a re-solve
     vertical_step: float = 0.02  # m, IK knot spacing on the vertical moves (straight in space)
     min_approach: float = 0.02  # m, least descent onto a block under a ceiling (no_clearance)
+    straight_tolerance: float = 0.005  # m, how far a vertical phase's TCP may stray off its line
 
 
 @dataclass(frozen=True)
@@ -112,8 +116,9 @@ class Phase:
 
 @dataclass(frozen=True)
 class MotionResult:
-    """Phases in execution order (empty unless ``ok``); ``failure`` is "ik_infeasible",
-    "no_clearance" (a ceiling leaves the hand no room to come down) or None."""
+    """Phases in execution order (empty unless ``ok``); ``failure`` is "ik_infeasible" (a
+    waypoint, or the straight line into it, out of the arm's reach), "no_clearance" (a ceiling
+    leaves the hand no room to come down) or None."""
 
     ok: bool
     phases: tuple[Phase, ...]
@@ -269,25 +274,99 @@ def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, m
     return ok, q, pos_err, rot_err, resolved
 
 
-def _vertical_path(
-    solver: IKSolver, pose_a: np.ndarray, pose_b: np.ndarray, q_a, q_b, step: float
-) -> np.ndarray:
-    """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
-    one IK point every ``step`` m, so the tool moves straight instead of drifting sideways. The
-    last knot solves pose_b on the same IK branch (it may differ from ``q_b``). Falls back to
-    the plain joint segment q_a -> q_b when a knot fails or the knots jump."""
-    ends = np.stack([q_a, q_b])  # (2, J)
+class _NotStraight(Exception):
+    """No IK path keeps the TCP on the straight line into ``waypoint`` (`_vertical_path`)."""
+
+    def __init__(self, waypoint: str):
+        super().__init__(waypoint)
+        self.waypoint = waypoint
+
+
+def _line_knots(pose_a: np.ndarray, pose_b: np.ndarray, step: float) -> np.ndarray:
+    """(n, 4, 4): poses every ``step`` m along the straight line pose_a -> pose_b with pose_a's
+    rotation, pose_b's position last (pose_a not included); empty when the line is shorter
+    than two steps."""
     n = math.ceil(float(np.linalg.norm(pose_b[:3, 3] - pose_a[:3, 3])) / step)
     if n < 2:
-        return ends
-    knots = np.repeat(pose_a[None], n, axis=0)  # (n, 4, 4), the end pose included
+        return np.zeros((0, 4, 4))
+    knots = np.repeat(pose_a[None], n, axis=0)  # (n, 4, 4)
     frac = np.arange(1, n + 1)[:, None] / n  # (n, 1)
     knots[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
-    found = solver.follow(knots, q_a)  # Gauss-Newton from q_a: one continuous IK branch
-    path = np.vstack([q_a, found.q])  # (n+1, J); it may end at another solution for pose_b
-    if not found.ok.all() or np.abs(np.diff(path, axis=0)).max() > 0.3:
+    return knots
+
+
+def _walk(solver: IKSolver, knots: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+    """Joint knots (n+1, J) from ``q0`` through ``knots`` (n, 4, 4) on one IK branch, each
+    knot continued from the one before: the knots left are solved at once from the last one
+    found, and the run of them that converges without a joint jumping more than
+    ``KNOT_JUMP`` rad is kept (the first alone with more iterations where none does); None
+    where a knot cannot be continued."""
+    path = [np.asarray(q0, dtype=np.float64)]
+    while len(path) <= len(knots):
+        rest = knots[len(path) - 1 :]
+        found = solver.follow(rest, path[-1])
+        chain = np.vstack([path[-1], found.q])  # (m+1, J)
+        fine = found.ok & (np.abs(np.diff(chain, axis=0)).max(1) <= KNOT_JUMP)  # (m,)
+        run = len(fine) if fine.all() else int(np.argmin(fine))
+        if run == 0:
+            found = solver.follow(rest[:1], path[-1], iterations=30)
+            if not found.ok[0] or np.abs(found.q[0] - path[-1]).max() > KNOT_JUMP:
+                return None
+            run, chain = 1, np.vstack([path[-1], found.q])
+        path.extend(chain[1 : run + 1])
+    return np.stack(path)
+
+
+def _smooth(path: np.ndarray) -> bool:
+    """No joint of ``path`` (K, J) changes by more than ``KNOT_JUMP`` between knots."""
+    return bool(np.abs(np.diff(path, axis=0)).max() <= KNOT_JUMP)
+
+
+def bow(solver: IKSolver, path: np.ndarray, samples: int = 30) -> float:
+    """How far (m) the TCP strays from the straight line between its two ends along the
+    piecewise linear joint ``path`` (K, J), sampled ``samples`` times per segment."""
+    frac = np.linspace(0.0, 1.0, samples)[:, None, None]  # (S, 1, 1)
+    dense = (path[:-1][None] + frac * np.diff(path, axis=0)[None]).reshape(-1, path.shape[1])
+    p = solver.tcp_positions(dense)  # (S * (K - 1), 3)
+    a, line = p[0], p[-1] - p[0]
+    t = np.clip((p - a) @ line / max(float(line @ line), 1e-12), 0.0, 1.0)  # (S',)
+    return float(np.linalg.norm(p - (a + t[:, None] * line), axis=1).max())
+
+
+def _vertical_path(
+    solver: IKSolver,
+    pose_a: np.ndarray,
+    pose_b: np.ndarray,
+    q_a,
+    q_b,
+    config: PickPlaceConfig,
+    free_start: bool = False,
+) -> np.ndarray | None:
+    """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
+    one IK point every ``config.vertical_step`` m, so the tool moves straight instead of
+    drifting sideways. The knots follow one IK branch from ``q_a``: all solved at once from
+    ``q_a`` (cheap on short lines), else each from the one before; the last solves pose_b on
+    that branch (it may differ from ``q_b``). With ``free_start`` (nothing before pose_a is
+    planned yet) the branch may also be followed up from ``q_b``, and the path then starts at
+    another solution of pose_a. Failing those, the plain joint segment q_a -> q_b if its TCP
+    strays at most ``config.straight_tolerance`` from the line, else None: near the arm's base
+    one branch may not reach both ends (the elbow at its limit), and a joint segment there bows
+    centimetres off the vertical, into whatever stands beside the pick or the place."""
+    ends = np.stack([q_a, q_b])  # (2, J)
+    knots = _line_knots(pose_a, pose_b, config.vertical_step)  # (n, 4, 4)
+    if not len(knots):
         return ends
-    return path
+    found = solver.follow(knots, q_a)  # every knot from q_a: one continuous IK branch
+    path = np.vstack([q_a, found.q])  # (n+1, J)
+    if found.ok.all() and _smooth(path):
+        return path
+    path = _walk(solver, knots, q_a)
+    if path is None and free_start:
+        up = _walk(solver, _line_knots(pose_b, pose_a, config.vertical_step), q_b)
+        path = None if up is None else up[::-1]
+    if path is not None:
+        return path
+    return ends if bow(solver, ends) <= config.straight_tolerance else None
 
 
 def _dip(solver: IKSolver, positions: np.ndarray) -> float:
@@ -333,15 +412,20 @@ def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> t
     (4, 4)). The vertical paths come first, so the free-space phases can pass into them."""
     spec, dt = solver.spec, config.dt
     paths = {}
-    for src, dst in (("pre_grasp", "grasp"), ("grasp", "lift"), ("pre_place", "place")):
-        paths[dst] = _vertical_path(
-            solver, pose[src], pose[dst], w[src], w[dst], config.vertical_step
-        )
-        w[dst] = paths[dst][-1]  # later phases start where this one ends
-    paths["retreat"] = _vertical_path(
-        solver, pose["place"], pose["retreat"], w["place"], w["retreat"], config.vertical_step
+    # (start, end, whether the start is free): descend and lower start where a free-space
+    # phase, planned after them, will end; lift and retreat start where the hand stands
+    lines = (
+        ("pre_grasp", "grasp", True),
+        ("grasp", "lift", False),
+        ("pre_place", "place", True),
+        ("place", "retreat", False),
     )
-    w["retreat"] = paths["retreat"][-1]
+    for src, dst, free_start in lines:
+        path = _vertical_path(solver, pose[src], pose[dst], w[src], w[dst], config, free_start)
+        if path is None:
+            raise _NotStraight(dst)
+        paths[dst] = path
+        w[src], w[dst] = path[0], path[-1]  # the phases before and after meet this one
     share = config.pass_share if config.blend else 0.0
     # arclength speeds where descend starts, lift ends and lower starts
     down = pass_speed(paths["grasp"], share, spec, config.approach)
@@ -447,7 +531,18 @@ def plan_pick_place(
 
     w = {"now": q_now, **dict(zip(WAYPOINTS, q, strict=True))}  # name -> (J,)
     start = time.perf_counter()
-    phases = _phases(solver, w, dict(zip(WAYPOINTS, targets, strict=True)), config)
+    try:
+        phases = _phases(solver, w, dict(zip(WAYPOINTS, targets, strict=True)), config)
+    except _NotStraight as bent:
+        k = WAYPOINTS.index(bent.waypoint)
+        evidence = {
+            "waypoint": bent.waypoint,
+            "target_xyz": tuple(float(v) for v in targets[k, :3, 3]),
+            "straight": False,
+            "unreachable": (bent.waypoint,),
+        }
+        ik_time += time.perf_counter() - start
+        return MotionResult(False, (), "ik_infeasible", evidence, ik_time, grasp)
     ik_time += time.perf_counter() - start
     final = np.stack([w[n] for n in WAYPOINTS])  # (6, J), after the vertical re-solves
     steps = np.abs(np.diff(np.vstack([q_now[None], final]), axis=0)).max(1)  # (6,) rad
@@ -495,9 +590,13 @@ def corrected_place(
     here = solver.fk(q_now)[0]
     pre, place, up = poses
     q_pre, q_place, q_up = ends.q
-    paths = [_vertical_path(solver, here, pre, q_now, q_pre, config.vertical_step)]
-    paths.append(_vertical_path(solver, pre, place, paths[0][-1], q_place, config.vertical_step))
-    paths.append(_vertical_path(solver, place, up, paths[1][-1], q_up, config.vertical_step))
+    paths = [_vertical_path(solver, here, pre, q_now, q_pre, config)]
+    for a, b, q_b in ((pre, place, q_place), (place, up, q_up)):
+        if paths[-1] is None:
+            return None
+        paths.append(_vertical_path(solver, a, b, paths[-1][-1], q_b, config))
+    if paths[-1] is None:
+        return None
     spec, dt, limits = solver.spec, config.dt, config.approach
     shift_path, lower_path, retreat_path = paths  # each (K >= 2, J): `_vertical_path`
     return (

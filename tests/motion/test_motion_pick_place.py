@@ -202,6 +202,34 @@ def test_vertical_moves_follow_the_cartesian_line(solver, planned, name):
     assert drift.max() < 0.003, (name, drift.max())
 
 
+def _drift(solver, result, name: str) -> float:
+    """How far (m) the TCP of phase ``name`` strays sideways from the phase's end point."""
+    path = next(p for p in result.phases if p.name == name).trajectory
+    xyz = solver.fk(path.positions[::5])[:, :3, 3]  # (S', 3)
+    return float(np.linalg.norm(xyz[:, :2] - xyz[-1, :2], axis=1).max())
+
+
+def test_vertical_moves_near_the_arms_base_stay_on_their_lines(solver):
+    """Near the base, from a high hover, the descend's IK branch from the pre-grasp solution
+    runs into the elbow's limit before the grasp; the path is followed up from the grasp
+    instead (the pre-grasp solution changes). A plain joint segment bowed 2 cm and more."""
+    req = PickPlaceRequest((0.234, -0.188, HALF), 0.0, (0.5, 0.2, HALF), 0.0, 0.30)
+    result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    assert result.ok, result.evidence
+    for name in ("descend", "lift", "lower", "retreat"):
+        assert _drift(solver, result, name) < 0.003, name
+
+
+def test_a_vertical_line_no_ik_branch_follows_is_a_returned_failure(solver):
+    """Closer to the base no branch reaches both ends of the descend: the move fails as
+    unreachable at the grasp, saying the line was not straight, instead of bowing."""
+    req = PickPlaceRequest((0.192, -0.203, HALF), 0.0, (0.5, 0.2, HALF), 0.0, 0.15)
+    result = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    assert not result.ok and result.failure == "ik_infeasible"
+    assert result.evidence["waypoint"] == "grasp" and result.evidence["straight"] is False
+    assert result.phases == ()
+
+
 def test_polyline_segment_respects_limits_and_passes_every_knot():
     from motion.trajectory import SpeedLimits, polyline_segment
     from robots.panda import PANDA
