@@ -14,7 +14,9 @@ the failure memory's keys (`tamp.geo.search`), so a place is a stable choice, no
 - In a region ``r`` (``"r.p<x>_<y>"``, ``"r.g<i>"``, ``"r.s<j>"``): first the packing
   places, flush against the inner rectangle's edges (`PACK_MARGIN` in) and against the objects
   already in the region (`PACK_GAP` beside them), every combination of those x and y in
-  order of x then y (columns filled from the low corner), named by their position in mm; then
+  order of x then y (columns filled from the low corner), named by their position in mm;
+  along an axis where the object leaves less play than the scene's narrowest object is wide
+  (a Hanoi peg under its largest disc), centred instead; then
   the grid over the inner rectangle at pitch object width + `REGION_GAP`, centred in the
   rectangle, nearest the region's centre first; then ``samples`` seeded uniform positions
   (nearest the centre first). Every one has the object's footprint inside the inner rectangle
@@ -188,6 +190,7 @@ def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> 
         and r.lo[0] <= x.pose.xyz[0] <= r.hi[0]
         and r.lo[1] <= x.pose.xyz[1] <= r.hi[1]
     ]
+    narrowest = min(2 * min(x.half[:2]) for x in scene.objects)  # m, the least footprint side
     for suffix, yaw in _yaws(o, 0.0):
         hx, hy = _extent(o, yaw)
         lo, hi = (
@@ -201,6 +204,13 @@ def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> 
             ex, ey = _extent_of(s)
             xs |= {s.centre[0] + ex + PACK_GAP + hx, s.centre[0] - ex - PACK_GAP - hx}
             ys |= {s.centre[1] + ey + PACK_GAP + hy, s.centre[1] - ey - PACK_GAP - hy}
+        # along an axis with less play than any object is wide, packing against an edge
+        # leaves a gap nothing can use: the place is centred there, as far from both edges as
+        # it can be (a placed object settles millimetres from where it was released)
+        if hi[0] - lo[0] < narrowest + PACK_GAP:
+            xs = {(lo[0] + hi[0]) / 2}
+        if hi[1] - lo[1] < narrowest + PACK_GAP:
+            ys = {(lo[1] + hi[1]) / 2}
         for x, y in sorted((x, y) for x in xs for y in ys):
             if lo[0] - 1e-9 <= x <= hi[0] + 1e-9 and lo[1] - 1e-9 <= y <= hi[1] + 1e-9:
                 name = f"{r.name}.p{round(x * 1000)}_{round(y * 1000)}{suffix}"

@@ -58,6 +58,19 @@ def test_region_places_pack_against_walls_and_objects_then_grid_then_samples():
     assert [far(p) for p in grid] == sorted(far(p) for p in grid)
 
 
+def test_a_region_that_holds_one_object_places_it_centred_on_the_tight_axis():
+    """A Hanoi peg under its largest disc: 4.5 mm of play a side, less than any object is
+    wide. Packed flush (2 mm in), a disc released 4 mm off read as standing outside the peg
+    (variant 17 of ``hanoi``); centred, it keeps the play on both sides. Along the roomy axis
+    the places still pack against the edges (a wide tray's: the test above)."""
+    peg = {"name": "peg", "min": [0.44, 0.10], "max": [0.515, 0.30]}  # 75 mm x 200 mm
+    d, small = cube("d", 0.3, -0.1, 0.033, size=0.066), cube("small", 0.3, 0.1, 0.02, size=0.04)
+    s = scene(d, small, regions=[peg])
+    packed = [p for p in candidate_places(s, "d", "peg", n=20) if ".p" in p.name]
+    assert packed and {round(p.xyz[0], 4) for p in packed} == {0.4775}
+    assert {round(p.xyz[1], 4) for p in packed} == {0.135, 0.265}  # flush, 2 mm in
+
+
 def test_without_parking_the_table_is_no_place_and_regions_are_the_fixed_targets():
     from dataclasses import replace
 
