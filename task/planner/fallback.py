@@ -87,7 +87,10 @@ def fall_back(
     and ``state`` is not the initial state, a greedy search from the initial state may find a
     plan that drops the windows' moves (``from_start``; only without a cost source or with
     one that can ``forget`` the moves committed to it); the last search there is, it runs
-    until the ``deadline`` when there is one, not for ``fallback_nodes``. Before all that,
+    until the ``deadline`` when there is one, not for ``fallback_nodes``; with a deadline,
+    each search before it stops at an equal share of the time left to those still to come
+    (A* at a third where both others may follow), so that under load A* alone does not spend
+    the deadline where a start over would have found a plan. Before all that,
     where such a start over is possible, A* may look from the initial state for
     ``config.restart_probe`` expansions, and its plan is taken when it finds one: windows
     that packed a region in a bad order left a state from which A* spent the whole deadline
@@ -125,11 +128,24 @@ def fall_back(
                 windows,
                 costs,
             )
-    found = search(domain, problem, state, feasible, config.fallback_nodes, deadline)
+    restart = state != start and can_forget  # a last search from the initial state may run
+    stages = 1 + (search is lazy_best_first) + restart  # searches that may still run, this one too
+
+    def share(stages: int) -> float | None:
+        """The deadline of a search with ``stages`` searches (itself included) still to run:
+        an equal share of the time left, so that under load a slow first search does not
+        leave the later ones, from elsewhere, no time at all."""
+        if deadline is None or stages <= 1:
+            return deadline
+        now = time.perf_counter()
+        return now + max(0.0, deadline - now) / stages
+
+    found = search(domain, problem, state, feasible, config.fallback_nodes, share(stages))
     if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late():
-        greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, deadline)
+        stages -= 1
+        greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, share(stages))
         found = _after(found, greedy, f"A* {found.reason}; then greedy: {greedy.reason}")
-    if found.status is SearchStatus.BUDGET and state != start and can_forget and not late():
+    if found.status is SearchStatus.BUDGET and restart and not late():
         last = config.fallback_nodes if deadline is None else sys.maxsize  # the time left
         again = lazy_greedy(domain, problem, start, feasible, last, deadline)
         if again.status is SearchStatus.SOLVED:

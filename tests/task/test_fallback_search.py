@@ -362,6 +362,45 @@ def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
         assert_valid(problem, found.moves)
 
 
+def test_with_a_deadline_each_search_gets_an_equal_share_of_the_time_left(monkeypatch):
+    """A*, then greedy from where the windows left off, then greedy from the initial state:
+    with 60 s left, A* may take a third, the greedy search after it half of what is left, the
+    start over the rest. Before, under load A* spent the whole deadline from a state the
+    start over then had no time to leave (tall variant 18: no plan in 120 s)."""
+    import task.planner.fallback as fb
+
+    problem = random_problem(8, 3)
+    start = BW.initial_state(problem)
+    wandered = BW.apply_move(problem, start, BW.legal_moves(problem, start)[0])
+    given = []
+
+    def spy(search, name):
+        def run(domain, problem, state, feasible, nodes, deadline):
+            given.append((name, state == start, deadline - time.perf_counter()))
+            # the first two stand for searches that run out of their budget at once
+            return search(
+                domain, problem, state, feasible, 1 if len(given) < 3 else nodes, deadline
+            )
+
+        return run
+
+    monkeypatch.setattr(fb, "lazy_best_first", spy(fb.lazy_best_first, "A*"))
+    monkeypatch.setattr(fb, "lazy_greedy", spy(fb.lazy_greedy, "greedy"))
+    source = Forgetful(problem, lambda state, move: False)
+    config = PlannerConfig(fallback=True, fallback_nodes=50)
+    found = fb.fall_back(BW, problem, wandered, source, [0], 0, config, time.perf_counter() + 60)
+    assert [(name, at_start) for name, at_start, _ in given] == [
+        ("A*", False),
+        ("greedy", False),
+        ("greedy", True),
+    ]
+    left = [t for _, _, t in given]
+    assert left[0] == pytest.approx(20, abs=0.5) and left[1] == pytest.approx(30, abs=0.5)
+    assert left[2] == pytest.approx(60, abs=0.5)
+    assert found.status is SearchStatus.SOLVED and found.from_start
+    assert_valid(problem, found.moves)
+
+
 def test_a_run_of_one_blocks_moves_is_merged_where_the_merged_move_is_allowed():
     """a to the table then onto c is one move, a onto c, unless that move is ruled out where
     the run began; a run that comes back where it began is cut; other moves stay as they
