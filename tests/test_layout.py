@@ -43,6 +43,7 @@ ROOM_FORBIDDEN = {
     "task/domains": OPTIMISER,
 }
 ROOMS = {
+    "motion": ("pick_place",),
     "tamp": ("bench", "camera", "cli", "loop", "sim", "world"),
     "task": ("data", "domains", "planner", "symbolic"),
 }

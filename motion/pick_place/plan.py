@@ -46,6 +46,7 @@ import numpy as np
 from motion.errors import MotionError
 from motion.grasps import Grasp, back_out, grasps, world_tcp
 from motion.ik import IKSolver, grasp_yaw, pose_yaw, top_down_pose
+from motion.pick_place.lines import vertical_path
 from motion.trajectory import (
     APPROACH,
     TRANSIT,
@@ -60,7 +61,6 @@ from motion.trajectory import (
 
 WAYPOINTS = ("pre_grasp", "grasp", "lift", "pre_place", "place", "retreat")
 PHASES = ("approach", "descend", "close", "lift", "transit", "lower", "open", "retreat")
-KNOT_JUMP = 0.3  # rad, the most a joint may change between IK knots of a vertical phase
 
 
 @dataclass(frozen=True)
@@ -275,98 +275,11 @@ def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, m
 
 
 class _NotStraight(Exception):
-    """No IK path keeps the TCP on the straight line into ``waypoint`` (`_vertical_path`)."""
+    """No IK path keeps the TCP on the straight line into ``waypoint`` (`vertical_path`)."""
 
     def __init__(self, waypoint: str):
         super().__init__(waypoint)
         self.waypoint = waypoint
-
-
-def _line_knots(pose_a: np.ndarray, pose_b: np.ndarray, step: float) -> np.ndarray:
-    """(n, 4, 4): poses every ``step`` m along the straight line pose_a -> pose_b with pose_a's
-    rotation, pose_b's position last (pose_a not included); empty when the line is shorter
-    than two steps."""
-    n = math.ceil(float(np.linalg.norm(pose_b[:3, 3] - pose_a[:3, 3])) / step)
-    if n < 2:
-        return np.zeros((0, 4, 4))
-    knots = np.repeat(pose_a[None], n, axis=0)  # (n, 4, 4)
-    frac = np.arange(1, n + 1)[:, None] / n  # (n, 1)
-    knots[:, :3, 3] = pose_a[:3, 3] + frac * (pose_b[:3, 3] - pose_a[:3, 3])
-    return knots
-
-
-def _walk(solver: IKSolver, knots: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
-    """Joint knots (n+1, J) from ``q0`` through ``knots`` (n, 4, 4) on one IK branch, each
-    knot continued from the one before: the knots left are solved at once from the last one
-    found, and the run of them that converges without a joint jumping more than
-    ``KNOT_JUMP`` rad is kept (the first alone with more iterations where none does); None
-    where a knot cannot be continued."""
-    path = [np.asarray(q0, dtype=np.float64)]
-    while len(path) <= len(knots):
-        rest = knots[len(path) - 1 :]
-        found = solver.follow(rest, path[-1])
-        chain = np.vstack([path[-1], found.q])  # (m+1, J)
-        fine = found.ok & (np.abs(np.diff(chain, axis=0)).max(1) <= KNOT_JUMP)  # (m,)
-        run = len(fine) if fine.all() else int(np.argmin(fine))
-        if run == 0:
-            found = solver.follow(rest[:1], path[-1], iterations=30)
-            if not found.ok[0] or np.abs(found.q[0] - path[-1]).max() > KNOT_JUMP:
-                return None
-            run, chain = 1, np.vstack([path[-1], found.q])
-        path.extend(chain[1 : run + 1])
-    return np.stack(path)
-
-
-def _smooth(path: np.ndarray) -> bool:
-    """No joint of ``path`` (K, J) changes by more than ``KNOT_JUMP`` between knots."""
-    return bool(np.abs(np.diff(path, axis=0)).max() <= KNOT_JUMP)
-
-
-def bow(solver: IKSolver, path: np.ndarray, samples: int = 30) -> float:
-    """How far (m) the TCP strays from the straight line between its two ends along the
-    piecewise linear joint ``path`` (K, J), sampled ``samples`` times per segment."""
-    frac = np.linspace(0.0, 1.0, samples)[:, None, None]  # (S, 1, 1)
-    dense = (path[:-1][None] + frac * np.diff(path, axis=0)[None]).reshape(-1, path.shape[1])
-    p = solver.tcp_positions(dense)  # (S * (K - 1), 3)
-    a, line = p[0], p[-1] - p[0]
-    t = np.clip((p - a) @ line / max(float(line @ line), 1e-12), 0.0, 1.0)  # (S',)
-    return float(np.linalg.norm(p - (a + t[:, None] * line), axis=1).max())
-
-
-def _vertical_path(
-    solver: IKSolver,
-    pose_a: np.ndarray,
-    pose_b: np.ndarray,
-    q_a,
-    q_b,
-    config: PickPlaceConfig,
-    free_start: bool = False,
-) -> np.ndarray | None:
-    """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
-    one IK point every ``config.vertical_step`` m, so the tool moves straight instead of
-    drifting sideways. The knots follow one IK branch from ``q_a``: all solved at once from
-    ``q_a`` (cheap on short lines), else each from the one before; the last solves pose_b on
-    that branch (it may differ from ``q_b``). With ``free_start`` (nothing before pose_a is
-    planned yet) the branch may also be followed up from ``q_b``, and the path then starts at
-    another solution of pose_a. Failing those, the plain joint segment q_a -> q_b if its TCP
-    strays at most ``config.straight_tolerance`` from the line, else None: near the arm's base
-    one branch may not reach both ends (the elbow at its limit), and a joint segment there bows
-    centimetres off the vertical, into whatever stands beside the pick or the place."""
-    ends = np.stack([q_a, q_b])  # (2, J)
-    knots = _line_knots(pose_a, pose_b, config.vertical_step)  # (n, 4, 4)
-    if not len(knots):
-        return ends
-    found = solver.follow(knots, q_a)  # every knot from q_a: one continuous IK branch
-    path = np.vstack([q_a, found.q])  # (n+1, J)
-    if found.ok.all() and _smooth(path):
-        return path
-    path = _walk(solver, knots, q_a)
-    if path is None and free_start:
-        up = _walk(solver, _line_knots(pose_b, pose_a, config.vertical_step), q_b)
-        path = None if up is None else up[::-1]
-    if path is not None:
-        return path
-    return ends if bow(solver, ends) <= config.straight_tolerance else None
 
 
 def _dip(solver: IKSolver, positions: np.ndarray) -> float:
@@ -421,7 +334,16 @@ def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> t
         ("place", "retreat", False),
     )
     for src, dst, free_start in lines:
-        path = _vertical_path(solver, pose[src], pose[dst], w[src], w[dst], config, free_start)
+        path = vertical_path(
+            solver,
+            pose[src],
+            pose[dst],
+            w[src],
+            w[dst],
+            config.vertical_step,
+            config.straight_tolerance,
+            free_start,
+        )
         if path is None:
             raise _NotStraight(dst)
         paths[dst] = path
@@ -557,74 +479,3 @@ def plan_pick_place(
     if grasp is not None:
         evidence["grasp"] = grasp.name
     return MotionResult(True, phases, None, evidence, ik_time, grasp)
-
-
-def corrected_place(
-    solver: IKSolver,
-    q_now,
-    phases: tuple[Phase, ...],
-    shift,
-    config: PickPlaceConfig = PickPlaceConfig(),
-) -> tuple[Phase, ...] | None:
-    """The place side of a pick-and-place corrected for where the held object sits in the
-    hand: the arm is at ``q_now`` (J,), held still near the end of ``phases``' transit, and
-    the object sits ``-shift`` (3,) (m, base frame, z ignored) away in the hand from where the
-    plan has it, so the plan's lower, place and retreat TCP poses move by ``shift``. Returns
-    the phases that replace the plan's ``lower``, ``open`` and ``retreat``: ``shift`` (a
-    straight Cartesian move of the TCP from where it stands to the moved start of the lower,
-    at the near-contact speed), ``lower`` and ``retreat`` along the planned lines moved by
-    ``shift``, and ``open``; None when an IK point on them fails (run the plan as it is then)."""
-    by_name = {p.name: p for p in phases}
-    if not {"lower", "retreat"} <= set(by_name):
-        raise MotionError("corrected_place needs the plan's lower and retreat phases")
-    q_now = np.asarray(q_now, dtype=np.float64)
-    move = np.zeros(3)
-    move[:2] = np.asarray(shift, dtype=np.float64)[:2]
-    lower = by_name["lower"].trajectory.positions
-    up_q = by_name["retreat"].trajectory.positions[-1]
-    poses = solver.fk(np.stack([lower[0], lower[-1], up_q]))  # (3, 4, 4)
-    poses[:, :3, 3] += move
-    ends = solver.follow(poses, q_now, solver.config.max_iterations)  # seeded at the hand now
-    if not ends.ok.all():
-        return None
-    here = solver.fk(q_now)[0]
-    pre, place, up = poses
-    q_pre, q_place, q_up = ends.q
-    paths = [_vertical_path(solver, here, pre, q_now, q_pre, config)]
-    for a, b, q_b in ((pre, place, q_place), (place, up, q_up)):
-        if paths[-1] is None:
-            return None
-        paths.append(_vertical_path(solver, a, b, paths[-1][-1], q_b, config))
-    if paths[-1] is None:
-        return None
-    spec, dt, limits = solver.spec, config.dt, config.approach
-    shift_path, lower_path, retreat_path = paths  # each (K >= 2, J): `_vertical_path`
-    return (
-        Phase("shift", polyline_segment(shift_path, dt, spec, limits), "closed", limits),
-        Phase("lower", polyline_segment(lower_path, dt, spec, limits), "closed", limits),
-        Phase("open", JointTrajectory.hold(lower_path[-1], config.open_time, dt), "open"),
-        Phase("retreat", polyline_segment(retreat_path, dt, spec, limits), "open", limits),
-    )
-
-
-def split_lower(
-    solver: IKSolver, lower: Phase, above: float, config: PickPlaceConfig = PickPlaceConfig()
-) -> tuple[Phase, Phase] | None:
-    """``lower`` (a vertical phase ending at the place) cut where the TCP stands ``above`` m
-    over its end: two ``lower`` phases along the same joint path, each rest to rest (the hand
-    stops there, e.g. to look at what it holds once more); None when the phase does not come
-    down from higher than that."""
-    from motion.guard import thin  # the guard imports this module
-
-    knots = thin(lower.trajectory.positions, 0.002)  # (K, J)
-    z = solver.fk(knots)[:, 2, 3]  # (K,)
-    cut = int(np.argmax(z <= z[-1] + above))  # the first knot that low
-    if z[0] <= z[-1] + above or not 0 < cut < len(knots) - 1:
-        return None
-    dt = float(lower.trajectory.times[1] - lower.trajectory.times[0])
-    limits = lower.limits or config.approach
-    upper, rest = knots[: cut + 1], knots[cut:]
-    return (
-        Phase(lower.name, polyline_segment(upper, dt, solver.spec, limits), lower.gripper, limits),
-        Phase(lower.name, polyline_segment(rest, dt, solver.spec, limits), lower.gripper, limits),
-    )
