@@ -13,6 +13,7 @@ through the generic lift and its declared binding instead.
 - `tamp.geo.ours.bridge`: scene + goal -> Blocksworld on places, and planned moves back;
 - `tamp.geo.ours.costs`: `GeoCosts`, the arm's price of every move, with failure memory;
 - `tamp.geo.ours.cells`: the empty cells as variables of the planner's Adam, per restart row;
+- `tamp.geo.ours.placing`: the opening moves into position, taken without a window;
 - `tamp.geo.ours.planner`: `plan_motion_aware`, `plan_pddl`, `OursConfig`, and the ablation
   `plan_motion_aware_sampled` (cells placed by rejection sampling).
 """

@@ -488,6 +488,11 @@ class GeoCosts:
                     out[i, j] = min(out[i, j] + self.config.order * closed, IMPOSSIBLE - 1.0)
         return out, allowed
 
+    def closes(self, state: State) -> dict[str, int]:
+        """Goal cell -> how many other empty cells of its region filling it closes in crisp
+        ``state`` (`_closes`); empty without goal regions."""
+        return self._closes(state) if self._shapes else {}
+
     def _closes(self, state: State) -> dict[str, int]:
         """Goal cell -> how many other cells of its region, empty in ``state``, filling it
         closes: their hand room reaches its body where the cells are now (`hand_reaches`)."""

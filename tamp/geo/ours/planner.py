@@ -5,12 +5,17 @@
 1. bridge the scene and goal to a Blocksworld problem on capacity-one places
    (`tamp.geo.ours.bridge`: the goal regions' cells placed jointly by gradient,
    `tamp.geo.ours.pack`);
-2. plan it with `task.planner.plan` and the arm's prices in the objective (`GeoCosts`): the
-   receding windows (the empty cells' places optimised with each restart row's logits and
-   fixed by the committed row, `tamp.geo.ours.cells`), then, when they revisit a state or
-   run out, the planner's complete lazy fallback (`task.symbolic.lazy_search`) over the moves
-   the prices allow, A* from the initial state first (`RESTART_PROBE` expansions); an
-   object moved twice in a row in the plan is moved once (`merge_runs`);
+2. take the moves that put a goal object onto the target its goal names where the prices
+   leave them open, each bound by the full check as in step 3 (`tamp.geo.ours.placing`: a
+   tower built bottom up, objects sorted into their cells), only before the first window
+   (after one, they would put back what the window moved out of the way);
+   then plan the rest with `task.planner.plan` and the arm's prices in the objective
+   (`GeoCosts`): the receding windows (the empty cells' places optimised with each restart
+   row's logits and fixed by the committed row, `tamp.geo.ours.cells`), then, when they
+   revisit a state or run out, the planner's complete lazy fallback
+   (`task.symbolic.lazy_search`) over the moves the prices allow, A* from the initial state
+   first (`RESTART_PROBE` expansions); an object moved twice in a row in the plan is moved
+   once (`merge_runs`);
 3. map the plan back to `GeoMove`s in the predicted worlds and bind each to a grasp with the
    full check (`tamp.geo.check.check_move`, the grasps `GeoCosts` found free first). A move
    no grasp passes is fed back as failure memory (`GeoCosts.avoid`: that move, in that state,
@@ -52,13 +57,14 @@ from dataclasses import dataclass, field, replace
 from tamp.geo.ours.bridge import PACK, Bridged, bridge
 from tamp.geo.ours.costs import GeoCostConfig, GeoCosts
 from tamp.geo.ours.pack import PackConfig
+from tamp.geo.ours.placing import next_placing
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE
-from task.domains.blocksworld import DOMAIN, apply_move
+from task.domains.blocksworld import DOMAIN, apply_move, is_goal
 from task.domains.blocksworld import check_move as legal
 from task.errors import TampError
 from task.planner import plan
@@ -122,6 +128,10 @@ class OursConfig:
     # how the goal regions' cells are placed (`tamp.geo.ours.bridge.SAMPLERS`): by gradient,
     # or by rejection sampling at the same budget (the ablation ``motion-aware-sampled``)
     sampler: str = "gradient"
+    # before the first window, the moves that put a goal object onto the target its goal names,
+    # taken without a window where the prices leave them open (`tamp.geo.ours.placing`); False:
+    # every move planned by the windows and the fallback
+    placing: bool = True
 
 
 def _check():
@@ -265,6 +275,15 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
                 return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
             limit = planner.time_limit_s
             planner = replace(planner, time_limit_s=left if limit is None else min(limit, left))
+        if config.placing and not plans:  # the opening moves into position (`placing`)
+            state, world, more, failed = _take_placing(bridged, state, world, tools, costs, check)
+            bound += more
+            stats["placing_moves"] = stats.get("placing_moves", 0) + len(more)
+            if failed is not None:
+                failures.append(failed)
+                continue
+            if is_goal(bridged.problem, state):
+                return _done(GeoStatus.SOLVED, tuple(bound), "", stats, t0, plans, failures)
         plans += 1
         now = replace(bridged.problem, init=state)
         result = plan(now, planner, seed=config.seed + plans - 1, costs=costs)
@@ -298,6 +317,19 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     why = f"{len(failures)} planned moves failed the full check; the replan budget is spent"
     stats["bound"] = tuple(bound)
     return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
+
+
+def _take_placing(bridged: Bridged, state, world, tools, costs: GeoCosts, check):
+    """The placing moves (`tamp.geo.ours.placing.next_placing`) from crisp ``state`` and
+    ``world``, each bound by the full check as it is taken (`_bind`), until none is open or
+    one fails; returns as `_bind` does."""
+    bound: list[GeoMove] = []
+    while (move := next_placing(bridged.problem, state, costs)) is not None:
+        state, world, more, failed = _bind(bridged, state, world, (move,), tools, costs, check)
+        bound += more
+        if failed is not None:
+            return state, world, tuple(bound), failed
+    return state, world, tuple(bound), None
 
 
 def _allowed(costs: GeoCosts) -> Callable:
