@@ -12,10 +12,7 @@ onto the very target its goal names (its goal cell, or its goal object in positi
 filling first the cells whose filling closes no other empty cell of their region (the packer's
 placing order, `GeoCosts.closes`), then the cheapest. Where a place it fills is wanted later as
 a parking spot or the hand's room, the windows and the fallback still plan from the state it
-reached (every move stays reversible); where they find no plan from there within half the time
-left (a tower built up to where the arm's reach runs out, which the plan had to build
-otherwise), the planner starts over from the initial state without placing moves
-(`tamp.geo.ours.planner`).
+reached (at worst a longer plan, never a lost one: every move stays reversible).
 
 Where every move of a plan is such a move (a tower built bottom up, objects sorted into their
 regions' cells) no window runs: the receding windows plan only the decisions that need them

@@ -8,9 +8,7 @@
 2. take the moves that put a goal object onto the target its goal names where the prices
    leave them open, each bound by the full check as in step 3 (`tamp.geo.ours.placing`: a
    tower built bottom up, objects sorted into their cells), only before the first window
-   (after one, they would put back what the window moved out of the way); where the planner
-   then finds no plan within half the time left, planning starts over from the initial
-   state without them;
+   (after one, they would put back what the window moved out of the way);
    then plan the rest with `task.planner.plan` and the arm's prices in the objective
    (`GeoCosts`): the receding windows (the empty cells' places optimised with each restart
    row's logits and fixed by the committed row, `tamp.geo.ours.cells`), then, when they
@@ -264,22 +262,10 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
     solver, q = getattr(tools, "solver", None), getattr(tools, "q", None)
     costs = GeoCosts(bridged, solver, q, config.costs, pack=config.pack)
     failures, plans, cuts = [], 0, 0
-    start, scene0 = bridged.problem.init, bridged.scene
-    state, world, bound = start, scene0, []
+    state, world, bound = bridged.problem.init, bridged.scene, []
     least = moves_lower_bound(bridged.problem, bridged.problem.init)  # moves the goal needs
     windows = max(config.planner.max_windows, math.ceil(WINDOWS_PER_BOUND_MOVE * least))
-    opened = 0  # placing moves bound before the first window; -1 once planning started over
     while len(failures) <= config.replans and cuts <= config.cuts:
-        if config.placing and not plans and opened >= 0:  # the opening moves (`placing`)
-            state, world, more, failed = _take_placing(bridged, state, world, tools, costs, check)
-            bound += more
-            opened += len(more)
-            stats["placing_moves"] = opened
-            if failed is not None:
-                failures.append(failed)
-                continue
-            if is_goal(bridged.problem, state):
-                return _done(GeoStatus.SOLVED, tuple(bound), "", stats, t0, plans, failures)
         planner = replace(config.planner, max_windows=windows)
         if config.soft_time_s is not None:
             left = config.soft_time_s - (time.perf_counter() - t0)
@@ -287,10 +273,17 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
                 stats["bound"] = tuple(bound)
                 why = f"the differentiable planner's {config.soft_time_s:g} s ran out"
                 return _done(GeoStatus.BUDGET, (), why, stats, t0, plans, failures)
-            if opened > 0:  # half is kept for starting over without the placing moves
-                left /= 2
             limit = planner.time_limit_s
             planner = replace(planner, time_limit_s=left if limit is None else min(limit, left))
+        if config.placing and not plans:  # the opening moves into position (`placing`)
+            state, world, more, failed = _take_placing(bridged, state, world, tools, costs, check)
+            bound += more
+            stats["placing_moves"] = stats.get("placing_moves", 0) + len(more)
+            if failed is not None:
+                failures.append(failed)
+                continue
+            if is_goal(bridged.problem, state):
+                return _done(GeoStatus.SOLVED, tuple(bound), "", stats, t0, plans, failures)
         plans += 1
         now = replace(bridged.problem, init=state)
         result = plan(now, planner, seed=config.seed + plans - 1, costs=costs)
@@ -301,14 +294,6 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
             why = result.stats.get("fallback", {}).get("reason", "no plan")
             why = f"within the discretised places: {why}"
             return _done(GeoStatus.UNSOLVABLE, (), why, stats, t0, plans, failures)
-        if not result.solved and opened > 0:
-            # the placing moves led where no plan was found (a tower built up to where the
-            # arm's reach runs out, which the plan had to build otherwise): start over from
-            # the initial state, every move planned by the windows and the fallback
-            why = result.stats.get("fallback", {}).get("reason", "the windows ran out")
-            stats["started_over"] = f"after {opened} placing moves: {why}"
-            state, world, bound, opened = start, scene0, [], -1
-            continue
         if not result.solved:
             why = result.stats.get("fallback", {}).get("reason", "the windows ran out")
             if state != bridged.problem.init:

@@ -11,11 +11,10 @@ from tamp.geo.ours import as_ours, plan_motion_aware
 from tamp.geo.ours.placing import next_placing, placing_moves
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoStatus, moved
-from tamp.world.goal import parse_goal
 from tamp.world.relations import read_facts
 from task.costs import IMPOSSIBLE
 from task.domains.blocksworld import HOP
-from task.problem import TABLE, Move, Plan, PlanResult, PlanStatus, Problem
+from task.problem import TABLE, Move, Problem
 from tests.tamp.geo.geo_scenes import tools
 
 
@@ -91,34 +90,3 @@ def test_objects_moved_out_of_an_alcove_are_not_put_back_before_the_target_goes_
     assert result.status is GeoStatus.SOLVED, result.reason
     assert result.stats["placing_moves"] == 0 and result.stats["plans"] >= 1
     assert len(result.moves) == 6
-
-
-def test_where_no_plan_follows_the_placing_moves_planning_starts_over_without_them(monkeypatch):
-    import tamp.geo.ours.planner as ours
-    from tests.tamp.geo.geo_scenes import cube, scene
-
-    # a free, c on b: a goes into its cell at once (a placing move), b only once c is off it
-    s = scene(cube("a", 0.45, 0.2), cube("b", 0.55, 0.2), cube("c", 0.55, 0.2, z=0.075))
-    goal = parse_goal("(and (in a goal) (in b goal))", s)
-    calls = []
-
-    def planner_failing_after_placing(problem, config, seed=0, costs=None):
-        calls.append((problem.init, config.time_limit_s))
-        if len(calls) == 1:  # from where the placing moves left off: no plan
-            return PlanResult(PlanStatus.NO_PLAN, Plan(()), problem, None, {"windows": 1})
-        return real(problem, config, seed=seed, costs=costs)
-
-    real = ours.plan
-    monkeypatch.setattr(ours, "plan", planner_failing_after_placing)
-    config = replace(as_ours(SearchConfig(seed=0, max_time_s=90.0)), search=None)
-    result = plan_motion_aware(s, goal, tools(), config)
-    assert result.status is GeoStatus.SOLVED, result.reason
-    assert result.stats["placing_moves"] == 1
-    assert result.stats["started_over"].startswith("after 1 placing moves")
-    (first, first_limit), (second, second_limit) = calls
-    assert first != second  # the first from a in its cell, the second from the initial state
-    assert first_limit <= config.soft_time_s / 2 < second_limit  # half kept for starting over
-    world = s
-    for m in result.moves:  # the moves replay from the initial world to the goal
-        world = moved(world, m.obj, m.place.pose)
-    assert goal.holds(read_facts(world))
