@@ -11,8 +11,9 @@ onto the very target its goal names (its goal cell, or its goal object in positi
 `next_placing` takes the one the arm's prices (`tamp.geo.ours.costs.GeoCosts`) leave open,
 filling first the cells whose filling closes no other empty cell of their region (the packer's
 placing order, `GeoCosts.closes`), then the cheapest. Where a place it fills is wanted later as
-a parking spot or the hand's room, the windows and the fallback still plan from the state it
-reached (at worst a longer plan, never a lost one: every move stays reversible).
+a parking spot or the hand's room, the windows and the fallback plan on from the state it
+reached, where the placed objects may move again (the plan is then longer, and may take longer
+to find).
 
 Where every move of a plan is such a move (a tower built bottom up, objects sorted into their
 regions' cells) no window runs: the receding windows plan only the decisions that need them
