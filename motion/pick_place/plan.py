@@ -379,35 +379,22 @@ def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> t
     )
     up, low = (0.0, 0.0) if still else (up, low)
     grasp, place = w["grasp"], w["place"]
+
+    def vertical(name: str, end: str, gripper: str, v0: float = 0.0, v1: float = 0.0) -> Phase:
+        """The vertical phase along the path into waypoint ``end``, passing through its ends
+        at arclength speeds ``v0`` and ``v1``."""
+        path = polyline_segment(paths[end], dt, spec, config.approach, v0, v1)
+        return Phase(name, path, gripper, config.approach)
+
     return (
         Phase("approach", approach, "open", config.transit),
-        Phase(
-            "descend",
-            polyline_segment(paths["grasp"], dt, spec, config.approach, down),
-            "open",
-            config.approach,
-        ),
+        vertical("descend", "grasp", "open", down),
         Phase("close", JointTrajectory.hold(grasp, config.close_time, dt), "closed"),
-        Phase(
-            "lift",
-            polyline_segment(paths["lift"], dt, spec, config.approach, 0.0, up),
-            "closed",
-            config.approach,
-        ),
+        vertical("lift", "lift", "closed", 0.0, up),
         Phase("transit", transit, "closed", config.transit),
-        Phase(
-            "lower",
-            polyline_segment(paths["place"], dt, spec, config.approach, low),
-            "closed",
-            config.approach,
-        ),
+        vertical("lower", "place", "closed", low),
         Phase("open", JointTrajectory.hold(place, config.open_time, dt), "open"),
-        Phase(
-            "retreat",
-            polyline_segment(paths["retreat"], dt, spec, config.approach),
-            "open",
-            config.approach,
-        ),
+        vertical("retreat", "retreat", "open"),
     )
 
 
