@@ -61,6 +61,11 @@ class PlannerConfig:
     fallback: bool | None = None  # when the windows revisit a state or run out, search on from
     # the world state, complete over the moves the cost source allows (`task.symbolic.lazy_search`);
     # None: only with a cost source (motion-aware planning); never with beliefs (perception)
+    own_state_costs: bool = True  # with a cost source, each window move after the first is
+    # checked in the state it starts from, and the window is cut before the first one the
+    # source rules out there (`task.costs.IMPOSSIBLE`): the window's matrix prices every step
+    # in the window's start state, where a move its earlier moves make legal is illegal and
+    # priced 0 (`task.planner.windows.own_state_prefix`). False: every decoded move is kept
     fallback_nodes: int = 5_000  # state expansions the fallback may spend per problem (each
     # expanded state is priced once by the cost source when one of its moves is checked)
     shorten: bool = False  # cut cycles and redundant moves out of a plan that reaches the goal

@@ -43,7 +43,7 @@ def fallback_on(
     return costs is not None if config.fallback is None else config.fallback
 
 
-def _cost_checks(domain: Domain, problem: Problem, costs: CostSource, index: int):
+def cost_checks(domain: Domain, problem: Problem, costs: CostSource, index: int):
     """``feasible(state, move)`` from a cost source: a move is ruled out where its price
     reaches `task.costs.IMPOSSIBLE` (as the decoder rules it out), one pricing per state, and
     the priced windows by state (their ``commit`` records the moves the fallback chose)."""
@@ -101,7 +101,7 @@ def fall_back(
     of one block's moves merged (`task.symbolic.shorten.merge_runs`, each merged move checked
     feasible) before it is committed."""
     feasible, windows = (
-        (None, {}) if costs is None else _cost_checks(domain, problem, costs, indices[i])
+        (None, {}) if costs is None else cost_checks(domain, problem, costs, indices[i])
     )
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
 

@@ -8,11 +8,12 @@ of batching can be measured.
 
 Each window decodes against a crisp state (the true one, or under the perceived protocol of
 `task.beliefs` the one read from the current image), then applies its moves to the true state,
-the world. A move illegal there ends the plan as inexecutable (`PlanStatus.INVALID`, the move
-kept last so that `task.symbolic.validate` names it); with the crisp check on and the true
-protocol that never happens. Under the perceived protocol a window that predicts the goal is
-confirmed by one more reading (a new image, no optimisation), so a perfect reading gives
-exactly the true protocol's plans.
+the world (with a cost source, only up to a move the source rules out in the state it starts
+from: `PlannerConfig.own_state_costs`). A move illegal there ends the plan as inexecutable
+(`PlanStatus.INVALID`, the move kept last so that `task.symbolic.validate` names it); with
+the crisp check on and the true protocol that never happens. Under the perceived protocol a
+window that predicts the goal is confirmed by one more reading (a new image, no
+optimisation), so a perfect reading gives exactly the true protocol's plans.
 
 With ``PlannerConfig(improve_s=...)`` a plan found (without beliefs and move costs) is handed to
 an anytime improvement (`task.symbolic.lazy_search.improve`): A* on the domain's lower bound,
@@ -33,8 +34,14 @@ from task.costs import CostSource
 from task.domains import get_domain
 from task.domains.base import Domain, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
-from task.planner.fallback import fall_back, fallback_on
-from task.planner.windows import crisp_states, execute, next_window, take_safe
+from task.planner.fallback import cost_checks, fall_back, fallback_on
+from task.planner.windows import (
+    crisp_states,
+    execute,
+    next_window,
+    own_state_prefix,
+    take_safe,
+)
 from task.problem import Plan, PlanResult, PlanStatus, Problem
 from task.rollout import OutOfTime
 from task.symbolic.lazy_search import (
@@ -79,6 +86,8 @@ def _run(
     timed_out = False
     trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
     safe = [0] * len(problems)  # moves taken without a window (`PlannerConfig.safe_from`)
+    own_state = costs is not None and source is None and config.own_state_costs
+    cut = [0] * len(problems)  # windows cut before a move priced out in its own state
     for _ in range(config.max_windows):
         if source is None and costs is None:
             active = take_safe(
@@ -108,15 +117,20 @@ def _run(
         for i, seen, win in zip(active, crisp, decoded, strict=True):
             windows[i] += 1
             misread[i] += seen != states[i]
+            planned = win.moves
+            if own_state:  # each move after the first priced where it starts
+                feasible, _ = cost_checks(domain, problems[i], costs, indices[i])
+                planned = own_state_prefix(domain, problems[i], states[i], planned, feasible)
+                cut[i] += len(planned) < len(win.moves)
             tried, states[i], illegal[i], looped = execute(
-                domain, problems[i], states[i], win.moves, visited[i]
+                domain, problems[i], states[i], planned, visited[i]
             )
             if looped and fallback and trigger[i] is None:
                 trigger[i] = "cycle"  # the windows revisit a state: the fallback takes over
             moves[i].extend(tried)
             executed.append(tried)
-            if not perceived:
-                solved[i] = win.reached  # decoded on the world: the world reached the goal
+            if not perceived:  # decoded on the world: the world reached the goal
+                solved[i] = win.reached and len(planned) == len(win.moves)
             elif domain.is_goal(problems[i], seen):
                 solved[i] = True  # the image already showed the goal (no move was decoded)
             elif win.reached and illegal[i] is None:
@@ -175,6 +189,8 @@ def _run(
             status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
         if safe[i]:
             stats["safe_moves"] = safe[i]
+        if cut[i]:
+            stats["own_state_cuts"] = cut[i]
         if i in improved:
             stats["improve"] = improved[i]
         if i in searched:

@@ -2,12 +2,13 @@
 the action logits with Adam (`task.optimize`), decode the moves against a crisp state and execute
 the legal ones on the world; a part of a big problem in a window of its own
 (`PlannerConfig.safe_from`, `task.domains.base.window_part`), and the domain's safe moves taken
-without one.
+without one; with a cost source, a window cut before a move the source rules out in its own
+state (`own_state_prefix`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import torch
 
@@ -143,6 +144,30 @@ def execute(
         looped = looped or state in visited
         visited.add(state)
     return tuple(done), state, None, looped
+
+
+def own_state_prefix(
+    domain: Domain,
+    problem: Problem,
+    state: State,
+    moves: Sequence[Move],
+    feasible: Callable[[State, Move], bool],
+) -> tuple[Move, ...]:
+    """The window ``moves`` from the world ``state`` up to (not including) the first move
+    after the first that is legal in the state it starts from but that ``feasible`` (the cost
+    source's verdict there, `task.planner.fallback.cost_checks`) rules out
+    (`PlannerConfig.own_state_costs`). The window's cost matrix priced every step in its start
+    state, where such a move may still have been illegal (priced 0, so the decoder kept it):
+    the next window starts before it and prices it where it would be made. The first move
+    was priced in its own state by the decoder and is always kept; an illegal move is left
+    to `execute`, which names it."""
+    for k, move in enumerate(moves):
+        if domain.check_move(problem, state, move) is not None:
+            break
+        if k > 0 and not feasible(state, move):
+            return tuple(moves[:k])
+        state = domain.apply_move(problem, state, move)
+    return tuple(moves)
 
 
 def take_safe(
