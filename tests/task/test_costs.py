@@ -4,7 +4,7 @@ preferring, among equally short plans, the one whose moves cost less."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import pytest
 import torch
@@ -109,3 +109,80 @@ def test_the_weighted_motion_term_steers_the_logits():
         for seed in range(4):
             result = plan(UNSTACK, config, seed=seed, costs=FixedCosts(matrix))
             assert result.solved and result.plan.moves[0] == Move("a", target), (weight, seed)
+
+
+@dataclass
+class AfterCosts:
+    """A cost source whose prices depend on the state: b onto c is ruled out
+    (`IMPOSSIBLE`) while a sits on d (a's body in the way of b's hand, say); a to the table
+    costs `EXPENSIVE`, every other move 1."""
+
+    lr: float = 0.0
+    matrix: torch.Tensor | None = None
+
+    def __call__(self, indices, states, restarts):
+        matrix = torch.ones((len(states), 4, 5))
+        matrix[:, A, TABLE_COL] = EXPENSIVE
+        for p, state in enumerate(states):
+            if state[A] == "d":
+                matrix[p, 1, 2] = IMPOSSIBLE  # b -> c
+        self.matrix = matrix
+        return self
+
+    def compute(self):
+        return self.matrix
+
+    def parameters(self):
+        return []
+
+    def commit(self, rows, moves):
+        pass
+
+    def price(self, state, move) -> float:
+        row, col = UNSTACK.entities.index(move.entity), UNSTACK.index(move.target)
+        return float(self(None, [state], 1).compute()[0, row, col])
+
+
+def _priced_out_in_own_state(result, source) -> list[Move]:
+    state, out = BW.initial_state(UNSTACK), []
+    for move in result.plan.moves:
+        if source.price(state, move) >= IMPOSSIBLE:
+            out.append(move)
+        state = BW.apply_move(UNSTACK, state, move)
+    return out
+
+
+def test_a_window_is_cut_before_a_move_priced_out_in_its_own_state():
+    """The window's matrix prices b onto c in the initial state, where b is covered (the
+    move is illegal there and its entry does not count): a onto d then b onto c looks
+    cheapest. With `PlannerConfig.own_state_costs` the window is cut after a onto d and the
+    next one, priced where b onto c would be made, moves a on; without it the plan keeps a
+    move its own state rules out."""
+    config = PlannerConfig(lambda_motion=0.05, horizon=3, lookahead=3, max_windows=6)
+    kept = plan(UNSTACK, replace(config, own_state_costs=False), seed=0, costs=AfterCosts())
+    assert kept.plan.moves == (Move("a", "d"), Move("b", "c"))  # the trap the cut avoids
+    assert _priced_out_in_own_state(kept, AfterCosts()) == [Move("b", "c")]
+    source = AfterCosts()
+    result = plan(UNSTACK, config, seed=0, costs=source)
+    assert result.solved
+    assert _priced_out_in_own_state(result, source) == []
+    assert result.stats["own_state_cuts"] >= 1
+    assert "own_state_cuts" not in kept.stats
+
+
+def test_own_state_prefix_keeps_the_first_move_and_stops_at_the_first_ruled_out():
+    from task.planner.windows import own_state_prefix
+
+    start = BW.initial_state(UNSTACK)
+    moves = (Move("a", "d"), Move("b", "c"), Move("a", TABLE))
+    ruled_out = {Move("b", "c"), Move("a", "d")}
+
+    def feasible(state, move):
+        return move not in ruled_out
+
+    # the first move is the decoder's, priced in its own state there: kept
+    assert own_state_prefix(BW, UNSTACK, start, moves, feasible) == (Move("a", "d"),)
+    assert own_state_prefix(BW, UNSTACK, start, moves, lambda s, m: True) == moves
+    # an illegal move is left to `execute`, which names it
+    illegal = (Move("a", "d"), Move("d", TABLE), Move("b", "c"))  # d is under a
+    assert own_state_prefix(BW, UNSTACK, start, illegal, feasible) == illegal
