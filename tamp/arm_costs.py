@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,7 +39,7 @@ from motion.pick_place import PickPlaceConfig
 from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
-from task.problem import TABLE, Problem
+from task.problem import TABLE, Move, Problem
 
 # the move cost with the sphere model's clearance to the scene's obstacles (weight 5 per m of
 # CHOMP cost: 0.2-0.9 for a move sweeping past clutter's posts, next to about 1 per move of
@@ -192,8 +192,12 @@ class ArmCosts:
         reach: float = 0.0,
         grasps: tuple[str, ...] = (),
         failed: Sequence[FailedMove] = (),
+        check: Callable[[Mapping[str, Pose], Move], bool] | None = None,
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
+        self.check = check  # the executor's own check of a move among poses (`verify`)
+        self._verified: dict[tuple[int, State, object], bool] = {}  # `verify`'s answers
+        self._refused: dict[tuple[int, State], set] = {}  # moves `verify` ruled out there
         self.failed = tuple(failed)  # moves the arm failed, by where (`FailedMove`)
         self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
         self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
@@ -205,6 +209,36 @@ class ArmCosts:
         self.boxes = obstacle_tensors(scene)  # the collision proxy's obstacles, made once
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
         self._decided: dict[int, list[tuple[object, XY | None]]] = {}
+
+    def verify(self, index: int, state: State, move) -> bool:
+        """Whether the executor finds ``move``'s motion in ``state`` of problem ``index``
+        (`task.costs.CostSource`'s optional check ahead, `task.planner.windows.own_state_prefix`):
+        ``check`` on the poses this source predicts there (`predict_poses`; a move onto a table
+        place goes to its centre), the arm where it is now. A move it fails is ruled out in that
+        state from then on (priced `BLOCKED`): the next window there decodes another. True
+        without ``check``, and with moving places (``reach`` > 0: the place is not known yet).
+        One check per (problem, state, move)."""
+        if self.check is None or self.reach > 0:
+            return True
+        from tamp.slots import plain_move  # tamp.slots builds on this module
+
+        key = (index, state, move)
+        if key not in self._verified:
+            problem = self.problems[index]
+            at = None if self.places is None else self.places[index]
+            plain = state if at is None else tuple(TABLE if x in at else x for x in state)
+            bases = (
+                None
+                if at is None
+                else {x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at}
+            )
+            now = predict_poses(problem.entities, plain, self.poses[index], self.scene, bases)
+            planned = move if at is None else plain_move(move, at)
+            self._verified[key] = ok = bool(self.check(now, planned))
+            if not ok:
+                self._refused.setdefault((index, state), set()).add(move)
+                self._cache.pop((index, state), None)
+        return self._verified[key]
 
     def decided(self, index: int) -> list[tuple[object, XY | None]]:
         """Every move the planner committed for problem ``index`` since this source was made,
@@ -340,6 +374,9 @@ class ArmCosts:
                 j = failed.columns(problem.entities, now, places[-1])
                 if j:
                     extra[-1][problem.entities.index(failed.entity), j] += BLOCKED
+            for move in self._refused.get((i, state), ()):  # its check ahead failed here
+                j = problem.targets.index(move.target)
+                extra[-1][problem.entities.index(move.entity), j] += BLOCKED
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
                 j = _column(problem, key, at, self.reach)
                 if j is not None:

@@ -14,6 +14,8 @@ so the scene's few slots stay the constraint they are. This module translates:
   each block's height is snapped to its level in the observed state, so the geometric reader's
   tight tolerances read the state the loop's looser reader read;
 - `blocks_goal`: a Blocksworld goal as the scene goal (``on`` / ``ontable`` atoms);
+- `geo_check`: one loop move checked over every grasp family without running it (the
+  loop's motion check of a planned move, `tamp.loop.execute.motion_check`);
 - `run_geo`: one loop move checked (every grasp family, blocked free-space phases rerouted) and run
   through `tamp.geo.check.check_move` and `tamp.geo.execute.run_move` in the loop's simulator,
   its outcome as the loop's `tamp.loop.execute.ExecutionResult`.
@@ -109,6 +111,32 @@ def geo_tools(solver, collision, guard, plan: bool = True, choices=CHOICES) -> T
     return Tools(solver, collision, guard=replace(guard, plan=plan), choices=tuple(choices))
 
 
+def geo_check(
+    move: Move,
+    target: Pose,
+    poses: Mapping[str, Pose],
+    scene: SceneConfig,
+    tools: Tools,
+    q_now,
+    seed: int = 0,
+):
+    """``move`` to ``target`` among the blocks at ``poses`` checked over every grasp family
+    of ``tools`` from the arm at ``q_now``, nothing run: ``(world, geo move, verdict)`` (a
+    `tamp.geo.check.MoveCheck`), what `run_geo` runs when the verdict passes."""
+    from tamp.geo.check import candidate_grasps, check_move, grasp_order
+    from tamp.geo.types import GeoMove, Place
+
+    world = world_scene(tuple(poses), poses, scene)
+    name = "table" if move.target == TABLE else f"on.{move.target}"
+    place = Place(name, move.target, tuple(float(v) for v in target.xyz), float(target.yaw))
+    geo = GeoMove(move.entity, place)
+    o = world.object(move.entity)
+    grasps = grasp_order(world, o, candidate_grasps(o, tools.choices))
+    grasps = tuple(sorted(grasps, key=_family_rank))
+    verdict = check_move(world, geo, tools, grasps=grasps, q_now=q_now, seed=seed)
+    return world, geo, verdict
+
+
 def run_geo(
     sim,
     move: Move,
@@ -128,20 +156,11 @@ def run_geo(
     the grasp, or the geometric failure). ``config``: the loop's `ExecConfig` (the place check's
     tolerances); ``observe``: the block poses after the run (default: the simulator's sensor is
     not read here, so the place is not checked)."""
-    from tamp.geo.check import candidate_grasps, check_move, grasp_order
     from tamp.geo.execute import RunConfig, rests_of, run_move
-    from tamp.geo.types import GeoMove, Place
     from tamp.loop.execute import ExecutionResult, Failure
 
     wall0, sim0 = time.perf_counter(), sim.time
-    world = world_scene(tuple(poses), poses, scene)
-    name = "table" if move.target == TABLE else f"on.{move.target}"
-    place = Place(name, move.target, tuple(float(v) for v in target.xyz), float(target.yaw))
-    geo = GeoMove(move.entity, place)
-    o = world.object(move.entity)
-    grasps = grasp_order(world, o, candidate_grasps(o, tools.choices))
-    grasps = tuple(sorted(grasps, key=_family_rank))
-    verdict = check_move(world, geo, tools, grasps=grasps, q_now=sim.arm_q(), seed=seed)
+    world, geo, verdict = geo_check(move, target, poses, scene, tools, sim.arm_q(), seed)
 
     def result(failure: str | None, run=None, **evidence) -> ExecutionResult:
         kind = None if failure is None else Failure(FAILURES.get(failure, "ik_infeasible"))

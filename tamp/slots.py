@@ -17,7 +17,7 @@ continuous placements, the position its window decided), where the executor puts
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from motion.ik import IKSolver
@@ -112,6 +112,7 @@ def plan_on_places(
     reach: float = 0.0,
     grasps: tuple[str, ...] = (),
     failed: Sequence[FailedMove] = (),
+    check: Callable[[Mapping[str, Pose], Move], bool] | None = None,
 ) -> PlanResult:
     """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
     table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
@@ -122,8 +123,10 @@ def plan_on_places(
     ``grasps``: the grasp families the executor has besides top-down over the highest stack
     (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out);
     ``failed``: moves the arm failed, ruled out wherever they would be the same
-    (`FailedMove`). A goal tower taller than the scene's ``max_height`` is UNSOLVABLE at
-    once, its reason in ``stats["reason"]`` (the prices rule out every such tower)."""
+    (`FailedMove`); ``check``: the executor's check of a move among poses, with which the
+    windows vet each move they keep where it starts (`ArmCosts.verify`). A goal tower taller
+    than the scene's ``max_height`` is UNSOLVABLE at once, its reason in ``stats["reason"]``
+    (the prices rule out every such tower)."""
     tall = goal_height(problem)
     if tall > scene.max_height:  # no tower on this table takes it: say so, do not search
         why = (
@@ -144,6 +147,7 @@ def plan_on_places(
         reach=reach,
         grasps=grasps,
         failed=failed,
+        check=check,
     )
     result = plan(current, config, seed=seed, costs=costs)
     decided = costs.decided(0)

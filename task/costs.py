@@ -19,6 +19,15 @@ leaves `task`; the costs come in as a tensor. The costs are those of the window'
 for every step of the window (later steps see the same matrix): an approximation the next
 window corrects, as it starts from the state the executed moves reached.
 
+A source may also check moves ahead: an optional ``verify(index, state, move) -> bool`` says
+whether the move of problem ``index`` can be carried out where it starts (the arm's executor
+check on the poses the source predicts there, `tamp.arm_costs.ArmCosts.verify`). The receding
+windows call it on each move they keep (`task.planner.windows.own_state_prefix`), ending the
+window before the first it fails; the source then rules that move out in that state, so the
+next window decodes another. A cheap matrix for every move, an exact check for the few the
+windows choose: motion feasibility checked lazily, and a failure fed back, before anything
+runs.
+
 Shapes: P problems in the window (all of one size N, `Y` targets each), R restart rows per
 problem, adjacent in the batch (row ``p * R + r`` is restart r of problem p).
 """

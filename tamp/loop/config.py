@@ -40,6 +40,11 @@ class LoopConfig:
     crisp: str = "perceived"  # decode against the observed state; "true": against the truth
     placements: float = 0.0  # m: motion-aware, state: a block may go this far from a place's
     # centre, where the planner's Adam puts it (continuous placements; 0: the centre)
+    # motion-aware, state, fixed places: the planner's windows check each move they keep with
+    # the executor's own check on the poses they predict, before anything runs, and rule out
+    # where it starts a move that fails it (`tamp.arm_costs.ArmCosts.verify`). Off: on issue
+    # 13's cramped and shelf episodes it changed no outcome and cost planning time (BENCHMARKS)
+    check_ahead: bool = False
 
     def __post_init__(self) -> None:
         if self.observe not in OBSERVE:
@@ -50,6 +55,16 @@ class LoopConfig:
             raise TampError(
                 f"placements must lie in [0, 0.03] m (a block stays on its slot), "
                 f"got {self.placements}"
+            )
+        if self.check_ahead and (
+            self.observe != "state"
+            or self.placements > 0
+            or self.planner.lambda_motion <= 0
+            or self.execution.collision == "off"
+        ):
+            raise TampError(
+                "check_ahead needs motion-aware planning (lambda_motion > 0) with state "
+                "observation, fixed places (placements 0) and the collision model on"
             )
         if self.observe == "camera" and self.perception.mode == "state":
             raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

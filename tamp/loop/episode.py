@@ -43,6 +43,7 @@ from tamp.loop.execute import (
     Failure,
     execute_move,
     failed_pick,
+    motion_check,
     obstacle_boxes,
 )
 from tamp.loop.faults import draw
@@ -276,6 +277,24 @@ class Episode:
 
         return CHOICES
 
+    def _check_ahead(self, q) -> Callable | None:
+        """``check(poses, move)`` for the planner's windows (`LoopConfig.check_ahead`): whether
+        `tamp.loop.execute.motion_check` finds the move's motion among ``poses`` (the poses
+        the plan predicts) with the arm at ``q`` (where it stands now), nothing run; None
+        when the option is off (`LoopConfig` refuses it where it cannot apply)."""
+        cfg = self.config
+        if not cfg.check_ahead:
+            return None
+        seed = self.seed * 1000 + 999_983  # the motion planner's seed for checks ahead
+
+        def check(poses, move: Move) -> bool:
+            found = motion_check(
+                self.solver, move, dict(poses), q, cfg.execution, cfg.scene, self.collision, seed
+            )
+            return found is None
+
+        return check
+
     def _crisp_basis(self, observed):
         """The state decoded moves are checked against: the observed one (``crisp="perceived"``,
         the default: a robot has no oracle) or, with ``crisp="true"``, the simulator's true
@@ -308,6 +327,7 @@ class Episode:
                     self.config.placements,
                     self._grasps(),
                     self._failed,
+                    self._check_ahead(q),
                 )
             costs = ArmCosts(
                 [current],

@@ -182,7 +182,7 @@ def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Exp
         sim.run(back, "open", on_frame=on_frame, expected=expected)
 
 
-def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
+def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
     """(target pose, phases, IK time, rerouted phases) of the move, or (Failure, IK time,
     evidence); adds to ``times`` (check s, planner s, path rad, planner runs, failures). A move
     whose motion fails tries the quarter-turned grasp (a neighbour touching the block on one
@@ -206,7 +206,7 @@ def _plan(sim, solver, move, poses, config, scene, collision, seed, times):
             ceiling(target.xyz, scene.obstacles),
             turn,
         )
-        planned = plan_pick_place(solver, sim.arm_q(), request, config.motion)
+        planned = plan_pick_place(solver, q_now, request, config.motion)
         ik += planned.ik_time_s
         if not planned.ok:
             last = (Failure(planned.failure), ik, planned.evidence)
@@ -237,6 +237,36 @@ def _geo(sim, solver, move, target, poses, config, scene, collision, seed, drop_
         return run_geo(sim, move, target, poses, scene, tools, config, seed, drop_at, None, observe)
     except PerceptionError as err:
         return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
+
+
+def motion_check(
+    solver: IKSolver,
+    move: Move,
+    poses: dict[str, Pose],
+    q_now,
+    config: ExecConfig,
+    scene: SceneConfig,
+    collision: CollisionModel | None,
+    seed: int = 0,
+) -> Failure | None:
+    """What `execute_move` would find before the arm moves, with the blocks at ``poses`` and
+    the arm at ``q_now``, nothing run: None when it finds the move's motion (top-down, each
+    phase guarded, or with its geometric fallback every other grasp), else the failure it
+    would report. A planned move checked ahead, on the poses its plan predicts
+    (`tamp.arm_costs.ArmCosts.verify`)."""
+    times = [0.0, 0.0, 0.0, 0, 0]
+    planned = _plan(q_now, solver, move, poses, config, scene, collision, seed, times)
+    if not (isinstance(planned, tuple) and isinstance(planned[0], Failure)):
+        return None
+    if planned[0] in GEO_RETRIED and config.geo_fallback and config.collision == "plan":
+        target = place_pose(move, poses, scene)
+        if target is not None:
+            from tamp.blocks_geo import geo_check, geo_tools
+
+            tools = geo_tools(solver, collision, config.guard, plan=True)
+            if geo_check(move, target, poses, scene, tools, q_now, seed)[2].ok:
+                return None
+    return planned[0]
 
 
 def failed_pick(done: ExecutionResult) -> bool:
@@ -297,7 +327,7 @@ def execute_move(
         poses = observe()
     except PerceptionError as err:
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
-    planned = _plan(sim, solver, move, poses, config, scene, collision, seed, times)
+    planned = _plan(sim.arm_q(), solver, move, poses, config, scene, collision, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
         if planned[0] in GEO_RETRIED and config.geo_fallback and config.collision == "plan":
             target = place_pose(move, poses, scene)

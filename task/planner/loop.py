@@ -9,7 +9,9 @@ of batching can be measured.
 Each window decodes against a crisp state (the true one, or under the perceived protocol of
 `task.beliefs` the one read from the current image), then applies its moves to the true state,
 the world (with a cost source, only up to a move the source rules out in the state it starts
-from: `PlannerConfig.own_state_costs`). A move illegal there ends the plan as inexecutable
+from: `PlannerConfig.own_state_costs`; a source that checks moves ahead, such as the arm's
+executor check, also vets each move where it starts and rules out there the one it fails). A
+move illegal there ends the plan as inexecutable
 (`PlanStatus.INVALID`, the move kept last so that `task.symbolic.validate` names it); with
 the crisp check on and the true protocol that never happens. Under the perceived protocol a
 window that predicts the goal is confirmed by one more reading (a new image, no
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 
 import torch
 
@@ -120,7 +123,12 @@ def _run(
             planned = win.moves
             if own_state:  # each move after the first priced where it starts
                 feasible, _ = cost_checks(domain, problems[i], costs, indices[i])
-                planned = own_state_prefix(domain, problems[i], states[i], planned, feasible)
+                verify = getattr(costs, "verify", None)  # the source's optional check ahead
+                if verify is not None:
+                    verify = partial(verify, indices[i])
+                planned = own_state_prefix(
+                    domain, problems[i], states[i], planned, feasible, verify
+                )
                 cut[i] += len(planned) < len(win.moves)
             tried, states[i], illegal[i], looped = execute(
                 domain, problems[i], states[i], planned, visited[i]

@@ -152,6 +152,7 @@ def own_state_prefix(
     state: State,
     moves: Sequence[Move],
     feasible: Callable[[State, Move], bool],
+    verify: Callable[[State, Move], bool] | None = None,
 ) -> tuple[Move, ...]:
     """The window ``moves`` from the world ``state`` up to (not including) the first move
     after the first that is legal in the state it starts from but that ``feasible`` (the cost
@@ -159,12 +160,17 @@ def own_state_prefix(
     (`PlannerConfig.own_state_costs`). The window's cost matrix priced every step in its start
     state, where such a move may still have been illegal (priced 0, so the decoder kept it):
     the next window starts before it and prices it where it would be made. The first move
-    was priced in its own state by the decoder and is always kept; an illegal move is left
-    to `execute`, which names it."""
+    was priced in its own state by the decoder and is kept; an illegal move is left to
+    `execute`, which names it. ``verify`` (the cost source's check ahead,
+    `task.costs.CostSource`): each legal move, the first too, is also checked where it starts,
+    and the window ends before the first that fails (none kept when the first fails: the
+    source has ruled it out there, and the next window from the same state decodes another)."""
     for k, move in enumerate(moves):
         if domain.check_move(problem, state, move) is not None:
             break
         if k > 0 and not feasible(state, move):
+            return tuple(moves[:k])
+        if verify is not None and not verify(state, move):
             return tuple(moves[:k])
         state = domain.apply_move(problem, state, move)
     return tuple(moves)

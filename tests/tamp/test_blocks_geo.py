@@ -155,3 +155,24 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     alone = {k: v for k, v in done.evidence.items() if k != "geo"}
     assert not failed_pick(replace(done, evidence=alone))
     assert not failed_pick(ExecutionResult(move, True))
+
+
+def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
+    """`motion_check`, the planner's check ahead (no simulator): the far tower's top block to
+    a near slot passes through the geometric fallback's tilted grasp (and fails top-down
+    alone, as `execute_move` does), a block beyond the arm's reach fails on its IK."""
+    from robots.collision import PandaCollision
+    from tamp.loop.execute import ExecConfig, Failure, motion_check
+
+    poses, _, at, _ = _tall(slot=4)
+    move = PlacedMove("g", TABLE, at["slot0"], "slot0")
+    far = {"a": Pose((0.95, 0.3, 0.025)), "b": Pose((0.4, 0.0, 0.025))}
+    away = PlacedMove("a", TABLE, (0.4, -0.24), "slot0")
+    alone = replace(ExecConfig(), geo_fallback=False)
+    with PandaCollision() as model:
+        q = PANDA.q_home
+        assert motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model) is None
+        found = motion_check(solver, move, poses, q, alone, CRAMPED, model)
+        assert found is Failure.IK_INFEASIBLE
+        found = motion_check(solver, away, far, q, ExecConfig(), CRAMPED, model)
+        assert found is Failure.IK_INFEASIBLE

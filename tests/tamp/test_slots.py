@@ -93,6 +93,50 @@ def test_a_move_the_arm_failed_is_priced_out_in_that_state_only(solver):
     assert priced([0], [other]).compute()[0, 0, j] < BLOCKED
 
 
+def test_a_move_its_check_ahead_fails_is_priced_out_where_it_was_checked(solver):
+    """`ArmCosts.verify` hands the executor's check the poses it predicts in the state (a
+    block moved to a place stands at the place's centre) and the move as the executor gets
+    it (onto the table at the place); a move the check fails is `BLOCKED` in that state from
+    then on, checked once, and other states are not touched."""
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
+    calls = []
+
+    def check(seen, move):
+        calls.append((dict(seen), move))
+        return move.entity != "c"  # c cannot be moved, say
+
+    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], check=check)
+    moved = bw.apply_move(problem, problem.init, Move("a", "slot2"))
+    before = source([0], [moved]).compute()[0].clone()
+    assert source.verify(0, moved, Move("b", "slot4"))
+    seen, planned = calls[-1]
+    assert seen["a"].xyz == pytest.approx((*at["slot2"], SCENE.block_size / 2))
+    assert isinstance(planned, PlacedMove) and planned.at == at["slot4"]
+    assert not source.verify(0, moved, Move("c", "b"))
+    assert not source.verify(0, moved, Move("c", "b")) and len(calls) == 2  # checked once
+    after = source([0], [moved]).compute()[0]
+    diff = (after - before).numpy()
+    assert diff[2, 1] == pytest.approx(BLOCKED) and np.count_nonzero(diff) == 1
+    start = source([0], [problem.init]).compute()[0]
+    assert start[2, 1] < BLOCKED  # the same move in another state: not ruled out
+    never = ArmCosts(
+        [problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=0.01, check=None
+    )
+    assert never.verify(0, moved, Move("c", "b"))  # no check: every move passes
+    moving = ArmCosts(
+        [problem],
+        [poses],
+        SCENE,
+        solver,
+        PANDA.q_home,
+        places=[at],
+        reach=0.01,
+        check=lambda seen, move: False,
+    )
+    assert moving.verify(0, moved, Move("c", "b"))  # places that move are not known yet
+
+
 def test_planning_on_places_names_them_and_never_needs_more_than_the_table_has(solver):
     # five single blocks on a 6-slot table; the goal is one tower: no place is needed beyond
     five = Problem(
@@ -135,6 +179,55 @@ def test_a_cramped_table_the_unlimited_plan_overflows_is_solved_on_its_places():
     table = [m.move for m in report.moves if m.move.target == TABLE]
     assert table and all(isinstance(m, PlacedMove) for m in table)
     assert all(min(math.dist(m.at, s) for s in aware.scene.slots) < 1e-9 for m in table)
+
+
+@pytest.mark.sim
+def test_the_check_ahead_vets_every_planned_move_and_the_cramped_table_is_still_solved(
+    monkeypatch,
+):
+    """`LoopConfig.check_ahead`: the executor's motion check runs on the moves the windows
+    keep, on the poses the plan predicts, and the cramped ten-block episode still reaches the
+    goal without a replan."""
+    import random
+
+    import tamp.loop.episode as episode
+    from task.symbolic.generate import random_problem
+
+    seeds = random.Random("0:10")
+    problem = [random_problem(10, seeds.randrange(2**31)) for _ in range(8)][7]
+    base = LoopConfig()
+    aware = dataclasses.replace(
+        base,
+        scene=with_scene(base.scene, "cramped"),
+        planner=dataclasses.replace(base.planner, lambda_motion=0.05),
+        check_ahead=True,
+    )
+    checked = []
+    real = episode.motion_check
+
+    def counted(solver, move, poses, *rest):
+        checked.append(move)
+        return real(solver, move, poses, *rest)
+
+    monkeypatch.setattr(episode, "motion_check", counted)
+    report = run_episode(problem, aware, seed=0)
+    assert report.reached_goal and report.replans == 0
+    assert len(checked) >= len(report.moves)  # every executed move was checked ahead
+
+
+def test_the_check_ahead_is_refused_where_it_cannot_apply():
+    from task.errors import TampError
+
+    aware = LoopConfig(planner=dataclasses.replace(PlannerConfig(), lambda_motion=0.05))
+    assert dataclasses.replace(aware, check_ahead=True).check_ahead
+    refused = (
+        {"placements": 0.01},
+        {"planner": PlannerConfig()},  # task-only: no prices, no windows to vet
+        {"execution": dataclasses.replace(aware.execution, collision="off")},
+    )
+    for change in refused:
+        with pytest.raises(TampError, match="check_ahead needs"):
+            dataclasses.replace(aware, check_ahead=True, **change)
 
 
 def test_random_suites_keep_the_problems_that_fit_the_scene():

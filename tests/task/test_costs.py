@@ -186,3 +186,85 @@ def test_own_state_prefix_keeps_the_first_move_and_stops_at_the_first_ruled_out(
     # an illegal move is left to `execute`, which names it
     illegal = (Move("a", "d"), Move("d", TABLE), Move("b", "c"))  # d is under a
     assert own_state_prefix(BW, UNSTACK, start, illegal, feasible) == illegal
+
+
+def test_own_state_prefix_ends_before_the_first_move_its_check_ahead_fails():
+    from task.planner.windows import own_state_prefix
+
+    start = BW.initial_state(UNSTACK)
+    moves = (Move("a", "d"), Move("b", "c"))
+    checked = []
+
+    def verify(state, move):
+        checked.append((state, move))
+        return move != Move("b", "c")
+
+    def fine(state, move):
+        return True
+
+    # the check ahead sees each move in the state it starts from, the first one too
+    assert own_state_prefix(BW, UNSTACK, start, moves, fine, verify) == (Move("a", "d"),)
+    after = BW.apply_move(UNSTACK, start, Move("a", "d"))
+    assert checked == [(start, Move("a", "d")), (after, Move("b", "c"))]
+    # a first move that fails its check ahead: nothing is kept
+    assert own_state_prefix(BW, UNSTACK, start, moves, fine, lambda s, m: False) == ()
+    # an illegal move is not checked: it is left to `execute`, which names it
+    illegal = (Move("b", "c"),)  # a is on b
+    assert own_state_prefix(BW, UNSTACK, start, illegal, fine, lambda s, m: False) == illegal
+
+
+@dataclass
+class CheckedCosts:
+    """Every move costs 1 and a to the table `EXPENSIVE`, so a onto d looks best; the source's
+    check ahead (`task.costs.CostSource`'s optional ``verify``) fails a onto d, which it then
+    prices out in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
+
+    lr: float = 0.0
+    matrix: torch.Tensor | None = None
+    refused: set = field(default_factory=set)
+    checked: list = field(default_factory=list)
+
+    def __call__(self, indices, states, restarts):
+        matrix = torch.ones((len(states), 4, 5))
+        matrix[:, A, TABLE_COL] = EXPENSIVE
+        for p, state in enumerate(states):
+            for s, move in self.refused:
+                if s == state:
+                    matrix[p, UNSTACK.entities.index(move.entity), UNSTACK.index(move.target)] = (
+                        IMPOSSIBLE
+                    )
+        self.matrix = matrix
+        return self
+
+    def compute(self):
+        return self.matrix
+
+    def parameters(self):
+        return []
+
+    def commit(self, rows, moves):
+        pass
+
+    def verify(self, index, state, move) -> bool:
+        self.checked.append(move)
+        if move == Move("a", "d"):
+            self.refused.add((state, move))
+            return False
+        return True
+
+
+def test_a_move_that_fails_the_check_ahead_is_replaced_before_anything_runs():
+    """The windows decode a onto d (cheapest), the check ahead fails it, and the next window
+    from the same state moves a to the table instead: the plan never holds a onto d, and
+    every move it holds was checked."""
+    config = PlannerConfig(lambda_motion=0.05, horizon=3, lookahead=3, max_windows=6)
+    unchecked = plan(UNSTACK, config, seed=0, costs=AfterCosts())
+    assert unchecked.plan.moves[0] == Move("a", "d")  # what the prices alone choose
+    source = CheckedCosts()
+    result = plan(UNSTACK, config, seed=0, costs=source)
+    assert result.solved
+    assert result.plan.moves == (Move("a", TABLE), Move("b", "c"))
+    assert Move("a", "d") in source.checked
+    assert set(result.plan.moves) <= set(source.checked)
+    off = plan(UNSTACK, replace(config, own_state_costs=False), seed=0, costs=CheckedCosts())
+    assert off.plan.moves[0] == Move("a", "d")  # the check ahead rides on own_state_costs
