@@ -224,15 +224,7 @@ class ArmCosts:
 
         key = (index, state, move)
         if key not in self._verified:
-            problem = self.problems[index]
-            at = None if self.places is None else self.places[index]
-            plain = state if at is None else tuple(TABLE if x in at else x for x in state)
-            bases = (
-                None
-                if at is None
-                else {x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at}
-            )
-            now = predict_poses(problem.entities, plain, self.poses[index], self.scene, bases)
+            at, _, now = self._predicted(index, state)
             planned = move if at is None else plain_move(move, at)
             self._verified[key] = ok = bool(self.check(now, planned))
             if not ok:
@@ -340,6 +332,24 @@ class ArmCosts:
         penalty = DETOUR if self.grasps else BLOCKED
         return penalty * (block_depths(self.solver, solved, blocks) > DEEP)
 
+    def _predicted(self, index: int, state: State):
+        """``(places, plain state, poses)`` of problem ``index`` in ``state``: its table
+        places (None without), the state with every place read as the table, and the block
+        poses predicted there (`predict_poses`, a tower on a place standing at its centre)."""
+        problem = self.problems[index]
+        at = None if self.places is None else self.places[index]
+        plain = state if at is None else tuple(TABLE if x in at else x for x in state)
+        bases = (
+            None
+            if at is None
+            else {x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at}
+        )
+        return (
+            at,
+            plain,
+            predict_poses(problem.entities, plain, self.poses[index], self.scene, bases),
+        )
+
     def _inputs(self, todo: list[tuple[int, State]]):
         """Picks (P, N, 3), places (P, Y, 3), the added costs (P, N, Y) of the pairs, their
         blocks as boxes (a turned block as its axis-aligned bounding box) and (P, N + Y) the
@@ -347,14 +357,8 @@ class ArmCosts:
         picks, places, extra, half, under, other = [], [], [], [], [], []
         s = self.scene.block_size
         for i, state in todo:
-            problem, at = self.problems[i], None if self.places is None else self.places[i]
-            plain = state if at is None else tuple(TABLE if x in at else x for x in state)
-            bases = (
-                None
-                if at is None
-                else {x: at[p] for x, p in zip(problem.entities, state, strict=True) if p in at}
-            )
-            now = predict_poses(problem.entities, plain, self.poses[i], self.scene, bases)
+            problem = self.problems[i]
+            at, plain, now = self._predicted(i, state)
             xyz = np.array([now[x].xyz for x in problem.entities])  # (N, 3)
             up = xyz + np.array([0.0, 0.0, s])  # onto each block
             if at is None:

@@ -239,6 +239,12 @@ def _geo(sim, solver, move, target, poses, config, scene, collision, seed, drop_
         return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
 
 
+def _geo_retries(failure: Failure, config: ExecConfig) -> bool:
+    """Whether the geometric fallback retries a top-down move that failed with ``failure``:
+    one of `GEO_RETRIED`, with the fallback on and the collision model planning detours."""
+    return failure in GEO_RETRIED and config.geo_fallback and config.collision == "plan"
+
+
 def motion_check(
     solver: IKSolver,
     move: Move,
@@ -258,7 +264,7 @@ def motion_check(
     planned = _plan(q_now, solver, move, poses, config, scene, collision, seed, times)
     if not (isinstance(planned, tuple) and isinstance(planned[0], Failure)):
         return None
-    if planned[0] in GEO_RETRIED and config.geo_fallback and config.collision == "plan":
+    if _geo_retries(planned[0], config):
         target = place_pose(move, poses, scene)
         if target is not None:
             from tamp.blocks_geo import geo_check, geo_tools
@@ -329,7 +335,7 @@ def execute_move(
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
     planned = _plan(sim.arm_q(), solver, move, poses, config, scene, collision, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
-        if planned[0] in GEO_RETRIED and config.geo_fallback and config.collision == "plan":
+        if _geo_retries(planned[0], config):
             target = place_pose(move, poses, scene)
             if target is not None:
                 again = _geo(

@@ -90,6 +90,7 @@ def _run(
     trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
     safe = [0] * len(problems)  # moves taken without a window (`PlannerConfig.safe_from`)
     own_state = costs is not None and source is None and config.own_state_costs
+    check_ahead = getattr(costs, "verify", None)  # the cost source's optional check ahead
     cut = [0] * len(problems)  # windows cut before a move priced out in its own state
     for _ in range(config.max_windows):
         if source is None and costs is None:
@@ -123,9 +124,7 @@ def _run(
             planned = win.moves
             if own_state:  # each move after the first priced where it starts
                 feasible, _ = cost_checks(domain, problems[i], costs, indices[i])
-                verify = getattr(costs, "verify", None)  # the source's optional check ahead
-                if verify is not None:
-                    verify = partial(verify, indices[i])
+                verify = None if check_ahead is None else partial(check_ahead, indices[i])
                 planned = own_state_prefix(
                     domain, problems[i], states[i], planned, feasible, verify
                 )

@@ -112,20 +112,22 @@ def test_the_weighted_motion_term_steers_the_logits():
 
 
 @dataclass
-class AfterCosts:
-    """A cost source whose prices depend on the state: b onto c is ruled out
-    (`IMPOSSIBLE`) while a sits on d (a's body in the way of b's hand, say); a to the table
-    costs `EXPENSIVE`, every other move 1."""
+class StateCosts:
+    """A cost source priced per state without placements: every move 1, a to the table
+    `EXPENSIVE`, and what ``ruled_out(state)`` names (entity row, target column) `IMPOSSIBLE`."""
 
     lr: float = 0.0
     matrix: torch.Tensor | None = None
+
+    def ruled_out(self, state) -> list[tuple[int, int]]:
+        return []
 
     def __call__(self, indices, states, restarts):
         matrix = torch.ones((len(states), 4, 5))
         matrix[:, A, TABLE_COL] = EXPENSIVE
         for p, state in enumerate(states):
-            if state[A] == "d":
-                matrix[p, 1, 2] = IMPOSSIBLE  # b -> c
+            for row, col in self.ruled_out(state):
+                matrix[p, row, col] = IMPOSSIBLE
         self.matrix = matrix
         return self
 
@@ -137,6 +139,15 @@ class AfterCosts:
 
     def commit(self, rows, moves):
         pass
+
+
+@dataclass
+class AfterCosts(StateCosts):
+    """Prices that depend on the state: b onto c is ruled out (`IMPOSSIBLE`) while a sits on
+    d (a's body in the way of b's hand, say)."""
+
+    def ruled_out(self, state) -> list[tuple[int, int]]:
+        return [(1, 2)] if state[A] == "d" else []  # b -> c
 
     def price(self, state, move) -> float:
         row, col = UNSTACK.entities.index(move.entity), UNSTACK.index(move.target)
@@ -214,36 +225,20 @@ def test_own_state_prefix_ends_before_the_first_move_its_check_ahead_fails():
 
 
 @dataclass
-class CheckedCosts:
-    """Every move costs 1 and a to the table `EXPENSIVE`, so a onto d looks best; the source's
-    check ahead (`task.costs.CostSource`'s optional ``verify``) fails a onto d, which it then
-    prices out in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
+class CheckedCosts(StateCosts):
+    """a onto d looks best (a to the table is `EXPENSIVE`); the source's check ahead
+    (`task.costs.CostSource`'s optional ``verify``) fails a onto d, which it then prices out
+    in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
 
-    lr: float = 0.0
-    matrix: torch.Tensor | None = None
     refused: set = field(default_factory=set)
     checked: list = field(default_factory=list)
 
-    def __call__(self, indices, states, restarts):
-        matrix = torch.ones((len(states), 4, 5))
-        matrix[:, A, TABLE_COL] = EXPENSIVE
-        for p, state in enumerate(states):
-            for s, move in self.refused:
-                if s == state:
-                    matrix[p, UNSTACK.entities.index(move.entity), UNSTACK.index(move.target)] = (
-                        IMPOSSIBLE
-                    )
-        self.matrix = matrix
-        return self
-
-    def compute(self):
-        return self.matrix
-
-    def parameters(self):
-        return []
-
-    def commit(self, rows, moves):
-        pass
+    def ruled_out(self, state) -> list[tuple[int, int]]:
+        return [
+            (UNSTACK.entities.index(move.entity), UNSTACK.index(move.target))
+            for s, move in self.refused
+            if s == state
+        ]
 
     def verify(self, index, state, move) -> bool:
         self.checked.append(move)
@@ -258,8 +253,6 @@ def test_a_move_that_fails_the_check_ahead_is_replaced_before_anything_runs():
     from the same state moves a to the table instead: the plan never holds a onto d, and
     every move it holds was checked."""
     config = PlannerConfig(lambda_motion=0.05, horizon=3, lookahead=3, max_windows=6)
-    unchecked = plan(UNSTACK, config, seed=0, costs=AfterCosts())
-    assert unchecked.plan.moves[0] == Move("a", "d")  # what the prices alone choose
     source = CheckedCosts()
     result = plan(UNSTACK, config, seed=0, costs=source)
     assert result.solved
@@ -267,4 +260,5 @@ def test_a_move_that_fails_the_check_ahead_is_replaced_before_anything_runs():
     assert Move("a", "d") in source.checked
     assert set(result.plan.moves) <= set(source.checked)
     off = plan(UNSTACK, replace(config, own_state_costs=False), seed=0, costs=CheckedCosts())
-    assert off.plan.moves[0] == Move("a", "d")  # the check ahead rides on own_state_costs
+    # the prices alone choose a onto d: the check ahead rides on own_state_costs
+    assert off.plan.moves[0] == Move("a", "d")
