@@ -136,6 +136,9 @@ def plan_on_places(
         stats = {"reason": why, "time_s": 0.0, "windows": 0}
         return PlanResult(PlanStatus.UNSOLVABLE, Plan(()), problem, stats=stats)
     current, at = slotted(problem, problem.init, poses, scene)
+    moved = room_goals(current, at, scene)
+    if moved:  # a goal tower's base stands where the tower has no room: it moves first
+        current = with_room(current, moved)
     costs = ArmCosts(
         [current],
         [poses],
@@ -154,7 +157,75 @@ def plan_on_places(
     if [m for m, _ in decided] != list(result.plan.moves):  # the planner commits every move
         raise RuntimeError("the planner's moves differ from those committed to the cost source")
     moves = tuple(plain_move(m, at, xy) for m, xy in decided)
-    return replace(result, plan=Plan(moves))
+    stats = dict(result.stats)
+    if moved:  # each moved base and the position of the place it was sent to
+        stats["room_goals"] = {x: at[p] for x, p in moved.items()}
+    return replace(result, plan=Plan(moves), stats=stats)
+
+
+def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> dict[str, str]:
+    """The goal towers of the slotted ``problem`` (its ``init``: the observed state, on the
+    places ``at``) whose base stands where the whole tower has no room (a slot under a board,
+    `SceneConfig.capacity`), each with the place it is to stand on instead: base -> place.
+
+    A Blocksworld goal names which block stands on which, rarely where a tower stands; the
+    windows and the fallback price each move in the state it is made, so a tower grows under
+    the board until its next block has no room, and only then must it come down again. Reading
+    the room from the geometry, as a robot would, the base's place is chosen here instead: the
+    places with room for the whole tower, not chosen for another tower nor holding a base that
+    stays, the least covered first, then the nearest. A base stays where it may stay (its goal
+    leaves its support free, or it is on the table already) and the tower has room (with the
+    blocks below the base); a tower every place has room for is left to the planner, and so is
+    a base with no place to go (the prices rule out every move onto a tower at its slot's
+    capacity)."""
+    goal = dict(problem.goal)
+    support = dict(zip(problem.entities, problem.init, strict=True))
+    above = {y: x for x, y in problem.goal if y in problem.entities}
+    room = {p: scene.capacity(xy) for p, xy in at.items() if p in problem.fixed}
+
+    def height(x: str) -> int:  # the goal tower from x up
+        n, seen = 1, {x}
+        while x in above and above[x] not in seen:
+            x = above[x]
+            n, seen = n + 1, seen | {x}
+        return n
+
+    def stand(x: str) -> tuple[str, int]:  # the place under x now and the blocks below x
+        below = 0
+        while support[x] in support:
+            x, below = support[x], below + 1
+        return support[x], below
+
+    bases = [x for x in above if goal.get(x, TABLE) in (TABLE, *problem.fixed)]
+    out: dict[str, str] = {}
+    stays: set[str] = set()
+    for base in bases:
+        place, below = stand(base)
+        if goal.get(base) in problem.fixed:  # the goal names its place: the planner's to keep
+            stays.add(goal[base])
+            continue
+        if (base not in goal or below == 0) and room.get(place, 0) >= height(base) + below:
+            stays.add(place)  # it may stay where it stands, and the tower has room there
+        elif any(room[p] < height(base) for p in room):  # not every place takes the tower
+            out[base] = ""
+    covered = {p: sum(stand(x)[0] == p for x in problem.entities) for p in room}
+    for base in sorted(out, key=height, reverse=True):  # the tallest chooses first
+        now = at[stand(base)[0]]  # every tower stands on one of the places
+        fits = [p for p in room if room[p] >= height(base) and p not in (*stays, *out.values())]
+        if not fits:
+            del out[base]
+            continue
+        out[base] = min(fits, key=lambda p: (covered[p], math.dist(at[p], now)))
+    return out
+
+
+def with_room(problem: Problem, moved: Mapping[str, str]) -> Problem:
+    """``problem`` with each base of ``moved`` (`room_goals`) to stand on its place (the goal
+    atom replaces any on the table). The table's places stay capacity-one slots a block never
+    moves between directly (the loop's plain problem has one table): a clear base on a low
+    slot goes to its place over another block."""
+    goal = tuple((x, y) for x, y in problem.goal if x not in moved) + tuple(moved.items())
+    return replace(problem, goal=goal)
 
 
 def goal_height(problem: Problem) -> int:

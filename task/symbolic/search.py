@@ -50,7 +50,8 @@ def _heuristic(state: _Code, goal: dict[int, int], claimed: dict[int, int]) -> i
             s = state[x]
             g = goal.get(x, s)
             met = g == s or (g == n and s > n)
-            must[x] = not met or (s < n and (claimed.get(s, x) != x or moves(s)))
+            taken = s != n and claimed.get(s, x) != x  # another block's goal support
+            must[x] = not met or taken or (s < n and moves(s))
         return bool(must[x])
 
     return sum(moves(x) for x in range(n))
@@ -62,7 +63,9 @@ def moves_lower_bound(problem: Problem, state: tuple[str, ...]) -> int:
     Table slots (`task.domains.blocksworld.slotted`) count as the table where the goal names
     the table (the bound ignores their capacity: a relaxation, so it stays admissible); a
     block whose goal is one slot must move while it stands anywhere else (the geometric
-    planner's region cells: without this the bound was blind to every cell goal)."""
+    planner's region cells: without this the bound was blind to every cell goal), and a block
+    standing on a slot another block's goal names must move too (a slot holds one tower: a base
+    sent to a place with room, `tamp.slots.room_goals`, needs that place cleared)."""
     names, goal, claimed = _bound_codes(problem)
     return _heuristic(tuple(names[s] for s in state), goal, claimed)
 
@@ -76,7 +79,7 @@ def _bound_codes(problem: Problem) -> tuple[dict[str, int], dict[int, int], dict
     names = {name: i if i < n else n + 1 + i for i, name in enumerate(problem.targets)}
     names[TABLE] = n
     goal = {names[x]: names[y] for x, y in problem.goal}
-    return names, goal, {y: x for x, y in goal.items() if y < n}
+    return names, goal, {y: x for x, y in goal.items() if y != n}
 
 
 def _successors(state: _Code) -> list[tuple[int, int]]:

@@ -124,7 +124,8 @@ def test_the_planner_keeps_within_the_slots_an_unlimited_plan_exceeds():
 
 def test_the_lower_bound_counts_a_block_off_its_goal_slot_and_not_one_on_any_slot():
     """A goal naming one slot (the geometric planner's region cells) needs a move while the
-    block stands on another; a goal of the table is met on any slot."""
+    block stands on another, and one of any other block standing on that slot; a goal of the
+    table is met on any other slot."""
     from dataclasses import replace
 
     from task.symbolic.search import moves_lower_bound
@@ -134,4 +135,7 @@ def test_the_lower_bound_counts_a_block_off_its_goal_slot_and_not_one_on_any_slo
     cell = replace(p, goal=(("c", "s2"), ("a", TABLE)))  # c wants s2, a anywhere on the table
     assert moves_lower_bound(cell, cell.init) == 2  # c is on s1; a is on b, not on a slot
     moved = bw.apply_move(cell, cell.init, Move("a", "s2"))
-    assert moves_lower_bound(cell, moved) == 1  # a on s2 meets its table goal; c still off s2
+    # a on s2 meets its table goal, but c's goal names s2: a must leave it, c must get there
+    assert moves_lower_bound(cell, moved) == 2
+    there = replace(cell, goal=(("c", "s1"), ("a", TABLE)))  # c already on its slot
+    assert moves_lower_bound(there, moved) == 0
