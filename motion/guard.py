@@ -68,6 +68,11 @@ class GuardConfig:
     # m, the margin of the vertical phases: a block lifted from beside a touching neighbour
     # slides along it, which is no collision
     vertical_margin: float = 0.002
+    # rad (the largest joint's move): a free-space phase that starts where the arm stands
+    # within the margin of something but clear of it at ``vertical_margin`` (where the last
+    # move left it, tracking included) is checked at that margin this near its start, so the
+    # arm may move off; MoveIt's start-state fix moves such a start to a valid state nearby
+    escape: float = 0.15
     dt: float = 0.002
 
 
@@ -170,6 +175,30 @@ def _margin(model: CollisionModel, value: float):
         model.margin = before
 
 
+def _escapes(model: CollisionModel, q0: np.ndarray, fingers: float, ignore, config) -> bool:
+    """Whether the arm at ``q0`` stands within the model's margin of something but clear of it
+    at ``config.vertical_margin`` (a free-space phase may move off, `GuardConfig.escape`)."""
+    if config.escape <= 0 or model.valid(q0, fingers, ignore):
+        return False
+    with _margin(model, min(model.margin, config.vertical_margin)):
+        return model.valid(q0, fingers, ignore)
+
+
+def _check_leaving(model: CollisionModel, path: np.ndarray, fingers, ignore, config, near: bool):
+    """``path`` (K, J) checked at the model's margin; with ``near`` (the arm stands within it
+    at the start, `_escapes`) its samples within ``config.escape`` of the start, up to the first
+    beyond, are checked at ``config.vertical_margin`` and the rest at the margin."""
+    if not near:
+        return _check_path(model, path, fingers, ignore, config.max_step)
+    beyond = np.abs(path - path[0]).max(axis=1) > config.escape  # (K,)
+    k = int(np.argmax(beyond)) if beyond.any() else len(path) - 1
+    with _margin(model, min(model.margin, config.vertical_margin)):
+        found = _check_path(model, path[: k + 1], fingers, ignore, config.max_step)
+    if not found.ok or k == len(path) - 1:
+        return found
+    return _check_path(model, path[k:], fingers, ignore, config.max_step)
+
+
 def _guard_phase(
     phase: Phase, model: CollisionModel, fingers: float, ignore, config: GuardConfig, seed: int
 ):
@@ -177,15 +206,12 @@ def _guard_phase(
     rerouted one, or None), the evidence of a collision, check and planning seconds."""
     start = time.perf_counter()
     free = phase.name in FREE_SPACE
+    path = thin(phase.trajectory.positions, config.max_step)
+    # a free-space phase may leave where the arm stands within the margin (`GuardConfig.escape`)
+    near = free and _escapes(model, path[0], fingers, ignore, config)
     # the vertical phases move straight up or down beside blocks the move touches
     with _margin(model, model.margin if free else min(model.margin, config.vertical_margin)):
-        found = _check_path(
-            model,
-            thin(phase.trajectory.positions, config.max_step),
-            fingers,
-            ignore,
-            config.max_step,
-        )
+        found = _check_leaving(model, path, fingers, ignore, config, near)
     t_check = time.perf_counter() - start
     if found.ok:
         return phase, {}, t_check, 0.0
@@ -204,14 +230,27 @@ def _guard_phase(
     rrt = replace(config.rrt or PathPlannerConfig(resolution=0.0015, simplify_time=5.0), seed=seed)
     q = phase.trajectory.positions  # (S, J)
 
+    low = min(model.margin, config.vertical_margin)  # about the start, when it may leave
+
     def valid(x: np.ndarray) -> bool:
-        return model.valid(x, fingers, ignore)
+        if model.valid(x, fingers, ignore):
+            return True
+        if not near or np.abs(x - q[0]).max() > config.escape:
+            return False
+        with _margin(model, low):
+            return model.valid(x, fingers, ignore)
 
     batch = None
     if getattr(model, "valid_batch", None) is not None:
 
         def batch(x: np.ndarray) -> np.ndarray:
-            return model.valid_batch(x, fingers, ignore)
+            ok = model.valid_batch(x, fingers, ignore)
+            if near:
+                again = ~ok & (np.abs(x - q[0]).max(axis=1) <= config.escape)
+                if again.any():
+                    with _margin(model, low):
+                        ok[again] = model.valid_batch(x[again], fingers, ignore)
+            return ok
 
     # plan with a wider berth: the planner checks only every ~0.02 rad
     with _margin(model, model.margin + config.plan_pad):
@@ -220,9 +259,8 @@ def _guard_phase(
         evidence |= {"planner": found_path.failure, "checks": found_path.checks}
         return None, evidence, t_check, found_path.time_s
     trajectory = path_trajectory(found_path.path, config.dt, limits=config.speed)
-    again = _check_path(
-        model, thin(trajectory.positions, config.max_step), fingers, ignore, config.max_step
-    )
+    detour = thin(trajectory.positions, config.max_step)
+    again = _check_leaving(model, detour, fingers, ignore, config, near)
     if not again.ok:  # the planner checks at its own resolution; this is the final word
         evidence |= {"planner": "detour_collides", "detour_other": again.contact.other}
         return None, evidence, t_check, found_path.time_s

@@ -175,3 +175,54 @@ def test_sphere_screening_gives_the_meshes_verdicts_and_skips_them_where_clear(
         assert counted.paths == 0
     else:
         assert counted.paths >= 1
+
+
+def _plate_below(model, q, gap: float, tcp_z: float) -> Box:
+    """A plate under the open hand at ``q`` (fingers down, the tool at height ``tcp_z``) with
+    its top ``gap`` m below the lowest point of the hand (found by bisection on the model's
+    verdict at margin 0)."""
+    lo, hi = 0.0, tcp_z + 0.03  # plate top heights (m): free at lo, in the fingers at hi
+    before = model.margin
+    model.margin = 0.0
+    model.hold(None)
+    try:
+        for _ in range(30):
+            mid = (lo + hi) / 2
+            model.set_boxes([Box("plate", (0.45, -0.2, mid - 0.005), (0.1, 0.1, 0.005))])
+            lo, hi = (mid, hi) if model.valid(q, 0.04) else (lo, mid)
+    finally:
+        model.margin = before
+    top = lo - gap
+    return Box("plate", (0.45, -0.2, top - 0.005), (0.1, 0.1, 0.005))
+
+
+def test_a_free_move_may_leave_where_the_arm_stands_within_the_margin(model):
+    """The arm left 6 mm above a plate (within the 10 mm margin, clear at the vertical 2 mm):
+    a free move up and away is allowed (`GuardConfig.escape`), the same move down toward it
+    is refused, and so is moving off from 1 mm (within even the vertical margin) or with the
+    escape off."""
+    from motion.ik import top_down_pose
+    from motion.trajectory import polyline_segment
+
+    solver = IKSolver()
+    tool = ((0.45, -0.2, 0.12), (0.45, -0.2, 0.30), (0.45, 0.2, 0.30))  # low, high, across
+    found = solver.solve(np.stack([top_down_pose(xyz, 0.0) for xyz in tool]), PANDA.q_home)
+    assert np.asarray(found.ok).all()
+    low, high, far = np.asarray(found.q)
+    up = polyline_segment(np.linspace(low, high, 20))
+    down = polyline_segment(np.linspace(high, low, 20))
+    near = _plate_below(model, low, 0.006, 0.12)
+    model.set_boxes([near])
+    model.hold(None)
+    assert not model.valid(low, 0.04)  # within the 10 mm margin where it stands
+    assert guard_free_move(up, model, [near], GuardConfig(plan=False)) is up
+    assert guard_free_move(down, model, [near], GuardConfig(plan=False)) is None
+    assert guard_free_move(up, model, [near], GuardConfig(plan=False, escape=0.0)) is None
+    touching = _plate_below(model, low, 0.001, 0.12)
+    assert guard_free_move(up, model, [touching], GuardConfig(plan=False)) is None
+    # the motion planner may start there too: the way across the wall is gone around
+    across = polyline_segment(np.linspace(low, far, 20))
+    routed = guard_free_move(across, model, [near, WALL], seed=1)
+    assert routed is not None and routed is not across
+    assert np.allclose(routed.positions[[0, -1]], across.positions[[0, -1]])
+    assert guard_free_move(across, model, [near, WALL], GuardConfig(escape=0.0), seed=1) is None
