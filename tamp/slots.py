@@ -196,26 +196,25 @@ def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> di
             x, below = support[x], below + 1
         return support[x], below
 
+    stands = {x: stand(x) for x in problem.entities}
     bases = [x for x in above if goal.get(x, TABLE) in (TABLE, *problem.fixed)]
-    out: dict[str, str] = {}
     stays: set[str] = set()
+    homeless = []
     for base in bases:
-        place, below = stand(base)
+        place, below = stands[base]
         if goal.get(base) in problem.fixed:  # the goal names its place: the planner's to keep
             stays.add(goal[base])
-            continue
-        if (base not in goal or below == 0) and room.get(place, 0) >= height(base) + below:
+        elif (base not in goal or below == 0) and room.get(place, 0) >= height(base) + below:
             stays.add(place)  # it may stay where it stands, and the tower has room there
         elif any(room[p] < height(base) for p in room):  # not every place takes the tower
-            out[base] = ""
-    covered = {p: sum(stand(x)[0] == p for x in problem.entities) for p in room}
-    for base in sorted(out, key=height, reverse=True):  # the tallest chooses first
-        now = at[stand(base)[0]]  # every tower stands on one of the places
+            homeless.append(base)
+    covered = {p: sum(at_place == p for at_place, _ in stands.values()) for p in room}
+    out: dict[str, str] = {}
+    for base in sorted(homeless, key=height, reverse=True):  # the tallest chooses first
+        now = at[stands[base][0]]  # every tower stands on one of the places
         fits = [p for p in room if room[p] >= height(base) and p not in (*stays, *out.values())]
-        if not fits:
-            del out[base]
-            continue
-        out[base] = min(fits, key=lambda p: (covered[p], math.dist(at[p], now)))
+        if fits:
+            out[base] = min(fits, key=lambda p: (covered[p], math.dist(at[p], now)))
     return out
 
 
