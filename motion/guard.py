@@ -175,12 +175,18 @@ def _margin(model: CollisionModel, value: float):
         model.margin = before
 
 
+def _low(model: CollisionModel, config: GuardConfig) -> float:
+    """The margin of the vertical phases and of a start the arm may leave: the model's margin
+    or ``config.vertical_margin``, whichever is smaller."""
+    return min(model.margin, config.vertical_margin)
+
+
 def _escapes(model: CollisionModel, q0: np.ndarray, fingers: float, ignore, config) -> bool:
     """Whether the arm at ``q0`` stands within the model's margin of something but clear of it
     at ``config.vertical_margin`` (a free-space phase may move off, `GuardConfig.escape`)."""
     if config.escape <= 0 or model.valid(q0, fingers, ignore):
         return False
-    with _margin(model, min(model.margin, config.vertical_margin)):
+    with _margin(model, _low(model, config)):
         return model.valid(q0, fingers, ignore)
 
 
@@ -192,7 +198,7 @@ def _check_leaving(model: CollisionModel, path: np.ndarray, fingers, ignore, con
         return _check_path(model, path, fingers, ignore, config.max_step)
     beyond = np.abs(path - path[0]).max(axis=1) > config.escape  # (K,)
     k = int(np.argmax(beyond)) if beyond.any() else len(path) - 1
-    with _margin(model, min(model.margin, config.vertical_margin)):
+    with _margin(model, _low(model, config)):
         found = _check_path(model, path[: k + 1], fingers, ignore, config.max_step)
     if not found.ok or k == len(path) - 1:
         return found
@@ -210,7 +216,7 @@ def _guard_phase(
     # a free-space phase may leave where the arm stands within the margin (`GuardConfig.escape`)
     near = free and _escapes(model, path[0], fingers, ignore, config)
     # the vertical phases move straight up or down beside blocks the move touches
-    with _margin(model, model.margin if free else min(model.margin, config.vertical_margin)):
+    with _margin(model, model.margin if free else _low(model, config)):
         found = _check_leaving(model, path, fingers, ignore, config, near)
     t_check = time.perf_counter() - start
     if found.ok:
@@ -230,7 +236,7 @@ def _guard_phase(
     rrt = replace(config.rrt or PathPlannerConfig(resolution=0.0015, simplify_time=5.0), seed=seed)
     q = phase.trajectory.positions  # (S, J)
 
-    low = min(model.margin, config.vertical_margin)  # about the start, when it may leave
+    low = _low(model, config)  # about the start, when it may leave
 
     def valid(x: np.ndarray) -> bool:
         if model.valid(x, fingers, ignore):

@@ -184,11 +184,7 @@ def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> di
     room = {p: scene.capacity(xy) for p, xy in at.items() if p in problem.fixed}
 
     def height(x: str) -> int:  # the goal tower from x up
-        n, seen = 1, {x}
-        while x in above and above[x] not in seen:
-            x = above[x]
-            n, seen = n + 1, seen | {x}
-        return n
+        return _chain(x, above)
 
     def stand(x: str) -> tuple[str, int]:  # the place under x now and the blocks below x
         below = 0
@@ -231,14 +227,17 @@ def goal_height(problem: Problem) -> int:
     """Blocks in the tallest tower ``problem``'s goal names: its longest chain of blocks
     each on the next (1 when the goal puts no block on another)."""
     below = {x: y for x, y in problem.goal if y in problem.entities}
-    tallest = 1
-    for x in problem.entities:
-        n, seen = 1, {x}
-        while x in below and below[x] not in seen:
-            x = below[x]
-            n, seen = n + 1, seen | {x}
-        tallest = max(tallest, n)
-    return tallest
+    return max((_chain(x, below) for x in problem.entities), default=1)
+
+
+def _chain(x: str, step: Mapping[str, str]) -> int:
+    """Blocks in the chain from ``x`` following ``step`` (the goal's block on x, or under it)
+    until it ends or comes back to a block already counted (a cyclic goal)."""
+    n, seen = 1, {x}
+    while x in step and step[x] not in seen:
+        x = step[x]
+        n, seen = n + 1, seen | {x}
+    return n
 
 
 def fits(problem: Problem, scene: SceneConfig) -> bool:
