@@ -183,9 +183,6 @@ def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> di
     above = {y: x for x, y in problem.goal if y in problem.entities}
     room = {p: scene.capacity(xy) for p, xy in at.items() if p in problem.fixed}
 
-    def height(x: str) -> int:  # the goal tower from x up
-        return _chain(x, above)
-
     def stand(x: str) -> tuple[str, int]:  # the place under x now and the blocks below x
         below = 0
         while support[x] in support:
@@ -194,21 +191,22 @@ def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> di
 
     stands = {x: stand(x) for x in problem.entities}
     bases = [x for x in above if goal.get(x, TABLE) in (TABLE, *problem.fixed)]
+    height = {x: _chain(x, above) for x in bases}  # the goal tower from each base up
     stays: set[str] = set()
     homeless = []
     for base in bases:
         place, below = stands[base]
         if goal.get(base) in problem.fixed:  # the goal names its place: the planner's to keep
             stays.add(goal[base])
-        elif (base not in goal or below == 0) and room.get(place, 0) >= height(base) + below:
+        elif (base not in goal or below == 0) and room.get(place, 0) >= height[base] + below:
             stays.add(place)  # it may stay where it stands, and the tower has room there
-        elif any(room[p] < height(base) for p in room):  # not every place takes the tower
+        elif any(room[p] < height[base] for p in room):  # not every place takes the tower
             homeless.append(base)
     covered = {p: sum(at_place == p for at_place, _ in stands.values()) for p in room}
     out: dict[str, str] = {}
-    for base in sorted(homeless, key=height, reverse=True):  # the tallest chooses first
+    for base in sorted(homeless, key=height.get, reverse=True):  # the tallest chooses first
         now = at[stands[base][0]]  # every tower stands on one of the places
-        fits = [p for p in room if room[p] >= height(base) and p not in (*stays, *out.values())]
+        fits = [p for p in room if room[p] >= height[base] and p not in (*stays, *out.values())]
         if fits:
             out[base] = min(fits, key=lambda p: (covered[p], math.dist(at[p], now)))
     return out
