@@ -264,6 +264,22 @@ class IKSolver:
             a.flags.writeable = False
         return out
 
+    def from_seeds(self, targets, seeds, iterations: int | None = None) -> IKResult:
+        """IK of each target ``targets[k]`` (B, 4, 4) from its own seed ``seeds[k]`` (B, J),
+        in one batch, with no retries: where it converges, the solution on that seed's
+        branch (other postures of the arm at one pose, from seeds spread over the joint
+        space). ``iterations``: at most that many steps (default ``config.max_iterations``);
+        ``ok`` also requires the datasheet limits."""
+        h = _as_float64(targets, (4, 4), "targets")  # (B, 4, 4)
+        qs = _as_float64(seeds, (self.dof,), "seeds")  # (B, J)
+        if qs.shape[0] != h.shape[0]:
+            raise MotionError(f"{qs.shape[0]} seeds for {h.shape[0]} targets")
+        q0 = np.clip(qs, self.q_min, self.q_max)
+        steps = self.config.max_iterations if iterations is None else iterations
+        q, pos_err, rot_err, conv = self._iterate(q0, h, steps)
+        ok = conv & self._inside(q)
+        return IKResult(ok=ok, q=q, pos_err=pos_err, rot_err=rot_err)
+
     def follow(self, targets, q_seed, iterations: int = 10) -> IKResult:
         """Batched Gauss-Newton IK from one seed ``q_seed`` (J,) for nearby ``targets`` (B, 4, 4).
 

@@ -14,8 +14,9 @@ so the scene's few slots stay the constraint they are. This module translates:
   each block's height is snapped to its level in the observed state, so the geometric reader's
   tight tolerances read the state the loop's looser reader read;
 - `blocks_goal`: a Blocksworld goal as the scene goal (``on`` / ``ontable`` atoms);
-- `geo_check`: one loop move checked over every grasp family without running it (the
-  loop's motion check of a planned move, `tamp.loop.execute.motion_check`);
+- `geo_check`: one loop move checked over every grasp family, and a colliding grasp in other
+  postures of the arm (`POSTURES`), without running it (the loop's motion check of a planned
+  move, `tamp.loop.execute.motion_check`);
 - `run_geo`: one loop move checked (every grasp family, blocked free-space phases rerouted) and run
   through `tamp.geo.check.check_move` and `tamp.geo.execute.run_move` in the loop's simulator,
   its outcome as the loop's `tamp.loop.execute.ExecutionResult`.
@@ -46,6 +47,11 @@ CHOICES = ("top", "side", "tilt")  # the grasp families the loop's geometric mov
 # 7-block tower's top moved to a near slot: the side grasp touched the table for 137 physics
 # steps, the tilted one touched nothing)
 FAMILY_RANK = {"top": 0, "tilt": 1, "side": 2}
+# seeds of other arm postures the loop's geometric moves try a colliding grasp in
+# (`tamp.geo.postures`): on the cramped table a block put down behind a 5-block tower cleared
+# it in 4 of 16 other postures of a top-down grasp, where the nearest posture of every grasp
+# hit the tower
+POSTURES = 16
 # geometric failures as the loop names them (a failure not listed: ik_infeasible, the arm
 # found no way to make the move)
 FAILURES = {
@@ -102,13 +108,22 @@ def blocks_goal(problem: Problem) -> Goal:
     return Goal(tuple(("ontable", x) if y == TABLE else ("on", x, y) for x, y in problem.goal))
 
 
-def geo_tools(solver, collision, guard, plan: bool = True, choices=CHOICES) -> Tools:
+def geo_tools(
+    solver, collision, guard, plan: bool = True, choices=CHOICES, postures: int = POSTURES
+) -> Tools:
     """`tamp.geo.check.Tools` over the loop's IK solver and collision model (not closed by the
     loop's `Episode.close` twice: do not call its ``close``); ``plan``: reroute blocked
-    free-space phases with the motion planner."""
+    free-space phases with the motion planner; ``postures``: seeds of the other arm postures
+    a colliding grasp is tried in (`tamp.geo.postures`)."""
     from tamp.geo.check import Tools
 
-    return Tools(solver, collision, guard=replace(guard, plan=plan), choices=tuple(choices))
+    return Tools(
+        solver,
+        collision,
+        guard=replace(guard, plan=plan),
+        choices=tuple(choices),
+        postures=postures,
+    )
 
 
 def geo_check(
@@ -182,18 +197,22 @@ def run_geo(
     below = next((x for x, p in poses.items() if _on(p, poses[move.entity], scene)), TABLE)
     rests = rests_of(world, geo, below)
     run = run_move(sim, geo, verdict, rests, RunConfig(), on_frame, drop_at)
-    grasp = verdict.grasp.name
+    # the grasp, and whether it passed in another posture of the arm (`tamp.geo.postures`)
+    held = {
+        "grasp": verdict.grasp.name,
+        **({"posture": True} if verdict.evidence.get("posture") else {}),
+    }
     if not run.ok:
-        return result(run.failure, run, grasp=grasp, **run.evidence)
+        return result(run.failure, run, **held, **run.evidence)
     if observe is None:
-        return result(None, run, grasp=grasp)
+        return result(None, run, **held)
     seen = observe()[move.entity]
     dxy = float(np.linalg.norm(seen.xy - np.asarray(geo.place.xyz[:2])))
     dz = abs(seen.xyz[2] - geo.place.xyz[2])
     if dxy > config.place_tol_xy or dz > config.place_tol_z:
-        out = result(None, run, grasp=grasp, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4))
+        out = result(None, run, **held, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4))
         return replace(out, ok=False, failure=Failure.MISPLACED)
-    return result(None, run, grasp=grasp)
+    return result(None, run, **held)
 
 
 def _family_rank(grasp) -> int:

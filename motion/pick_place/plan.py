@@ -250,17 +250,35 @@ def _cube_targets(
     return np.stack([top_down_pose(xyz, yaw) for xyz, yaw in xyz_yaw])  # (6, 4, 4)
 
 
-def _solve_waypoints(solver: IKSolver, targets: np.ndarray, q_now: np.ndarray, max_jump: float):
+def _solve_waypoints(
+    solver: IKSolver,
+    targets: np.ndarray,
+    q_now: np.ndarray,
+    max_jump: float,
+    seeds: tuple[np.ndarray, np.ndarray] | None = None,
+):
     """Batched IK, then re-solve from the previous waypoint where the joint path jumps (one
-    Gauss-Newton run from it) or fails (every seed again)."""
-    first = solver.solve(targets, q_now)
-    ok, q = first.ok.copy(), first.q.copy()  # (W,), (W, J)
-    pos_err, rot_err = first.pos_err.copy(), first.rot_err.copy()
+    Gauss-Newton run from it) or fails (every seed again). ``seeds``: the configurations the
+    pick's waypoints (pre-grasp, grasp, lift) and the place's (pre-place, place, retreat) are
+    solved from instead of ``q_now``, each side on its own branch (the transit between them
+    is free space)."""
+    if seeds is None:
+        first = solver.solve(targets, q_now)
+        starts = {0: q_now}
+        ok, q = first.ok.copy(), first.q.copy()  # (W,), (W, J)
+        pos_err, rot_err = first.pos_err.copy(), first.rot_err.copy()
+    else:
+        sides = [solver.solve(targets[:3], seeds[0]), solver.solve(targets[3:], seeds[1])]
+        starts = {0: np.asarray(seeds[0], float), 3: np.asarray(seeds[1], float)}
+        ok, q, pos_err, rot_err = (
+            np.concatenate([getattr(r, a) for r in sides])
+            for a in ("ok", "q", "pos_err", "rot_err")
+        )
     resolved = []
     for k in range(len(targets)):
-        prev = q_now if k == 0 else q[k - 1]
+        prev = starts[k] if k in starts else q[k - 1]
         jump = float(np.abs(q[k] - prev).max())
-        if (ok[k] and jump <= max_jump) or (k > 0 and not ok[k - 1]):
+        if (ok[k] and jump <= max_jump) or (k not in starts and not ok[k - 1]):
             continue  # fine as it is, or no valid previous solution to seed from
         if ok[k]:  # solved, but on another branch: Gauss-Newton from the previous waypoint
             again = solver.follow(targets[k : k + 1], prev, solver.config.max_iterations)
@@ -403,8 +421,14 @@ def plan_pick_place(
     q_now,
     request: PickPlaceRequest,
     config: PickPlaceConfig = PickPlaceConfig(),
+    seeds: tuple | None = None,
 ) -> MotionResult:
-    """Plan one move from the arm configuration ``q_now`` (J,); see the module docstring."""
+    """Plan one move from the arm configuration ``q_now`` (J,); see the module docstring.
+    ``seeds``: two configurations (J,) to solve the pick's and the place's waypoints from
+    instead of ``q_now``: another posture of the arm at the same hand poses (a 7-joint arm
+    reaches a pose along a one-parameter family; the nearest one to ``q_now`` may put the
+    forearm or wrist into a neighbour where another does not). The approach still starts at
+    ``q_now``, and the transit joins the two sides."""
     q_now = np.asarray(q_now, dtype=np.float64)
     if q_now.shape != (solver.dof,) or not np.isfinite(q_now).all():
         raise MotionError(f"q_now has shape {q_now.shape}; expected finite ({solver.dof},)")
@@ -422,8 +446,12 @@ def plan_pick_place(
         }
         return MotionResult(False, (), "no_clearance", evidence, grasp=grasp)
     start = time.perf_counter()
+    if seeds is not None:
+        seeds = tuple(np.asarray(x, dtype=np.float64) for x in seeds)
+        if len(seeds) != 2 or any(x.shape != (solver.dof,) for x in seeds):
+            raise MotionError(f"seeds must be two configurations of shape ({solver.dof},)")
     ok, q, pos_err, rot_err, resolved = _solve_waypoints(
-        solver, targets, q_now, config.max_joint_jump
+        solver, targets, q_now, config.max_joint_jump, seeds
     )
     ik_time = time.perf_counter() - start
     if not ok.all():

@@ -50,6 +50,8 @@ EPISODE_COLUMNS = (
     "first_plan_moves",
     "arm_path_rad",
     "failures",
+    "geo_moves",
+    "posture_moves",
 )
 
 
@@ -130,6 +132,10 @@ def summarise(
         "collided": sum(r.collided for r in reports),  # episodes whose arm touched something
         "touched": dict(sum((Counter(r.touched) for r in reports), Counter())),
         "rerouted": sum(bool(m.rerouted) for m in moves),  # moves run on a planner's detour
+        # moves the geometric fallback made (`tamp.blocks_geo`), and of those, in another
+        # posture of the arm than the nearest (`tamp.geo.postures`)
+        "geo_moves": sum(_geo(m) for m in moves),
+        "posture_moves": sum(_posture(m) for m in moves),
         "planner_failures": sum(m.planner_failures for m in moves),  # runs that found no way
         "arm_path_rad": sum(m.path_rad for m in moves) / max(len(reports), 1),  # per episode
         "plan_per_episode_s": sum(r.plan_time_s for r in reports) / max(len(reports), 1),
@@ -175,6 +181,16 @@ def _episode(item: tuple) -> EpisodeReport:
     return dataclasses.replace(report, problem=name)
 
 
+def _geo(move) -> bool:
+    """Whether the geometric fallback made ``move`` (an `ExecutionResult`)."""
+    return move.ok and move.evidence.get("geo") == "ok"
+
+
+def _posture(move) -> bool:
+    """Whether ``move`` was made in another posture of the arm than the nearest one."""
+    return _geo(move) and bool(move.evidence.get("posture"))
+
+
 def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
     """One ``episodes.csv`` row per episode (columns `EPISODE_COLUMNS`)."""
     return [
@@ -196,6 +212,8 @@ def episode_rows(reports: Sequence[EpisodeReport]) -> list[dict]:
             "first_plan_moves": len(r.first_plan),
             "arm_path_rad": round(sum(m.path_rad for m in r.moves), 3),
             "failures": " ".join(m.failure.value for m in r.moves if m.failure is not None),
+            "geo_moves": sum(_geo(m) for m in r.moves),
+            "posture_moves": sum(_posture(m) for m in r.moves),
         }
         for r in reports
     ]

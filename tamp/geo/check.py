@@ -9,6 +9,8 @@ the obstacles, the regions' walls and floors and the other objects as boxes, the
 included. The first grasp that passes wins. Before the full plan, one batched IK call solves
 the grasp and place poses of every candidate grasp and checks the arm there for collisions
 (`quick_check`): a grasp that fails there fails the full check too, so it is skipped cheaply.
+With `Tools` ``postures``, once every grasp failed, those that collided are tried again in
+other postures of the arm (`tamp.geo.postures`: the IK branch as a choice).
 
 Transit height: the hand carries the object over what stands near its way (objects and fixed
 boxes within `CORRIDOR` of the straight line from pick to place), not over the highest stack
@@ -87,7 +89,10 @@ class Tools:
     model for the motion planner's batches: `motion.sphere_check.Screened`), the pick-and-place and
     guard settings, the grasp families to try, and ``q`` (J,), the arm configuration moves are
     planned from (home unless told). ``guard.plan`` False: a blocked phase fails the move
-    rather than being rerouted by the motion planner (the search's default: fast)."""
+    rather than being rerouted by the motion planner (the search's default: fast).
+    ``postures`` > 0: a grasp that collides in the arm's nearest posture is tried again in
+    others found from that many seeds (`tamp.geo.postures`), after every grasp failed in
+    its nearest one; 0 (the search's default): never."""
 
     def __init__(
         self,
@@ -99,6 +104,7 @@ class Tools:
         margin: float = 0.01,
         choices: tuple[str, ...] = ("top", "side", "tilt"),
         quick: bool = True,
+        postures: int = 0,
     ) -> None:
         self.solver = solver or IKSolver()
         if collision is None:
@@ -111,6 +117,7 @@ class Tools:
         self.collision = collision
         self.q = np.asarray(PANDA.q_home if q is None else q, dtype=np.float64)
         self.pick_place, self.guard, self.choices, self.quick = pick_place, guard, choices, quick
+        self.postures = postures  # seeds of other arm postures for a colliding grasp (0: none)
         self.checks = 0  # check_move calls
         self.check_time_s = 0.0
 
@@ -348,6 +355,17 @@ def check_move(
             GraspTry(g.name, result["failure"], result["side"], where, ev.get("other", ""))
         )
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
+    if full and tools.postures > 0:  # the colliding grasps again, in other postures
+        from tamp.geo.postures import POSTURE_GRASPS, plan_postures
+
+        collided = [t.grasp for t in tried if t.failure == "collision"]
+        for g in [g for g in grasps if g.name in collided][:POSTURE_GRASPS]:
+            phases = plan_postures(scene, o, move, g, support, heights, tools, q, seed)
+            if phases is not None:
+                tried.append(GraspTry(g.name, None, where="posture"))
+                return verdict(
+                    ok=True, grasp=g, motion=phases, tried=tuple(tried), evidence={"posture": True}
+                )
     return verdict(ok=False, failure=last[0], evidence=last[1], tried=tuple(tried))
 
 

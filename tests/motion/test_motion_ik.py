@@ -156,3 +156,18 @@ def test_follow_tracks_a_vertical_line_on_one_branch(solver):
 def test_follow_reports_targets_it_cannot_reach(solver):
     far = top_down_pose((2.0, 0.0, 0.1), 0.0)[None]
     assert not solver.follow(far, np.asarray(PANDA.q_home)).ok[0]
+
+
+def test_from_seeds_solves_each_pose_on_its_own_seeds_branch(solver):
+    """Two seeds of one top-down pose: each converges to a solution of that pose near its own
+    seed (another posture of the arm), not to one answer for both."""
+    pose = top_down_pose((0.5, -0.1, 0.1), 0.0)
+    near = solver.solve(pose[None], PANDA.q_home).q[0]
+    other = near + np.array([-1.0, 0.0, 1.5, 0.0, 1.2, 0.0, 0.0])  # the elbow swung aside
+    found = solver.from_seeds(np.stack([pose, pose]), np.stack([near, other]))
+    assert found.ok.all()
+    np.testing.assert_allclose(solver.fk(found.q)[:, :3, 3], [pose[:3, 3]] * 2, atol=2e-4)
+    assert np.abs(found.q[0] - near).max() < 1e-3
+    assert np.abs(found.q[1] - found.q[0]).max() > 0.5  # a different posture of the same pose
+    with pytest.raises(MotionError, match="2 seeds for 1 targets"):
+        solver.from_seeds(pose[None], np.stack([near, other]))

@@ -292,3 +292,23 @@ def test_a_lower_split_short_of_the_place_stops_there_and_ends_where_it_did(plan
     assert 0.015 < cut[2, 3] - end[2, 3] <= 0.02
     np.testing.assert_allclose(cut[:2, 3], end[:2, 3], atol=1e-3)  # straight above the place
     assert split_lower(solver, rest, 0.05, CONFIG) is None  # it starts lower than that
+
+
+def test_seeds_plan_the_same_move_in_another_posture(solver):
+    """``seeds`` solve the pick's and the place's waypoints from other configurations: the
+    hand makes the same move (the same grasp and place poses) in another posture of the arm,
+    the approach still starting where the arm stands."""
+    req = REQUESTS["table_to_stack"]
+    nearest = plan_pick_place(solver, PANDA.q_home, req, CONFIG)
+    grasp = next(p for p in nearest.phases if p.name == "descend").trajectory.positions[-1]
+    place = next(p for p in nearest.phases if p.name == "lower").trajectory.positions[-1]
+    swing = np.array([-0.8, 0.0, 1.2, 0.0, 1.0, 0.0, 0.0])
+    other = plan_pick_place(solver, PANDA.q_home, req, CONFIG, seeds=(grasp + swing, place - swing))
+    assert other.ok, other.evidence
+    np.testing.assert_allclose(other.phases[0].trajectory.positions[0], PANDA.q_home)
+    for name, before in (("descend", grasp), ("lower", place)):
+        after = next(p for p in other.phases if p.name == name).trajectory.positions[-1]
+        np.testing.assert_allclose(solver.fk(after), solver.fk(before), atol=1e-3)
+        assert np.abs(after - before).max() > 0.3  # the same hand pose, another posture
+    with pytest.raises(MotionError, match="two configurations"):
+        plan_pick_place(solver, PANDA.q_home, req, CONFIG, seeds=(grasp,))
