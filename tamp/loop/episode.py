@@ -26,6 +26,7 @@ frame period and ``on_frame`` (a video) keeps the period the simulator had when 
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from collections import Counter
 from collections.abc import Callable, Mapping
@@ -35,6 +36,7 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
+from perception.errors import PerceptionError
 from tamp.arm_costs import ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
@@ -390,11 +392,14 @@ class Episode:
             p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
             return
         p.state = reading.state
-        if done.ok and p.state == expected:
+        elsewhere = done.ok and self._elsewhere(move)
+        if done.ok and p.state == expected and not elsewhere:
             return
         p.queue = []
         p.replans += 1
         why = describe(done) if not done.ok else "the state differs from the plan"
+        if done.ok and p.state == expected:  # the plan's later moves assumed the named place
+            why = f"{move.entity} went to another table place than the planned {elsewhere}"
         self.say(f"replan {p.replans}: {why}")
         if out_of_reach(p.moves):
             p.stop(EpisodeStatus.OUT_OF_REACH, why)
@@ -403,6 +408,23 @@ class Episode:
                 EpisodeStatus.REPLAN_BUDGET,
                 f"more than {self.config.max_replans} replans; last: {why}",
             )
+
+    def _elsewhere(self, move: Move) -> str | None:
+        """The table place a move that named one (`tamp.slots.PlacedMove`) was planned to, when
+        the block was observed standing elsewhere after it (the executor tried the next free
+        slots: the top-down hand could not put it there), else None. The plan's later moves
+        were priced with the block there, and the slots have different room (a shelf over
+        one takes a lower tower), so the rest of the plan no longer holds."""
+        at = getattr(move, "at", None)
+        if at is None:
+            return None
+        try:
+            seen = self._poses()[move.entity]
+        except PerceptionError:
+            return None  # the reading already decided
+        if math.dist(seen.xy, at) <= self.config.scene.slot_radius:
+            return None
+        return getattr(move, "place", None) or f"({at[0]:.2f}, {at[1]:.2f})"
 
     # --- acting and sensing ----------------------------------------------------------------
     def _act(self, move: Move, label: str, drop_at: float | None = None) -> ExecutionResult:
