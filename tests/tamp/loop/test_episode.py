@@ -209,3 +209,33 @@ def test_the_camera_refuses_more_blocks_than_it_has_colours_before_any_simulator
     problem = Problem("nine", "blocksworld", names, (TABLE,) * 9, (("a", "b"),))
     with pytest.raises(TampError, match="camera tells at most 8"):
         Episode(problem, LoopConfig(observe="camera"))
+
+
+@pytest.mark.sim
+def test_a_block_left_on_another_table_place_than_planned_triggers_a_replan(monkeypatch):
+    """A move that named a table place (`PlacedMove`) and went through, but left its block on
+    another slot (the executor's next free one): the state is the planned one, yet the plan's
+    later moves assumed the block on its place, so the loop replans and says why. A block on
+    its place, or a move onto a block, goes on."""
+    from tamp.scene import Reading
+    from tamp.slots import PlacedMove
+
+    episode = Episode(THREE, LoopConfig(), seed=0)
+    try:
+        seen = {x: Pose((0.40, 0.12 * k, 0.025)) for k, x in enumerate(THREE.entities)}
+        seen["b"] = Pose((0.40, 0.0, 0.025))  # b stands on the table, at (0.40, 0.00)
+        monkeypatch.setattr(episode, "_poses", lambda: seen)
+        state = (TABLE, TABLE, TABLE)
+        monkeypatch.setattr(episode, "observe", lambda: Reading(state))
+        there = PlacedMove("b", TABLE, (0.40, 0.0), "slot1")
+        away = PlacedMove("b", TABLE, (0.56, 0.12), "slot3")
+        assert episode._elsewhere(there) is None
+        assert episode._elsewhere(away) == "slot3"
+        assert episode._elsewhere(Move("b", "c")) is None
+        for move, replans in ((there, 0), (Move("b", "c"), 0), (away, 1)):
+            p = Progress(state, first_solved=True, queue=[A_B])
+            episode.check(p, move, ExecutionResult(move, True), state)
+            assert p.replans == replans and p.queue == ([] if replans else [A_B])
+            assert not p.stopped
+    finally:
+        episode.sim.close()
