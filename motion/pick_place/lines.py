@@ -53,6 +53,18 @@ def _walk(solver: IKSolver, knots: np.ndarray, q0: np.ndarray) -> np.ndarray | N
     return np.stack(path)
 
 
+def line_path(
+    solver: IKSolver, pose_a: np.ndarray, pose_b: np.ndarray, q_a, step: float
+) -> np.ndarray | None:
+    """Joint knots (K, J) from ``q_a`` (a solution of ``pose_a``) along the straight line to
+    ``pose_b`` (same rotation), one IK point every ``step`` m on ``q_a``'s branch; None where
+    that branch cannot follow the line. Unlike `vertical_path`, no other branch and no plain
+    joint segment: the path of that one posture of the arm (`tamp.geo.postures`)."""
+    q_a = np.asarray(q_a, dtype=np.float64)
+    knots = _line_knots(pose_a, pose_b, step)  # (n, 4, 4)
+    return _walk(solver, knots, q_a) if len(knots) else q_a[None]
+
+
 def bow(solver: IKSolver, path: np.ndarray, samples: int = 30) -> float:
     """How far (m) the TCP strays from the straight line between its two ends along the
     piecewise linear joint ``path`` (K, J), sampled ``samples`` times per segment."""

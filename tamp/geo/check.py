@@ -200,7 +200,9 @@ def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
     return float(np.linalg.norm(p - (a + t * ab)))
 
 
-def _request(o: Movable, move: GeoMove, grasp: Grasp, clear_z: float, scene: Scene):
+def pick_place_request(o: Movable, move: GeoMove, grasp: Grasp, clear_z: float, scene: Scene):
+    """The `PickPlaceRequest` of moving ``o`` as ``move`` says, held by ``grasp``, its transit
+    over ``clear_z``, under the ceilings over the pick and the place."""
     place = move.place
     common = (
         o.pose.xyz,
@@ -240,7 +242,9 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
     targets = []
     for g in grasps:
-        wp = waypoint_targets(_request(o, move, g, heights[0], scene), hand, tools.pick_place)
+        wp = waypoint_targets(
+            pick_place_request(o, move, g, heights[0], scene), hand, tools.pick_place
+        )
         targets += [wp[1], wp[4]]  # grasp, place
     found = tools.solver.solve(np.stack(targets), q)  # (2G,)
     support = support_box(scene, dict(read_facts(scene).supports).get(o.name, TABLE))
@@ -374,7 +378,7 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
     its side and evidence; the transit goes over the near things, then over everything."""
     failure = None
     for clear_z in heights:
-        request = _request(o, move, g, clear_z, scene)
+        request = pick_place_request(o, move, g, clear_z, scene)
         planned = plan_pick_place(tools.solver, q, request, tools.pick_place)
         if not planned.ok:
             bad = planned.evidence.get("waypoint", "")

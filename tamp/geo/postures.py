@@ -42,6 +42,7 @@ import numpy as np
 from motion.guard import guard_pick_place, hold_picked
 from motion.ik import pose_yaw
 from motion.pick_place import plan_pick_place, waypoint_targets
+from motion.pick_place.lines import line_path
 
 POSTURE_STD = 1.0  # rad per joint: the spread of the seeds about the arm's configuration
 POSTURE_PAIRS = 6  # pick-and-place postures planned and guarded at most, per grasp and height
@@ -71,17 +72,15 @@ def _distinct(solutions: list[tuple[int, np.ndarray]]) -> list[tuple[int, np.nda
 def _clear_lines(model, ends, lines, fingers: float, ignore, tools) -> list:
     """The postures ``ends`` ((seed index, (J,)) at the common low end of ``lines``) whose arm
     stays clear along every straight line of ``lines`` ((4, 4) low end, (4, 4) high end)
-    walked up on its own branch (`motion.pick_place.lines`), at the model's current margin
-    and held object."""
-    from motion.pick_place.lines import _line_knots, _walk
-
-    knots = [_line_knots(a, b, tools.pick_place.vertical_step) for a, b in lines]
+    followed up on its own branch (`motion.pick_place.lines.line_path`), at the model's
+    current margin and held object."""
+    step = tools.pick_place.vertical_step
     out = []
     for k, q_end in ends:
         if not model.valid(q_end, fingers, ignore):
             continue
-        for line in knots:
-            path = _walk(tools.solver, line, q_end) if len(line) else q_end[None]
+        for low, high in lines:
+            path = line_path(tools.solver, low, high, q_end, step)
             if path is None:
                 break
             if not model.check_path(path, fingers, ignore, tools.guard.max_step).ok:
@@ -132,21 +131,21 @@ def plan_postures(scene, o, move, grasp, support, heights, tools, q, seed: int =
     """The guarded phases of ``move`` with ``grasp`` in another posture of the arm (see the
     module docstring), or None when no pair tried passes. ``heights``: the transit heights to
     try (`tamp.geo.check.transit_heights`); ``q`` (J,): where the arm stands."""
-    from tamp.geo.check import _request, pick_place_world
+    from tamp.geo.check import pick_place_request, pick_place_world
 
     q = np.asarray(q, dtype=np.float64)
     quick = replace(tools.guard, plan=False)
     world = pick_place_world(scene, o, move, grasp, support)
     # the grasp and place poses do not depend on the transit height: screened once, up to
     # the lowest hover
-    request = _request(o, move, grasp, heights[0], scene)
+    request = pick_place_request(o, move, grasp, heights[0], scene)
     picks, places = clear_postures(scene, o, move, grasp, support, request, tools, q, seed)
     pairs = sorted(
         ((a, b) for a in picks for b in places if a[0] or b[0]),  # not the nearest pair
         key=lambda ab: np.linalg.norm(ab[0][1] - q) + np.linalg.norm(ab[1][1] - ab[0][1]),
     )[:POSTURE_PAIRS]
     for clear_z in heights:
-        request = _request(o, move, grasp, clear_z, scene)
+        request = pick_place_request(o, move, grasp, clear_z, scene)
         for (_, pick), (_, place) in pairs:
             planned = plan_pick_place(
                 tools.solver, q, request, tools.pick_place, seeds=(pick, place)
