@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts, FailedMove
+from tamp.arm_costs import BLOCKED, ArmCosts, FailedMove
 from tamp.scene import Pose, SceneConfig, SceneError, layout
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
@@ -156,11 +156,35 @@ def plan_on_places(
     decided = costs.decided(0)
     if [m for m, _ in decided] != list(result.plan.moves):  # the planner commits every move
         raise RuntimeError("the planner's moves differ from those committed to the cost source")
-    moves = tuple(plain_move(m, at, xy) for m, xy in decided)
     stats = dict(result.stats)
+    if reach == 0 and result.status is PlanStatus.SOLVED:  # each move onto a place's centre
+        merged = _merge_runs(current, [m for m, _ in decided], costs)
+        if len(merged) < len(decided):
+            stats["merged_runs"] = len(decided) - len(merged)
+            decided = [(m, at.get(m.target)) for m in merged]
+    moves = tuple(plain_move(m, at, xy) for m, xy in decided)
     if moved:  # each moved base and the position of the place it was sent to
         stats["room_goals"] = {x: at[p] for x, p in moved.items()}
     return replace(result, plan=Plan(moves), stats=stats)
+
+
+def _merge_runs(problem: Problem, moves: Sequence[Move], costs: ArmCosts) -> tuple:
+    """``moves`` (a plan of the slotted ``problem`` from its initial state) with each run of one
+    block's moves made one move where the same state follows and the arm's prices leave that
+    move open where it is made (`task.symbolic.shorten.merge_runs`): the receding windows
+    commit their moves one by one, and a block parked twice or three times in a row costs the
+    arm a pick-and-place each time. The fallback search's plans are merged so already."""
+    from task.domains import get_domain
+    from task.symbolic.shorten import merge_runs
+
+    domain = get_domain(problem.domain)
+
+    def open_(state, move: Move) -> bool:
+        matrix = costs([0], [state]).compute()[0]  # (N, Y), priced once per state
+        e, j = problem.entities.index(move.entity), problem.targets.index(move.target)
+        return float(matrix[e, j]) < BLOCKED
+
+    return merge_runs(domain, problem, problem.init, moves, open_)
 
 
 def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> dict[str, str]:
