@@ -343,3 +343,21 @@ def test_a_goal_tower_taller_than_the_scene_takes_is_unsolvable_at_once(solver, 
     )
     seven = dataclasses.replace(eight, goal=chain[1:])  # b on ... on h
     assert goal_height(seven) == 7
+
+
+def test_a_block_parked_twice_in_a_row_moves_once_where_the_arm_may(solver):
+    """The windows commit moves one by one, so a plan may move a block twice in a row:
+    `_merge_runs` makes the run one move where the same state follows and the arm's prices
+    leave that move open, and leaves it where they rule the move out (a failure there)."""
+    from tamp.slots import _merge_runs
+
+    poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
+    problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
+    run = [Move("a", "slot2"), Move("a", "d"), Move("b", "c")]
+    costs = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
+    assert _merge_runs(problem, run, costs) == (Move("a", "d"), Move("b", "c"))
+    back = [Move("a", "slot2"), Move("a", "b"), Move("a", "d"), Move("b", "c")]
+    assert _merge_runs(problem, back, costs) == (Move("a", "d"), Move("b", "c"))
+    avoid = {FOUR.init: {failed_key(Move("a", "d"))}}  # a onto d failed in the initial state
+    priced = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], avoid=avoid)
+    assert _merge_runs(problem, run, priced) == tuple(run)
