@@ -151,6 +151,25 @@ def hold_picked(model: CollisionModel, world: PickPlaceWorld | None) -> None:
         model.hold(half=tuple(half), pose=pose)
 
 
+def path_clear(
+    path: np.ndarray,
+    model: CollisionModel,
+    world: PickPlaceWorld,
+    phase: str,
+    config: GuardConfig = GuardConfig(),
+) -> bool:
+    """Whether the joint path ``path`` (K, J), not yet a timed phase, is clear as the guard
+    checks phase ``phase`` of the move in ``world``: its boxes, held object, fingers and
+    allowed contacts, a vertical phase at the vertical margin (a screen for paths a planner
+    considers before it plans them, `tamp.geo.postures`). Leaves the model set for it."""
+    boxes, held, fingers, ignore = _situation(phase, world, config.open_width)
+    model.set_boxes(boxes)
+    hold_picked(model, world if held else None)
+    low = model.margin if phase in FREE_SPACE else _low(model, config)
+    with _margin(model, low):
+        return _check_path(model, path, fingers, ignore, config.max_step).ok
+
+
 def _check_path(model: CollisionModel, path: np.ndarray, fingers: float, ignore, step: float):
     """``model.check_path(path, fingers, ignore, step)`` (a `robots.collision.PathCheck`),
     screened by ``model.valid_batch`` when the model has one: a path the conservative batch

@@ -21,7 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 from motion.ik import IKSolver
-from tamp.arm_costs import BLOCKED, ArmCosts, FailedMove
+from tamp.arm_costs import ArmCosts, FailedMove
 from tamp.scene import Pose, SceneConfig, SceneError, layout
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
@@ -171,20 +171,17 @@ def plan_on_places(
 def _merge_runs(problem: Problem, moves: Sequence[Move], costs: ArmCosts) -> tuple:
     """``moves`` (a plan of the slotted ``problem`` from its initial state) with each run of one
     block's moves made one move where the same state follows and the arm's prices leave that
-    move open where it is made (`task.symbolic.shorten.merge_runs`): the receding windows
-    commit their moves one by one, and a block parked twice or three times in a row costs the
-    arm a pick-and-place each time. The fallback search's plans are merged so already."""
+    move open where it is made (`task.symbolic.shorten.merge_runs` with the cost source's
+    `task.planner.fallback.cost_checks`): the receding windows commit their moves one by one,
+    and a block parked twice or three times in a row costs the arm a pick-and-place each
+    time. The fallback search's plans are merged so already."""
     from task.domains import get_domain
+    from task.planner.fallback import cost_checks
     from task.symbolic.shorten import merge_runs
 
     domain = get_domain(problem.domain)
-
-    def open_(state, move: Move) -> bool:
-        matrix = costs([0], [state]).compute()[0]  # (N, Y), priced once per state
-        e, j = problem.entities.index(move.entity), problem.targets.index(move.target)
-        return float(matrix[e, j]) < BLOCKED
-
-    return merge_runs(domain, problem, problem.init, moves, open_)
+    feasible, _ = cost_checks(domain, problem, costs, 0)
+    return merge_runs(domain, problem, problem.init, moves, feasible)
 
 
 def room_goals(problem: Problem, at: Mapping[str, XY], scene: SceneConfig) -> dict[str, str]:

@@ -39,13 +39,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from motion.guard import guard_pick_place, hold_picked
+from motion.guard import guard_pick_place, path_clear
 from motion.ik import pose_yaw
 from motion.pick_place import plan_pick_place, waypoint_targets
 from motion.pick_place.lines import line_path
 
 POSTURE_STD = 1.0  # rad per joint: the spread of the seeds about the arm's configuration
-POSTURE_PAIRS = 6  # pick-and-place postures planned and guarded at most, per grasp and height
+POSTURE_PAIRS = 6  # pick-and-place posture pairs per grasp, each planned at every transit height
 POSTURE_GRASPS = 4  # colliding grasps of one check tried in other postures at most
 SAME = 0.1  # rad (the largest joint's difference): two solutions of one pose are one posture
 VERTICAL = ("descend", "lift", "lower", "retreat")
@@ -69,61 +69,44 @@ def _distinct(solutions: list[tuple[int, np.ndarray]]) -> list[tuple[int, np.nda
     return kept
 
 
-def _clear_lines(model, ends, lines, fingers: float, ignore, tools) -> list:
+def _clear_lines(ends, lines, world, phase: str, tools) -> list:
     """The postures ``ends`` ((seed index, (J,)) at the common low end of ``lines``) whose arm
     stays clear along every straight line of ``lines`` ((4, 4) low end, (4, 4) high end)
-    followed up on its own branch (`motion.pick_place.lines.line_path`), at the model's
-    current margin and held object."""
-    step = tools.pick_place.vertical_step
-    out = []
+    followed up on its own branch (`motion.pick_place.lines.line_path`), checked as the guard
+    checks ``phase`` of the move in ``world`` (`motion.guard.path_clear`)."""
+    step, out = tools.pick_place.vertical_step, []
     for k, q_end in ends:
-        if not model.valid(q_end, fingers, ignore):
-            continue
+        if not path_clear(q_end[None], tools.collision, world, phase, tools.guard):
+            continue  # clear at its end first: no line walked for a posture that is not
         for low, high in lines:
             path = line_path(tools.solver, low, high, q_end, step)
-            if path is None:
-                break
-            if not model.check_path(path, fingers, ignore, tools.guard.max_step).ok:
+            if path is None or not path_clear(path, tools.collision, world, phase, tools.guard):
                 break
         else:
             out.append((k, q_end))
     return out
 
 
-def clear_postures(scene, o, move, grasp, support, request, tools, q, seed: int):
+def clear_postures(world, request, tools, q, seed: int):
     """The distinct clear postures ((seed index, (J,)) lists) of the pick side at the grasp
-    pose and of the place side at the place pose of ``request`` (steps 1 and 2 of the
-    module docstring): clear there and along the vertical line above, the descent for the
-    pick and the lowering for the place."""
-    from tamp.geo.check import pick_place_world
-
-    solver, model = tools.solver, tools.collision
+    pose and of the place side at the place pose of ``request``, the move in ``world`` (a
+    `motion.guard.PickPlaceWorld`; steps 1 and 2 of the module docstring): clear there and
+    along the straight lines above, the descent and the lift for the pick (both as the
+    descent is checked: the open hand around the object) and the lowering for the place."""
+    solver = tools.solver
     hand = pose_yaw(solver.fk(q)[0])
     targets = waypoint_targets(request, hand, tools.pick_place)  # (6, 4, 4)
     pair = targets[[1, 4]]  # the grasp and the place
-    world = pick_place_world(scene, o, move, grasp, support)
     starts = posture_seeds(q, tools.postures, seed)  # (S, J)
     s = len(starts)
     found = solver.from_seeds(np.repeat(pair, s, axis=0), np.tile(starts, (2, 1)))  # (2S,)
     picks = _distinct([(k, found.q[k].copy()) for k in range(s) if found.ok[k]])
     places = _distinct([(k, found.q[s + k].copy()) for k in range(s) if found.ok[s + k]])
-    before = model.margin
-    try:
-        model.margin = min(before, tools.guard.vertical_margin)
-        model.set_boxes(world.boxes)
-        model.hold(None)
-        ignore = (("hand", o.name),)
-        # the descent and the lift, from the grasp up (the lift with the open hand: a screen)
-        up = [(targets[1], targets[0]), (targets[1], targets[2])]
-        picks = _clear_lines(model, picks, up, tools.guard.open_width, ignore, tools)
-        model.set_boxes(tuple(b for b in world.boxes if b.name != o.name))
-        hold_picked(model, world)
-        grip, ignore = grasp.width / 2, (("held", world.placed_on),)
-        lower = [(targets[4], targets[3])]  # the lowering, from the place up
-        places = _clear_lines(model, places, lower, grip, ignore, tools) if picks else []
-    finally:
-        model.margin = before
-        model.hold(None)
+    up = [(targets[1], targets[0]), (targets[1], targets[2])]  # the descent and the lift
+    picks = _clear_lines(picks, up, world, "descend", tools)
+    lower = [(targets[4], targets[3])]  # the lowering, from the place up
+    places = _clear_lines(places, lower, world, "lower", tools) if picks else []
+    tools.collision.hold(None)
     return picks, places
 
 
@@ -139,7 +122,7 @@ def plan_postures(scene, o, move, grasp, support, heights, tools, q, seed: int =
     # the grasp and place poses do not depend on the transit height: screened once, up to
     # the lowest hover
     request = pick_place_request(o, move, grasp, heights[0], scene)
-    picks, places = clear_postures(scene, o, move, grasp, support, request, tools, q, seed)
+    picks, places = clear_postures(world, request, tools, q, seed)
     pairs = sorted(
         ((a, b) for a in picks for b in places if a[0] or b[0]),  # not the nearest pair
         key=lambda ab: np.linalg.norm(ab[0][1] - q) + np.linalg.norm(ab[1][1] - ab[0][1]),

@@ -26,7 +26,6 @@ frame period and ``on_frame`` (a video) keeps the period the simulator had when 
 from __future__ import annotations
 
 import dataclasses
-import math
 import time
 from collections import Counter
 from collections.abc import Callable, Mapping
@@ -36,7 +35,6 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
-from perception.errors import PerceptionError
 from tamp.arm_costs import ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
@@ -392,7 +390,7 @@ class Episode:
             p.stop(EpisodeStatus.UNREADABLE, "; ".join(reading.issues))
             return
         p.state = reading.state
-        elsewhere = done.ok and self._elsewhere(move)
+        elsewhere = self._elsewhere(move, done)
         if done.ok and p.state == expected and not elsewhere:
             return
         p.queue = []
@@ -409,21 +407,16 @@ class Episode:
                 f"more than {self.config.max_replans} replans; last: {why}",
             )
 
-    def _elsewhere(self, move: Move) -> str | None:
+    @staticmethod
+    def _elsewhere(move: Move, done: ExecutionResult) -> str | None:
         """The table place a move that named one (`tamp.slots.PlacedMove`) was planned to, when
-        the block was observed standing elsewhere after it (the executor tried the next free
-        slots: the top-down hand could not put it there), else None. The plan's later moves
-        were priced with the block there, and the slots have different room (a shelf over
-        one takes a lower tower), so the rest of the plan no longer holds."""
-        at = getattr(move, "at", None)
-        if at is None:
+        the executor put the block on another one (``placed_at`` in ``done``'s evidence,
+        `tamp.loop.execute.placed_elsewhere`), else None. The plan's later moves were priced
+        with the block there, and the slots have different room (a shelf over one takes a
+        lower tower), so the rest of the plan no longer holds."""
+        if not done.ok or "placed_at" not in done.evidence:
             return None
-        try:
-            seen = self._poses()[move.entity]
-        except PerceptionError:
-            return None  # the reading already decided
-        if math.dist(seen.xy, at) <= self.config.scene.slot_radius:
-            return None
+        at = move.at
         return getattr(move, "place", None) or f"({at[0]:.2f}, {at[1]:.2f})"
 
     # --- acting and sensing ----------------------------------------------------------------

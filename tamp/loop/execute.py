@@ -275,6 +275,17 @@ def motion_check(
     return planned[0]
 
 
+def placed_elsewhere(move: Move, target: Pose) -> dict:
+    """``{"placed_at": (x, y)}`` when ``move`` named a table place (`tamp.slots.PlacedMove`)
+    and the executor put the block on another one, ``target`` (the next free slot: the
+    top-down hand could not reach the named one, or it was taken), else ``{}``: evidence of a
+    move that went through but not where its plan had it (`tamp.loop.episode`)."""
+    at = getattr(move, "at", None)
+    if at is None or float(np.hypot(*np.subtract(target.xy, at))) <= 1e-6:
+        return {}
+    return {"placed_at": (round(float(target.xyz[0]), 4), round(float(target.xyz[1]), 4))}
+
+
 def failed_pick(done: ExecutionResult) -> bool:
     """Whether ``done`` failed to pick its block with every grasp, before the arm moved: the
     top-down pick (its IK or its approach and descent) and every grasp of the geometric
@@ -353,8 +364,10 @@ def execute_move(
                 )
                 if again.ok or again.path_rad > 0:  # it made the move, or it ran and failed
                     first = result(planned[0], planned[1])  # the top-down tries' times
+                    moved = placed_elsewhere(move, target) if again.ok else {}
                     return replace(
                         again,
+                        evidence={**again.evidence, **moved},
                         sim_time_s=first.sim_time_s,
                         wall_time_s=first.wall_time_s,
                         ik_time_s=first.ik_time_s,
@@ -415,4 +428,4 @@ def execute_move(
             off_z_m=round(dz, 4),
             target=[round(v, 4) for v in target.xyz],
         )
-    return result(None, ik, tracking_rad=round(worst, 4))
+    return result(None, ik, tracking_rad=round(worst, 4), **placed_elsewhere(move, target))

@@ -5,6 +5,7 @@ replanning, observation noise, an unreachable block, and a loose block tidied aw
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -211,30 +212,42 @@ def test_the_camera_refuses_more_blocks_than_it_has_colours_before_any_simulator
         Episode(problem, LoopConfig(observe="camera"))
 
 
+def test_the_executor_says_when_it_put_a_block_on_another_table_place_than_named():
+    from tamp.loop.execute import placed_elsewhere
+    from tamp.slots import PlacedMove
+
+    named = PlacedMove("b", TABLE, (0.40, 0.0), "slot1")
+    assert placed_elsewhere(named, Pose((0.40, 0.0, 0.025))) == {}
+    assert placed_elsewhere(named, Pose((0.56, 0.12, 0.025))) == {"placed_at": (0.56, 0.12)}
+    assert placed_elsewhere(Move("b", TABLE), Pose((0.56, 0.12, 0.025))) == {}
+
+
 @pytest.mark.sim
 def test_a_block_left_on_another_table_place_than_planned_triggers_a_replan(monkeypatch):
-    """A move that named a table place (`PlacedMove`) and went through, but left its block on
-    another slot (the executor's next free one): the state is the planned one, yet the plan's
-    later moves assumed the block on its place, so the loop replans and says why. A block on
-    its place, or a move onto a block, goes on."""
+    """A move that named a table place (`PlacedMove`) and went through, but whose block the
+    executor put on another slot (``placed_at``: the next free one): the state is the planned
+    one, yet the plan's later moves assumed the block on its place, so the loop replans and
+    says why. A block put on its place, or a move onto a block, goes on."""
     from tamp.scene import Reading
     from tamp.slots import PlacedMove
 
     episode = Episode(THREE, LoopConfig(), seed=0)
     try:
-        seen = {x: Pose((0.40, 0.12 * k, 0.025)) for k, x in enumerate(THREE.entities)}
-        seen["b"] = Pose((0.40, 0.0, 0.025))  # b stands on the table, at (0.40, 0.00)
-        monkeypatch.setattr(episode, "_poses", lambda: seen)
         state = (TABLE, TABLE, TABLE)
         monkeypatch.setattr(episode, "observe", lambda: Reading(state))
         there = PlacedMove("b", TABLE, (0.40, 0.0), "slot1")
-        away = PlacedMove("b", TABLE, (0.56, 0.12), "slot3")
-        assert episode._elsewhere(there) is None
-        assert episode._elsewhere(away) == "slot3"
-        assert episode._elsewhere(Move("b", "c")) is None
-        for move, replans in ((there, 0), (Move("b", "c"), 0), (away, 1)):
+        away = ExecutionResult(there, True, evidence={"placed_at": (0.56, 0.12)})
+        assert episode._elsewhere(there, ExecutionResult(there, True)) is None
+        assert episode._elsewhere(there, away) == "slot1"
+        assert episode._elsewhere(there, replace(away, ok=False)) is None
+        cases = (
+            (ExecutionResult(there, True), 0),
+            (ExecutionResult(Move("b", "c"), True), 0),
+            (away, 1),
+        )
+        for done, replans in cases:
             p = Progress(state, first_solved=True, queue=[A_B])
-            episode.check(p, move, ExecutionResult(move, True), state)
+            episode.check(p, done.move, done, state)
             assert p.replans == replans and p.queue == ([] if replans else [A_B])
             assert not p.stopped
     finally:
