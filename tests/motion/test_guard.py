@@ -226,3 +226,19 @@ def test_a_free_move_may_leave_where_the_arm_stands_within_the_margin(model):
     assert routed is not None and routed is not across
     assert np.allclose(routed.positions[[0, -1]], across.positions[[0, -1]])
     assert guard_free_move(across, model, [near, WALL], GuardConfig(escape=0.0), seed=1) is None
+
+
+def test_a_path_is_clear_or_not_as_the_guard_checks_its_phase(model, planned):
+    """`path_clear` screens a joint path before it is a phase, as the guard would check it:
+    the transit's path through the wall is blocked, the same path in a free scene clear, and
+    the descent clear beside a far block but not with a neighbour an open finger passes
+    through."""
+    from motion.guard import path_clear
+
+    path = {p.name: thin(p.trajectory.positions, 0.02) for p in planned}
+    assert not path_clear(path["transit"], model, _world(WALL), "transit")
+    assert path_clear(path["transit"], model, _world(), "transit")
+    side = Box("b", (PICK[0], PICK[1] + 0.045, 0.025), HALF)
+    fine = Box("c", (PICK[0] + 0.3, PICK[1], 0.025), HALF)
+    assert path_clear(path["descend"], model, _world(fine), "descend")
+    assert not path_clear(path["descend"], model, _world(side), "descend")
