@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Protocol
 import numpy as np
 
 from motion.pick_place import Phase
-from motion.trajectory import TRANSIT, SpeedLimits, polyline_segment
+from motion.trajectory import APPROACH, TRANSIT, SpeedLimits, polyline_segment, thin
 
 if TYPE_CHECKING:
     from motion.grasps import Grasp
@@ -111,16 +111,6 @@ class Guarded:
     check_time_s: float = 0.0
     plan_time_s: float = 0.0
     planner_runs: int = 0  # motion-planner runs, whether or not they found a detour
-
-
-def thin(positions: np.ndarray, step: float) -> np.ndarray:
-    """The samples (K, J) of a densely sampled joint path (S, J) about ``step`` rad apart (the
-    first and last kept): a trajectory sampled every 2 ms repeats nearly the same
-    configuration many times, and the checker interpolates between what is kept."""
-    moved = np.abs(np.diff(positions, axis=0)).max(axis=1)  # (S-1,)
-    ticks = np.floor(np.concatenate([[0.0], np.cumsum(moved)]) / step)  # (S,)
-    keep = np.flatnonzero(np.diff(ticks, prepend=-1.0) > 0)
-    return positions[np.unique(np.concatenate([keep, [len(positions) - 1]]))]
 
 
 def _situation(name: str, world: PickPlaceWorld, open_width: float):
@@ -301,8 +291,6 @@ def at_rest(phase: Phase, step: float = 0.002) -> Phase:
     """``phase`` re-timed rest to rest along the same path (its samples ``step`` rad apart as
     knots), with the limits it was timed with (`motion.trajectory.APPROACH` when unknown); the
     phase itself when it already starts and ends at rest."""
-    from motion.trajectory import APPROACH
-
     trajectory = phase.trajectory
     if not np.abs(trajectory.velocities[[0, -1]]).any():
         return phase

@@ -24,6 +24,9 @@ acceleration limit within 32 ms (joint 2) and keeps every ramp smooth at the 2 m
 MoveIt's ``panda_moveit_config`` uses about 25% of the accelerations on a real arm, whose
 tracking is worse than a simulator's; the friction grasp holds at these values in both
 simulators (`tests/tamp/loop`).
+
+`thin` takes a densely sampled joint path back to knots about a step apart, so that a timed
+phase can be checked (`motion.guard`) or re-timed along the same path.
 """
 
 from __future__ import annotations
@@ -181,6 +184,16 @@ def direction_at(path, end: int) -> np.ndarray:
         return np.zeros(path.shape[1])
     k = moving[0] if end == 0 else moving[-1]
     return d[k] / seg[k]
+
+
+def thin(positions: np.ndarray, step: float) -> np.ndarray:
+    """The samples (K, J) of a densely sampled joint path (S, J) about ``step`` rad apart (the
+    first and last kept): a trajectory sampled every 2 ms repeats nearly the same
+    configuration many times, and the checker interpolates between what is kept."""
+    moved = np.abs(np.diff(positions, axis=0)).max(axis=1)  # (S-1,)
+    ticks = np.floor(np.concatenate([[0.0], np.cumsum(moved)]) / step)  # (S,)
+    keep = np.flatnonzero(np.diff(ticks, prepend=-1.0) > 0)
+    return positions[np.unique(np.concatenate([keep, [len(positions) - 1]]))]
 
 
 def straight_segment(

@@ -11,7 +11,7 @@ from motion.errors import MotionError
 from motion.ik import IKSolver
 from motion.pick_place.lines import vertical_path
 from motion.pick_place.plan import Phase, PickPlaceConfig
-from motion.trajectory import JointTrajectory, polyline_segment
+from motion.trajectory import JointTrajectory, polyline_segment, thin
 
 
 def corrected_place(
@@ -70,8 +70,6 @@ def split_lower(
     over its end: two ``lower`` phases along the same joint path, each rest to rest (the hand
     stops there, e.g. to look at what it holds once more); None when the phase does not come
     down from higher than that."""
-    from motion.guard import thin  # the guard imports this module
-
     knots = thin(lower.trajectory.positions, 0.002)  # (K, J)
     z = solver.fk(knots)[:, 2, 3]  # (K,)
     cut = int(np.argmax(z <= z[-1] + above))  # the first knot that low

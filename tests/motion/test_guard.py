@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motion.guard import GuardConfig, PickPlaceWorld, guard_free_move, guard_pick_place, thin
+from motion.guard import GuardConfig, PickPlaceWorld, guard_free_move, guard_pick_place
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceRequest, plan_pick_place
+from motion.trajectory import thin
 from robots.collision import Box, PandaCollision
 from robots.panda import PANDA
 
