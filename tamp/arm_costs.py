@@ -36,7 +36,7 @@ import torch
 from motion.cost import Blocks, MoveCostConfig, block_depths, move_costs_batch, site_solutions
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceConfig
-from tamp.scene import Pose, SceneConfig, free_slot, read_state, towers
+from tamp.scene import XY, Pose, SceneConfig, free_slot, plain_move, read_state, towers
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem
@@ -101,9 +101,6 @@ def predict_poses(
         for level, x in enumerate(tower):
             out[x] = Pose((slot[0], slot[1], s / 2 + level * s), 0.0)
     return out
-
-
-XY = tuple[float, float]
 
 
 class _Fixed:
@@ -220,8 +217,6 @@ class ArmCosts:
         One check per (problem, state, move)."""
         if self.check is None or self.reach > 0:
             return True
-        from tamp.slots import plain_move  # tamp.slots builds on this module
-
         key = (index, state, move)
         if key not in self._verified:
             at, _, now = self._predicted(index, state)
@@ -539,7 +534,7 @@ class FailedMove:
 
 def failed_key(move) -> tuple[str, object]:
     """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
-    ("at", place, x, y) for a move onto a planned table place (`tamp.slots.PlacedMove`: the
+    ("at", place, x, y) for a move onto a planned table place (`tamp.scene.PlacedMove`: the
     place's name and the position the block was to go to, to the mm)."""
     at = getattr(move, "at", None)
     if at is not None:

@@ -4,7 +4,8 @@ Blocks are cubes (5 cm by default), or upright cylinders as tall as they are wid
 colours from the scene's palette; ``SceneConfig.bodies`` may give any entity its own solid
 (`Body`: a cube, cuboid or cylinder of any size), which the simulators build. Each tower
 stands on a *table slot*, a fixed grid of positions in front of the robot; a block moved onto
-the table goes to a free slot. ``layout`` turns a state into poses (with small seeded jitter);
+the table goes to a free slot, or to the place a plan named for it (`PlacedMove`, made by
+`plain_move` from a move onto a planner's table place, `tamp.slots`). ``layout`` turns a state into poses (with small seeded jitter);
 ``read_state`` turns observed poses into a state, with tolerances, and says which block it
 cannot explain.
 
@@ -16,7 +17,7 @@ from __future__ import annotations
 import colorsys
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -42,6 +43,7 @@ PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
 CAMERA_COLOURS = 8  # blocks that camera perception can tell apart by colour
 SHAPES = ("cube", "cylinder")
 BODY_KINDS = ("cube", "cuboid", "cylinder")
+XY = tuple[float, float]  # a position on the table (x, y), m
 
 
 class SceneError(TampError):
@@ -328,12 +330,30 @@ def free_slots(
     )
 
 
+@dataclass(frozen=True)
+class PlacedMove(Move):
+    """A move onto the table with the table position ``at`` (x, y) the plan chose for it, at
+    the planner's table place named ``place`` (None: not planned on places)."""
+
+    at: XY | None = field(default=None, compare=False)
+    place: str | None = field(default=None, compare=False)
+
+
+def plain_move(move: Move, at: Mapping[str, XY], where: XY | None = None) -> Move:
+    """A planned move onto a place as a move onto the table at that place (`PlacedMove`):
+    at ``where`` when given (the position its window decided), else at the place's centre."""
+    if move.target in at:
+        xy = at[move.target] if where is None else where
+        return PlacedMove(move.entity, TABLE, xy, move.target)
+    return move
+
+
 def place_pose(
     move: Move, poses: Mapping[str, Pose], config: SceneConfig = SceneConfig(), rank: int = 0
 ) -> Pose | None:
     """Where the moved block's centre should end: on top of the target block, or on a free
     table slot, the ``rank``-th best (None when the table has no more free slots); a move
-    that names its table place (``move.at``, `tamp.slots.PlacedMove`) tries that first."""
+    that names its table place (``move.at``, `PlacedMove`) tries that first."""
     if move.entity not in poses:
         raise ProblemError(f"unknown block {one_of(move.entity, sorted(poses))}")
     s = config.block_size

@@ -8,36 +8,25 @@ its place. A tower standing off every slot (nudged, or laid out elsewhere) keeps
 named ``spot_<base>``, which other towers may use once it is empty. The observed state reads
 each tower base's place from its observed pose, nothing else.
 
-The loop stays on the plain problem: `plain_move` turns a planned move onto a place into a
-move onto the table that carries the place's name and position (`PlacedMove.at`: with
-continuous placements, the position its window decided), where the executor puts the block
-(`tamp.scene.place_pose`).
+The loop stays on the plain problem: `tamp.scene.plain_move` turns a planned move onto a place
+into a move onto the table that carries the place's name and position
+(`tamp.scene.PlacedMove.at`: with continuous placements, the position its window decided),
+where the executor puts the block (`tamp.scene.place_pose`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 
 from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts, FailedMove
-from tamp.scene import Pose, SceneConfig, SceneError, layout
+from tamp.scene import XY, Pose, SceneConfig, SceneError, layout, plain_move
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
 from task.planner import plan
 from task.problem import TABLE, Move, Plan, PlanResult, PlanStatus, Problem
-
-XY = tuple[float, float]
-
-
-@dataclass(frozen=True)
-class PlacedMove(Move):
-    """A move onto the table with the table position ``at`` (x, y) the plan chose for it, at
-    the planner's table place named ``place`` (None: not planned on places)."""
-
-    at: XY | None = field(default=None, compare=False)
-    place: str | None = field(default=None, compare=False)
 
 
 def places(
@@ -89,15 +78,6 @@ def slotted(
         data=problem.data,
     )
     return with_slots(current, tuple(at), where), at
-
-
-def plain_move(move: Move, at: Mapping[str, XY], where: XY | None = None) -> Move:
-    """A planned move onto a place as a move onto the table at that place (`PlacedMove`):
-    at ``where`` when given (the position its window decided), else at the place's centre."""
-    if move.target in at:
-        xy = at[move.target] if where is None else where
-        return PlacedMove(move.entity, TABLE, xy, move.target)
-    return move
 
 
 def plan_on_places(

@@ -409,7 +409,7 @@ class Episode:
 
     @staticmethod
     def _elsewhere(move: Move, done: ExecutionResult) -> str | None:
-        """The table place a move that named one (`tamp.slots.PlacedMove`) was planned to, when
+        """The table place a move that named one (`tamp.scene.PlacedMove`) was planned to, when
         the executor put the block on another one (``placed_at`` in ``done``'s evidence,
         `tamp.loop.execute.placed_elsewhere`), else None. The plan's later moves were priced
         with the block there, and the slots have different room (a shelf over one takes a

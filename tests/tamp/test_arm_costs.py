@@ -67,7 +67,8 @@ def test_a_motion_aware_episode_takes_the_move_the_arm_prefers(solver):
     """a must leave b: onto d or onto the table, two moves either way. Planning for the task
     alone, this episode (seed 0) puts a onto d; with the arm's costs it puts a on a table
     place that the arm prices below a onto d, at that place's centre, and both moves run."""
-    from tamp.slots import PlacedMove, slotted
+    from tamp.scene import PlacedMove
+    from tamp.slots import slotted
 
     config = LoopConfig(planner=PlannerConfig(lambda_motion=0.05))
     report = run_episode(FOUR, config, seed=0, solver=solver)

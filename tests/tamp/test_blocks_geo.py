@@ -15,8 +15,8 @@ from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, DETOUR, ArmCosts
 from tamp.blocks_geo import CHOICES, blocks_goal, world_scene
 from tamp.obstacles import with_scene
-from tamp.scene import Pose, SceneConfig, layout, read_state
-from tamp.slots import PlacedMove, slotted
+from tamp.scene import PlacedMove, Pose, SceneConfig, layout, read_state
+from tamp.slots import slotted
 from tamp.world.relations import read_facts
 from task.problem import TABLE, Problem
 

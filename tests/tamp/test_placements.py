@@ -11,8 +11,8 @@ import torch
 from motion.ik import IKSolver
 from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, ArmCosts, failed_key
-from tamp.scene import layout
-from tamp.slots import PlacedMove, slotted
+from tamp.scene import PlacedMove, layout
+from tamp.slots import slotted
 from task.problem import TABLE, Move
 from tests.tamp.test_arm_costs import FOUR, SCENE
 

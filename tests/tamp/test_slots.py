@@ -16,8 +16,8 @@ from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, ArmCosts, failed_key
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
-from tamp.scene import Pose, SceneConfig, layout, place_pose
-from tamp.slots import PlacedMove, places, plain_move, plan_on_places, slotted
+from tamp.scene import PlacedMove, Pose, SceneConfig, layout, place_pose, plain_move
+from tamp.slots import places, plan_on_places, slotted
 from task.config import PlannerConfig
 from task.domains import blocksworld as bw
 from task.problem import TABLE, Move, Problem

@@ -214,7 +214,7 @@ def test_the_camera_refuses_more_blocks_than_it_has_colours_before_any_simulator
 
 def test_the_executor_says_when_it_put_a_block_on_another_table_place_than_named():
     from tamp.loop.execute import placed_elsewhere
-    from tamp.slots import PlacedMove
+    from tamp.scene import PlacedMove
 
     named = PlacedMove("b", TABLE, (0.40, 0.0), "slot1")
     assert placed_elsewhere(named, Pose((0.40, 0.0, 0.025))) == {}
@@ -228,8 +228,7 @@ def test_a_block_left_on_another_table_place_than_planned_triggers_a_replan(monk
     executor put on another slot (``placed_at``: the next free one): the state is the planned
     one, yet the plan's later moves assumed the block on its place, so the loop replans and
     says why. A block put on its place, or a move onto a block, goes on."""
-    from tamp.scene import Reading
-    from tamp.slots import PlacedMove
+    from tamp.scene import PlacedMove, Reading
 
     episode = Episode(THREE, LoopConfig(), seed=0)
     try:
