@@ -2,7 +2,7 @@
 
 `VideoWriter` writes the frames it is given as they come, so a long episode never holds its
 video in memory. `EpisodeVideo` records an episode off its physics loop's critical path: a frame
-is a `tamp.sim.base.Snapshot` of the world (joint positions and block poses, a few hundred
+is a `tamp.sim.truth.Snapshot` of the world (joint positions and block poses, a few hundred
 bytes, read through the simulator's ground truth under its ``recording()`` grant) sent to a
 spawned process, which poses its own copy of the world (``video=True``),
 renders it at `VIDEO_SIZE` with ``render_video`` and writes it. The episode's simulator, and so

@@ -22,14 +22,14 @@ import abc
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, NamedTuple
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
     from motion.trajectory import JointTrajectory
 from tamp.scene import Body, Pose, SceneConfig, cube_yaw
-from tamp.sim.truth import GroundTruth
+from tamp.sim.truth import GroundTruth, Snapshot
 from task.errors import TampError, one_of
 
 SIMULATORS = ("pybullet", "mujoco")
@@ -117,16 +117,6 @@ class Expected:
     handled: str | None = None
     held: str | None = None
     rests: frozenset[str] = frozenset()
-
-
-class Snapshot(NamedTuple):
-    """What a video frame shows (`GroundTruth.snapshot`, `Simulator.show`), in any backend:
-    arm and finger joint positions (J + 2,), block centres (N, 3) and orientations (N, 4) as
-    quaternions (w, x, y, z), blocks in ``entities`` order."""
-
-    joints: np.ndarray
-    centres: np.ndarray
-    quats: np.ndarray
 
 
 class Simulator(abc.ABC):

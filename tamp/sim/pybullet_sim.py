@@ -38,10 +38,10 @@ from tamp.sim.base import (
     GripperReading,
     Lighting,
     Simulator,
-    Snapshot,
     body_mass,
     body_yaw,
 )
+from tamp.sim.truth import Snapshot
 from task.errors import TampError
 
 FINGER_FORCE = 40.0  # N per finger

@@ -27,16 +27,25 @@ import sys
 from collections import Counter
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from typing import TYPE_CHECKING
+from typing import NamedTuple
+
+import numpy as np
 
 from tamp.scene import Pose, SceneConfig, read_state
 from task.errors import TampError
 
-if TYPE_CHECKING:
-    from tamp.sim.base import Snapshot
-
 GRANTS = ("scoring", "experimenter", "oracle", "recording")
 RULE = "simulator ground truth only scores episodes"
+
+
+class Snapshot(NamedTuple):
+    """What a video frame shows (`GroundTruth.snapshot`, `tamp.sim.base.Simulator.show`), in
+    any backend: arm and finger joint positions (J + 2,), block centres (N, 3) and orientations
+    (N, 4) as quaternions (w, x, y, z), blocks in ``entities`` order."""
+
+    joints: np.ndarray
+    centres: np.ndarray
+    quats: np.ndarray
 
 
 class GroundTruthLeak(TampError):
@@ -132,7 +141,7 @@ class GroundTruth:
         return read_state(entities, self._read_poses(), scene).state
 
     def snapshot(self) -> Snapshot:
-        """The arm, fingers and true block poses now (`tamp.sim.base.Snapshot`), what a video
+        """The arm, fingers and true block poses now (`Snapshot`), what a video
         frame shows; raises `GroundTruthLeak` outside a grant when locked."""
         self._check("snapshot")
         if self._read_snapshot is None:

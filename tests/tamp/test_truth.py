@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from tamp.scene import Pose
-from tamp.sim.base import GripperReading, Simulator, Snapshot
-from tamp.sim.truth import GRANTS, RULE, GroundTruth, GroundTruthLeak
+from tamp.sim.base import GripperReading, Simulator
+from tamp.sim.truth import GRANTS, RULE, GroundTruth, GroundTruthLeak, Snapshot
 from task.problem import TABLE
 
 ROOT = Path(__file__).resolve().parents[2]
