@@ -37,9 +37,16 @@ from motion.grasps import Grasp, object_frame
 from motion.grasps import grasps as make_grasps
 from motion.guard import GuardConfig, PickPlaceWorld, guard_pick_place, hold_picked
 from motion.ik import IKSolver, pose_yaw
-from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pick_place
+from motion.pick_place import (
+    Phase,
+    PickPlaceConfig,
+    PickPlaceRequest,
+    plan_pick_place,
+    waypoint_targets,
+)
 from robots.panda import PANDA
 from tamp.geo.places import free, placed_solid
+from tamp.geo.postures import POSTURE_GRASPS, plan_postures
 from tamp.geo.types import TABLE, GeoMove, moved
 from tamp.obstacles import ceiling
 from tamp.world.geometry import Solid, fixed_solids, footprint_gap, of_movable
@@ -234,8 +241,6 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
     around the object at the grasp, the held object at the place). Returns grasp name ->
     None (passes) or (failure, side, evidence). A grasp this rules out fails `check_move` too
     (the full plan solves these poses and checks these configurations among others)."""
-    from motion.pick_place import waypoint_targets
-
     o = scene.object(move.obj)
     q = tools.q if q_now is None else np.asarray(q_now, dtype=np.float64)
     hand = pose_yaw(tools.solver.fk(q)[0])
@@ -360,11 +365,11 @@ def check_move(
         )
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
     if full and tools.postures > 0:  # the colliding grasps again, in other postures
-        from tamp.geo.postures import POSTURE_GRASPS, plan_postures
-
         collided = [t.grasp for t in tried if t.failure == "collision"]
         for g in [g for g in grasps if g.name in collided][:POSTURE_GRASPS]:
-            phases = plan_postures(scene, o, move, g, support, heights, tools, q, seed)
+            world = pick_place_world(scene, o, move, g, support)
+            requests = [pick_place_request(o, move, g, z, scene) for z in heights]
+            phases = plan_postures(world, requests, tools, q, seed)
             if phases is not None:
                 tried.append(GraspTry(g.name, None, where="posture"))
                 return verdict(

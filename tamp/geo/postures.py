@@ -110,25 +110,22 @@ def clear_postures(world, request, tools, q, seed: int):
     return picks, places
 
 
-def plan_postures(scene, o, move, grasp, support, heights, tools, q, seed: int = 0):
-    """The guarded phases of ``move`` with ``grasp`` in another posture of the arm (see the
-    module docstring), or None when no pair tried passes. ``heights``: the transit heights to
-    try (`tamp.geo.check.transit_heights`); ``q`` (J,): where the arm stands."""
-    from tamp.geo.check import pick_place_request, pick_place_world
-
+def plan_postures(world, requests, tools, q, seed: int = 0):
+    """The guarded phases of one move with one grasp in another posture of the arm (see the
+    module docstring), or None when no pair tried passes. ``world``: the guard's
+    `motion.guard.PickPlaceWorld` of the move; ``requests``: its `PickPlaceRequest` at each
+    transit height to try, lowest first (`tamp.geo.check.transit_heights`); ``q`` (J,): where
+    the arm stands."""
     q = np.asarray(q, dtype=np.float64)
     quick = replace(tools.guard, plan=False)
-    world = pick_place_world(scene, o, move, grasp, support)
     # the grasp and place poses do not depend on the transit height: screened once, up to
     # the lowest hover
-    request = pick_place_request(o, move, grasp, heights[0], scene)
-    picks, places = clear_postures(world, request, tools, q, seed)
+    picks, places = clear_postures(world, requests[0], tools, q, seed)
     pairs = sorted(
         ((a, b) for a in picks for b in places if a[0] or b[0]),  # not the nearest pair
         key=lambda ab: np.linalg.norm(ab[0][1] - q) + np.linalg.norm(ab[1][1] - ab[0][1]),
     )[:POSTURE_PAIRS]
-    for clear_z in heights:
-        request = pick_place_request(o, move, grasp, clear_z, scene)
+    for request in requests:
         for (_, pick), (_, place) in pairs:
             planned = plan_pick_place(
                 tools.solver, q, request, tools.pick_place, seeds=(pick, place)
