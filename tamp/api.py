@@ -36,7 +36,8 @@ from typing import TYPE_CHECKING
 from task import data
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
-from task.domains import GENERIC, get_domain, names, recognise
+from task.domains import GENERIC, get_domain, names
+from task.domains.match import recognise
 from task.errors import PDDLError, TampError, one_of
 from task.instances import Instance, from_text
 from task.problem import TABLE, Action, Move, PlanResult, PlanStatus, Problem

@@ -8,8 +8,9 @@ one file keeps helpers beside it under its own prefix: ``blocksworld_pddl``, ``l
 ``sokoban_grid`` (the grid's static tables), ``strips_soft`` (the lift's tensors). ``strips``
 is the generic soft lift of any grounded STRIPS domain: the planner of a PDDL domain no file is
 written for, and the oracle the hand-written domains are tested on. The room ``match`` finds
-the hand-written domain a PDDL domain is up to renaming (by structure, never by name) and
-keeps the user's names in plans. The domains build on the crisp side (`task.symbolic`), which
+the hand-written domain a PDDL domain is up to renaming (by structure, never by name;
+`task.domains.match.recognise`) and keeps the user's names in plans; it builds on this
+registry, which never imports it. The domains build on the crisp side (`task.symbolic`), which
 never imports them.
 """
 
@@ -36,12 +37,3 @@ def get_domain(name: str) -> Domain:
     if name not in _NAMES:
         raise ProblemError(f"unknown domain {one_of(name, _NAMES)}")
     return importlib.import_module(f"task.domains.{name}").DOMAIN
-
-
-def recognise(pddl_domain) -> str:
-    """The name of the hand-written domain a parsed PDDL domain is up to renaming (by its
-    structure, `task.domains.match.match_domain`), else the generic lift."""
-    from task.domains.match import Match, match_domain
-
-    found = match_domain(pddl_domain)
-    return found.rules if isinstance(found, Match) else GENERIC

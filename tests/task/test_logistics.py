@@ -12,8 +12,9 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
-from task.domains import get_domain, recognise
+from task.domains import get_domain
 from task.domains import logistics_pddl as lp
+from task.domains.match import recognise
 from task.errors import PDDLError, ProblemError
 from task.planner import plan
 from task.problem import Move

@@ -15,9 +15,9 @@ import torch
 
 from task import data
 from task.config import PlannerConfig
-from task.domains import get_domain, recognise
+from task.domains import get_domain
 from task.domains.blocksworld import to_pddl as blocksworld_pddl
-from task.domains.match import Match, NearMiss, match_domain, rename
+from task.domains.match import Match, NearMiss, match_domain, recognise, rename
 from task.errors import PDDLError
 from task.instances import choose_rules, from_text
 from task.planner import plan

@@ -12,7 +12,8 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
-from task.domains import get_domain, recognise
+from task.domains import get_domain
+from task.domains.match import recognise
 from task.domains.sokoban import estimate, ready
 from task.domains.sokoban_pddl import grid_problem, problem_from_text
 from task.errors import PDDLError, ProblemError

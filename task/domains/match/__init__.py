@@ -11,12 +11,13 @@ add and delete lists as sets of atom shapes over parameter positions.
 - ``renaming``: the `Renaming` value, both ways, and the wrappers that make a domain's
   ``to_actions``/``to_atoms`` speak the user's names;
 - ``recognise``: `match_domain` -> `Match` | `NearMiss` | None, over the registered domains;
+  `recognise`: the name of the domain's rules (a match's, else the generic lift);
 - ``problem``: a user's problem read as the hand-written domain's (`to_reference`);
 - ``rename``: seeded random renamings of a domain and its problems (tests, benchmarks).
 """
 
 from task.domains.match.problem import to_reference
-from task.domains.match.recognise import Match, NearMiss, match_domain
+from task.domains.match.recognise import Match, NearMiss, match_domain, recognise
 from task.domains.match.rename import RenamedFiles, rename, rename_folder
 from task.domains.match.renaming import Renamed, Renaming
 
@@ -27,6 +28,7 @@ __all__ = [
     "RenamedFiles",
     "Renaming",
     "match_domain",
+    "recognise",
     "rename",
     "rename_folder",
     "to_reference",

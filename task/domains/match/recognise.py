@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 from pddl.core import Domain
 
+from task.domains import GENERIC, get_domain, names
 from task.domains.match.renaming import Renaming
 from task.domains.match.schema import Shape, shape
 from task.domains.match.search import explain, find
@@ -43,7 +44,6 @@ class NearMiss:
 @functools.cache
 def reference_domain(rules: str) -> Domain:
     """The parsed PDDL file of registered domain ``rules``."""
-    from task.domains import get_domain
     from task.symbolic import pddl_io
 
     text = get_domain(rules).pddl_domain_text()
@@ -59,8 +59,6 @@ def _reference_shape(rules: str) -> Shape:
 
 def candidates() -> tuple[str, ...]:
     """The registered domains a PDDL domain can match (all but the generic lift)."""
-    from task.domains import GENERIC, names
-
     return tuple(n for n in names() if n != GENERIC)
 
 
@@ -86,3 +84,10 @@ def match_domain(domain: Domain, among: Sequence[str] | None = None) -> Match | 
     if isinstance(user, str):
         return None
     return _match(user, tuple(candidates() if among is None else among))
+
+
+def recognise(pddl_domain: Domain) -> str:
+    """The name of the hand-written domain a parsed PDDL domain is up to renaming (by its
+    structure, `match_domain`), else the generic lift (`task.domains.GENERIC`)."""
+    found = match_domain(pddl_domain)
+    return found.rules if isinstance(found, Match) else GENERIC

@@ -312,7 +312,7 @@ def test_hanoi_plans_become_disc_moves(n_discs):
 
 
 def test_hanoi_domain_is_embedded_and_read_by_the_generic_lift():
-    from task.domains import recognise
+    from task.domains.match import recognise
 
     assert hanoi.DOMAIN_FILE in data.names()
     assert str(HANOI.name) == hanoi.DOMAIN
