@@ -2,12 +2,12 @@
 
 Blocks are cubes (5 cm by default), or upright cylinders as tall as they are wide, with distinct
 colours from the scene's palette; ``SceneConfig.bodies`` may give any entity its own solid
-(`Body`: a cube, cuboid or cylinder of any size), which the simulators build. Each tower
-stands on a *table slot*, a fixed grid of positions in front of the robot; a block moved onto
-the table goes to a free slot, or to the place a plan named for it (`PlacedMove`, made by
-`plain_move` from a move onto a planner's table place, `tamp.slots`). ``layout`` turns a state into poses (with small seeded jitter);
-``read_state`` turns observed poses into a state, with tolerances, and says which block it
-cannot explain.
+(`Body`: a cube, cuboid or cylinder of any size), which the simulators build. Each tower stands
+on a *table slot*, a fixed grid of positions in front of the robot; a block moved onto the table
+goes to a free slot, or to the place a plan named for it (`PlacedMove`, made by `plain_move`
+from a move onto a planner's table place, `tamp.slots`). ``layout`` turns a state into poses
+(with small seeded jitter); ``read_state`` turns observed poses into a state, with tolerances,
+and says which block it cannot explain.
 
 World frame = the robot base frame (``panda_link0``); the table surface is z = 0.
 """
