@@ -30,18 +30,18 @@ pairs the two: the mesh model answers ``valid`` and ``check_path``, the spheres
 ``valid_batch``, which `motion.rrt.plan_path` uses to search).
 
 Speed. `CHUNK` configurations at a time; forward kinematics and the broad phases batch-last
-(`motion.sphere_fk`). A bounding sphere per link (L = 11) is tested first: against the table,
-and against each box's world bounds axis by axis, (L, O, B); the flagged (configuration, link)
-pairs go to the narrow phase in three `BUCKETS` of links by sphere count (each link's spheres
-padded to its bucket's widest, placed in one batched product per bucket). Self pairs go
-through the bounding spheres (the pairs `APART` always keeps apart never), then the link's
-bounding sphere against the other link's box, then clusters of at most `CLUSTER` spheres of
-the link (their bounding spheres against that box first), then each sphere against the DOP's
-box and, where near, its 26 planes. A configuration with a contact found is not tested
-further (``valid_batch``). Without square roots where only the sign of a clearance matters,
-nor BLAS (numpy's OpenBLAS spreads a large product over a second thread): one thread.
-tests/motion/test_sphere_check.py checks the verdicts against a check that tests every
-sphere against everything.
+(`motion.sphere_fk`, `motion.sphere_bounds`). A bounding sphere per link (L = 11) is tested
+first: against the table, and against each box's world bounds axis by axis, (L, O, B); the
+flagged (configuration, link) pairs go to the narrow phase in three `BUCKETS` of links by sphere
+count (each link's spheres padded to its bucket's widest, placed in one batched product per
+bucket). Self pairs go through the bounding spheres (the pairs `APART` always keeps apart
+never), then the link's bounding sphere against the other link's box, then clusters of at most
+`CLUSTER` spheres of the link (their bounding spheres against that box first), then each sphere
+against the DOP's box and, where near, its 26 planes. A configuration with a contact found is
+not tested further (``valid_batch``). Without square roots where only the sign of a clearance
+matters, nor BLAS (numpy's OpenBLAS spreads a large product over a second thread): one thread.
+tests/motion/test_sphere_check.py checks the verdicts against a check that tests every sphere
+against everything.
 """
 
 from __future__ import annotations
@@ -53,24 +53,18 @@ from itertools import combinations
 import numpy as np
 
 from motion.errors import MotionError
-from motion.sphere_fk import (
-    _FLOAT,
-    PARTS,
-    _batch_first,
-    _bound,
-    _box_gap,
-    _box_sdf,
-    _chain,
-    _clusters,
-    _dop_gap,
-    _dops,
-    _frames,
-    _link_spheres,
-    _near_box,
-    _obb_gap,
-    _onehot,
-    _turn,
+from motion.sphere_bounds import (
+    bound,
+    box_gap,
+    box_sdf,
+    clusters,
+    dop_gap,
+    dops,
+    near_box,
+    obb_gap,
+    turn,
 )
+from motion.sphere_fk import FLOAT, PARTS, batch_first, chain, frames, link_spheres, onehot
 from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck, densify
 from robots.panda import PANDA, PandaSpec
 from robots.panda_spheres import COVER_GAP, FINGERS
@@ -120,16 +114,16 @@ class SphereCollision:
         self.margin, self.self_margin, self.spec = float(margin), float(self_margin), spec
         self.gap = COVER_GAP
         self.parts = (*PARTS, HELD)  # (P,) = L links + the held box, as PandaCollision.parts
-        self._rot, self._off, self._hand, self._tcp = _chain(spec)
+        self._rot, self._off, self._hand, self._tcp = chain(spec)
         # each joint origin's rotation as (source axis, sign) per axis; the URDF's are all
         # quarter turns
         self._swaps = []
-        for turn in self._rot:
-            k = np.abs(turn).argmax(0)  # (3,) the parent axis each new axis is
-            if not np.allclose(np.abs(turn), _onehot(k), atol=1e-9):
-                raise MotionError(f"joint origin rotations must be quarter turns, got {turn}")
-            self._swaps.append([(int(k[a]), float(np.sign(turn[k[a], a]))) for a in range(3)])
-        spheres = _link_spheres()
+        for origin in self._rot:
+            k = np.abs(origin).argmax(0)  # (3,) the parent axis each new axis is
+            if not np.allclose(np.abs(origin), onehot(k), atol=1e-9):
+                raise MotionError(f"joint origin rotations must be quarter turns, got {origin}")
+            self._swaps.append([(int(k[a]), float(np.sign(origin[k[a], a]))) for a in range(3)])
+        spheres = link_spheres()
         # the G spheres, link by link: centres (G, 3) in their link's frame, radii (G,)
         self._local = np.concatenate([spheres[link][0] for link in PARTS])
         self._radii = np.concatenate([spheres[link][1] for link in PARTS])
@@ -148,10 +142,10 @@ class SphereCollision:
                     rows = np.arange(width)
                     rows = np.where(rows < self._count[link], rows, 0)
                     local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
-            self._pad_local.append(local.astype(_FLOAT))
-            self._pad_radii.append(radii.astype(_FLOAT))
+            self._pad_local.append(local.astype(FLOAT))
+            self._pad_radii.append(radii.astype(FLOAT))
         self._clusters(spheres)
-        bounds = [_bound(*spheres[link]) for link in PARTS]
+        bounds = [bound(*spheres[link]) for link in PARTS]
         self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
         self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
         index = {name: k for k, name in enumerate(self.parts)}
@@ -171,11 +165,11 @@ class SphereCollision:
         rule = [apart.get(frozenset((PARTS[a], PARTS[b])), (0, math.inf)) for a, b in pairs]
         self._apart_joint = np.array([j for j, _ in rule])
         self._apart_from = np.array([lowest for _, lowest in rule])
-        self._directions, self._dop = _dops()  # (26, 3), (L, 26)
+        self._directions, self._dop = dops()  # (26, 3), (L, 26)
         self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
-        self._cos, self._sin = np.zeros(0, _FLOAT), np.zeros(0, _FLOAT)  # (O,) of the yaws
+        self._cos, self._sin = np.zeros(0, FLOAT), np.zeros(0, FLOAT)  # (O,) of the yaws
         self._arm_vs_held = np.array([k for k, n in enumerate(PARTS) if n not in HAND])
-        self._world_half = np.zeros((3, 0), _FLOAT)  # (3, O): see set_boxes
+        self._world_half = np.zeros((3, 0), FLOAT)  # (3, O): see set_boxes
         self._names: list[str] = [TABLE]  # (O + 1,) the table, then the boxes
         self._box_c = np.zeros((0, 3))  # (O, 3)
         self._halves = np.ones((0, 3))  # (O, 3)
@@ -184,10 +178,10 @@ class SphereCollision:
         self._held_pose = np.eye(4)  # in the TCP frame
         self._masks: dict[frozenset, tuple[np.ndarray, np.ndarray]] = {}
         for name in ("_rot", "_off", "_hand", "_tcp", "_local", "_radii", "_bounds", "_reach"):
-            setattr(self, name, getattr(self, name).astype(_FLOAT))
-        self._directions, self._dop = self._directions.astype(_FLOAT), self._dop.astype(_FLOAT)
+            setattr(self, name, getattr(self, name).astype(FLOAT))
+        self._directions, self._dop = self._directions.astype(FLOAT), self._dop.astype(FLOAT)
         # the 26-DOP's first test: its axis-aligned box, centre (L, 3) and half extents (L, 3)
-        axes = [np.flatnonzero((self._directions == e).all(1))[0] for e in np.eye(3, dtype=_FLOAT)]
+        axes = [np.flatnonzero((self._directions == e).all(1))[0] for e in np.eye(3, dtype=FLOAT)]
         minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
         high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
         self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
@@ -195,12 +189,12 @@ class SphereCollision:
         self._dop_c = np.ascontiguousarray((self._dop - self._aabb_c @ self._directions.T).T)
 
     def _clusters(self, spheres) -> None:
-        """The self-collision narrow phase's clusters (`sphere_fk._clusters`), as float32."""
-        link_of, local, radii, count, mids, reach, first, parts = _clusters(spheres, CLUSTER)
+        """The self-collision narrow phase's clusters (`sphere_bounds.clusters`), as float32."""
+        link_of, local, radii, count, mids, reach, first, parts = clusters(spheres, CLUSTER)
         self._cluster_link, self._cluster_count = link_of, count  # (C,) each
-        self._cluster_local = local.astype(_FLOAT)  # (C, CLUSTER, 3)
-        self._cluster_radii = radii.astype(_FLOAT)  # (C, CLUSTER)
-        self._cluster_mid, self._cluster_reach = mids.astype(_FLOAT), reach.astype(_FLOAT)
+        self._cluster_local = local.astype(FLOAT)  # (C, CLUSTER, 3)
+        self._cluster_radii = radii.astype(FLOAT)  # (C, CLUSTER)
+        self._cluster_mid, self._cluster_reach = mids.astype(FLOAT), reach.astype(FLOAT)
         self._first_cluster, self._n_clusters = first, parts  # (L,) each
 
     # ---- the scene ---------------------------------------------------------------------------
@@ -223,16 +217,16 @@ class SphereCollision:
                 )
             seen.add(name)
             rows.append(row)
-        table = np.array(rows, dtype=_FLOAT).reshape(-1, 7)  # (O, 7)
+        table = np.array(rows, dtype=FLOAT).reshape(-1, 7)  # (O, 7)
         self._box_c, self._halves, self._yaws = table[:, :3], table[:, 3:6], table[:, 6]
-        self._turns = _turn(self._yaws).astype(_FLOAT)
+        self._turns = turn(self._yaws).astype(FLOAT)
         self._cos, self._sin = np.cos(self._yaws), np.sin(self._yaws)  # (O,) each
         # (3, O) half extents of each box's world axis-aligned bounding box (turned about z)
         c, s_ = np.abs(self._cos), np.abs(self._sin)
         h = self._halves
         self._world_half = np.stack(
             [c * h[:, 0] + s_ * h[:, 1], s_ * h[:, 0] + c * h[:, 1], h[:, 2]]
-        ).astype(_FLOAT)
+        ).astype(FLOAT)
         self._names = [TABLE, *(b.name for b in boxes)]
         self._masks = {}
 
@@ -253,8 +247,8 @@ class SphereCollision:
         r = relative[:3, :3]
         if np.abs(r @ r.T - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
             raise MotionError("held pose's rotation block is not a rotation (tolerance 1e-6)")
-        self._held_half = None if extents is None else extents.astype(_FLOAT)
-        self._held_pose = relative.astype(_FLOAT)
+        self._held_half = None if extents is None else extents.astype(FLOAT)
+        self._held_pose = relative.astype(FLOAT)
 
     def _mask(self, ignore: Ignore) -> tuple[np.ndarray, np.ndarray]:
         """Pairs to check, cached per ignore set: (P, O + 1) part vs table and boxes, (K,) link
@@ -300,12 +294,12 @@ class SphereCollision:
     # ---- kinematics --------------------------------------------------------------------------
 
     def _links(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
-        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk._links`."""
-        return _batch_first(*self._frames(q, fingers))
+        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk.links`."""
+        return batch_first(*self._frames(q, fingers))
 
     def _frames(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
-        """The same batch-last, (L + 1, 3, 3, B) and (L + 1, 3, B): see `sphere_fk._frames`."""
-        return _frames(q, fingers, self._off, self._swaps, self._hand, self._tcp)
+        """The same batch-last, (L + 1, 3, 3, B) and (L + 1, 3, B): see `sphere_fk.frames`."""
+        return frames(q, fingers, self._off, self._swaps, self._hand, self._tcp)
 
     def _place(self, rot: np.ndarray, pos: np.ndarray, bucket: int, link: np.ndarray):
         """World centres (M, S, 3) and grown radii (M, S) of the spheres of links ``link``
@@ -388,7 +382,7 @@ class SphereCollision:
             raise MotionError(f"q must have shape {want}, got {a.shape}")
         if not np.isfinite(a).all():
             raise MotionError("q contains NaN or inf")
-        return (a[None] if single else a).astype(_FLOAT)
+        return (a[None] if single else a).astype(FLOAT)
 
     # ---- the checks --------------------------------------------------------------------------
 
@@ -401,7 +395,7 @@ class SphereCollision:
         mid_t = pos_t[:links] + rot_t[:links, :, 0] * b[:, None, 0]  # (L, 3, B)
         mid_t += rot_t[:links, :, 1] * b[:, None, 1]
         mid_t += rot_t[:links, :, 2] * b[:, None, 2]
-        rot, pos = _batch_first(rot_t, pos_t)  # (B, F, 3, 3), (B, F, 3)
+        rot, pos = batch_first(rot_t, pos_t)  # (B, F, 3, 3), (B, F, 3)
         reach = self._reach + self.gap  # (L,)
         hit, found = np.zeros(n, dtype=bool), []  # found: [Contact]
 
@@ -437,7 +431,7 @@ class SphereCollision:
         if len(self._names) > 1:  # the bounding spheres against the boxes' world bounds
             near = np.empty((links, len(self._names) - 1, n), dtype=bool)  # (L, O, B)
             near[:] = scene[:links, 1:, None]
-            d, inside = np.empty(near.shape, dtype=_FLOAT), np.empty_like(near)
+            d, inside = np.empty(near.shape, dtype=FLOAT), np.empty_like(near)
             for axis in range(3):  # batch-last, in place: every operation over rows of B
                 room = self._world_half[axis] + (reach[:, None] + m)  # (L, O)
                 np.subtract(mid_t[:, axis, None], self._box_c[:, axis, None], out=d)
@@ -465,7 +459,7 @@ class SphereCollision:
         if near_b.size:  # link a's bounding sphere against link c's box, in c's frame
             d = mid_t[la, :, near_b] - pos[near_b, lc]  # (M, 3)
             d = np.einsum("mji,mj->mi", rot[near_b, lc], d) - self._aabb_c[lc]  # from its middle
-            keep = _near_box(d, self._aabb_h[lc], reach[la] + self.self_margin)
+            keep = near_box(d, self._aabb_h[lc], reach[la] + self.self_margin)
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
         if near_b.size:
             self._self_pairs(rot, pos, near_b, la, lc, record)
@@ -488,7 +482,7 @@ class SphereCollision:
         box_c, box_h = self._aabb_c[frame], self._aabb_h[frame]  # (N, 3) each
         centre = np.einsum("nij,nj->ni", r_rel[pair], self._cluster_mid[cluster]) + t_rel[pair]
         reach = self._cluster_reach[cluster] + (self.gap + self.self_margin)  # (N,)
-        keep = _near_box(centre - box_c, box_h, reach)
+        keep = near_box(centre - box_c, box_h, reach)
         pair, cluster, frame = pair[keep], cluster[keep], frame[keep]
         box_c, box_h = box_c[keep, None], box_h[keep, None]  # (N', 1, 3) each
         local = self._cluster_local[cluster]  # (N', S, 3), padded with repeats of the first
@@ -496,8 +490,8 @@ class SphereCollision:
         inner = np.matmul(local, np.swapaxes(r_rel[pair], 1, 2)) + (t_rel[pair, None] - box_c)
         grown = self._cluster_radii[cluster] + self.gap  # (N', S)
         # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
-        near_n, near_s = np.nonzero(_near_box(inner, box_h, grown + self.self_margin))
-        gap = _dop_gap(inner[near_n, near_s], self._directions, self._dop_c[:, frame[near_n]])
+        near_n, near_s = np.nonzero(near_box(inner, box_h, grown + self.self_margin))
+        gap = dop_gap(inner[near_n, near_s], self._directions, self._dop_c[:, frame[near_n]])
         gap -= grown[near_n, near_s]  # (K,) the 26-DOP's bound
         least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its spheres
         np.minimum.at(least, pair[near_n], gap)
@@ -507,7 +501,7 @@ class SphereCollision:
         """`sphere_fk._box_gap` of points (..., 3) to the boxes ``box`` (indices broadcasting
         with the points' leading axes, or a slice) less ``reach`` (...)."""
         d = points - self._box_c[box]  # (..., 3)
-        return _box_gap(d, self._cos[box], self._sin[box], self._halves[box], reach, exact)
+        return box_gap(d, self._cos[box], self._sin[box], self._halves[box], reach, exact)
 
     def _check_held(self, rot, pos, mid, scene, held_arm, record) -> None:
         """The held box at the TCP against the table, the boxes and the arm's links."""
@@ -528,21 +522,21 @@ class SphereCollision:
             if near_b.size:
                 box = columns[near_o]  # (M,)
                 turns, centres, halves = self._turns[box], self._box_c[box], self._halves[box]
-                sep = _obb_gap(r_box[near_b], t_box[near_b], half + m, turns, centres, halves)
+                sep = obb_gap(r_box[near_b], t_box[near_b], half + m, turns, centres, halves)
                 record(near_b, HELD, box + 1, sep + m, m)
         links = self._arm_vs_held[held_arm[self._arm_vs_held]]
         if links.size:
             reach = self._reach + self.gap
             # (B, L', 3) link bounds in the held box's frame
             inner = np.einsum("bji,blj->bli", r_box, mid[:, links] - t_box[:, None])
-            gap = _box_sdf(inner, half) - reach[links]  # (B, L')
+            gap = box_sdf(inner, half) - reach[links]  # (B, L')
             near_b, near_l = np.nonzero(gap < m)
             for k, _, rows, link in self._by_bucket(near_b, links[near_l]):
                 r_in = np.swapaxes(r_box[rows], 1, 2)  # (M, 3, 3) world -> held box
                 r_rel = r_in @ rot[rows, link]  # (M, 3, 3) link -> held box
                 t_rel = np.einsum("mij,mj->mi", r_in, pos[rows, link] - t_box[rows])  # (M, 3)
                 inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in its frame
-                record(rows, HELD, ~link, _box_sdf(inner, half) - grown, m)
+                record(rows, HELD, ~link, box_sdf(inner, half) - grown, m)
 
 
 class Screened:
