@@ -66,7 +66,7 @@ class BlockFit:
     seen_z: tuple[float, float]  # the lowest and highest visible side points (m)
 
 
-def _normals(points: np.ndarray, agree: float) -> tuple[np.ndarray, np.ndarray]:
+def surface_normals(points: np.ndarray, agree: float) -> tuple[np.ndarray, np.ndarray]:
     """Unit normals (H, W, 3) of an organised point cloud (H, W, 3), facing the camera, and
     where they are reliable (H, W): the normals from the pixel's right-and-below and its
     left-and-above neighbours agree within ``agree`` (cosine), so no crease or edge is near."""
@@ -179,7 +179,7 @@ def estimate_fits(
     labels = colour_labels(rgb, colours, config.segment)  # (H, W)
     hue = cv2.cvtColor(rgb, cv2.COLOR_RGB2HSV)[..., 0].astype(np.int16)  # (H, W)
     points = backproject(depth, camera)  # (H, W, 3)
-    normals, reliable = _normals(points, config.agree)  # (H, W, 3), (H, W)
+    normals, reliable = surface_normals(points, config.agree)  # (H, W, 3), (H, W)
     fits: dict[str, BlockFit | str] = {}
     for k, name in enumerate(entities):
         off = np.abs(hue - hue_of(colours[k]))

@@ -51,7 +51,7 @@ from scipy.spatial import cKDTree
 from perception.segment import SegmentConfig, colour_labels
 from tamp.camera.fit import FitConfig, Model, ObjectFit, fit_object, fold
 from tamp.camera.geometry import backproject
-from tamp.camera.poses import _normals
+from tamp.camera.poses import surface_normals
 from tamp.scene import Pose
 from tamp.sim.base import Camera, Lighting, Simulator
 from tamp.world.schema import Scene
@@ -205,7 +205,7 @@ class ScenePoses:
         for camera, rgb, depth in self.frames():
             labels = colour_labels(rgb, self.colours, self.config.segment)  # (H, W)
             points = backproject(depth, camera)  # (H, W, 3)
-            normals, reliable = _normals(points, self.config.agree)
+            normals, reliable = surface_normals(points, self.config.agree)
             for k in range(len(self.colours)):
                 mask = cv2.erode((labels == k).astype(np.uint8), cross).astype(bool)
                 if not mask.any():

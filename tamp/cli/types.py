@@ -159,7 +159,7 @@ def share(text: str) -> float:
     return value
 
 
-def _names(what: str, valid: tuple[str, ...]):
+def name_list(what: str, valid: tuple[str, ...]):
     """A type: a comma-separated list of names from ``valid``, duplicates dropped."""
 
     def parse(text: str) -> tuple[str, ...]:
@@ -196,4 +196,4 @@ BASELINES = ("us", "gn1")  # `tamp.bench.peers.slaney.BASELINES`, named without 
 
 def baseline_list(text: str) -> tuple[str, ...]:
     """``--baselines us,gn1``: Slaney & Thiebaux's algorithms to run beside ours."""
-    return _names("baseline", BASELINES)(text)
+    return name_list("baseline", BASELINES)(text)

@@ -25,7 +25,7 @@ import time
 
 from tamp.geo.check import MoveCheck, Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.places import candidate_places, fixed_targets
-from tamp.geo.search import DEFAULT, SearchConfig, _holds, heuristic, state_key
+from tamp.geo.search import DEFAULT, SearchConfig, heuristic, holds_in, state_key
 from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
@@ -65,7 +65,7 @@ def symbolic_plan(
     expanded = 0
     while queue and expanded < max_nodes:
         _, g, _, state, path = heapq.heappop(queue)
-        if all(_holds(a, dict(state)) for a in goal.atoms):
+        if all(holds_in(a, dict(state)) for a in goal.atoms):
             return list(path), expanded
         expanded += 1
         for move in symbolic_moves(state, targets):

@@ -120,7 +120,7 @@ def _movers(supports: dict, goal: Goal) -> set[str]:
 
     movers: set[str] = set()
     for atom in goal.atoms:
-        if _holds(atom, supports):
+        if holds_in(atom, supports):
             continue
         if atom[0] == "clear":
             movers |= stack(atom[1])
@@ -131,7 +131,9 @@ def _movers(supports: dict, goal: Goal) -> set[str]:
     return movers
 
 
-def _holds(atom: Atom, supports: dict) -> bool:
+def holds_in(atom: Atom, supports: dict) -> bool:
+    """Whether a goal ``atom`` (clear, ontable, on or in) holds where every object rests on
+    ``supports`` (object -> what it stands on, `TABLE` or a name)."""
     pred, x = atom[0], atom[1]
     if pred == "clear":
         return x not in supports.values()
@@ -424,7 +426,7 @@ class _Guide:
         for x in must:
             out |= {y for y, s in solids.items() if footprint_gap(solids[x], s) < NEAR}
         for atom in self.goal.atoms:
-            if atom[0] in ("in", "on") and not _holds(atom, supports):
+            if atom[0] in ("in", "on") and not holds_in(atom, supports):
                 out |= {y for y, s in supports.items() if s == atom[2]}
         return out
 

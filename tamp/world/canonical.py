@@ -43,18 +43,13 @@ from tamp.scene import Pose
 from tamp.sim.base import Camera
 from tamp.world.generators import (
     COLOURS,
+    GENERATORS,
     KERB,
     POST_HALF,
     TABLE_TOP,
     TRIES,
-    _blocked,
-    _hanoi,
-    _m,
-    _nonmonotonic,
-    _packed,
-    _sorting,
-    _tall,
     centre_first,
+    round_length,
 )
 from tamp.world.geometry import of_movable
 from tamp.world.goal import Goal, parse_goal
@@ -172,14 +167,7 @@ def generate(problem: str, seed: int, **size) -> CanonicalProblem:
         for key, v in valid.items()
     }
     drawn |= size
-    make = {
-        "blocked": _blocked,
-        "packed": _packed,
-        "nonmonotonic": _nonmonotonic,
-        "sorting": _sorting,
-        "tall": _tall,
-        "hanoi": _hanoi,
-    }[problem]
+    make = GENERATORS[problem]
     for _ in range(TRIES):
         made = make(rng, **drawn)
         if made is not None:
@@ -282,7 +270,7 @@ def _camera(objects: Sequence[Movable], regions: Sequence[Region]) -> Camera:
         eye = target + d * away
         if in_view(p, eye, target, default, margin=0.9):
             break
-    return Camera(tuple(_m(v) for v in eye), tuple(_m(v) for v in target))
+    return Camera(tuple(round_length(v) for v in eye), tuple(round_length(v) for v in target))
 
 
 def in_view(points, eye, target, camera: Camera = Camera(), margin: float = 1.0) -> bool:

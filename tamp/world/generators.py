@@ -1,10 +1,11 @@
 """The six canonical problems' generators: each draws one variant's geometry from a seeded rng.
 
-`_blocked`, `_packed`, `_nonmonotonic`, `_sorting`, `_tall` and `_hanoi` each return the
-objects, regions, obstacles, goal atoms, a note and a witness of one draw (or None when the draw
-misses what makes the problem hard); `tamp.world.canonical.generate` retries and checks them.
-Also the small helpers they share (rounding, colours, zones) and `centre_first`, the naive
-packer ``packed`` must defeat.
+`GENERATORS` names them: `_blocked`, `_packed`, `_nonmonotonic`, `_sorting`, `_tall` and
+`_hanoi` each return the objects, regions, obstacles, goal atoms, a note and a witness of one
+draw (or None when the draw misses what makes the problem hard);
+`tamp.world.canonical.generate` retries and checks them. Also the small helpers they share
+(rounding, `round_length`; colours, zones) and `centre_first`, the naive packer ``packed``
+must defeat.
 """
 
 from __future__ import annotations
@@ -71,7 +72,7 @@ def centre_first(
 _Made = tuple  # (objects, regions, obstacles, goal atoms, note, witness)
 
 
-def _m(value: float) -> float:
+def round_length(value: float) -> float:
     """A length rounded to 0.1 mm (files stay readable; every margin is millimetres)."""
     return round(float(value), 4) + 0.0
 
@@ -87,19 +88,24 @@ def _rgb(colour: str) -> tuple[float, float, float]:
 
 def _movable(name, kind, size, colour: str, xyz, yaw: float = 0.0) -> Movable:
     size = tuple(_size(s) for s in size)
-    return Movable(name, kind, size, _rgb(colour), Pose(tuple(_m(v) for v in xyz), _m(yaw)))
+    return Movable(
+        name, kind, size, _rgb(colour), Pose(tuple(round_length(v) for v in xyz), round_length(yaw))
+    )
 
 
 def _at(o: Movable, xyz, yaw: float | None = None) -> Movable:
     """``o`` moved to ``xyz`` (yaw kept unless given)."""
     yaw = o.pose.yaw if yaw is None else yaw
-    return replace(o, pose=Pose(tuple(_m(v) for v in xyz), _m(yaw)))
+    return replace(o, pose=Pose(tuple(round_length(v) for v in xyz), round_length(yaw)))
 
 
 def _zone(name: str, centre, side, colour: str) -> Region:
     """A marked rectangle (no floor, no walls) of ``side`` (sx, sy) m around ``centre``."""
     (cx, cy), (sx, sy) = centre, side
-    lo, hi = (_m(cx - sx / 2), _m(cy - sy / 2)), (_m(cx + sx / 2), _m(cy + sy / 2))
+    lo, hi = (
+        (round_length(cx - sx / 2), round_length(cy - sy / 2)),
+        (round_length(cx + sx / 2), round_length(cy + sy / 2)),
+    )
     return Region(name, lo, hi, rgb=_rgb(colour))
 
 
@@ -227,7 +233,9 @@ def _packed(rng: np.random.Generator, n: int) -> _Made | None:
         y = y0 + margin + (height - 2 * margin - span[c]) / 2
         for j in col:
             o = objects[j]
-            witness.append((o.name, Pose((_m(x), _m(y + o.half[1]), o.pose.xyz[2]), 0.0)))
+            witness.append(
+                (o.name, Pose((round_length(x), round_length(y + o.half[1]), o.pose.xyz[2]), 0.0))
+            )
             y += 2 * o.half[1] + gap_y
     footprint = sum(4 * o.half[0] * o.half[1] for o in objects)
     (ix0, iy0), (ix1, iy1) = tray.inner()
@@ -281,22 +289,26 @@ def _nonmonotonic(rng: np.random.Generator, n: int) -> _Made | None:
     t, h = KERB
     length = back - mouth
     walls = (
-        Obstacle("kerb_back", (_m(back + t / 2), _m(cy), h / 2), (t / 2, _m(inner / 2 + t), h / 2)),
+        Obstacle(
+            "kerb_back",
+            (round_length(back + t / 2), round_length(cy), h / 2),
+            (t / 2, round_length(inner / 2 + t), h / 2),
+        ),
         Obstacle(
             "kerb_left",
-            (_m(mouth + length / 2), _m(cy + inner / 2 + t / 2), h / 2),
-            (_m(length / 2), t / 2, h / 2),
+            (round_length(mouth + length / 2), round_length(cy + inner / 2 + t / 2), h / 2),
+            (round_length(length / 2), t / 2, h / 2),
         ),
         Obstacle(
             "kerb_right",
-            (_m(mouth + length / 2), _m(cy - inner / 2 - t / 2), h / 2),
-            (_m(length / 2), t / 2, h / 2),
+            (round_length(mouth + length / 2), round_length(cy - inner / 2 - t / 2), h / 2),
+            (round_length(length / 2), t / 2, h / 2),
         ),
     )
     alcove = Region(
         "alcove",
-        (_m(mouth), _m(cy - inner / 2)),
-        (_m(back), _m(cy + inner / 2)),
+        (round_length(mouth), round_length(cy - inner / 2)),
+        (round_length(back), round_length(cy + inner / 2)),
         rgb=_rgb("white"),
     )
     gtheta = -math.copysign(rng.uniform(0.6, 0.8), cy if cy else 1.0)
@@ -368,9 +380,9 @@ def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
                 mine.append(
                     Obstacle(
                         f"post_{len(posts) + len(mine)}",
-                        (_m(x + px), _m(y + py), POST_HALF[2]),
+                        (round_length(x + px), round_length(y + py), POST_HALF[2]),
                         POST_HALF,
-                        _m(yaw),
+                        round_length(yaw),
                     )
                 )
             solids = [of_movable(p) for p in objects] + [of_box(p) for p in posts]
@@ -391,7 +403,9 @@ def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
     for _ in range(n // 2):  # free posts between the objects
         for _ in range(20):
             x, y = _polar(rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65))
-            post = Obstacle(f"post_{len(posts)}", (_m(x), _m(y), POST_HALF[2]), POST_HALF)
+            post = Obstacle(
+                f"post_{len(posts)}", (round_length(x), round_length(y), POST_HALF[2]), POST_HALF
+            )
             solid = of_box(post)
             if (
                 _clear_of(solid, [of_movable(o) for o in objects], 0.03)
@@ -518,3 +532,14 @@ def _hanoi(rng: np.random.Generator, n: int) -> _Made | None:
         "one or an empty peg, which holds no two side by side"
     )
     return objects, pegs, (), atoms, note, ()
+
+
+# problem name -> its generator: (rng, **the variant's drawn parameters) -> `_Made` | None
+GENERATORS = {
+    "blocked": _blocked,
+    "packed": _packed,
+    "nonmonotonic": _nonmonotonic,
+    "sorting": _sorting,
+    "tall": _tall,
+    "hanoi": _hanoi,
+}

@@ -34,7 +34,7 @@ from pddl.logic.terms import Variable
 
 from task.errors import PDDLError
 from task.problem import Action
-from task.symbolic.strips import Atom, GroundAction, _subtype, _typed, initial_state
+from task.symbolic.strips import Atom, GroundAction, initial_state, is_subtype, object_types
 
 _FEATURES = (
     (Not, "negative precondition"),
@@ -228,7 +228,7 @@ def reachable(domain: Domain, problem: PDDLProblem) -> Grounding:
     Raises PDDLError for a domain or problem that is not STRIPS in the supported fragment.
     """
     schemas = _schemas(domain)
-    types = _typed(domain, problem)
+    types = object_types(domain, problem)
     parents = {str(k).lower(): (v and str(v).lower()) for k, v in domain.types.items()}
     facts = _Facts()
     for atom in sorted(initial_state(problem)):
@@ -242,7 +242,7 @@ def reachable(domain: Domain, problem: PDDLProblem) -> Grounding:
             allowed[name]["?" + str(param.name).lower()] = frozenset(
                 o
                 for o in types
-                if not wanted or any(_subtype(t, w, parents) for t in types[o] for w in wanted)
+                if not wanted or any(is_subtype(t, w, parents) for t in types[o] for w in wanted)
             )
     found: dict[tuple[str, tuple[str, ...]], GroundAction] = {}
     while True:

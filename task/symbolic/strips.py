@@ -99,7 +99,9 @@ def _schemas(domain: Domain) -> dict[str, PDDLAction]:
     return {str(a.name).lower(): a for a in domain.actions}
 
 
-def _subtype(tag: str, wanted: str, parents: dict[str, str | None]) -> bool:
+def is_subtype(tag: str, wanted: str, parents: dict[str, str | None]) -> bool:
+    """Whether type ``tag`` is ``wanted`` or below it in the type tree ``parents`` (type ->
+    its parent, None at a root); every type is an ``object``."""
     seen = set()
     while tag is not None and tag not in seen:
         if tag == wanted:
@@ -109,7 +111,9 @@ def _subtype(tag: str, wanted: str, parents: dict[str, str | None]) -> bool:
     return wanted == "object"
 
 
-def _typed(domain: Domain, problem: PDDLProblem) -> dict[str, frozenset[str]]:
+def object_types(domain: Domain, problem: PDDLProblem) -> dict[str, frozenset[str]]:
+    """Each object and constant (lower-case name) -> its declared types (``object`` when
+    untyped)."""
     objs = (*problem.objects, *domain.constants)
     return {
         str(o.name).lower(): frozenset(str(t).lower() for t in o.type_tags) or frozenset({"object"})
@@ -134,14 +138,14 @@ def ground(domain: Domain, problem: PDDLProblem, action: Action) -> GroundAction
             f"{action}: {name} takes {len(params)} arguments "
             f"({' '.join('?' + p for p in params)}), got {len(action.args)}"
         )
-    types = _typed(domain, problem)
+    types = object_types(domain, problem)
     parents = {str(k).lower(): (v and str(v).lower()) for k, v in domain.types.items()}
     args = tuple(a.lower() for a in action.args)
     for param, arg in zip(schema.parameters, args, strict=True):
         if arg not in types:
             raise ProblemError(f"{action}: unknown object {one_of(arg, sorted(types))}")
         wanted = {str(t).lower() for t in param.type_tags}
-        if wanted and not any(_subtype(t, w, parents) for t in types[arg] for w in wanted):
+        if wanted and not any(is_subtype(t, w, parents) for t in types[arg] for w in wanted):
             raise ProblemError(
                 f"{action}: {arg} is not of type {' or '.join(sorted(wanted))} for ?{param.name}"
             )
@@ -158,7 +162,7 @@ def ground(domain: Domain, problem: PDDLProblem, action: Action) -> GroundAction
 
 def ground_all(domain: Domain, problem: PDDLProblem) -> tuple[tuple[Action, GroundAction], ...]:
     """Every well-typed ground action of the problem (exponential in arity; small problems)."""
-    types = _typed(domain, problem)
+    types = object_types(domain, problem)
     parents = {str(k).lower(): (v and str(v).lower()) for k, v in domain.types.items()}
     out = []
     for name, schema in sorted(_schemas(domain).items()):
@@ -169,7 +173,8 @@ def ground_all(domain: Domain, problem: PDDLProblem) -> tuple[tuple[Action, Grou
                 [
                     o
                     for o in sorted(types)
-                    if not wanted or any(_subtype(t, w, parents) for t in types[o] for w in wanted)
+                    if not wanted
+                    or any(is_subtype(t, w, parents) for t in types[o] for w in wanted)
                 ]
             )
         for args in itertools.product(*domains):

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from motion.errors import MotionError
+from motion.sphere_bounds import dop_gap
 from motion.sphere_check import APART, APART_CLEARANCE, CHUNK, PARTS, Screened, SphereCollision
-from motion.sphere_fk import _dop_gap
 from robots.collision import Box
 from robots.panda import PANDA, data_dir
 from robots.panda_spheres import COVER, COVER_GAP, FINGERS, SPHERES
@@ -403,10 +403,10 @@ def test_a_batch_of_several_chunks_gets_the_reference_verdicts():
 
 
 def test_the_26_dop_bound_equals_the_matrix_product():
-    """`sphere_fk._dop_gap` (three broadcast products, no BLAS) against the matrix product."""
+    """`sphere_bounds.dop_gap` (three broadcast products, no BLAS) against the matrix product."""
     rng = np.random.default_rng(3)
     model = SphereCollision()
     p = rng.normal(0.0, 0.2, (500, 3)).astype(np.float32)
     support = model._dop_c[:, rng.integers(0, len(PARTS), 500)]  # (26, 500)
     want = (p.astype(float) @ model._directions.T.astype(float) - support.T).max(-1)
-    assert np.allclose(_dop_gap(p, model._directions, support), want, atol=1e-6)
+    assert np.allclose(dop_gap(p, model._directions, support), want, atol=1e-6)

@@ -17,9 +17,9 @@ from tamp.cli.options import (
 )
 from tamp.cli.types import (
     PLAN_THREADS,
-    _names,
     block_counts,
     bounded,
+    name_list,
     positive,
     radius_list,
     seed,
@@ -170,7 +170,7 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
     """What ``bench tamp`` runs: problems, variants, planners, simulators."""
     p.add_argument(
         "--problems",
-        type=_names("problem", TAMP_PROBLEMS),
+        type=name_list("problem", TAMP_PROBLEMS),
         default=",".join(TAMP_PROBLEMS),
         metavar="P[,P]",
         help=f"canonical problems, comma-separated ({','.join(TAMP_PROBLEMS)}; default: all)",
@@ -187,7 +187,7 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--planner",
         dest="planners",
-        type=_names("planner", TAMP_PLANNERS),
+        type=name_list("planner", TAMP_PLANNERS),
         default="soft,motion-aware,search-then-check",
         metavar="NAME[,NAME]",
         help="planners side by side (soft: task-only with execution; motion-aware: ours; "

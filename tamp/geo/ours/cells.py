@@ -32,7 +32,7 @@ import numpy as np
 import torch
 
 from tamp.geo.ours.bridge import Bridged, own_footprint
-from tamp.geo.ours.pack import PackConfig, _soft_area, placing_order
+from tamp.geo.ours.pack import PackConfig, placing_order, soft_area
 from tamp.geo.places import PACK_MARGIN
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
@@ -322,14 +322,14 @@ def _per_cell_overlap(centres, grown, body, fixed_xy, fixed_half, pack: PackConf
     lesser direction, counted for both cells) and against the fixed occupants."""
     c = centres.shape[1]
     d = centres[:, :, None] - centres[:, None]  # (R, C, C, 2)
-    pair = _soft_area(d, grown[:, :, None] + body[:, None] + pack.gap, config.beta, pack.eps)
+    pair = soft_area(d, grown[:, :, None] + body[:, None] + pack.gap, config.beta, pack.eps)
     if pack.ordered:
         pair = torch.minimum(pair, pair.transpose(1, 2))
     off = ~torch.eye(c, dtype=torch.bool)
     per = torch.where(off, pair, 0.0).sum(-1)  # (R, C)
     if fixed_xy.shape[0]:
         reach = grown[:, :, None] + fixed_half + pack.gap  # (R, C, F, 2)
-        per = per + _soft_area(centres[:, :, None] - fixed_xy, reach, config.beta, pack.eps).sum(-1)
+        per = per + soft_area(centres[:, :, None] - fixed_xy, reach, config.beta, pack.eps).sum(-1)
     return per
 
 

@@ -123,7 +123,7 @@ def _grown(half: torch.Tensor, turn: torch.Tensor, axis: torch.Tensor, config: P
     return h, torch.where(along, h.clamp_min(config.fingers), h.clamp_min(config.side))
 
 
-def _soft_area(d: torch.Tensor, reach: torch.Tensor, beta: float, eps: float) -> torch.Tensor:
+def soft_area(d: torch.Tensor, reach: torch.Tensor, beta: float, eps: float) -> torch.Tensor:
     """Smooth overlap area of boxes whose centres are ``d`` (..., 2) apart and whose half
     extents sum to ``reach`` (..., 2): prod over x, y of softplus(beta (reach - |d|)) / beta."""
     depth = reach - torch.sqrt(d * d + eps * eps)  # (..., 2)
@@ -149,14 +149,14 @@ def overlap_loss(
     m = xy.shape[1]
     d = xy[:, :, None] - xy[:, None]  # (R, M, M, 2)
     reach = half[:, :, None] + body[:, None] + gap  # (R, M, M, 2): i grown, j body
-    pair = _soft_area(d, reach, beta, eps)  # (R, M, M)
+    pair = soft_area(d, reach, beta, eps)  # (R, M, M)
     if ordered:
         pair = torch.minimum(pair, pair.transpose(1, 2))  # (R, M, M), symmetric
     off = ~torch.eye(m, dtype=torch.bool)
     loss = torch.where(off, pair, 0.0).sum((-1, -2))  # (R,)
     if fixed_xy.shape[0]:
         df = xy[:, :, None] - fixed_xy  # (R, M, F, 2)
-        loss = loss + _soft_area(df, half[:, :, None] + fixed_half + gap, beta, eps).sum((-1, -2))
+        loss = loss + soft_area(df, half[:, :, None] + fixed_half + gap, beta, eps).sum((-1, -2))
     return loss
 
 
