@@ -41,7 +41,9 @@ def atom_str(atom: Atom) -> str:
     return "(" + " ".join(atom) + ")"
 
 
-def _atom(pred: Predicate, binding: dict[str, str] | None = None) -> Atom:
+def atom_of(pred: Predicate, binding: dict[str, str] | None = None) -> Atom:
+    """``pred`` as an `Atom` (predicate and constants lower-case), its variables replaced by
+    ``binding`` (variable name -> object); PDDLError for a variable ``binding`` does not bind."""
     args = []
     for term in pred.terms:
         key = str(term.name).lower()
@@ -54,7 +56,7 @@ def _atom(pred: Predicate, binding: dict[str, str] | None = None) -> Atom:
     return (str(pred.name).lower(), *args)
 
 
-def _literals(formula: object, what: str) -> list[tuple[bool, Predicate]]:
+def flat_literals(formula: object, what: str) -> list[tuple[bool, Predicate]]:
     """Flatten a conjunction of literals into ``(positive, predicate)`` pairs."""
     if formula is None:
         return []
@@ -63,7 +65,7 @@ def _literals(formula: object, what: str) -> list[tuple[bool, Predicate]]:
     if isinstance(formula, Not) and isinstance(formula.argument, Predicate):
         return [(False, formula.argument)]
     if isinstance(formula, And):
-        return [lit for op in formula.operands for lit in _literals(op, what)]
+        return [lit for op in formula.operands for lit in flat_literals(op, what)]
     raise PDDLError(f"{what}: {formula} is not STRIPS (supported: and, not, atoms)")
 
 
@@ -73,20 +75,20 @@ def initial_state(problem: PDDLProblem) -> State:
     for fact in problem.init:
         if not isinstance(fact, Predicate):
             raise PDDLError(f"problem {problem.name}: init fact {fact} is not a STRIPS atom")
-        atoms.append(_atom(fact))
+        atoms.append(atom_of(fact))
     return frozenset(atoms)
 
 
 def goal_atoms(problem: PDDLProblem) -> tuple[Atom, ...]:
     """The goal as positive atoms in file order; PDDLError for anything but a conjunction."""
-    literals = _literals(problem.goal, f"problem {problem.name}: goal")
+    literals = flat_literals(problem.goal, f"problem {problem.name}: goal")
     negative = [p for positive, p in literals if not positive]
     if negative:
         raise PDDLError(
             f"problem {problem.name}: goal literal (not {negative[0]}) is not supported "
             "(goals are conjunctions of positive atoms)"
         )
-    return tuple(dict.fromkeys(_atom(p) for _, p in literals))
+    return tuple(dict.fromkeys(atom_of(p) for _, p in literals))
 
 
 def objects(domain: Domain, problem: PDDLProblem) -> tuple[str, ...]:
@@ -150,13 +152,13 @@ def ground(domain: Domain, problem: PDDLProblem, action: Action) -> GroundAction
                 f"{action}: {arg} is not of type {' or '.join(sorted(wanted))} for ?{param.name}"
             )
     binding = dict(zip(params, args, strict=True))
-    pre = _literals(schema.precondition, f"action {name}: precondition")
-    eff = _literals(schema.effect, f"action {name}: effect")
+    pre = flat_literals(schema.precondition, f"action {name}: precondition")
+    eff = flat_literals(schema.effect, f"action {name}: effect")
     return GroundAction(
-        frozenset(_atom(p, binding) for pos, p in pre if pos),
-        frozenset(_atom(p, binding) for pos, p in pre if not pos),
-        frozenset(_atom(p, binding) for pos, p in eff if pos),
-        frozenset(_atom(p, binding) for pos, p in eff if not pos),
+        frozenset(atom_of(p, binding) for pos, p in pre if pos),
+        frozenset(atom_of(p, binding) for pos, p in pre if not pos),
+        frozenset(atom_of(p, binding) for pos, p in eff if pos),
+        frozenset(atom_of(p, binding) for pos, p in eff if not pos),
     )
 
 

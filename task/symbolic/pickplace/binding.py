@@ -279,11 +279,11 @@ def _schema_atoms(domain: Domain, name: str) -> tuple[list, list, list]:
     """The (pre, add, delete) atoms of action ``name``'s schema, parameters as ``?p``."""
     schema = {str(a.name).lower(): a for a in domain.actions}[name]
     params = {str(p.name).lower(): f"?{str(p.name).lower()}" for p in schema.parameters}
-    pre = strips._literals(schema.precondition, f"action {name}: precondition")
-    eff = strips._literals(schema.effect, f"action {name}: effect")
-    pre_atoms = [strips._atom(p, params) for positive, p in pre if positive]
-    add = [strips._atom(p, params) for positive, p in eff if positive]
-    delete = [strips._atom(p, params) for positive, p in eff if not positive]
+    pre = strips.flat_literals(schema.precondition, f"action {name}: precondition")
+    eff = strips.flat_literals(schema.effect, f"action {name}: effect")
+    pre_atoms = [strips.atom_of(p, params) for positive, p in pre if positive]
+    add = [strips.atom_of(p, params) for positive, p in eff if positive]
+    delete = [strips.atom_of(p, params) for positive, p in eff if not positive]
     return pre_atoms, add, delete
 
 
