@@ -187,3 +187,29 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
         assert found is Failure.IK_INFEASIBLE  # no fallback given: top-down alone
         found = motion_check(solver, away, far, q, ExecConfig(), CRAMPED, model, 0, geo)
         assert found is Failure.IK_INFEASIBLE
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("fallback", [True, False])
+def test_the_episode_gives_its_executor_the_geometric_fallback(solver, monkeypatch, fallback):
+    """The executor imports nothing of the geometric room: the episode builds the fallback
+    (`tamp.blocks_geo.GeoFallback`) and gives it to every move, and none when it is off."""
+    from tamp.blocks_geo import GeoFallback
+    from tamp.loop import LoopConfig, episode, run_episode
+    from tamp.loop.execute import ExecConfig
+
+    given, real = [], episode.execute_move
+
+    def spy(*args, **kwargs):
+        given.append(kwargs.get("fallback"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(episode, "execute_move", spy)
+    two = Problem("two", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    config = LoopConfig(execution=replace(ExecConfig(), geo_fallback=fallback))
+    report = run_episode(two, config, seed=0, solver=solver)
+    assert report.reached_goal and given
+    if fallback:
+        assert all(isinstance(f, GeoFallback) for f in given)
+    else:
+        assert given == [None] * len(given)
