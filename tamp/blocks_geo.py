@@ -19,23 +19,29 @@ so the scene's few slots stay the constraint they are. This module translates:
   move, `tamp.loop.execute.motion_check`);
 - `run_geo`: one loop move checked (every grasp family, blocked free-space phases rerouted) and run
   through `tamp.geo.check.check_move` and `tamp.geo.execute.run_move` in the loop's simulator,
-  its outcome as the loop's `tamp.loop.execute.ExecutionResult`.
+  its outcome as the loop's `tamp.loop.execute.ExecutionResult` (the failure kinds are
+  `tamp.outcome.Failure`'s, the same in both rooms);
+- `GeoFallback`: the two as the loop executor's `tamp.loop.execute.Fallback`, which the episode
+  builds (`geo_fallback`) and gives the executor: `tamp.loop.execute` imports nothing of this
+  module or of `tamp.geo`.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tamp.outcome import Failure
 from tamp.scene import PALETTE, Pose, SceneConfig, read_state, towers
 from task.problem import TABLE, Move, Problem
 
 if TYPE_CHECKING:
     from tamp.geo.check import Tools
+    from tamp.loop.execute import ExecConfig, ExecutionResult
     from tamp.world.goal import Goal
     from tamp.world.schema import Scene
 
@@ -52,17 +58,6 @@ FAMILY_RANK = {"top": 0, "tilt": 1, "side": 2}
 # it in 4 of 16 other postures of a top-down grasp, where the nearest posture of every grasp
 # hit the tower
 POSTURES = 16
-# geometric failures as the loop names them (a failure not listed: ik_infeasible, the arm
-# found no way to make the move)
-FAILURES = {
-    "ik_infeasible": "ik_infeasible",
-    "no_grasp": "ik_infeasible",
-    "no_clearance": "no_clearance",
-    "collision": "collision",
-    "missed_grasp": "grasp_missed",
-    "dropped": "dropped",
-    "tracking_error": "tracking_error",
-}
 
 
 def world_scene(entities: Sequence[str], poses: Mapping[str, Pose], scene: SceneConfig) -> Scene:
@@ -172,18 +167,17 @@ def run_geo(
     tolerances); ``observe``: the block poses after the run (default: the simulator's sensor is
     not read here, so the place is not checked)."""
     from tamp.geo.execute import RunConfig, rests_of, run_move
-    from tamp.loop.execute import ExecutionResult, Failure
+    from tamp.loop.execute import ExecutionResult
 
     wall0, sim0 = time.perf_counter(), sim.time
     world, geo, verdict = geo_check(move, target, poses, scene, tools, sim.arm_q(), seed)
 
-    def result(failure: str | None, run=None, **evidence) -> ExecutionResult:
-        kind = None if failure is None else Failure(FAILURES.get(failure, "ik_infeasible"))
+    def result(failure: Failure | None, run=None, **evidence) -> ExecutionResult:
         return ExecutionResult(
             move,
             failure is None,
-            kind,
-            {"geo": failure or "ok", **evidence},
+            failure,
+            {"geo": "ok" if failure is None else failure.value, **evidence},
             sim.time - sim0,
             time.perf_counter() - wall0,
             check_time_s=verdict.time_s,
@@ -191,7 +185,7 @@ def run_geo(
         )
 
     if not verdict.ok:
-        tried = [f"{t.grasp}:{t.failure}" for t in verdict.tried]
+        tried = [f"{t.grasp}:{t.failure.value}" for t in verdict.tried]
         sides = sorted({t.side for t in verdict.tried if t.side})  # "pick", "place"
         return result(verdict.failure, tried=tried, sides=sides)
     below = next((x for x, p in poses.items() if _on(p, poses[move.entity], scene)), TABLE)
@@ -213,6 +207,49 @@ def run_geo(
         out = result(None, run, **held, off_xy_m=round(dxy, 4), off_z_m=round(dz, 4))
         return replace(out, ok=False, failure=Failure.MISPLACED)
     return result(None, run, **held)
+
+
+@dataclass(frozen=True)
+class GeoFallback:
+    """The geometric room as the loop executor's `tamp.loop.execute.Fallback`: `geo_check`
+    and `run_geo` over ``tools`` (`geo_tools`)."""
+
+    tools: Tools
+
+    def check(
+        self,
+        move: Move,
+        target: Pose,
+        poses: Mapping[str, Pose],
+        scene: SceneConfig,
+        q_now,
+        seed: int = 0,
+    ) -> bool:
+        """Whether `geo_check` passes ``move`` to ``target`` from the arm at ``q_now``."""
+        return geo_check(move, target, poses, scene, self.tools, q_now, seed)[2].ok
+
+    def run(
+        self,
+        sim,
+        move: Move,
+        target: Pose,
+        poses: Mapping[str, Pose],
+        scene: SceneConfig,
+        config: ExecConfig,
+        seed: int = 0,
+        drop_at: float | None = None,
+        observe: Callable[[], Mapping[str, Pose]] | None = None,
+    ) -> ExecutionResult:
+        """`run_geo` of ``move`` to ``target`` in ``sim``."""
+        return run_geo(
+            sim, move, target, poses, scene, self.tools, config, seed, drop_at, None, observe
+        )
+
+
+def geo_fallback(solver, collision, guard) -> GeoFallback:
+    """The loop executor's geometric fallback over its IK ``solver`` and ``collision`` model,
+    blocked free-space phases rerouted (``guard``: the executor's `GuardConfig`)."""
+    return GeoFallback(geo_tools(solver, collision, guard, plan=True))
 
 
 def _family_rank(grasp) -> int:

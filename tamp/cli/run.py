@@ -20,6 +20,7 @@ on the observed scene before it runs.
 from __future__ import annotations
 
 import argparse
+import enum
 import json
 import math
 import sys
@@ -257,12 +258,12 @@ def geo_lines(report) -> list[str]:
     outcome."""
     lines = []
     for k, m in enumerate(report.moves, 1):
-        lines.append(f"  {k:2d}. {m.move}: {'ok' if m.ok else 'FAILED ' + str(m.failure)}")
+        lines.append(f"  {k:2d}. {m.move}: {'ok' if m.ok else 'FAILED ' + m.failure.value}")
     reason = f" ({report.reason})" if report.reason else ""
     ok = sum(m.ok for m in report.moves)
     return [
         *lines,
-        f"{report.status}{reason}; goal reached (ground truth): "
+        f"{report.status.value}{reason}; goal reached (ground truth): "
         f"{'yes' if report.reached else 'no'}",
         f"moves {ok}/{len(report.moves)} ok, {report.replans} replans, motion failures "
         f"{report.motion_failures}, collisions {report.collisions}",
@@ -273,7 +274,10 @@ def geo_lines(report) -> list[str]:
 
 
 def _jsonable(value):
-    """``value`` with tuples as lists and numpy scalars as Python numbers, for json."""
+    """``value`` with tuples as lists, numpy scalars as Python numbers and enum members (a
+    `tamp.outcome.Failure`, an `EpisodeStatus`) as their values, for json."""
+    if isinstance(value, enum.Enum):
+        return value.value
     if isinstance(value, float) and not math.isfinite(value):
         return str(value)  # "inf", "-inf", "nan": json has no such numbers
     if isinstance(value, dict):

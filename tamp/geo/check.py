@@ -17,12 +17,12 @@ boxes within `CORRIDOR` of the straight line from pick to place), not over the h
 anywhere; when the guard finds that path blocked it tries again over everything (the safe
 height of `tamp.loop`).
 
-Failures (``MoveCheck.failure``): ``not_clear`` (something rests on the object),
-``unsupported`` (the place overlaps something or would not rest on its target), ``no_grasp``
-(no candidate grasp fits the gripper), ``ik_infeasible``, ``no_clearance`` (a ceiling leaves
-the hand no room), ``collision``. Each grasp tried leaves a `GraspTry` saying whether it failed
-on the pick side (independent of the place) or the place side, which the search's failure
-memory keys on.
+Failures (``MoveCheck.failure``, members of `tamp.outcome.Failure`, the executors' vocabulary):
+``not_clear`` (something rests on the object), ``unsupported`` (the place overlaps something
+or would not rest on its target), ``no_grasp`` (no candidate grasp fits the gripper),
+``ik_infeasible``, ``no_clearance`` (a ceiling leaves the hand no room), ``collision``. Each
+grasp tried leaves a `GraspTry` saying whether it failed on the pick side (independent of the
+place) or the place side, which the search's failure memory keys on.
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ from tamp.geo.places import free, placed_solid
 from tamp.geo.postures import POSTURE_GRASPS, plan_postures
 from tamp.geo.types import TABLE, GeoMove, moved
 from tamp.obstacles import ceiling
+from tamp.outcome import Failure
 from tamp.world.geometry import Solid, fixed_solids, footprint_gap, of_movable
 from tamp.world.relations import read_facts
 from tamp.world.schema import Movable, Scene
@@ -58,7 +59,15 @@ FINGER = 0.012  # m, a finger pad's thickness, for ordering grasps by the room b
 STROKE = 0.08  # m, the Panda's widest opening
 PICK_PHASES = ("approach", "descend")  # guard phases that do not depend on the place
 PICK_WAYPOINTS = ("pre_grasp", "grasp")  # IK waypoints that do not depend on the place
-FAILURES = ("not_clear", "unsupported", "no_grasp", "ik_infeasible", "no_clearance", "collision")
+# the failures a check finds (`tamp.outcome.Failure`, the executors' vocabulary)
+FAILURES = (
+    Failure.NOT_CLEAR,
+    Failure.UNSUPPORTED,
+    Failure.NO_GRASP,
+    Failure.IK_INFEASIBLE,
+    Failure.NO_CLEARANCE,
+    Failure.COLLISION,
+)
 
 
 @dataclass(frozen=True)
@@ -68,7 +77,7 @@ class GraspTry:
     (anything from the lift on)."""
 
     grasp: str
-    failure: str | None
+    failure: Failure | None
     side: str = ""
     where: str = ""  # the phase or IK waypoint that failed
     other: str = ""  # what the arm or the held object hit (a box name, "table" or a link)
@@ -83,7 +92,7 @@ class MoveCheck:
 
     ok: bool
     grasp: Grasp | None = None
-    failure: str | None = None
+    failure: Failure | None = None
     motion: tuple[Phase, ...] = ()
     evidence: dict = field(default_factory=dict)
     tried: tuple[GraspTry, ...] = ()
@@ -261,10 +270,10 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
         for k, g in enumerate(grasps):
             at_grasp, at_place = 2 * k, 2 * k + 1
             if not found.ok[at_grasp]:
-                out[g.name] = ("ik_infeasible", "pick", {"waypoint": "grasp"})
+                out[g.name] = (Failure.IK_INFEASIBLE, "pick", {"waypoint": "grasp"})
                 continue
             if not found.ok[at_place]:
-                out[g.name] = ("ik_infeasible", "place", {"waypoint": "place"})
+                out[g.name] = (Failure.IK_INFEASIBLE, "place", {"waypoint": "place"})
                 continue
             world = pick_place_world(scene, o, move, g, support)
             model.set_boxes(world.boxes)
@@ -272,13 +281,14 @@ def quick_check(scene: Scene, move: GeoMove, tools: Tools, grasps, q_now=None) -
             ignore = (("hand", o.name),)
             hits = model.contacts(found.q[at_grasp], tools.guard.open_width, ignore)
             if hits:
-                out[g.name] = ("collision", "pick", _contact("descend", hits[0]))
+                out[g.name] = (Failure.COLLISION, "pick", _contact("descend", hits[0]))
                 continue
             model.set_boxes(tuple(b for b in world.boxes if b.name != o.name))
             hold_picked(model, world)
             grip = g.width / 2
             hits = model.contacts(found.q[at_place], grip, (("held", world.placed_on),))
-            out[g.name] = None if not hits else ("collision", "place", _contact("lower", hits[0]))
+            place = (Failure.COLLISION, "place", _contact("lower", hits[0])) if hits else None
+            out[g.name] = place
     finally:
         model.margin = before
         model.hold(None)
@@ -324,24 +334,25 @@ def check_move(
     facts = read_facts(scene)
     if ("clear", o.name) not in facts.atoms:
         above = sorted(a[1] for a in facts.atoms if a[0] == "on" and a[2] == o.name)
-        return verdict(ok=False, failure="not_clear", evidence={"under": above})
+        return verdict(ok=False, failure=Failure.NOT_CLEAR, evidence={"under": above})
     if not _supported(scene, move):
         solid = placed_solid(o, move.place)
         where = [round(v, 4) for v in solid.centre]
         return verdict(
-            ok=False, failure="unsupported", evidence={"place": move.place.name, "at": where}
+            ok=False, failure=Failure.UNSUPPORTED, evidence={"place": move.place.name, "at": where}
         )
     if grasps is None:
         grasps = (move.grasp,) if move.grasp is not None else candidate_grasps(o, tools.choices)
         grasps = grasp_order(scene, o, grasps)
     grasps = tuple(g for g in grasps if g.width <= STROKE + 1e-9)  # a move's own grasp too
     if not grasps:
-        return verdict(ok=False, failure="no_grasp", evidence={"object": o.name, "kind": o.kind})
+        evidence = {"object": o.name, "kind": o.kind}
+        return verdict(ok=False, failure=Failure.NO_GRASP, evidence=evidence)
     q = tools.q if q_now is None else np.asarray(q_now, dtype=np.float64)
     support = support_box(scene, dict(facts.supports).get(o.name, TABLE))
     quick = tools.quick if quick is None else quick
     quick = quick_check(scene, move, tools, grasps, q) if quick or not full else {}
-    tried, last = [], ("collision", {})
+    tried, last = [], (Failure.COLLISION, {})
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
     for g in grasps:
         early = quick.get(g.name)
@@ -365,7 +376,7 @@ def check_move(
         )
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
     if full and tools.postures > 0:  # the colliding grasps again, in other postures
-        collided = [t.grasp for t in tried if t.failure == "collision"]
+        collided = [t.grasp for t in tried if t.failure is Failure.COLLISION]
         for g in [g for g in grasps if g.name in collided][:POSTURE_GRASPS]:
             world = pick_place_world(scene, o, move, g, support)
             requests = [pick_place_request(o, move, g, z, scene) for z in heights]
@@ -388,14 +399,15 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
         if not planned.ok:
             bad = planned.evidence.get("waypoint", "")
             side = "pick" if bad in PICK_WAYPOINTS else "place"
-            failure = {"failure": planned.failure, "side": side, "evidence": planned.evidence}
+            why = Failure(planned.failure)  # the motion layer's name of it
+            failure = {"failure": why, "side": side, "evidence": planned.evidence}
             continue
         world = pick_place_world(scene, o, move, g, support)
         guarded = guard_pick_place(planned.phases, tools.collision, world, tools.guard, seed)
         if guarded.ok:
             return guarded.phases
         side = "pick" if guarded.evidence.get("phase") in PICK_PHASES else "place"
-        failure = {"failure": "collision", "side": side, "evidence": guarded.evidence}
+        failure = {"failure": Failure.COLLISION, "side": side, "evidence": guarded.evidence}
         if side == "pick":
             break  # the transit height changes nothing before the lift
     return failure

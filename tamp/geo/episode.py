@@ -48,6 +48,7 @@ from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
 from tamp.sweep import torch_threads
@@ -66,33 +67,34 @@ OBSERVED = Tolerances(z=0.012, overlap=0.004, edge=0.002)
 SETTLE_S = 0.3  # simulated seconds the objects settle before each observation
 # a move the planner checked from home that fails from where the arm stands (its IK seeded
 # there, its hand turned as it is) is checked again from home, after a guarded trip there
-AGAIN_FROM_HOME = ("ik_infeasible", "collision")
+AGAIN_FROM_HOME = (Failure.IK_INFEASIBLE, Failure.COLLISION)
 HOME_TOL = 0.05  # rad, the arm stands at home when every joint is this near
 
 
 @dataclass(frozen=True)
 class MoveRecord:
     """One move attempted: its text, the grasp's name ("" when none was found), ok, and the
-    failure (a `check_move` failure, a run failure, or ``unexpected`` when the observed facts
-    differ from what the move was to give)."""
+    failure (`tamp.outcome.Failure`: a `check_move` failure, a run failure, or ``UNEXPECTED``
+    when the observed facts differ from what the move was to give)."""
 
     move: str
     grasp: str
     ok: bool
-    failure: str | None = None
+    failure: Failure | None = None
     evidence: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
 class GeoReport:
-    """An episode's outcome. ``status``: ``reached`` / ``not_reached`` (the plans ran out
-    without the goal), ``no_plan`` (the planner's status and reason in ``reason``),
-    ``replan_budget``, ``move_budget``. ``reached`` is scored on ground truth."""
+    """An episode's outcome. ``status`` (`tamp.outcome.EpisodeStatus`, the loop's vocabulary):
+    ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
+    saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET``,
+    ``MOVE_BUDGET``. ``reached`` is scored on ground truth."""
 
     reached: bool
     planner: str
     backend: str
-    status: str
+    status: EpisodeStatus
     reason: str = ""
     moves: tuple[MoveRecord, ...] = ()
     motion_failures: int = 0  # moves whose check or run failed
@@ -273,14 +275,14 @@ def run_geo_episode(
     records: list[MoveRecord] = []
     plan_times, plan_stats = [], []
     path, first_len, replans, failures = 0.0, 0, 0, 0
-    status, reason = "not_reached", ""
+    status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
         with torch_threads(1):
             _settle(sim, on_frame)
             world = observe(sim, scene, camera)
             while True:
                 if goal.holds(read_facts(world, OBSERVED)):
-                    status = "reached"
+                    status = EpisodeStatus.GOAL_REACHED
                     break
                 t0 = time.perf_counter()
                 plan = plan_fn(world, goal, tools, config)
@@ -291,14 +293,14 @@ def run_geo_episode(
                     f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
                 )
                 if not plan.solved:
-                    status, reason = "no_plan", f"{plan.status.value}: {plan.reason}"
+                    status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
                     break
                 if not first_len:
                     first_len = len(plan.moves)
                 replan = False
                 for move in plan.moves:
                     if len(records) >= max_moves:
-                        status, reason = "move_budget", f"{max_moves} moves used"
+                        status, reason = EpisodeStatus.MOVE_BUDGET, f"{max_moves} moves used"
                         break
                     k = len(records)
                     record, world, ran = _act(
@@ -307,20 +309,21 @@ def run_geo_episode(
                     records.append(record)
                     say(
                         f"move {k + 1}: {record.move}: "
-                        f"{'ok' if record.ok else 'failed: ' + str(record.failure)}"
+                        f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
                     )
                     path += ran
-                    failures += record.failure not in (None, "unexpected")
+                    failures += record.failure not in (None, Failure.UNEXPECTED)
                     if not record.ok:
                         replan = True
                         break
-                if status == "move_budget":
+                if status is EpisodeStatus.MOVE_BUDGET:
                     break
                 if replan or not goal.holds(read_facts(world, OBSERVED)):
                     replans += 1
                     if replans > max_replans:
-                        status = "replan_budget"
-                        reason = f"more than {max_replans} replans; last: {records[-1].failure}"
+                        status = EpisodeStatus.REPLAN_BUDGET
+                        last = records[-1].failure
+                        reason = f"more than {max_replans} replans; last: {last and last.value}"
                         break
             with sim.truth.scoring():
                 truth = _with_poses(scene, sim.truth.block_poses())
@@ -331,8 +334,9 @@ def run_geo_episode(
             recorder.close()
         if own:
             tools.close()
-    if status == "reached" and not reached:
-        status, reason = "not_reached", "the robot saw the goal; the ground truth does not hold it"
+    if status is EpisodeStatus.GOAL_REACHED and not reached:
+        status = EpisodeStatus.NOT_REACHED
+        reason = "the robot saw the goal; the ground truth does not hold it"
     return GeoReport(
         reached=reached,
         planner=planner,
@@ -403,7 +407,7 @@ def _act(
     if want != got:
         # what the run itself noticed (re-grasps on release, corrections) stays beside it
         evidence = {**ran.evidence, "missing": sorted(want - got), "extra": sorted(got - want)}
-        return MoveRecord(move.text(), name, False, "unexpected", evidence), seen, path
+        return MoveRecord(move.text(), name, False, Failure.UNEXPECTED, evidence), seen, path
     return MoveRecord(move.text(), name, True, None, ran.evidence), seen, path
 
 

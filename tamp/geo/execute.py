@@ -7,9 +7,10 @@ meant to make (`tamp.sim.base.Expected`: the hand on the object it handles; the 
 what it leaves while lifted and on what it goes onto while lowered), so the experimenter's
 contact scoring (``Simulator.touched``) counts every other touch. Failures are read from the
 gripper as a real robot reads them: after closing, the fingers must stand at the grasp's width
-(within ``width_tol``) pushed on both sides (``missed_grasp``); after the lift and the transit
+(within ``width_tol``) pushed on both sides (``grasp_missed``); after the lift and the transit
 they must still stand at that width (``dropped``); a joint tracking error beyond
-``max_tracking`` means the arm was blocked (``tracking_error``). After a failure at the object
+``max_tracking`` means the arm was blocked (``tracking_error``): the failure kinds are
+`tamp.outcome.Failure`'s, the loop executor's. After a failure at the object
 the hand opens and backs out along its descent. After the release the fingers must stand open
 (their opening within ``width_tol`` of the stroke): an object that turned a little in the
 fingers on the way can stay wedged between the open pads (PyBullet: a pad's edge sunk a
@@ -49,6 +50,7 @@ from robots.panda import PANDA
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
 from tamp.loop.execute import holding
+from tamp.outcome import Failure
 from tamp.sim.base import Expected, Simulator
 
 
@@ -72,12 +74,12 @@ class RunConfig:
 
 @dataclass(frozen=True)
 class MoveRun:
-    """What running one move did: ``ok`` or the ``failure`` (``missed_grasp``, ``dropped``,
-    ``tracking_error``) with ``evidence``; simulated seconds, joint path run (rad: the sum of
+    """What running one move did: ``ok`` or the ``failure`` (`Failure`: ``GRASP_MISSED``,
+    ``DROPPED``, ``TRACKING``) with ``evidence``; simulated seconds, joint path run (rad: the sum of
     |dq| over the phases started) and wall seconds."""
 
     ok: bool
-    failure: str | None = None
+    failure: Failure | None = None
     evidence: dict = field(default_factory=dict)
     sim_time_s: float = 0.0
     path_rad: float = 0.0
@@ -117,7 +119,7 @@ def run_move(
     width = check.grasp.width
     evidence: dict = {}
 
-    def done(failure: str | None = None, **found) -> MoveRun:
+    def done(failure: Failure | None = None, **found) -> MoveRun:
         return MoveRun(
             failure is None,
             failure,
@@ -172,14 +174,14 @@ def run_move(
         worst = sim.run(phase.trajectory, phase.gripper, release, on_frame, expected)
         if worst > config.max_tracking:
             freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
-            return done("tracking_error", phase=phase.name, error_rad=round(worst, 3), **freed)
+            return done(Failure.TRACKING, phase=phase.name, error_rad=round(worst, 3), **freed)
         if phase.name == "close":
             missed = holding(sim, width, config, fresh=True)
             if missed is None and sim.grasp == "weld" and not sim.attach():
                 missed = {"weld": "no object between the fingers"}
             if missed is not None:
                 freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
-                return done("missed_grasp", **missed, **freed)
+                return done(Failure.GRASP_MISSED, **missed, **freed)
         elif phase.name == "open":
             closing = expected_contacts("lower", move.obj, rests)
             evidence |= _release(sim, config, on_frame, closing, phase.trajectory.duration)
@@ -189,7 +191,7 @@ def run_move(
                 sim.detach()
                 hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
                 sim.run(hold, "open", on_frame=on_frame, expected=handling)
-                return done("dropped", after=phase.name, injected=release is not None, **gone)
+                return done(Failure.DROPPED, after=phase.name, injected=release is not None, **gone)
     return done()
 
 

@@ -51,6 +51,7 @@ from motion.grasps import world_tcp
 from tamp.geo.check import MoveCheck, Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.places import apart, candidate_places, free, supported_on
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, Place, moved
+from tamp.outcome import Failure
 from tamp.world.geometry import fixed_solids, footprint_gap, of_movable
 from tamp.world.goal import Goal
 from tamp.world.relations import Atom, read_facts
@@ -188,12 +189,12 @@ class _Memory:
         for t in check.tried:
             if t.failure is None:
                 continue
-            if t.side == "pick" and (t.failure == "ik_infeasible" or t.other in self.fixed):
+            if t.side == "pick" and (t.failure is Failure.IK_INFEASIBLE or t.other in self.fixed):
                 self.pick.setdefault((move.obj, here, t.grasp), set()).add("fixed")
             elif t.side == "pick" and t.other in names:
                 culprit = (t.other, _pose_key(scene.object(t.other)))
                 self.pick.setdefault((move.obj, here, t.grasp), set()).add(culprit)
-            elif t.failure == "ik_infeasible" and t.where == "place":
+            elif t.failure is Failure.IK_INFEASIBLE and t.where == "place":
                 self.place.add((move.obj, t.grasp, move.place.name))
             else:
                 self.move.add((key, move.obj, t.grasp, move.place.name))

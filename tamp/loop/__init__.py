@@ -4,7 +4,8 @@
   (``start``, ``step``, ``execute``, ``check``, ``observe``, ``report``) that ``given`` drives
   too, and `run_episode`;
 - ``config``: `LoopConfig`, the settings of an episode;
-- ``report``: `EpisodeStatus` and `EpisodeReport`, what an episode returns;
+- ``report``: `EpisodeReport`, what an episode returns, with its `EpisodeStatus`
+  (`tamp.outcome`: the geometric episode's statuses too);
 - ``observe``: what the robot senses: block poses (for the arm) and the symbolic state (for the
   planner), from the mocap oracle or from the camera;
 - ``sensors``: the two pose sensors, `MocapPoses` (``observe="state"`` only: the one sensor whose
@@ -23,6 +24,7 @@
 from tamp.loop.config import LoopConfig
 from tamp.loop.episode import Episode, run_episode
 from tamp.loop.recover import describe
-from tamp.loop.report import EpisodeReport, EpisodeStatus
+from tamp.loop.report import EpisodeReport
+from tamp.outcome import EpisodeStatus
 
 __all__ = ["Episode", "EpisodeReport", "EpisodeStatus", "LoopConfig", "describe", "run_episode"]

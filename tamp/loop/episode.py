@@ -40,7 +40,7 @@ from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import (
     ExecutionResult,
-    Failure,
+    Fallback,
     execute_move,
     failed_pick,
     motion_check,
@@ -49,8 +49,9 @@ from tamp.loop.execute import (
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
-from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
+from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
+from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
@@ -277,6 +278,16 @@ class Episode:
 
         return CHOICES
 
+    def _fallback(self) -> Fallback | None:
+        """The executor's geometric fallback (`tamp.blocks_geo.GeoFallback` over the episode's
+        IK solver and collision model) when it has one (as `_grasps`), else None."""
+        execution = self.config.execution
+        if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
+            return None
+        from tamp.blocks_geo import geo_fallback
+
+        return geo_fallback(self.solver, self.collision, execution.guard)
+
     def _check_ahead(self, q) -> Callable | None:
         """``check(poses, move)`` for the planner's windows (`LoopConfig.check_ahead`): whether
         `tamp.loop.execute.motion_check` finds the move's motion among ``poses`` (the poses
@@ -289,7 +300,15 @@ class Episode:
 
         def check(poses, move: Move) -> bool:
             found = motion_check(
-                self.solver, move, dict(poses), q, cfg.execution, cfg.scene, self.collision, seed
+                self.solver,
+                move,
+                dict(poses),
+                q,
+                cfg.execution,
+                cfg.scene,
+                self.collision,
+                seed,
+                self._fallback(),
             )
             return found is None
 
@@ -437,6 +456,7 @@ class Episode:
             self.collision,
             self.seed * 1000 + self._acts,
             on_phase=None if self.recorder is None else self.recorder.phase,
+            fallback=self._fallback(),
         )
         if self.recorder is not None:
             self.recorder.moved(self.sim, label, done)

@@ -18,10 +18,10 @@ the experimenter's contact scoring counts every other touch of the arm or the ca
 
 from __future__ import annotations
 
-import enum
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -31,25 +31,11 @@ from motion.pick_place import Phase, PickPlaceConfig, PickPlaceRequest, plan_pic
 from motion.trajectory import JointTrajectory
 from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
+from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Expected, Simulator
 from task.errors import TampError, one_of
 from task.problem import TABLE, Move
-
-
-class Failure(enum.Enum):
-    """Why a move failed; each is a replanning trigger for the loop."""
-
-    IK_INFEASIBLE = "ik_infeasible"  # a waypoint of the pick-and-place has no IK solution
-    NO_FREE_SLOT = "no_free_slot"  # a move to the table found every table slot taken
-    GRASP_MISSED = "grasp_missed"  # after closing, the fingers do not hold a block-wide object
-    DROPPED = "dropped"  # the block left the fingers after the lift
-    MISPLACED = "misplaced"  # after release the block is not where it was to be placed
-    TRACKING = "tracking_error"  # the arm could not follow its trajectory (blocked)
-    UNOBSERVABLE = "unobservable"  # the camera could not see a block the move needs, from home
-    NO_CLEARANCE = "no_clearance"  # an overhead obstacle leaves the hand no room at a tower
-    COLLISION = "collision"  # a trajectory would hit something, and no detour was found
-
 
 COLLISION_MODES = ("plan", "check", "off")
 # what the top-down executor failed with that the geometric room's grasps may still make
@@ -73,8 +59,9 @@ class ExecConfig:
     guard: GuardConfig = GuardConfig()
     slot_tries: int = 3  # free table slots a move to the table tries before it fails
     # collision "plan": a move the top-down grasps cannot make (no IK, a collision, no
-    # clearance) is checked and run by the geometric room (`tamp.blocks_geo.run_geo`): side
-    # and tilted grasps too, the transit at the corridor's height; False: top-down only
+    # clearance) is checked and run by the executor's `Fallback`, the geometric room
+    # (`tamp.blocks_geo.GeoFallback`, which the episode builds): side and tilted grasps too,
+    # the transit at the corridor's height; False: top-down only
     geo_fallback: bool = True
 
     def __post_init__(self) -> None:
@@ -102,6 +89,41 @@ class ExecutionResult:
 
 
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
+
+
+class Fallback(Protocol):
+    """Another way to make a move the top-down grasps could not (one of `GEO_RETRIED`), given
+    to the executor by whoever builds it (the episode: `tamp.blocks_geo.GeoFallback`, every
+    grasp family of the geometric room), so this module imports no room of its own."""
+
+    def check(
+        self,
+        move: Move,
+        target: Pose,
+        poses: Mapping[str, Pose],
+        scene: SceneConfig,
+        q_now,
+        seed: int = 0,
+    ) -> bool:
+        """Whether it finds ``move``'s motion to ``target`` among the blocks at ``poses`` from
+        the arm at ``q_now``, nothing run."""
+        ...
+
+    def run(
+        self,
+        sim: Simulator,
+        move: Move,
+        target: Pose,
+        poses: Mapping[str, Pose],
+        scene: SceneConfig,
+        config: ExecConfig,
+        seed: int = 0,
+        drop_at: float | None = None,
+        observe: Observe | None = None,
+    ) -> ExecutionResult:
+        """Check ``move`` to ``target`` from the arm's configuration now and run it when it
+        passes; the place checked on the poses ``observe`` gives after it."""
+        ...
 
 
 def holding(sim: Simulator, width: float, config, fresh: bool) -> dict | None:
@@ -226,23 +248,24 @@ def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
     return last
 
 
-def _geo(sim, solver, move, target, poses, config, scene, collision, seed, drop_at, observe):
-    """``move`` checked and run by the geometric room (`tamp.blocks_geo.run_geo`) to
-    ``target``; the place checked on the poses ``observe`` gives after
-    it (a block the camera cannot see then: ``unobservable``)."""
-    from tamp.blocks_geo import geo_tools, run_geo
-
-    tools = geo_tools(solver, collision, config.guard, plan=True)
+def _geo(sim, fallback: Fallback, move, target, poses, config, scene, seed, drop_at, observe):
+    """``move`` checked and run by ``fallback`` to ``target``; the place checked on the poses
+    ``observe`` gives after it (a block the camera cannot see then: ``unobservable``)."""
     try:
-        return run_geo(sim, move, target, poses, scene, tools, config, seed, drop_at, None, observe)
+        return fallback.run(sim, move, target, poses, scene, config, seed, drop_at, observe)
     except PerceptionError as err:
         return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
 
 
-def _geo_retries(failure: Failure, config: ExecConfig) -> bool:
-    """Whether the geometric fallback retries a top-down move that failed with ``failure``:
-    one of `GEO_RETRIED`, with the fallback on and the collision model planning detours."""
-    return failure in GEO_RETRIED and config.geo_fallback and config.collision == "plan"
+def _geo_retries(failure: Failure, config: ExecConfig, fallback: Fallback | None) -> bool:
+    """Whether ``fallback`` retries a top-down move that failed with ``failure``: one of
+    `GEO_RETRIED`, with a fallback given and on, and the collision model planning detours."""
+    return (
+        fallback is not None
+        and failure in GEO_RETRIED
+        and config.geo_fallback
+        and config.collision == "plan"
+    )
 
 
 def motion_check(
@@ -254,24 +277,21 @@ def motion_check(
     scene: SceneConfig,
     collision: CollisionModel | None,
     seed: int = 0,
+    fallback: Fallback | None = None,
 ) -> Failure | None:
     """What `execute_move` would find before the arm moves, with the blocks at ``poses`` and
     the arm at ``q_now``, nothing run: None when it finds the move's motion (top-down, each
-    phase guarded, or with its geometric fallback every other grasp), else the failure it
-    would report. A planned move checked ahead, on the poses its plan predicts
+    phase guarded, or with its ``fallback`` every other grasp), else the failure it would
+    report. A planned move checked ahead, on the poses its plan predicts
     (`tamp.arm_costs.ArmCosts.verify`)."""
     times = [0.0, 0.0, 0.0, 0, 0]
     planned = _plan(q_now, solver, move, poses, config, scene, collision, seed, times)
     if not (isinstance(planned, tuple) and isinstance(planned[0], Failure)):
         return None
-    if _geo_retries(planned[0], config):
+    if _geo_retries(planned[0], config, fallback):
         target = place_pose(move, poses, scene)
-        if target is not None:
-            from tamp.blocks_geo import geo_check, geo_tools
-
-            tools = geo_tools(solver, collision, config.guard, plan=True)
-            if geo_check(move, target, poses, scene, tools, q_now, seed)[2].ok:
-                return None
+        if target is not None and fallback.check(move, target, poses, scene, q_now, seed):
+            return None
     return planned[0]
 
 
@@ -311,6 +331,7 @@ def execute_move(
     collision: CollisionModel | None = None,
     seed: int = 0,
     on_phase: Callable[[Simulator, Phase], None] | None = None,
+    fallback: Fallback | None = None,
 ) -> ExecutionResult:
     """Pick ``move.entity`` where it is observed and place it on ``move.target``.
 
@@ -318,6 +339,8 @@ def execute_move(
     ``collision``: the arm's collision model (`robots.collision.PandaCollision`), which checks
     the planned phases unless ``config.collision`` is "off"; ``seed`` seeds the motion planner.
     ``on_phase(sim, phase)`` is called as each planned phase starts (a recording, `tamp.rerun_log`).
+    ``fallback``: another way to make a move the top-down grasps could not (`Fallback`: the
+    geometric room's, `tamp.blocks_geo.GeoFallback`); None: top-down only.
     """
     wall0, sim0 = time.perf_counter(), sim.time
 
@@ -346,21 +369,11 @@ def execute_move(
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
     planned = _plan(sim.arm_q(), solver, move, poses, config, scene, collision, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
-        if _geo_retries(planned[0], config):
+        if _geo_retries(planned[0], config, fallback):
             target = place_pose(move, poses, scene)
             if target is not None:
                 again = _geo(
-                    sim,
-                    solver,
-                    move,
-                    target,
-                    poses,
-                    config,
-                    scene,
-                    collision,
-                    seed,
-                    drop_at,
-                    observe,
+                    sim, fallback, move, target, poses, config, scene, seed, drop_at, observe
                 )
                 if again.ok or again.path_rad > 0:  # it made the move, or it ran and failed
                     first = result(planned[0], planned[1])  # the top-down tries' times

@@ -33,7 +33,8 @@ import numpy as np
 
 from tamp.loop.config import LoopConfig
 from tamp.loop.episode import Episode
-from tamp.loop.report import EpisodeReport, EpisodeStatus, Progress
+from tamp.loop.report import EpisodeReport, Progress
+from tamp.outcome import EpisodeStatus
 from tamp.scene import SceneConfig, read_state
 from task import data
 from task.domains.blocksworld import moves_to_actions, to_atoms, to_pddl

@@ -11,7 +11,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from tamp.loop.execute import ExecutionResult, Failure
+from tamp.loop.execute import ExecutionResult
+from tamp.outcome import Failure
 from tamp.scene import Pose, Reading
 from tamp.sim.base import Simulator
 from task.problem import TABLE, Move

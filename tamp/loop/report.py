@@ -1,25 +1,16 @@
-"""What an episode reports: `EpisodeStatus`, why it stopped, and `EpisodeReport`, what happened;
+"""What an episode reports: its `tamp.outcome.EpisodeStatus`, why it stopped (the geometric
+episode's vocabulary too), and `EpisodeReport`, what happened;
 `Progress` is the tally an episode keeps while it runs, which becomes its report."""
 
 from __future__ import annotations
 
 import dataclasses
-import enum
 import time
 from dataclasses import dataclass, field
 
 from tamp.loop.execute import ExecutionResult
+from tamp.outcome import EpisodeStatus
 from task.problem import Move
-
-
-class EpisodeStatus(enum.Enum):
-    GOAL_REACHED = "goal_reached"  # the observed state satisfies the goal
-    NO_PLAN = "no_plan"  # the task planner found no plan from an observed state
-    REPLAN_BUDGET = "replan_budget"  # more failures than ``max_replans``
-    UNREADABLE = "unreadable"  # the observed poses do not form a blocksworld state
-    OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
-    INVALID_PLAN = "invalid_plan"  # a given plan stopped at a step it could not attempt
-    PLAN_ENDED = "plan_ended"  # a given plan ran to its end without reaching the goal
 
 
 @dataclass(frozen=True)

@@ -13,7 +13,7 @@ import pytest
 from motion.ik import IKSolver
 from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, DETOUR, ArmCosts
-from tamp.blocks_geo import CHOICES, blocks_goal, world_scene
+from tamp.blocks_geo import CHOICES, blocks_goal, geo_fallback, world_scene
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout, read_state
 from tamp.slots import slotted
@@ -93,7 +93,8 @@ def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
     reach the top from above (no IK at the pre-grasp); the geometric fallback makes the move
     (a tilted grasp), touching nothing."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, Failure, execute_move
+    from tamp.loop.execute import ExecConfig, execute_move
+    from tamp.outcome import Failure
     from tamp.sim import make_simulator
 
     poses, _, at, _ = _tall(slot=4)
@@ -103,7 +104,10 @@ def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
         with sim, PandaCollision() as model:
             observe = sim.truth._read_poses  # the test is the pose sensor
             config = replace(ExecConfig(), geo_fallback=fallback)
-            done = execute_move(sim, solver, move, observe, config, CRAMPED, collision=model)
+            geo = geo_fallback(solver, model, config.guard)
+            done = execute_move(
+                sim, solver, move, observe, config, CRAMPED, collision=model, fallback=geo
+            )
             state = read_state(TALL.entities, observe(), CRAMPED).state
             if not fallback:
                 assert done.failure is Failure.IK_INFEASIBLE
@@ -139,7 +143,8 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     the loop then rules out every move of the block while it stands there). A move that
     failed on the place side, or without the fallback's verdict, is not."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, ExecutionResult, Failure, execute_move, failed_pick
+    from tamp.loop.execute import ExecConfig, ExecutionResult, execute_move, failed_pick
+    from tamp.outcome import Failure
     from tamp.sim import make_simulator
 
     poses = {"a": Pose((0.95, 0.3, 0.025)), "b": Pose((0.4, 0.0, 0.025))}
@@ -147,7 +152,10 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     sim = make_simulator("pybullet", ("a", "b"), poses, CRAMPED)
     with sim, PandaCollision() as model:
         observe = sim.truth._read_poses
-        done = execute_move(sim, solver, move, observe, ExecConfig(), CRAMPED, collision=model)
+        geo = geo_fallback(solver, model, ExecConfig().guard)
+        done = execute_move(
+            sim, solver, move, observe, ExecConfig(), CRAMPED, collision=model, fallback=geo
+        )
     assert done.failure is Failure.IK_INFEASIBLE and done.evidence["waypoint"] == "pre_grasp"
     assert done.evidence["geo"]["sides"] == ["pick"] and failed_pick(done)
     place_side = {**done.evidence, "geo": {**done.evidence["geo"], "sides": ["pick", "place"]}}
@@ -162,7 +170,8 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
     a near slot passes through the geometric fallback's tilted grasp (and fails top-down
     alone, as `execute_move` does), a block beyond the arm's reach fails on its IK."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, Failure, motion_check
+    from tamp.loop.execute import ExecConfig, motion_check
+    from tamp.outcome import Failure
 
     poses, _, at, _ = _tall(slot=4)
     move = PlacedMove("g", TABLE, at["slot0"], "slot0")
@@ -170,9 +179,37 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
     away = PlacedMove("a", TABLE, (0.4, -0.24), "slot0")
     alone = replace(ExecConfig(), geo_fallback=False)
     with PandaCollision() as model:
-        q = PANDA.q_home
-        assert motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model) is None
-        found = motion_check(solver, move, poses, q, alone, CRAMPED, model)
+        q, geo = PANDA.q_home, geo_fallback(solver, model, ExecConfig().guard)
+        assert motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model, 0, geo) is None
+        found = motion_check(solver, move, poses, q, alone, CRAMPED, model, 0, geo)
         assert found is Failure.IK_INFEASIBLE
-        found = motion_check(solver, away, far, q, ExecConfig(), CRAMPED, model)
+        found = motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model)
+        assert found is Failure.IK_INFEASIBLE  # no fallback given: top-down alone
+        found = motion_check(solver, away, far, q, ExecConfig(), CRAMPED, model, 0, geo)
         assert found is Failure.IK_INFEASIBLE
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("fallback", [True, False])
+def test_the_episode_gives_its_executor_the_geometric_fallback(solver, monkeypatch, fallback):
+    """The executor imports nothing of the geometric room: the episode builds the fallback
+    (`tamp.blocks_geo.GeoFallback`) and gives it to every move, and none when it is off."""
+    from tamp.blocks_geo import GeoFallback
+    from tamp.loop import LoopConfig, episode, run_episode
+    from tamp.loop.execute import ExecConfig
+
+    given, real = [], episode.execute_move
+
+    def spy(*args, **kwargs):
+        given.append(kwargs.get("fallback"))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(episode, "execute_move", spy)
+    two = Problem("two", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    config = LoopConfig(execution=replace(ExecConfig(), geo_fallback=fallback))
+    report = run_episode(two, config, seed=0, solver=solver)
+    assert report.reached_goal and given
+    if fallback:
+        assert all(isinstance(f, GeoFallback) for f in given)
+    else:
+        assert given == [None] * len(given)

@@ -17,7 +17,8 @@ from motion.trajectory import JointTrajectory
 from robots.panda import PANDA
 from tamp.cli import main
 from tamp.cli.run import FRAME_PERIOD
-from tamp.loop.execute import Failure, execute_move
+from tamp.loop.execute import execute_move
+from tamp.outcome import Failure
 from tamp.scene import Pose, layout, read_state
 from tamp.sim import SIMULATORS, make_simulator
 from task.errors import TampError

@@ -140,7 +140,7 @@ def play(item: Item) -> dict:
         "planner": item.planner,
         "sim": item.sim,
         "observe": item.observe,
-        "status": report.status,
+        "status": report.status.value,
         "reached": report.reached,
         "clean": report.reached and report.motion_failures == 0,
         "plan_length": report.plan_length,
@@ -257,7 +257,7 @@ def _failure(record) -> str:
     run said so: ``failure[@phase][:other]``."""
     ev = record.evidence or {}
     where = ev.get("phase", ev.get("waypoint", ""))
-    out = record.failure
+    out = record.failure.value
     if where:
         out += f"@{where}"
     if ev.get("other"):

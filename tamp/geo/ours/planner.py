@@ -60,6 +60,7 @@ from tamp.geo.ours.pack import PackConfig
 from tamp.geo.ours.placing import next_placing
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoMove, GeoPlan, GeoStatus, moved
+from tamp.outcome import Failure
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 from task.config import PlannerConfig
@@ -98,13 +99,13 @@ PLANNER = PlannerConfig(
 WINDOWS_PER_BOUND_MOVE = 1.5
 # check failures no movable object takes part in: ruled out wherever the object stands as it
 # stood (`GeoCosts.avoid`'s ``fixed``), not only in the state they happened in
-FIXED_FAILURES = ("ik_infeasible", "no_clearance")
+FIXED_FAILURES = (Failure.IK_INFEASIBLE, Failure.NO_CLEARANCE)
 # grasps a planned move's full check takes at a time, the grasps the prices found free at both
 # ends first (`_check_in_turn`): the first of them passed every move of packed, sorting and
 # tall, variants 0-2 (74 of 74), and the check's batched IK and collision tests then cover
 # one grasp, not all twenty of a cuboid (bind time 5.6 s with four at a time, 3.7-4.2 with one)
 CHECK_CHUNK = 1
-BEFORE_GRASPS = ("not_clear", "unsupported")  # check failures whatever the grasp
+BEFORE_GRASPS = (Failure.NOT_CLEAR, Failure.UNSUPPORTED)  # check failures whatever the grasp
 
 
 @dataclass(frozen=True)
@@ -398,7 +399,7 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
             movable = {x.name for x in world.objects}
             for t in tried:
                 fixed = t.failure in FIXED_FAILURES or (
-                    t.failure == "collision" and bool(t.other) and t.other not in movable
+                    t.failure is Failure.COLLISION and bool(t.other) and t.other not in movable
                 )
                 costs.avoid(state, move, t.grasp, geo.place.name, fixed, t.side)
             if not tried:  # failed before any grasp: the move, at that place, in that state
@@ -427,7 +428,7 @@ def _check_in_turn(check, world, geo: GeoMove, tools, order, chunk: int = CHECK_
         if verdict.ok or verdict.failure in BEFORE_GRASPS:
             return verdict
         if not getattr(verdict, "tried", ()):
-            if verdict.failure == "no_grasp":
+            if verdict.failure is Failure.NO_GRASP:
                 continue  # every grasp of this chunk too wide for the hand
             break  # refused before any grasp: the others would be too
         tried += verdict.tried

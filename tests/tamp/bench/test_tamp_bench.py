@@ -50,7 +50,7 @@ def _row(problem, planner, sim, reached, failures=0, collisions=0, t=1.0):
         "variant": 0,
         "planner": planner,
         "sim": sim,
-        "status": "reached" if reached else "no_plan",
+        "status": "goal_reached" if reached else "no_plan",
         "reached": reached,
         "clean": reached and failures == 0,
         "plan_length": 3 if reached else 0,
@@ -113,9 +113,11 @@ def test_one_episode_writes_results_and_rows(tmp_path):
 
 def test_a_failed_moves_place_and_a_successful_moves_run_notes_reach_the_row():
     from tamp.geo.episode import MoveRecord
+    from tamp.outcome import Failure
 
-    hit = MoveRecord("move(a -> b)", "top0", False, "collision", {"phase": "lift", "other": "p1"})
-    ik = MoveRecord("move(a -> c)", "", False, "ik_infeasible", {})
+    where = {"phase": "lift", "other": "p1"}
+    hit = MoveRecord("move(a -> b)", "top0", False, Failure.COLLISION, where)
+    ik = MoveRecord("move(a -> c)", "", False, Failure.IK_INFEASIBLE, {})
     done = MoveRecord("move(a -> d)", "top0", True, None, {"regrasped": 1, "corrected_mm": 2.5})
     plain = MoveRecord("move(b -> d)", "top0", True, None, {})
     assert bench._failure(hit) == "collision@lift:p1" and bench._failure(ik) == "ik_infeasible"

@@ -16,7 +16,8 @@ from tamp.bench.vision import perception
 from tamp.cli import build_parser
 from tamp.cli.options import planner_config
 from tamp.loop import EpisodeReport, EpisodeStatus
-from tamp.loop.execute import ExecutionResult, Failure
+from tamp.loop.execute import ExecutionResult
+from tamp.outcome import Failure
 from task import instances
 from task.errors import TampError
 from task.problem import Move, Plan, PlanResult, PlanStatus

@@ -31,6 +31,7 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
     assert main(argv) == 0
     report = json.loads((out / "report.json").read_text())
     assert report["reached_goal"] and report["replans"] == 0
+    assert report["status"] == "goal_reached"  # as the geometric episode spells it
     # b is under a in the file: a must go first (from a laid-out state of three single
     # blocks, one move would do)
     assert report["plans"] == [["move(a -> table)", "move(b -> c)"]]
@@ -148,6 +149,7 @@ def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
     assert main(argv) == 0
     report = json.loads((out / "report.json").read_text())
     assert report["report"]["reached"] and report["report"]["collisions"] == 0
+    assert report["report"]["status"] == "goal_reached"  # as the Blocksworld loop spells it
     assert [m["move"].split(" at ")[0] for m in report["report"]["moves"]] == ["move a -> tray"]
     assert report["config"]["executor"] == "geometric"
     printed = capsys.readouterr()

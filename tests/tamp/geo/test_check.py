@@ -8,6 +8,7 @@ import pytest
 from tamp.geo.check import candidate_grasps, check_move, transit_heights
 from tamp.geo.places import candidate_places
 from tamp.geo.types import TABLE, GeoMove, Place
+from tamp.outcome import Failure
 from tests.tamp.geo.geo_scenes import blocked, cube, scene, tools
 
 pytestmark = pytest.mark.sim
@@ -18,7 +19,7 @@ def test_a_grasp_blocked_by_neighbours_is_rejected_on_the_pick_side():
     place = candidate_places(s, "t", "goal")[0]
     tops = candidate_grasps(s.object("t"), ("top",))
     verdict = check_move(s, GeoMove("t", place), tools(), grasps=tops)
-    assert not verdict.ok and verdict.failure == "collision"
+    assert not verdict.ok and verdict.failure is Failure.COLLISION
     assert len(verdict.tried) == len(tops) == 4
     assert {t.side for t in verdict.tried} == {"pick"}  # whatever the place
     assert {t.other for t in verdict.tried} <= {"w", "e", "n"}
@@ -39,9 +40,9 @@ def test_a_free_cube_is_accepted_with_a_grasp_and_phases_to_run():
 def test_a_covered_object_and_an_occupied_place_are_refused_before_any_motion():
     s = scene(cube("a", 0.5, 0.1), cube("b", 0.5, 0.1, 0.075), cube("c", 0.45, -0.25))
     onto_c = candidate_places(s, "b", "c")[0]
-    assert check_move(s, GeoMove("a", onto_c), tools()).failure == "not_clear"
+    assert check_move(s, GeoMove("a", onto_c), tools()).failure is Failure.NOT_CLEAR
     taken = Place("fake", TABLE, (0.5, 0.1, 0.025))
-    assert check_move(s, GeoMove("c", taken), tools()).failure == "unsupported"
+    assert check_move(s, GeoMove("c", taken), tools()).failure is Failure.UNSUPPORTED
 
 
 def test_transit_goes_over_what_is_near_its_way_not_the_highest_stack_anywhere():

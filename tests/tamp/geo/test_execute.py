@@ -13,6 +13,7 @@ from robots.panda import PANDA
 from tamp.geo.check import MoveCheck
 from tamp.geo.execute import RunConfig, run_move
 from tamp.geo.types import GeoMove, Place
+from tamp.outcome import Failure
 from tamp.sim.base import GripperReading
 
 WIDTH = 0.057  # m, the object between the fingers
@@ -110,7 +111,7 @@ def test_a_missed_grasp_frees_an_object_wedged_askew_between_the_fingers_before_
     move, check = _move()
     hand = _Hand(stuck=1, closes=0.045)  # closed askew: 4.5 cm where the object is 5.7
     ran = run_move(hand, move, check, ("table", "table"), RunConfig())
-    assert ran.failure == "missed_grasp"
+    assert ran.failure is Failure.GRASP_MISSED
     assert ran.evidence["regrasped"] == 1 and "not_released" not in ran.evidence
     descend = len(check.motion[1].trajectory.positions)
     after_close = hand.commands[3:]  # the back-off: open, close on it again, open, back up

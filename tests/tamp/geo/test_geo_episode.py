@@ -9,6 +9,7 @@ import pytest
 
 from tamp.geo.episode import PLANNERS, planner_by_name, run_geo_episode
 from tamp.geo.search import SearchConfig
+from tamp.outcome import EpisodeStatus, Failure
 from tamp.world.goal import parse_goal
 from task.errors import TampError
 from tests.tamp.geo.geo_scenes import hemmed, tools
@@ -27,7 +28,7 @@ def test_search_then_check_reaches_the_goal_in_pybullet_without_a_collision():
         planner_config=SMALL,
         tools=tools(),
     )
-    assert report.reached and report.status == "reached", report
+    assert report.reached and report.status is EpisodeStatus.GOAL_REACHED, report
     assert report.collisions == 0 and report.touched == {}
     assert report.motion_failures == 0
     assert [m.move.split()[1] for m in report.moves][-1] == "t"
@@ -48,8 +49,8 @@ def test_task_only_planning_fails_on_it_and_says_why():
         tools=tools(),
         max_replans=1,
     )
-    assert not report.reached and report.status == "replan_budget"
-    assert {m.failure for m in report.moves} == {"collision"}
+    assert not report.reached and report.status is EpisodeStatus.REPLAN_BUDGET
+    assert {m.failure for m in report.moves} == {Failure.COLLISION}
     assert all(m.move.startswith("move t -> goal") for m in report.moves)
     assert report.collisions == 0 and report.arm_path_rad == 0  # refused before moving
 

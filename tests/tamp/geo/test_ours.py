@@ -15,6 +15,7 @@ from tamp.geo.ours.bridge import PACK
 from tamp.geo.ours.pack import pack_sampled
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoStatus, moved
+from tamp.outcome import Failure
 from tamp.world.geometry import of_movable, penetration
 from tamp.world.goal import parse_goal
 from tamp.world.relations import read_facts
@@ -112,7 +113,7 @@ class _Refuse:
     def __call__(self, world, move, tools, grasps=(), quick=None):
         self.seen.append((move.obj, move.place.name))
         if len(self.seen) <= self.n:
-            return MoveCheck(ok=False, failure="collision", evidence={"fake": True})
+            return MoveCheck(ok=False, failure=Failure.COLLISION, evidence={"fake": True})
         return MoveCheck(ok=True, grasp=grasps[0] if grasps else None)
 
 

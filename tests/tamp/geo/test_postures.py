@@ -12,6 +12,7 @@ from robots.panda import PANDA
 from tamp.blocks_geo import geo_check, geo_tools
 from tamp.geo.postures import posture_seeds
 from tamp.obstacles import with_scene
+from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig
 from task.problem import TABLE, Move
 
@@ -57,7 +58,7 @@ def test_another_posture_puts_a_block_down_behind_a_tower_the_nearest_one_hits(s
     with PandaCollision(0.01) as model:
         plain = geo_tools(solver, model, GuardConfig(), postures=0)
         _, _, nearest = geo_check(move, target, poses, CRAMPED, plain, q)
-        assert not nearest.ok and nearest.failure == "collision"
+        assert not nearest.ok and nearest.failure is Failure.COLLISION
         assert all(t.failure is not None for t in nearest.tried)
         tools = geo_tools(solver, model, GuardConfig(), postures=16)
         _, _, other = geo_check(move, target, poses, CRAMPED, tools, q)

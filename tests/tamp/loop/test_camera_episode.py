@@ -15,9 +15,10 @@ from motion.trajectory import straight_segment
 from perception.errors import PerceptionError
 from robots.panda import PANDA
 from tamp.loop import Episode, EpisodeStatus, LoopConfig
-from tamp.loop.execute import Failure, execute_move
+from tamp.loop.execute import execute_move
 from tamp.loop.observe import HOME_TOL
 from tamp.loop.sensors import CameraPoses
+from tamp.outcome import Failure
 from tamp.sim import SIMULATORS, GroundTruthLeak
 from task.problem import TABLE, Move, Problem
 

@@ -12,8 +12,9 @@ import pytest
 from motion.ik import IKSolver
 from robots.collision import PandaCollision
 from tamp.loop import LoopConfig, run_episode
-from tamp.loop.execute import ExecConfig, Failure, execute_move
+from tamp.loop.execute import ExecConfig, execute_move
 from tamp.obstacles import Obstacle, with_scene
+from tamp.outcome import Failure
 from tamp.scene import SceneConfig, layout, read_state
 from tamp.sim import SIMULATORS, make_simulator
 from task.problem import TABLE, Move, Problem

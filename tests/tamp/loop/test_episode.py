@@ -12,10 +12,11 @@ import pytest
 
 from motion.ik import IKSolver
 from tamp.loop import Episode, EpisodeReport, EpisodeStatus, LoopConfig, describe, run_episode
-from tamp.loop.execute import ExecutionResult, Failure
+from tamp.loop.execute import ExecutionResult
 from tamp.loop.faults import Injection
 from tamp.loop.recover import out_of_reach
 from tamp.loop.report import Progress
+from tamp.outcome import Failure
 from tamp.scene import Pose
 from tamp.sim import SIMULATORS
 from task.errors import TampError

@@ -18,11 +18,13 @@ from motion.trajectory import JointTrajectory, straight_segment
 from robots.collision import PandaCollision
 from robots.panda import PANDA
 from tamp.bench.motion import episode_rows
+from tamp.blocks_geo import geo_fallback
 from tamp.loop import LoopConfig
-from tamp.loop.execute import ExecConfig, Failure, execute_move
+from tamp.loop.execute import ExecConfig, execute_move
 from tamp.loop.given import GivenPlanEpisode, parse_given
 from tamp.loop.score import MoveScore, Scorer
 from tamp.obstacles import Obstacle
+from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig, layout
 from tamp.sim import SIMULATORS, make_simulator
 from tamp.sim.pybullet_sim import PyBulletSim
@@ -176,6 +178,7 @@ def test_a_planner_run_that_finds_no_way_is_not_a_reroute(solver):
                     ExecConfig(geo_fallback=fallback),
                     scene=scene,
                     collision=model,
+                    fallback=geo_fallback(solver, model, ExecConfig().guard),
                 )
             )
     done, geo = outcomes

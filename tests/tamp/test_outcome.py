@@ -1,0 +1,94 @@
+"""One outcome vocabulary (`tamp.outcome`): both executors, their failure memories and both
+episodes name a failure or a status by one enum member, spelled once; and the loop executor
+reaches the geometric room's fallback without importing it (no import circle)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+import tamp.blocks_geo
+from tamp.geo.check import FAILURES
+from tamp.geo.episode import AGAIN_FROM_HOME, GeoReport, MoveRecord
+from tamp.geo.ours.planner import BEFORE_GRASPS, FIXED_FAILURES
+from tamp.loop import EpisodeStatus as LoopStatus
+from tamp.loop.execute import GEO_RETRIED
+from tamp.outcome import EpisodeStatus, Failure
+
+ROOT = Path(__file__).resolve().parents[2]
+# the executors and the fallback between them, whose imports must form no circle
+EXECUTORS = {
+    "tamp.loop.execute": ROOT / "tamp/loop/execute.py",
+    "tamp.geo.execute": ROOT / "tamp/geo/execute.py",
+    "tamp.blocks_geo": ROOT / "tamp/blocks_geo.py",
+}
+# where a failure or a status is made, remembered or compared: no spelling of one as a string
+SOURCES = (
+    *sorted((ROOT / "tamp/geo").rglob("*.py")),
+    ROOT / "tamp/blocks_geo.py",
+    ROOT / "tamp/loop/execute.py",
+    ROOT / "tamp/loop/episode.py",
+    ROOT / "tamp/loop/recover.py",
+)
+# every spelling in use, and the geometric room's old ones
+SPELLINGS = {f.value for f in Failure} | {s.value for s in EpisodeStatus}
+OLD = {"missed_grasp", "reached"}
+
+
+def _imported(path: Path) -> set[str]:
+    """Every module ``path`` imports, at module level or inside a function."""
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            found |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
+    return found
+
+
+def test_the_executors_and_the_fallback_import_one_another_in_no_circle():
+    edges = {m: {n for n in EXECUTORS if n in _imported(p)} for m, p in EXECUTORS.items()}
+    assert "tamp.blocks_geo" not in edges["tamp.loop.execute"]
+
+    def reaches(start: str, goal: str, seen: frozenset = frozenset()) -> bool:
+        return any(
+            n == goal or (n not in seen and reaches(n, goal, seen | {n})) for n in edges[start]
+        )
+
+    circles = [m for m in EXECUTORS if reaches(m, m)]
+    assert not circles, edges
+
+
+@pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_failure_or_status_is_spelled_as_a_string(path):
+    """A failure kind or a status is an enum member where it is made, remembered or compared;
+    its string lives only in `tamp.outcome` (no table maps one room's words to the other's)."""
+    tree = ast.parse(path.read_text())
+    docstrings = {
+        id(n.body[0].value)
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Module | ast.ClassDef | ast.FunctionDef) and ast.get_docstring(n)
+    }
+    spelled = sorted(
+        (n.lineno, n.value)
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Constant) and n.value in SPELLINGS | OLD and id(n) not in docstrings
+    )
+    assert not spelled, spelled
+
+
+def test_the_rooms_sets_of_failures_are_members_of_the_one_enum():
+    assert not hasattr(tamp.blocks_geo, "FAILURES")  # the string table of the old mapping
+    for group in (FAILURES, AGAIN_FROM_HOME, FIXED_FAILURES, BEFORE_GRASPS, GEO_RETRIED):
+        assert group and all(isinstance(f, Failure) for f in group), group
+
+
+def test_both_episodes_report_in_one_status_enum():
+    assert LoopStatus is EpisodeStatus
+    assert GeoReport.__dataclass_fields__["status"].type == "EpisodeStatus"
+    assert MoveRecord.__dataclass_fields__["failure"].type == "Failure | None"
+    assert EpisodeStatus.GOAL_REACHED.value == "goal_reached"
+    assert len({s.value for s in EpisodeStatus}) == len(EpisodeStatus)
+    assert len({f.value for f in Failure}) == len(Failure)
