@@ -12,14 +12,14 @@ clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a mo
 table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so
 does a move the arm failed in that state before (``avoid``, `failed_key`) or, in any state,
 where it failed (``failed``, `FailedMove`: picked and put among the same blocks). Each point's
-IK is solved once per source (`ArmCosts._site_solutions`). With ``grasps`` (the
-executor's geometric fallback, `tamp.blocks_geo`: tilted and side grasps, corridor transits) the
+IK is solved once per source (`ArmCosts._site_solutions`). With ``grasps`` (the executor's
+geometric fallback, `tamp.loop.geo_fallback`: tilted and side grasps, corridor transits) the
 prices agree with what that executor can do: a pick or place out of top-down reach that one of
-those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead. The
-matrix is computed once per state: the table placement is the scene's free slot, or with table
-places (`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
-placements): every window optimises fresh offsets, one set per restart row, with the logits, and the
-source records, for each committed move, the position the chosen row decided it with
+those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead.
+The matrix is computed once per state: the table placement is the scene's free slot, or with
+table places (`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
+placements): every window optimises fresh offsets, one set per restart row, with the logits, and
+the source records, for each committed move, the position the chosen row decided it with
 (`ArmCosts.decided`).
 """
 
@@ -413,7 +413,7 @@ class ArmCosts:
     def _grasped(self, points: np.ndarray, yaws: np.ndarray) -> np.ndarray:
         """(M,) whether some grasp of ``self.grasps`` (`motion.grasps.grasps` of a cube) holds
         a block centred at ``points`` (M, 3), turned ``yaws`` (M,), with the arm's IK solved:
-        where the executor's geometric fallback (`tamp.blocks_geo.run_geo`) may still pick or
+        where the executor's geometric fallback (`tamp.loop.geo_fallback.run_geo`) may still pick or
         place it when no top-down grasp reaches over the highest stack. One batched IK call for
         the poses (to the mm and 0.01 rad) this source has not tested before."""
         from motion.grasps import world_tcp

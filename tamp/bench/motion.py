@@ -132,7 +132,7 @@ def summarise(
         "collided": sum(r.collided for r in reports),  # episodes whose arm touched something
         "touched": dict(sum((Counter(r.touched) for r in reports), Counter())),
         "rerouted": sum(bool(m.rerouted) for m in moves),  # moves run on a planner's detour
-        # moves the geometric fallback made (`tamp.blocks_geo`), and of those, in another
+        # moves the geometric fallback made (`tamp.loop.geo_fallback`), and of those, in another
         # posture of the arm than the nearest (`tamp.geo.postures`)
         "geo_moves": sum(_geo(m) for m in moves),
         "posture_moves": sum(_posture(m) for m in moves),

@@ -49,9 +49,8 @@ from motion.trajectory import JointTrajectory, straight_segment
 from robots.panda import PANDA
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
-from tamp.loop.execute import holding
 from tamp.outcome import Failure
-from tamp.sim.base import Expected, Simulator
+from tamp.sim.base import Expected, Simulator, holding
 
 
 @dataclass(frozen=True)

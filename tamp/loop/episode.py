@@ -269,22 +269,22 @@ class Episode:
 
     def _grasps(self) -> tuple[str, ...]:
         """The grasp families the executor has beyond top-down over the highest stack: those of
-        its geometric fallback (`tamp.blocks_geo.CHOICES`) when it has one (collision mode
+        its geometric fallback (`tamp.loop.geo_fallback.CHOICES`) when it has one (collision mode
         "plan" and ``execution.geo_fallback``), else none."""
         execution = self.config.execution
         if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
             return ()
-        from tamp.blocks_geo import CHOICES
+        from tamp.loop.geo_fallback import CHOICES
 
         return CHOICES
 
     def _fallback(self) -> Fallback | None:
-        """The executor's geometric fallback (`tamp.blocks_geo.GeoFallback` over the episode's
-        IK solver and collision model) when it has one (as `_grasps`), else None."""
+        """The executor's geometric fallback (`tamp.loop.geo_fallback.GeoFallback` over the
+        episode's IK solver and collision model) when it has one (as `_grasps`), else None."""
         execution = self.config.execution
         if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
             return None
-        from tamp.blocks_geo import geo_fallback
+        from tamp.loop.geo_fallback import geo_fallback
 
         return geo_fallback(self.solver, self.collision, execution.guard)
 

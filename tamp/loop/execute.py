@@ -33,7 +33,7 @@ from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
 from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
-from tamp.sim.base import Expected, Simulator
+from tamp.sim.base import Expected, Simulator, holding
 from task.errors import TampError, one_of
 from task.problem import TABLE, Move
 
@@ -60,7 +60,7 @@ class ExecConfig:
     slot_tries: int = 3  # free table slots a move to the table tries before it fails
     # collision "plan": a move the top-down grasps cannot make (no IK, a collision, no
     # clearance) is checked and run by the executor's `Fallback`, the geometric room
-    # (`tamp.blocks_geo.GeoFallback`, which the episode builds): side and tilted grasps too,
+    # (`tamp.loop.geo_fallback.GeoFallback`, which the episode builds): side and tilted grasps too,
     # the transit at the corridor's height; False: top-down only
     geo_fallback: bool = True
 
@@ -93,7 +93,7 @@ Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: 
 
 class Fallback(Protocol):
     """Another way to make a move the top-down grasps could not (one of `GEO_RETRIED`), given
-    to the executor by whoever builds it (the episode: `tamp.blocks_geo.GeoFallback`, every
+    to the executor by whoever builds it (the episode: `tamp.loop.geo_fallback.GeoFallback`, every
     grasp family of the geometric room), so this module imports no room of its own."""
 
     def check(
@@ -124,25 +124,6 @@ class Fallback(Protocol):
         """Check ``move`` to ``target`` from the arm's configuration now and run it when it
         passes; the place checked on the poses ``observe`` gives after it."""
         ...
-
-
-def holding(sim: Simulator, width: float, config, fresh: bool) -> dict | None:
-    """None when the fingers hold an object ``width`` (m) wide: opened to that width within
-    ``config.width_tol`` and, on a fresh grasp, both pushing at least ``config.min_force``
-    (a weld grasp holds once made); otherwise the evidence that they do not. ``config``: an
-    `ExecConfig` or anything with those two fields (`tamp.geo.execute.RunConfig`)."""
-    r = sim.gripper()
-    wide = abs(r.width - width) <= config.width_tol
-    floor = config.min_force if fresh else 0.0
-    both = r.left_force > floor and r.right_force > floor
-    if wide and (both or (sim.grasp == "weld" and not fresh)):
-        return None
-    return {
-        "finger_width": round(r.width, 4),
-        "grasp_width": round(width, 4),
-        "left_force": round(r.left_force, 3),
-        "right_force": round(r.right_force, 3),
-    }
 
 
 def obstacle_boxes(scene: SceneConfig):
@@ -309,7 +290,7 @@ def placed_elsewhere(move: Move, target: Pose) -> dict:
 def failed_pick(done: ExecutionResult) -> bool:
     """Whether ``done`` failed to pick its block with every grasp, before the arm moved: the
     top-down pick (its IK or its approach and descent) and every grasp of the geometric
-    fallback (`tamp.blocks_geo.run_geo`: each one's failure on the pick side), whatever the
+    fallback (`tamp.loop.geo_fallback.run_geo`: each one's failure on the pick side), whatever the
     place. False without that fallback's verdict: the top-down pick alone hovers over the
     highest stack anywhere, which other moves change."""
     from tamp.geo.check import PICK_PHASES, PICK_WAYPOINTS
@@ -340,7 +321,7 @@ def execute_move(
     the planned phases unless ``config.collision`` is "off"; ``seed`` seeds the motion planner.
     ``on_phase(sim, phase)`` is called as each planned phase starts (a recording, `tamp.rerun_log`).
     ``fallback``: another way to make a move the top-down grasps could not (`Fallback`: the
-    geometric room's, `tamp.blocks_geo.GeoFallback`); None: top-down only.
+    geometric room's, `tamp.loop.geo_fallback.GeoFallback`); None: top-down only.
     """
     wall0, sim0 = time.perf_counter(), sim.time
 

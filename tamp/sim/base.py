@@ -323,3 +323,23 @@ class Simulator(abc.ABC):
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def holding(sim: Simulator, width: float, config, fresh: bool) -> dict | None:
+    """None when the fingers hold an object ``width`` (m) wide: opened to that width within
+    ``config.width_tol`` and, on a fresh grasp, both pushing at least ``config.min_force``
+    (a weld grasp holds once made); otherwise the evidence that they do not. ``config``: anything
+    with those two fields (`tamp.loop.execute.ExecConfig`, `tamp.geo.execute.RunConfig`). What
+    the finger sensors say, so both executors read a grasp the same way."""
+    r = sim.gripper()
+    wide = abs(r.width - width) <= config.width_tol
+    floor = config.min_force if fresh else 0.0
+    both = r.left_force > floor and r.right_force > floor
+    if wide and (both or (sim.grasp == "weld" and not fresh)):
+        return None
+    return {
+        "finger_width": round(r.width, 4),
+        "grasp_width": round(width, 4),
+        "left_force": round(r.left_force, 3),
+        "right_force": round(r.right_force, 3),
+    }

@@ -1,6 +1,6 @@
 """One outcome vocabulary (`tamp.outcome`): both executors, their failure memories and both
-episodes name a failure or a status by one enum member, spelled once; and the loop executor
-reaches the geometric room's fallback without importing it (no import circle)."""
+episodes name a failure or a status by one enum member, spelled once (that no import circle
+joins the executors is `tests/test_layout.py`'s)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-import tamp.blocks_geo
+import tamp.loop.geo_fallback
 from tamp.geo.check import FAILURES
 from tamp.geo.episode import AGAIN_FROM_HOME, GeoReport, MoveRecord
 from tamp.geo.ours.planner import BEFORE_GRASPS, FIXED_FAILURES
@@ -18,16 +18,10 @@ from tamp.loop.execute import GEO_RETRIED
 from tamp.outcome import EpisodeStatus, Failure
 
 ROOT = Path(__file__).resolve().parents[2]
-# the executors and the fallback between them, whose imports must form no circle
-EXECUTORS = {
-    "tamp.loop.execute": ROOT / "tamp/loop/execute.py",
-    "tamp.geo.execute": ROOT / "tamp/geo/execute.py",
-    "tamp.blocks_geo": ROOT / "tamp/blocks_geo.py",
-}
 # where a failure or a status is made, remembered or compared: no spelling of one as a string
 SOURCES = (
     *sorted((ROOT / "tamp/geo").rglob("*.py")),
-    ROOT / "tamp/blocks_geo.py",
+    ROOT / "tamp/loop/geo_fallback.py",
     ROOT / "tamp/loop/execute.py",
     ROOT / "tamp/loop/episode.py",
     ROOT / "tamp/loop/recover.py",
@@ -35,30 +29,6 @@ SOURCES = (
 # every spelling in use, and the geometric room's old ones
 SPELLINGS = {f.value for f in Failure} | {s.value for s in EpisodeStatus}
 OLD = {"missed_grasp", "reached"}
-
-
-def _imported(path: Path) -> set[str]:
-    """Every module ``path`` imports, at module level or inside a function."""
-    found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.Import):
-            found |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-            found |= {node.module} | {f"{node.module}.{a.name}" for a in node.names}
-    return found
-
-
-def test_the_executors_and_the_fallback_import_one_another_in_no_circle():
-    edges = {m: {n for n in EXECUTORS if n in _imported(p)} for m, p in EXECUTORS.items()}
-    assert "tamp.blocks_geo" not in edges["tamp.loop.execute"]
-
-    def reaches(start: str, goal: str, seen: frozenset = frozenset()) -> bool:
-        return any(
-            n == goal or (n not in seen and reaches(n, goal, seen | {n})) for n in edges[start]
-        )
-
-    circles = [m for m in EXECUTORS if reaches(m, m)]
-    assert not circles, edges
 
 
 @pytest.mark.parametrize("path", SOURCES, ids=lambda p: str(p.relative_to(ROOT)))
@@ -80,7 +50,7 @@ def test_no_failure_or_status_is_spelled_as_a_string(path):
 
 
 def test_the_rooms_sets_of_failures_are_members_of_the_one_enum():
-    assert not hasattr(tamp.blocks_geo, "FAILURES")  # the string table of the old mapping
+    assert not hasattr(tamp.loop.geo_fallback, "FAILURES")  # the string table of the old mapping
     for group in (FAILURES, AGAIN_FROM_HOME, FIXED_FAILURES, BEFORE_GRASPS, GEO_RETRIED):
         assert group and all(isinstance(f, Failure) for f in group), group
 

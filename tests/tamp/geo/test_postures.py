@@ -1,5 +1,5 @@
 """Other postures of the arm for a colliding grasp (`tamp.geo.postures`): the IK branch as a
-choice in the geometric check the loop's fallback runs (`tamp.blocks_geo.geo_check`)."""
+choice in the geometric check the loop's fallback runs (`tamp.loop.geo_fallback.geo_check`)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 from motion.guard import GuardConfig
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.blocks_geo import geo_check, geo_tools
 from tamp.geo.postures import posture_seeds
+from tamp.loop.geo_fallback import geo_check, geo_tools
 from tamp.obstacles import with_scene
 from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig

@@ -18,9 +18,9 @@ from motion.trajectory import JointTrajectory, straight_segment
 from robots.collision import PandaCollision
 from robots.panda import PANDA
 from tamp.bench.motion import episode_rows
-from tamp.blocks_geo import geo_fallback
 from tamp.loop import LoopConfig
 from tamp.loop.execute import ExecConfig, execute_move
+from tamp.loop.geo_fallback import geo_fallback
 from tamp.loop.given import GivenPlanEpisode, parse_given
 from tamp.loop.score import MoveScore, Scorer
 from tamp.obstacles import Obstacle

@@ -1,5 +1,5 @@
-"""The loop's world as a geometric scene (`tamp.blocks_geo`), the executor's geometric fallback
-(`tamp.loop.execute`: a move top-down grasps over the highest stack cannot make, made with
+"""The loop's world as a geometric scene (`tamp.loop.geo_fallback`), the executor's geometric
+fallback (`tamp.loop.execute`: a move top-down grasps over the highest stack cannot make, made with
 another grasp and a lower transit) and the motion-aware prices that agree with it
 (`tamp.arm_costs.ArmCosts`' ``grasps``)."""
 
@@ -13,7 +13,7 @@ import pytest
 from motion.ik import IKSolver
 from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, DETOUR, ArmCosts
-from tamp.blocks_geo import CHOICES, blocks_goal, geo_fallback, world_scene
+from tamp.loop.geo_fallback import CHOICES, blocks_goal, geo_fallback, world_scene
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout, read_state
 from tamp.slots import slotted
@@ -193,10 +193,10 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
 @pytest.mark.parametrize("fallback", [True, False])
 def test_the_episode_gives_its_executor_the_geometric_fallback(solver, monkeypatch, fallback):
     """The executor imports nothing of the geometric room: the episode builds the fallback
-    (`tamp.blocks_geo.GeoFallback`) and gives it to every move, and none when it is off."""
-    from tamp.blocks_geo import GeoFallback
+    (`tamp.loop.geo_fallback.GeoFallback`) and gives it to every move, and none when it is off."""
     from tamp.loop import LoopConfig, episode, run_episode
     from tamp.loop.execute import ExecConfig
+    from tamp.loop.geo_fallback import GeoFallback
 
     given, real = [], episode.execute_move
 
