@@ -39,6 +39,7 @@ ROOM_FORBIDDEN = {
     "tamp/loop": ("tamp.bench", "tamp.cli"),
     "tamp/bench": ("tamp.cli",),
     "tamp/world": ("tamp.loop", "tamp.camera", "tamp.bench", "tamp.cli"),
+    "tamp/geo": ("tamp.bench", "tamp.cli"),
     "task/symbolic": (*OPTIMISER, "task.domains", "torch"),
     "task/domains": OPTIMISER,
 }

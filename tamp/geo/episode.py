@@ -47,7 +47,7 @@ from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
 from tamp.sweep import torch_threads
@@ -214,8 +214,8 @@ def run_geo_episode(
     seed: int = 0,
     planner_config: SearchConfig | None = None,
     video: str | Path | None = None,
-    max_moves: int = 20,
-    max_replans: int = 3,
+    max_moves: int = GeoLimits.max_moves,
+    max_replans: int = GeoLimits.max_replans,
     inject: dict | None = None,
     tools: Tools | None = None,
     grasp: str = "friction",
@@ -225,15 +225,16 @@ def run_geo_episode(
 ) -> GeoReport:
     """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
-    `SearchConfig` with ``seed``); ``video``: a file path to record the episode to (.mp4 or
-    .gif); ``inject``: fault injection, ``{"drop": [k, ...]}`` opens the gripper mid-transit
-    on those move indices; ``tools``: reuse an IK solver and collision model (else built and
-    closed here); ``domain``: ``(pddl_domain_text, binding_text)`` the motion-aware planner
-    plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules); refused for the
-    other planners, which plan over the moves the geometry allows. ``observation``: the pose
-    sensor, one of `OBSERVATIONS` (``"camera"``: `tamp.camera.scene_poses.ScenePoses`).
-    ``on_event``: called with a line after each plan and each move (progress, e.g. for
-    ``tamp run``); what it is told is also in the report."""
+    `SearchConfig` with ``seed`` and `GeoLimits`' ``planning_s``); ``max_moves`` and
+    ``max_replans``: the episode's limits (`GeoLimits`' defaults); ``video``: a file path to
+    record the episode to (.mp4 or .gif); ``inject``: fault injection, ``{"drop": [k, ...]}``
+    opens the gripper mid-transit on those move indices; ``tools``: reuse an IK solver and
+    collision model (else built and closed here); ``domain``: ``(pddl_domain_text,
+    binding_text)`` the motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower
+    of Hanoi by its rules); refused for the other planners, which plan over the moves the
+    geometry allows. ``observation``: the pose sensor, one of `OBSERVATIONS` (``"camera"``:
+    `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
+    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report."""
     say = on_event or (lambda line: None)
     if observation not in OBSERVATIONS:
         raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
@@ -244,7 +245,7 @@ def run_geo_episode(
                 f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
             )
         plan_fn = partial(plan_fn, domain=domain)
-    config = planner_config or SearchConfig(seed=seed)
+    config = planner_config or SearchConfig(seed=seed, max_time_s=GeoLimits.planning_s)
     inject = inject or {}
     drops = set(inject.get("drop", ()))
     wall0 = time.perf_counter()

@@ -29,14 +29,13 @@ from pathlib import Path
 
 import numpy as np
 
+from tamp.geo.types import GeoLimits
 from tamp.sweep import run_items
 from task.errors import TampError
 
 PLANNERS = ("soft", "motion-aware", "search-then-check")  # the three, side by side
 OBSERVE = ("state", "camera")  # `tamp.geo.episode.OBSERVATIONS`
-# every episode's limits (`run_geo_episode`): moves run (Tower of Hanoi with 5 discs takes 31
-# at best), plans after the first, and each planner call's wall clock (`SearchConfig`)
-LIMITS = {"max_moves": 40, "max_replans": 3, "planning_s": 120.0}
+LIMITS = GeoLimits()  # every episode's limits (`run_geo_episode`): the documented defaults
 ROW_COLUMNS = (
     "problem",
     "variant",
@@ -124,10 +123,10 @@ def play(item: Item) -> dict:
             item.planner,
             item.sim,
             seed=item.seed,
-            planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS["planning_s"]),
+            planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS.planning_s),
             video=item.video,
-            max_moves=LIMITS["max_moves"],
-            max_replans=LIMITS["max_replans"],
+            max_moves=LIMITS.max_moves,
+            max_replans=LIMITS.max_replans,
             domain=domain,
             observation=item.observe,
         )
