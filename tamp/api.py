@@ -20,6 +20,11 @@ Inputs that may be PDDL are read by one rule: a `pathlib.Path` is a file, a ``st
 text (a plan ``str`` is plan text: ``(unstack a b)`` lines or moves ``move(a -> b)``). Units:
 metres, radians and seconds, in the robot base frame (the table surface at z = 0).
 
+Process-wide settings are the caller's: nothing here changes torch's thread count. An episode
+is a small problem that runs fastest on one thread, as ``tamp run`` and the benchmarks run it;
+wrap a call in ``tamp.sweep.torch_threads(1)`` (or call ``torch.set_num_threads(1)``) to do
+the same.
+
 What each function wraps, for reading further: `task.instances` (PDDL in), `task.planner`
 (the soft-T_P planner), `task.symbolic.validate` (the crisp validator), `tamp.loop` (episodes;
 `tamp.loop.given` for a given plan), `tamp.world` (scene files), `tamp.camera.image_pair`

@@ -50,7 +50,6 @@ from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
-from tamp.sweep import torch_threads
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
@@ -234,7 +233,9 @@ def run_geo_episode(
     of Hanoi by its rules); refused for the other planners, which plan over the moves the
     geometry allows. ``observation``: the pose sensor, one of `OBSERVATIONS` (``"camera"``:
     `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
-    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report."""
+    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report.
+    Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an episode
+    on one thread (`tamp.sweep.torch_threads`)."""
     say = on_event or (lambda line: None)
     if observation not in OBSERVATIONS:
         raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
@@ -276,56 +277,55 @@ def run_geo_episode(
     path, first_len, replans, failures = 0.0, 0, 0, 0
     status, reason = "not_reached", ""
     try:
-        with torch_threads(1):
-            _settle(sim, on_frame)
-            world = observe(sim, scene, camera)
-            while True:
-                if goal.holds(read_facts(world, OBSERVED)):
-                    status = "reached"
+        _settle(sim, on_frame)
+        world = observe(sim, scene, camera)
+        while True:
+            if goal.holds(read_facts(world, OBSERVED)):
+                status = "reached"
+                break
+            t0 = time.perf_counter()
+            plan = plan_fn(world, goal, tools, config)
+            plan_times.append(time.perf_counter() - t0)
+            plan_stats.append(dict(plan.stats))
+            say(
+                f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
+                f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
+            )
+            if not plan.solved:
+                status, reason = "no_plan", f"{plan.status.value}: {plan.reason}"
+                break
+            if not first_len:
+                first_len = len(plan.moves)
+            replan = False
+            for move in plan.moves:
+                if len(records) >= max_moves:
+                    status, reason = "move_budget", f"{max_moves} moves used"
                     break
-                t0 = time.perf_counter()
-                plan = plan_fn(world, goal, tools, config)
-                plan_times.append(time.perf_counter() - t0)
-                plan_stats.append(dict(plan.stats))
-                say(
-                    f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
-                    f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
+                k = len(records)
+                record, world, ran = _act(
+                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
                 )
-                if not plan.solved:
-                    status, reason = "no_plan", f"{plan.status.value}: {plan.reason}"
+                records.append(record)
+                say(
+                    f"move {k + 1}: {record.move}: "
+                    f"{'ok' if record.ok else 'failed: ' + str(record.failure)}"
+                )
+                path += ran
+                failures += record.failure not in (None, "unexpected")
+                if not record.ok:
+                    replan = True
                     break
-                if not first_len:
-                    first_len = len(plan.moves)
-                replan = False
-                for move in plan.moves:
-                    if len(records) >= max_moves:
-                        status, reason = "move_budget", f"{max_moves} moves used"
-                        break
-                    k = len(records)
-                    record, world, ran = _act(
-                        sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
-                    )
-                    records.append(record)
-                    say(
-                        f"move {k + 1}: {record.move}: "
-                        f"{'ok' if record.ok else 'failed: ' + str(record.failure)}"
-                    )
-                    path += ran
-                    failures += record.failure not in (None, "unexpected")
-                    if not record.ok:
-                        replan = True
-                        break
-                if status == "move_budget":
+            if status == "move_budget":
+                break
+            if replan or not goal.holds(read_facts(world, OBSERVED)):
+                replans += 1
+                if replans > max_replans:
+                    status = "replan_budget"
+                    reason = f"more than {max_replans} replans; last: {records[-1].failure}"
                     break
-                if replan or not goal.holds(read_facts(world, OBSERVED)):
-                    replans += 1
-                    if replans > max_replans:
-                        status = "replan_budget"
-                        reason = f"more than {max_replans} replans; last: {records[-1].failure}"
-                        break
-            with sim.truth.scoring():
-                truth = _with_poses(scene, sim.truth.block_poses())
-            reached = goal.holds(read_facts(truth, OBSERVED))
+        with sim.truth.scoring():
+            truth = _with_poses(scene, sim.truth.block_poses())
+        reached = goal.holds(read_facts(truth, OBSERVED))
     finally:
         sim.close()
         if recorder is not None:
