@@ -226,3 +226,23 @@ def test_library_code_keeps_no_process_global_state():
         for line in _module_state(path)
     ]
     assert not found, found
+
+
+def _sys_modules_writes(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    return [
+        f"{path.relative_to(ROOT)}:{node.lineno}"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Subscript)
+        and isinstance(node.ctx, ast.Store | ast.Del)
+        and ast.unparse(node.value) == "sys.modules"
+    ]
+
+
+def test_library_code_leaves_the_import_machinery_alone():
+    """No library module stores into or deletes from ``sys.modules`` (e.g. to hide a module
+    from a dependency's import): what is imported stays as Python imported it."""
+    found = [
+        w for p in PACKAGES for path in (ROOT / p).rglob("*.py") for w in _sys_modules_writes(path)
+    ]
+    assert not found, found
