@@ -21,7 +21,7 @@ import contextlib
 import io
 import logging
 import math
-import sys
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,20 +62,16 @@ class IKResult:
 
 
 def _import_pytorch_kinematics():
-    """Import pytorch_kinematics without its optional MJCF loader.
+    """Import pytorch_kinematics (its package ``__init__`` imports mujoco, for its MJCF loader).
 
-    Its package ``__init__`` would import mujoco, which reads ``MUJOCO_GL`` once at import time;
-    importing it here, before a simulator backend has set that variable, could pin the wrong GL
-    backend. Blocking the name for the duration of this import makes pytorch_kinematics skip it.
+    MuJoCo picks its OpenGL backend from ``MUJOCO_GL`` once, when first imported; unset, that
+    would be GLFW, which needs a display. So the simulators' default (headless EGL unless the
+    user chose one, `robots.mujoco_loader`) is set before, as docs/motion.md says; the import
+    machinery itself is left alone.
     """
-    block = "mujoco" not in sys.modules
-    if block:
-        sys.modules["mujoco"] = None  # type: ignore[assignment]  # import mujoco -> ImportError
-    try:
-        import pytorch_kinematics
-    finally:
-        if block and sys.modules.get("mujoco", 0) is None:
-            del sys.modules["mujoco"]
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    import pytorch_kinematics
+
     return pytorch_kinematics
 
 

@@ -20,6 +20,11 @@ Inputs that may be PDDL are read by one rule: a `pathlib.Path` is a file, a ``st
 text (a plan ``str`` is plan text: ``(unstack a b)`` lines or moves ``move(a -> b)``). Units:
 metres, radians and seconds, in the robot base frame (the table surface at z = 0).
 
+Process-wide settings are the caller's: nothing here changes torch's thread count. An episode
+is a small problem that runs fastest on one thread, as ``tamp run`` and the benchmarks run it;
+wrap a call in ``tamp.sweep.torch_threads(1)`` (or call ``torch.set_num_threads(1)``) to do
+the same.
+
 What each function wraps, for reading further: `task.instances` (PDDL in), `task.planner`
 (the soft-T_P planner), `task.symbolic.validate` (the crisp validator), `tamp.loop` (episodes;
 `tamp.loop.given` for a given plan), `tamp.world` (scene files), `tamp.camera.image_pair`
@@ -447,25 +452,26 @@ def run_geometric(
     ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
     (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through
     by the motion-aware planner. Returns a `tamp.geo.episode.GeoReport`."""
-    from tamp.bench.geo.run import LIMITS  # tamp run's and bench tamp's limits
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.scene_file import scene_episode
     from tamp.geo.search import SearchConfig
+    from tamp.geo.types import GeoLimits
 
     if (domain is None) != (binding is None):
         raise TampError("run_geometric: domain and binding go together (a bound domain)")
     rules = None if domain is None else (domain, binding)
     task = scene_episode(str(scene), goal, planner, rules)
+    limits = GeoLimits()  # tamp run's and bench tamp's
     return run_geo_episode(
         task.scene,
         task.goal,
         task.planner,
         sim,
         seed=seed,
-        planner_config=SearchConfig(seed=seed, max_time_s=LIMITS["planning_s"]),
+        planner_config=SearchConfig(seed=seed, max_time_s=limits.planning_s),
         video=video,
-        max_moves=LIMITS["max_moves"],
-        max_replans=LIMITS["max_replans"],
+        max_moves=limits.max_moves,
+        max_replans=limits.max_replans,
         domain=task.domain,
         observation=observation,
     )

@@ -17,11 +17,10 @@ Ray workers compute on one thread each: the processes are the parallelism (Ray's
 with ``OMP_NUM_THREADS=1`` too).
 
 `torch_threads(n)`: a block run with ``n`` torch intra-op threads (one small problem: thread
-hand-offs cost more than they give, and on a busy machine they wait for cores).
+hand-offs cost more than they give, and on a busy machine they wait for cores). The setting is
+the process's, so only the edges choose it (the commands of `tamp.cli` and the benchmarks'
+item functions, around the episodes they run); the library leaves it to its caller.
 
-`process_solver()`: the one `motion.ik.IKSolver` of the process that calls it, built on first
-use, so a worker builds it once for all its episodes (it keeps no state between solves, so
-sharing it changes no result).
 """
 
 from __future__ import annotations
@@ -38,8 +37,6 @@ from task.errors import TampError
 
 RAY_MISSING = "--ray needs Ray: pip install 'soft-tamp[ray]'"
 
-_SOLVERS: dict[int, Any] = {}  # os.getpid() -> that process's IKSolver (a forked child: its own)
-
 
 @contextmanager
 def torch_threads(n: int):
@@ -52,16 +49,6 @@ def torch_threads(n: int):
         yield
     finally:
         torch.set_num_threads(before)
-
-
-def process_solver():
-    """This process's `motion.ik.IKSolver`, built on its first call."""
-    pid = os.getpid()
-    if pid not in _SOLVERS:
-        from motion.ik import IKSolver
-
-        _SOLVERS[pid] = IKSolver()
-    return _SOLVERS[pid]
 
 
 def run_items(

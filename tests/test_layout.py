@@ -347,3 +347,80 @@ def test_no_import_circles():
         for circle in _circles(graph)
     ]
     assert not bad, bad
+
+
+MUTATORS = {"append", "extend", "insert", "add", "update", "setdefault", "pop", "popitem"}
+MUTATORS |= {"clear", "remove", "discard"}
+
+
+def _module_state(path: Path) -> list[str]:
+    """Where a function of ``path`` changes a module-level dict, list or set (a store into it,
+    a deletion from it or a mutating method call), or rebinds a module name (``global``)."""
+    tree = ast.parse(path.read_text(), filename=str(path))
+    containers = {
+        t.id
+        for node in tree.body
+        if isinstance(node, ast.Assign | ast.AnnAssign)
+        and isinstance(node.value, ast.Dict | ast.List | ast.Set | ast.Call)
+        and not (
+            isinstance(node.value, ast.Call) and _called(node.value) not in {"dict", "list", "set"}
+        )
+        for t in (node.targets if isinstance(node, ast.Assign) else [node.target])
+        if isinstance(t, ast.Name)
+    }
+    found = []
+    for fn in ast.walk(tree):
+        if not isinstance(fn, ast.FunctionDef | ast.AsyncFunctionDef):
+            continue
+        for node in ast.walk(fn):
+            if isinstance(node, ast.Global):
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno} global {node.names}")
+            target = None
+            if isinstance(node, ast.Subscript) and isinstance(node.ctx, ast.Store | ast.Del):
+                target = node.value
+            elif isinstance(node, ast.Call) and _mutates(node):
+                target = node.func.value
+            if isinstance(target, ast.Name) and target.id in containers:
+                found.append(f"{path.relative_to(ROOT)}:{node.lineno} changes {target.id}")
+    return found
+
+
+def _mutates(call: ast.Call) -> bool:
+    return isinstance(call.func, ast.Attribute) and call.func.attr in MUTATORS
+
+
+def _called(call: ast.Call) -> str:
+    return call.func.id if isinstance(call.func, ast.Name) else ""
+
+
+def test_library_code_keeps_no_process_global_state():
+    """No function of the library changes a module-level container or rebinds a module name:
+    caches belong to an object the caller holds (e.g. an episode's IK solver), not to the
+    process."""
+    found = [
+        line
+        for package in PACKAGES
+        for path in sorted((ROOT / package).rglob("*.py"))
+        for line in _module_state(path)
+    ]
+    assert not found, found
+
+
+def _sys_modules_writes(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text(), filename=str(path))
+    return [
+        f"{path.relative_to(ROOT)}:{node.lineno}"
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Subscript)
+        and isinstance(node.ctx, ast.Store | ast.Del)
+        and ast.unparse(node.value) == "sys.modules"
+    ]
+
+
+def test_library_code_leaves_the_import_machinery_alone():
+    """No library module stores into or deletes from ``sys.modules`` (e.g. to hide a module
+    from a dependency's import): what is imported stays as Python imported it."""
+    found = [
+        w for p in PACKAGES for path in (ROOT / p).rglob("*.py") for w in _sys_modules_writes(path)
+    ]
+    assert not found, found

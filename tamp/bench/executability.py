@@ -20,6 +20,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from motion.ik import IKSolver
 from robots.panda import PANDA
 from tamp.bench.suites import Suite
 from tamp.loop import LoopConfig
@@ -27,7 +28,7 @@ from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
 from tamp.rerun_log import recorder_for
 from tamp.scene import layout
 from tamp.slots import plan_on_places
-from tamp.sweep import process_solver, run_items
+from tamp.sweep import run_items, torch_threads
 from task.config import PlannerConfig
 from task.domains import get_domain
 from task.errors import DataError, TampError
@@ -105,7 +106,7 @@ def our_plans(
     Without, the suite is planned in one batch, task only."""
     problems = [i.problem for i in suite.instances]
     if config.lambda_motion > 0:
-        solver, scene = process_solver(), base.scene
+        solver, scene = IKSolver(), base.scene  # one for every instance
         results = []
         for k, problem in enumerate(problems):
             poses = layout(problem.entities, problem.init, scene, seed * 100_003 + k)
@@ -231,7 +232,8 @@ def _given(item: tuple) -> tuple:
     columns."""
     *episode, (record, name) = item
     recorder = recorder_for(record, episode[2].sim, name)
-    r = GivenPlanEpisode(*episode, solver=process_solver(), recorder=recorder).run()
+    with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+        r = GivenPlanEpisode(*episode, recorder=recorder).run()
     return (
         r.reached_goal,
         *first_failure(r.steps, r.reached_goal),

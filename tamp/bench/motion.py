@@ -29,7 +29,7 @@ from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
 from tamp.rerun_log import recorder_for
-from tamp.sweep import process_solver, run_items
+from tamp.sweep import run_items, torch_threads
 from task.instances import Instance
 
 EPISODE_COLUMNS = (
@@ -156,7 +156,7 @@ def run(
     each ends. Episode ``k`` uses seed ``seed * 100_003 + k``: its own layout and fault draws,
     reproducible from ``seed`` whatever ``workers``/``ray_address`` (`tamp.sweep.run_items`).
     ``record``: a folder, each episode a Rerun recording under it (`tamp.rerun_log`)."""
-    ik = time_ik(process_solver())
+    ik = time_ik(IKSolver())
     items = [
         (inst.problem, replace(base, sim=name), seed * 100_003 + k, inst.name, record)
         for name in sims
@@ -177,7 +177,8 @@ def _episode(item: tuple) -> EpisodeReport:
     """`run`'s episode ``(problem, config, seed, name, record)``, in the process that runs it."""
     problem, config, seed, name, record = item
     recorder = recorder_for(record, config.sim, name)
-    report = run_episode(problem, config, seed, solver=process_solver(), recorder=recorder)
+    with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+        report = run_episode(problem, config, seed, recorder=recorder)
     return dataclasses.replace(report, problem=name)
 
 

@@ -145,8 +145,9 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
     rerouted), ``--crisp``, the perception network's options, faults other than drops, and
     ``--record``; ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
-    default). The limits not given are `tamp bench tamp`'s (`tamp.bench.geo.run.LIMITS`)."""
-    from tamp.bench.geo.run import LIMITS
+    default). The limits not given are the episode's defaults (`tamp.geo.types.GeoLimits`),
+    which ``tamp bench tamp`` runs with too."""
+    from tamp.geo.types import GeoLimits
     from tamp.loop.faults import KINDS, Injection
 
     given = [
@@ -178,7 +179,8 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         raise TampError(
             f"--inject {','.join(other)}: the geometric episode injects drops only (drop:P)"
         )
-    limit = args.time_limit_s if args.time_limit_s is not None else LIMITS["planning_s"]
+    limits = GeoLimits()
+    limit = args.time_limit_s if args.time_limit_s is not None else limits.planning_s
     return {
         "executor": "geometric",
         "why": task.why,
@@ -192,8 +194,8 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         "grasp": args.grasp,
         "observe": args.observe,
         "inject": str(inject),
-        "max_replans": LIMITS["max_replans"] if args.max_replans is None else args.max_replans,
-        "max_moves": LIMITS["max_moves"],
+        "max_replans": limits.max_replans if args.max_replans is None else args.max_replans,
+        "max_moves": limits.max_moves,
         "time_limit_s": limit,
         "seed": args.seed,
         "video": None if args.no_video or args.out is None else args.video_format,

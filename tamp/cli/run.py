@@ -39,6 +39,7 @@ from tamp.cli.recorded import (
 from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.rerun_log import RerunRecorder, require_rerun
+from tamp.sweep import torch_threads
 from tamp.video import EpisodeVideo
 from task import data
 from task.errors import TampError
@@ -49,6 +50,7 @@ from task.symbolic import pddl_io
 VIDEO_FPS = 10.0  # frames per second of playback, each rendered at VIDEO_SIZE (640x480)
 SPEEDUP = 4.0  # playback is 4x real time
 FRAME_PERIOD = SPEEDUP / VIDEO_FPS  # simulated seconds between video frames
+EPISODE_THREADS = 1  # torch threads: one small problem, thread hand-offs cost more than they give
 
 
 def load_problem(problem: str | None, domain: str | None) -> Problem:
@@ -162,7 +164,8 @@ def run_command(args: argparse.Namespace) -> int:
             f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
             file=sys.stderr,
         )
-    report = episode.run()
+    with torch_threads(EPISODE_THREADS):
+        report = episode.run()
     written = []
     if video is not None:
         try:
@@ -217,22 +220,23 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             f"seed {args.seed}",
             file=sys.stderr,
         )
-    report = run_geo_episode(
-        task.scene,
-        task.goal,
-        task.planner,
-        args.sim,
-        seed=args.seed,
-        planner_config=SearchConfig(seed=args.seed, max_time_s=recorded["time_limit_s"]),
-        video=video,
-        max_moves=recorded["max_moves"],
-        max_replans=recorded["max_replans"],
-        inject={"drop": drops},
-        grasp=args.grasp,
-        domain=task.domain,
-        observation=args.observe,
-        on_event=None if args.json else _say,
-    )
+    with torch_threads(EPISODE_THREADS):
+        report = run_geo_episode(
+            task.scene,
+            task.goal,
+            task.planner,
+            args.sim,
+            seed=args.seed,
+            planner_config=SearchConfig(seed=args.seed, max_time_s=recorded["time_limit_s"]),
+            video=video,
+            max_moves=recorded["max_moves"],
+            max_replans=recorded["max_replans"],
+            inject={"drop": drops},
+            grasp=args.grasp,
+            domain=task.domain,
+            observation=args.observe,
+            on_event=None if args.json else _say,
+        )
     body = {"report": _jsonable(asdict(report)), "config": recorded}
     written = []
     if video is not None and video.is_file():

@@ -47,11 +47,10 @@ from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
-from tamp.sweep import torch_threads
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
@@ -216,8 +215,8 @@ def run_geo_episode(
     seed: int = 0,
     planner_config: SearchConfig | None = None,
     video: str | Path | None = None,
-    max_moves: int = 20,
-    max_replans: int = 3,
+    max_moves: int = GeoLimits.max_moves,
+    max_replans: int = GeoLimits.max_replans,
     inject: dict | None = None,
     tools: Tools | None = None,
     grasp: str = "friction",
@@ -227,15 +226,18 @@ def run_geo_episode(
 ) -> GeoReport:
     """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
-    `SearchConfig` with ``seed``); ``video``: a file path to record the episode to (.mp4 or
-    .gif); ``inject``: fault injection, ``{"drop": [k, ...]}`` opens the gripper mid-transit
-    on those move indices; ``tools``: reuse an IK solver and collision model (else built and
-    closed here); ``domain``: ``(pddl_domain_text, binding_text)`` the motion-aware planner
-    plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules); refused for the
-    other planners, which plan over the moves the geometry allows. ``observation``: the pose
-    sensor, one of `OBSERVATIONS` (``"camera"``: `tamp.camera.scene_poses.ScenePoses`).
-    ``on_event``: called with a line after each plan and each move (progress, e.g. for
-    ``tamp run``); what it is told is also in the report."""
+    `SearchConfig` with ``seed`` and `GeoLimits`' ``planning_s``); ``max_moves`` and
+    ``max_replans``: the episode's limits (`GeoLimits`' defaults); ``video``: a file path to
+    record the episode to (.mp4 or .gif); ``inject``: fault injection, ``{"drop": [k, ...]}``
+    opens the gripper mid-transit on those move indices; ``tools``: reuse an IK solver and
+    collision model (else built and closed here); ``domain``: ``(pddl_domain_text,
+    binding_text)`` the motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower
+    of Hanoi by its rules); refused for the other planners, which plan over the moves the
+    geometry allows. ``observation``: the pose sensor, one of `OBSERVATIONS` (``"camera"``:
+    `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
+    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report.
+    Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an episode
+    on one thread (`tamp.sweep.torch_threads`)."""
     say = on_event or (lambda line: None)
     if observation not in OBSERVATIONS:
         raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
@@ -246,7 +248,7 @@ def run_geo_episode(
                 f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
             )
         plan_fn = partial(plan_fn, domain=domain)
-    config = planner_config or SearchConfig(seed=seed)
+    config = planner_config or SearchConfig(seed=seed, max_time_s=GeoLimits.planning_s)
     inject = inject or {}
     drops = set(inject.get("drop", ()))
     wall0 = time.perf_counter()
@@ -277,57 +279,56 @@ def run_geo_episode(
     path, first_len, replans, failures = 0.0, 0, 0, 0
     status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
-        with torch_threads(1):
-            _settle(sim, on_frame)
-            world = observe(sim, scene, camera)
-            while True:
-                if goal.holds(read_facts(world, OBSERVED)):
-                    status = EpisodeStatus.GOAL_REACHED
+        _settle(sim, on_frame)
+        world = observe(sim, scene, camera)
+        while True:
+            if goal.holds(read_facts(world, OBSERVED)):
+                status = EpisodeStatus.GOAL_REACHED
+                break
+            t0 = time.perf_counter()
+            plan = plan_fn(world, goal, tools, config)
+            plan_times.append(time.perf_counter() - t0)
+            plan_stats.append(dict(plan.stats))
+            say(
+                f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
+                f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
+            )
+            if not plan.solved:
+                status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
+                break
+            if not first_len:
+                first_len = len(plan.moves)
+            replan = False
+            for move in plan.moves:
+                if len(records) >= max_moves:
+                    status, reason = EpisodeStatus.MOVE_BUDGET, f"{max_moves} moves used"
                     break
-                t0 = time.perf_counter()
-                plan = plan_fn(world, goal, tools, config)
-                plan_times.append(time.perf_counter() - t0)
-                plan_stats.append(dict(plan.stats))
-                say(
-                    f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
-                    f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
+                k = len(records)
+                record, world, ran = _act(
+                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
                 )
-                if not plan.solved:
-                    status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
+                records.append(record)
+                say(
+                    f"move {k + 1}: {record.move}: "
+                    f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
+                )
+                path += ran
+                failures += record.failure not in (None, Failure.UNEXPECTED)
+                if not record.ok:
+                    replan = True
                     break
-                if not first_len:
-                    first_len = len(plan.moves)
-                replan = False
-                for move in plan.moves:
-                    if len(records) >= max_moves:
-                        status, reason = EpisodeStatus.MOVE_BUDGET, f"{max_moves} moves used"
-                        break
-                    k = len(records)
-                    record, world, ran = _act(
-                        sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
-                    )
-                    records.append(record)
-                    say(
-                        f"move {k + 1}: {record.move}: "
-                        f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
-                    )
-                    path += ran
-                    failures += record.failure not in (None, Failure.UNEXPECTED)
-                    if not record.ok:
-                        replan = True
-                        break
-                if status is EpisodeStatus.MOVE_BUDGET:
+            if status is EpisodeStatus.MOVE_BUDGET:
+                break
+            if replan or not goal.holds(read_facts(world, OBSERVED)):
+                replans += 1
+                if replans > max_replans:
+                    status = EpisodeStatus.REPLAN_BUDGET
+                    last = records[-1].failure
+                    reason = f"more than {max_replans} replans; last: {last and last.value}"
                     break
-                if replan or not goal.holds(read_facts(world, OBSERVED)):
-                    replans += 1
-                    if replans > max_replans:
-                        status = EpisodeStatus.REPLAN_BUDGET
-                        last = records[-1].failure
-                        reason = f"more than {max_replans} replans; last: {last and last.value}"
-                        break
-            with sim.truth.scoring():
-                truth = _with_poses(scene, sim.truth.block_poses())
-            reached = goal.holds(read_facts(truth, OBSERVED))
+        with sim.truth.scoring():
+            truth = _with_poses(scene, sim.truth.block_poses())
+        reached = goal.holds(read_facts(truth, OBSERVED))
     finally:
         sim.close()
         if recorder is not None:

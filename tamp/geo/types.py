@@ -4,6 +4,10 @@ A world state is a `tamp.world.schema.Scene` whose objects carry their current p
 are frozen; `moved` gives the scene after a move). Its symbolic state is read from the geometry
 with `tamp.world.relations.read_facts`, never given.
 
+`GeoLimits` are an episode's limits (`tamp.geo.episode.run_geo_episode`): moves run, plans after
+the first and each planner call's wall clock; ``tamp run``, ``tamp bench tamp`` and
+`tamp.api.run_geometric` run with its defaults.
+
 A `Place` is where an object's centre goes: on top of another object, in a region, or on the
 table, with its yaw. A `GeoMove` is one pick-and-place: the object, the grasp the hand holds it
 by (`motion.grasps.Grasp`; None when the planner leaves the choice to the executor) and the
@@ -24,7 +28,18 @@ from task.problem import TABLE
 if TYPE_CHECKING:
     from motion.grasps import Grasp
 
-__all__ = ["TABLE", "GeoMove", "GeoPlan", "GeoStatus", "Place", "moved"]
+__all__ = ["TABLE", "GeoLimits", "GeoMove", "GeoPlan", "GeoStatus", "Place", "moved"]
+
+
+@dataclass(frozen=True)
+class GeoLimits:
+    """A geometric episode's limits: ``max_moves`` moves run (Tower of Hanoi with 5 discs takes
+    31 at best), ``max_replans`` plans after the first, and ``planning_s`` each planner call's
+    wall clock (s, `tamp.geo.search.SearchConfig.max_time_s`)."""
+
+    max_moves: int = 40
+    max_replans: int = 3
+    planning_s: float = 120.0
 
 
 @dataclass(frozen=True)

@@ -56,7 +56,6 @@ from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from tamp.slots import plan_on_places
-from tamp.sweep import torch_threads
 from task.domains import get_domain
 from task.planner import plan
 from task.problem import Move, Problem
@@ -142,16 +141,15 @@ class Episode:
 
     def run(self) -> EpisodeReport:
         """Run the episode to the goal or a stop (`play`); closes the simulator (and the
-        recorder's file)."""
+        recorder's file). Torch's thread count is the caller's: ``tamp run`` and the benchmarks
+        run an episode on one thread (`tamp.sweep.torch_threads`)."""
         if self.recorder is None:
-            with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
-                return self.play()
+            return self.play()
         self._shown = (self.sim.frame_period, 0.0)  # on_frame keeps the period set by now
         self.sim.frame_period = self.recorder.period
         report = None
         try:
-            with torch_threads(1):
-                report = self.play()
+            report = self.play()
         finally:
             self.recorder.close(report)
         return report

@@ -171,3 +171,25 @@ def test_from_seeds_solves_each_pose_on_its_own_seeds_branch(solver):
     assert np.abs(found.q[1] - found.q[0]).max() > 0.5  # a different posture of the same pose
     with pytest.raises(MotionError, match="2 seeds for 1 targets"):
         solver.from_seeds(pose[None], np.stack([near, other]))
+
+
+def test_building_a_solver_leaves_mujoco_importable_and_headless():
+    """pytorch_kinematics imports mujoco; a solver built first (``MUJOCO_GL`` unset) leaves
+    ``sys.modules`` without a placeholder for it, and mujoco on the simulators' headless
+    default (EGL), so a MuJoCo simulator made afterwards still renders offscreen."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import sys; from motion.ik import IKSolver; IKSolver(); "
+        "print(sys.modules.get('mujoco', 0) is not None); "
+        "import mujoco.rendering.classic.gl_context as g; print(g._MUJOCO_GL)"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "MUJOCO_GL"}
+    root = Path(__file__).resolve().parents[2]
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=root, check=True
+    )
+    assert out.stdout.split() == ["True", "egl"]

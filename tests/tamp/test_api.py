@@ -138,3 +138,39 @@ def test_bad_input_is_one_line(call, words):
 def test_text_that_is_no_pddl_says_how_to_pass_a_file():
     with pytest.raises(PDDLError, match=r"pathlib\.Path"):
         api.plan("examples/problem.pddl")
+
+
+# the api functions that wrap a benchmark; nothing else in the entry layer imports tamp.bench
+BENCHMARK_WRAPPERS = {"random_suite", "folder_suite", "planbench_suite", "benchmark"}
+BENCHMARK_WRAPPERS |= {"benchmark_motion"}
+
+
+def test_only_the_benchmark_wrappers_import_tamp_bench():
+    """The library's defaults live in its components' configs (the geometric episode's limits:
+    `tamp.geo.types.GeoLimits`), never in a benchmark: outside the functions that wrap one,
+    `tamp.api` imports nothing from ``tamp.bench`` (type hints aside)."""
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(api))
+    found = set()
+    for fn in (n for n in tree.body if isinstance(n, ast.FunctionDef)):
+        for node in ast.walk(fn):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("tamp.bench"):
+                found.add(fn.name)
+    assert found and found <= BENCHMARK_WRAPPERS, sorted(found - BENCHMARK_WRAPPERS)
+
+
+def test_importing_the_api_loads_no_benchmark():
+    import subprocess
+    import sys
+
+    code = "import sys, tamp.api; print(sorted(m for m in sys.modules if m.startswith('tamp.b')))"
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=Path(__file__).parents[2],
+    )
+    assert out.stdout.strip() == "[]"

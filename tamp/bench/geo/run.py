@@ -29,14 +29,13 @@ from pathlib import Path
 
 import numpy as np
 
-from tamp.sweep import run_items
+from tamp.geo.types import GeoLimits
+from tamp.sweep import run_items, torch_threads
 from task.errors import TampError
 
 PLANNERS = ("soft", "motion-aware", "search-then-check")  # the three, side by side
 OBSERVE = ("state", "camera")  # `tamp.geo.episode.OBSERVATIONS`
-# every episode's limits (`run_geo_episode`): moves run (Tower of Hanoi with 5 discs takes 31
-# at best), plans after the first, and each planner call's wall clock (`SearchConfig`)
-LIMITS = {"max_moves": 40, "max_replans": 3, "planning_s": 120.0}
+LIMITS = GeoLimits()  # every episode's limits (`run_geo_episode`): the documented defaults
 ROW_COLUMNS = (
     "problem",
     "variant",
@@ -118,19 +117,20 @@ def play(item: Item) -> dict:
     # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
     domain = made.domain if item.planner == "motion-aware" else None
     try:
-        report = run_geo_episode(
-            made.scene,
-            made.goal,
-            item.planner,
-            item.sim,
-            seed=item.seed,
-            planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS["planning_s"]),
-            video=item.video,
-            max_moves=LIMITS["max_moves"],
-            max_replans=LIMITS["max_replans"],
-            domain=domain,
-            observation=item.observe,
-        )
+        with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
+            report = run_geo_episode(
+                made.scene,
+                made.goal,
+                item.planner,
+                item.sim,
+                seed=item.seed,
+                planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS.planning_s),
+                video=item.video,
+                max_moves=LIMITS.max_moves,
+                max_replans=LIMITS.max_replans,
+                domain=domain,
+                observation=item.observe,
+            )
     except TampError as exc:  # the episode's error is its row; the other episodes go on
         return _error_row(item, made.note, str(exc), time.perf_counter() - t0)
     errors = report.pose_errors

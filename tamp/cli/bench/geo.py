@@ -6,6 +6,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import asdict
 
 from tqdm import tqdm
 
@@ -21,7 +22,7 @@ def tamp_command(args: argparse.Namespace) -> int:
     from tamp.bench.geo import run as bench
 
     recorded = tamp_bench_config(args)  # refused combinations: before any work
-    recorded["limits"] = dict(bench.LIMITS)
+    recorded["limits"] = asdict(bench.LIMITS)
     out_folder(args.out)
     sims = sim_list(args.sim)
     videos = None

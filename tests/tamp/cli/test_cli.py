@@ -260,3 +260,31 @@ def test_plan_motion_aware_says_a_goal_tower_too_tall_for_the_scene_is_unsolvabl
         "(SceneConfig.max_height)\n"
     )
     assert main(["plan", str(domain), str(problem), *FAST]) == 0
+
+
+def test_tamp_run_runs_its_episode_on_one_torch_thread(monkeypatch):
+    """The thread count is the edge's choice: ``tamp run`` runs the episode on one thread
+    (the episode itself leaves the setting alone) and restores the caller's afterwards."""
+    import torch
+
+    from task.errors import TampError
+
+    seen = []
+
+    class Stop:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def run(self):
+            seen.append(torch.get_num_threads())
+            raise TampError("stopped here")
+
+    monkeypatch.setattr("tamp.cli.run.Episode", Stop)
+    before = torch.get_num_threads()
+    torch.set_num_threads(2)
+    try:
+        code = main(["run", "--json"])
+        after = torch.get_num_threads()
+    finally:
+        torch.set_num_threads(before)
+    assert code == 2 and seen == [1] and after == 2

@@ -9,6 +9,7 @@ import pytest
 
 from tamp.geo.episode import PLANNERS, planner_by_name, run_geo_episode
 from tamp.geo.search import SearchConfig
+from tamp.geo.types import GeoLimits
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.world.goal import parse_goal
 from task.errors import TampError
@@ -110,3 +111,14 @@ def test_a_corrected_place_runs_only_where_the_guard_finds_it_free():
         tail = corrected_place(kit.solver, above, verdict.motion, shift)
         assert tail is not None
         assert _free(scene, move, verdict.grasp, support, kit, tail) is free, shift
+
+
+def test_the_episode_limits_default_to_geo_limits():
+    """One home for the limits ``tamp run``, ``tamp bench tamp`` and `tamp.api.run_geometric`
+    run with: the episode's own defaults are `GeoLimits`'."""
+    import inspect
+
+    params = inspect.signature(run_geo_episode).parameters
+    limits = GeoLimits()
+    assert params["max_moves"].default == limits.max_moves
+    assert params["max_replans"].default == limits.max_replans

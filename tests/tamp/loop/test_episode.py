@@ -252,3 +252,27 @@ def test_a_block_left_on_another_table_place_than_planned_triggers_a_replan(monk
             assert not p.stopped
     finally:
         episode.sim.close()
+
+
+@pytest.mark.sim
+def test_an_episode_leaves_torchs_thread_count_to_its_caller(solver):
+    """Library code changes no process-wide setting: the episode plans with the thread count
+    its caller chose (``tamp run`` and the benchmarks choose one thread) and leaves it so."""
+    import torch
+
+    two = Problem("two", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    before, seen = torch.get_num_threads(), []
+    torch.set_num_threads(2)
+    try:
+        report = run_episode(
+            two,
+            LoopConfig(),
+            0,
+            solver=solver,
+            on_event=lambda _: seen.append(torch.get_num_threads()),
+        )
+        after = torch.get_num_threads()
+    finally:
+        torch.set_num_threads(before)
+    assert report.reached_goal, report.reason
+    assert seen and set(seen) == {2} and after == 2

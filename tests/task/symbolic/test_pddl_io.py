@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from task.errors import PDDLError, TampError
@@ -149,27 +151,29 @@ def test_a_binary_file_is_one_line_naming_it(tmp_path, loader):
     _error(excinfo, str(path), "not a text file")
 
 
-def test_the_compiled_grammar_is_cached_on_disk_and_parses_alike(
-    bw_domain_path, tmp_path, monkeypatch
-):
-    """The grammar's tables are written to the cache folder and read back from it; a parser
-    built without the cache, or from a corrupt cache file, parses the same problem alike."""
-    domain_text = bw_domain_path.read_text()
+def test_parsing_writes_nothing_to_the_users_home(bw_domain_path, tmp_path):
+    """The compiled grammar is kept in memory only: a fresh process that parses a domain and
+    a problem, its home and cache folders pointed at an empty folder, leaves that folder
+    empty (library code writes only the files it is told to)."""
+    import os
+    import subprocess
+    import sys
 
-    def parsed() -> str:
-        pddl_io._grammar.cache_clear()
-        domain = pddl_io.parse_domain(domain_text, "d")
-        return str(pddl_io.parse_problem(PROBLEM, "p", domain))
-
-    monkeypatch.setenv("SOFT_TAMP_NO_CACHE", "1")
-    plain = parsed()
-    monkeypatch.delenv("SOFT_TAMP_NO_CACHE")
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
-    assert parsed() == plain  # built, then written
-    (cached,) = (tmp_path / "soft-tamp").iterdir()
-    assert cached.stat().st_size > 0
-    assert parsed() == plain  # read back
-    cached.write_bytes(b"not a grammar\n")
-    assert parsed() == plain  # a corrupt file is rebuilt
-    assert cached.read_bytes() != b"not a grammar\n"
-    pddl_io._grammar.cache_clear()
+    code = (
+        "import sys; from task.symbolic import pddl_io; "
+        "d = pddl_io.parse_domain(open(sys.argv[1]).read(), 'd'); "
+        "print(pddl_io.parse_problem(sys.argv[2], 'p', d).name)"
+    )
+    env = {**os.environ, "HOME": str(tmp_path), "XDG_CACHE_HOME": str(tmp_path / "cache")}
+    env.pop("SOFT_TAMP_NO_CACHE", None)
+    root = Path(__file__).resolve().parents[3]
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(bw_domain_path), PROBLEM],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=root,
+        check=True,
+    )
+    assert out.stdout.strip()
+    assert list(tmp_path.rglob("*")) == []
