@@ -4,8 +4,9 @@
 raises `SceneFileError` with one line ``<source>: <field>: <problem>``, the field written as a
 path such as ``objects[2] (c).pose.xyz``. It refuses: a missing or unknown field (listing the
 valid ones), a value of the wrong type or range, an unknown schema version, a duplicate name, a
-region outside the table, two things overlapping, an object floating, sunk into the table, off
-the table or out of the arm's reach. `scene_dict` and `save_scene` write a scene back
+region outside the table or with none of its area within the arm's reach, two things
+overlapping, an object floating, sunk into the table, off the table or out of the arm's reach.
+`scene_dict` and `save_scene` write a scene back
 (``load_scene(scene_dict(s)) == s``); `load_named` reads the scenes shipped with the package.
 """
 
@@ -326,6 +327,7 @@ def _check(scene: Scene, tol: Tolerances) -> None:
                     f"table (x {scene.table.lo[0]}..{scene.table.hi[0]}, "
                     f"y {scene.table.lo[1]}..{scene.table.hi[1]} m)"
                 )
+        _region_reach(r, f"regions[{i}] ({r.name})")
     if scene.slots is not None:
         for x in scene.slots.xs:
             for y in scene.slots.ys:
@@ -358,6 +360,20 @@ def _check(scene: Scene, tol: Tolerances) -> None:
                 f"{where}: out of the arm's reach, {o.reach:.3f} m from the robot base's axis "
                 f"(the Panda reaches {MIN_REACH} to {MAX_REACH} m)"
             )
+
+
+def _region_reach(r: Region, where: str) -> None:
+    """Refuse a region none of whose rectangle lies between `MIN_REACH` and `MAX_REACH` from
+    the robot base's axis (a region partly within reach is fine)."""
+    near = math.hypot(*(min(max(0.0, r.lo[k]), r.hi[k]) for k in range(2)))
+    far = max(math.hypot(x, y) for x in (r.lo[0], r.hi[0]) for y in (r.lo[1], r.hi[1]))
+    if near <= MAX_REACH and far >= MIN_REACH:
+        return
+    what = f"its nearest point {near:.3f} m" if near > MAX_REACH else f"its farthest {far:.3f} m"
+    raise _Fault(
+        f"{where}: out of the arm's reach, {what} from the robot base's axis "
+        f"(the Panda reaches {MIN_REACH} to {MAX_REACH} m)"
+    )
 
 
 def _unique(scene: Scene) -> None:
