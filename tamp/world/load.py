@@ -24,8 +24,10 @@ from tamp.scene import PALETTE, Body, Pose, SceneConfig
 from tamp.sim.base import Camera
 from tamp.world.geometry import (
     TIGHT,
+    Solid,
     Tolerances,
     fixed_solids,
+    footprint_gap,
     of_movable,
     penetration,
     support,
@@ -345,10 +347,10 @@ def _check(scene: Scene, tol: Tolerances) -> None:
             depth = penetration(solids[i], other)
             if depth <= tol.overlap:
                 continue
-            if j < len(solids) and other.centre[2] > solids[i].top:  # the other sits too low
+            if j < len(solids) and _sunk(other, solids[i]):  # the other sits too low
                 here = f"objects[{j}] ({other.name}).pose.xyz"
                 raise _Fault(f"{here}: {other.name} sunk into {o.name} by {_mm(depth)}")
-            what = "sunk into" if o.pose.xyz[2] > other.top else "overlaps"
+            what = "sunk into" if _sunk(solids[i], other) else "overlaps"
             raise _Fault(f"{where}: {o.name} {what} {other.name} by {_mm(depth)}")
         rest = support(scene, o, tol)
         if not rest.faces:
@@ -360,6 +362,14 @@ def _check(scene: Scene, tol: Tolerances) -> None:
                 f"{where}: out of the arm's reach, {o.reach:.3f} m from the robot base's axis "
                 f"(the Panda reaches {MIN_REACH} to {MAX_REACH} m)"
             )
+
+
+def _sunk(upper: Solid, lower: Solid) -> bool:
+    """True when ``upper`` interpenetrates ``lower`` from above: its centre above ``lower``'s
+    top and their overlap in height no deeper than on the table. Beside a low wall or object,
+    overlapping it from the side, an object is not sunk into it but overlaps it."""
+    dz = min(upper.top, lower.top) - max(upper.bottom, lower.bottom)
+    return upper.centre[2] > lower.top and dz <= -footprint_gap(upper, lower)
 
 
 def _region_reach(r: Region, where: str) -> None:
