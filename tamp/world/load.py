@@ -52,6 +52,8 @@ from task.problem import TABLE
 MIN_REACH = 0.25  # m
 MAX_REACH = 0.78  # m
 
+MARK_THICKNESS = 0.001  # m, the drawn patch of a region without walls (`scene_config`)
+
 SCENES_DIR = Path(__file__).resolve().parent / "scenes"
 NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
 
@@ -111,15 +113,28 @@ def scene_config(scene: Scene, base: SceneConfig = SceneConfig()) -> SceneConfig
     scene's name, its obstacles followed by its regions' walls and base slabs as fixed boxes,
     its slot grid (``base``'s grid when the scene has none) and, when it has movable objects,
     each object's solid (``bodies``, `tamp.scene.Body` from its kind and half extents) and
-    colour (``palette``: object i, in the scene's order, has colour i)."""
+    colour (``palette``: object i, in the scene's order, has colour i). Each region without
+    walls is also a visual-only mark (``marks``, `_mark`) so that camera images show it."""
     grid = {} if scene.slots is None else {"slot_xs": scene.slots.xs, "slot_ys": scene.slots.ys}
     boxes = [b for r in scene.regions for b in (*r.walls(), r.slab()) if b is not None]
-    config = replace(base, name=scene.name, obstacles=(*scene.obstacles, *boxes), **grid)
+    marks = tuple(_mark(r) for r in scene.regions if r.wall_height <= 0)
+    config = replace(
+        base, name=scene.name, obstacles=(*scene.obstacles, *boxes), marks=marks, **grid
+    )
     if not scene.objects:  # a workcell: the loop's blocks keep base's bodies and colours
         return config
     bodies = tuple((o.name, Body(o.kind, o.half)) for o in scene.objects)
     palette = tuple((o.name, o.rgb) for o in scene.objects)
     return replace(config, bodies=bodies, palette=palette)
+
+
+def _mark(r: Region) -> Obstacle:
+    """The flat patch drawn over a region without walls, in its colour: its rectangle,
+    `MARK_THICKNESS` thick, from 1 mm above its surface (PyBullet's table is drawn up to
+    z = 0.001). Visual only: the simulators give it no collision."""
+    centre = ((r.lo[0] + r.hi[0]) / 2, (r.lo[1] + r.hi[1]) / 2, r.surface + 0.001)
+    half = ((r.hi[0] - r.lo[0]) / 2, (r.hi[1] - r.lo[1]) / 2, MARK_THICKNESS / 2)
+    return Obstacle(f"{r.name}:mark", (*centre[:2], centre[2] + half[2]), half, rgb=r.rgb)
 
 
 class _Fault(Exception):
