@@ -115,6 +115,9 @@ class SceneConfig:
     backdrop_y: float | None = None  # a vertical backdrop wall across the view at this y, m
     backdrop_grey: float = 0.45
     obstacles: tuple = ()  # fixed boxes (`tamp.obstacles.Obstacle`); see tamp.obstacles.SCENES
+    # flat boxes drawn but never collided with (`tamp.obstacles.Obstacle`): the marks of regions
+    # without walls (`tamp.world.load.scene_config`), so cameras see them
+    marks: tuple = ()
     name: str = "tabletop"  # the named scene the obstacles come from
     # each listed entity's own solid (`Body`); an entity not listed is the default block
     bodies: tuple[tuple[str, Body], ...] = ()

@@ -21,7 +21,10 @@ the failure memory's keys (`tamp.geo.search`), so a place is a stable choice, no
   rectangle, nearest the region's centre first; then ``samples`` seeded uniform positions
   (nearest the centre first). Every one has the object's footprint inside the inner rectangle
   and `REGION_CLEARANCE` from the other objects. Yaws: the region's axes (a non-square cuboid
-  also turned a quarter, suffix ``.r``).
+  also turned a quarter, suffix ``.r``). A region with a smaller region marked inside it (an
+  alcove in a larger area) offers only its free part: a place wholly inside the inner region
+  would have the inner one as its support (`tamp.world.relations.innermost`), so it is
+  offered as a place in the inner region, not in this one.
 - On the table (`task.problem.TABLE`; ``"table.s<i>"``, ``"table.g<i>"``): the scene's slot
   grid first (if it has one), then a grid of pitch `TABLE_PITCH` over the table within
   `TABLE_REACH` of the robot base's axis (its phase drawn from ``seed``), nearest the object
@@ -36,11 +39,21 @@ from __future__ import annotations
 
 import math
 import zlib
+from dataclasses import replace
 
 import numpy as np
 
 from tamp.geo.types import Place
-from tamp.world.geometry import Solid, fixed_solids, footprint_gap, of_movable, penetration
+from tamp.world.geometry import (
+    TIGHT,
+    Solid,
+    fixed_solids,
+    footprint_gap,
+    inside,
+    of_movable,
+    penetration,
+)
+from tamp.world.relations import innermost
 from tamp.world.schema import Movable, Region, Scene, SceneFileError
 from task.errors import one_of
 from task.problem import TABLE
@@ -227,7 +240,17 @@ def _in_region(scene: Scene, o: Movable, r: Region, seed: int, samples: int) -> 
     def near(place: Place) -> float:
         return math.dist(place.xyz[:2], centre)
 
-    return packed + sorted(grid, key=near) + sorted(drawn, key=near)
+    pool = packed + sorted(grid, key=near) + sorted(drawn, key=near)
+    nested = [
+        q
+        for q in scene.regions
+        if q.name != r.name
+        and abs(q.surface - r.surface) <= TIGHT.z
+        and innermost(scene, [r.name, q.name]) == q.name
+    ]
+    if not nested:
+        return pool
+    return [p for p in pool if not any(inside(q, replace(o, pose=p.pose)) for q in nested)]
 
 
 def _extent_of(s: Solid) -> tuple[float, float]:

@@ -106,6 +106,17 @@ class MuJoCoSim(Simulator):
                 quat=_quat(o.yaw),
                 rgba=[*o.rgb, 1],
             )
+        for o in scene.marks:  # drawn regions: visual only, like the backdrop
+            world.add_geom(
+                name=f"mark_{o.name}",
+                type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=list(o.half),
+                pos=list(o.centre),
+                quat=_quat(o.yaw),
+                rgba=[*o.rgb, 1],
+                contype=0,
+                conaffinity=2,
+            )
         bodies = {name: scene.body(name) for name in self.entities}
         if any(b.kind == "cylinder" for b in bodies.values()):  # matte like LatPlan's rubber
             s.add_material(name="block", specular=0.1, shininess=0.1)

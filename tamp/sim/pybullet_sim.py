@@ -115,6 +115,7 @@ class PyBulletSim(Simulator):
             at = [0.0, self.scene.backdrop_y, 1.5]
             self.backdrop = p.createMultiBody(0, -1, wall, at, physicsClientId=c)
         self.obstacles = [self._obstacle(o) for o in self.scene.obstacles]
+        self.marks = [self._mark(o) for o in self.scene.marks]
         self.robot = load_panda(c)
         self.blocks: dict[str, int] = {}
         for i, name in enumerate(self.entities):
@@ -158,6 +159,14 @@ class PyBulletSim(Simulator):
             p.GEOM_BOX, halfExtents=list(o.half), rgbaColor=[*o.rgb, 1], physicsClientId=c
         )
         return p.createMultiBody(0, col, vis, list(o.centre), _quat(o.yaw), physicsClientId=c)
+
+    def _mark(self, o) -> int:
+        """A region's drawn patch (`tamp.scene.SceneConfig.marks`): visual only, no collision."""
+        c = self.client
+        vis = p.createVisualShape(
+            p.GEOM_BOX, halfExtents=list(o.half), rgbaColor=[*o.rgb, 1], physicsClientId=c
+        )
+        return p.createMultiBody(0, -1, vis, list(o.centre), _quat(o.yaw), physicsClientId=c)
 
     def _block_shapes(self, body: Body, rgb) -> tuple[int, int]:
         """Collision and visual shape of one block (a box, or an upright cylinder)."""

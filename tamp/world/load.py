@@ -4,8 +4,9 @@
 raises `SceneFileError` with one line ``<source>: <field>: <problem>``, the field written as a
 path such as ``objects[2] (c).pose.xyz``. It refuses: a missing or unknown field (listing the
 valid ones), a value of the wrong type or range, an unknown schema version, a duplicate name, a
-region outside the table, two things overlapping, an object floating, sunk into the table, off
-the table or out of the arm's reach. `scene_dict` and `save_scene` write a scene back
+region outside the table or with none of its area within the arm's reach, two things
+overlapping, an object floating, sunk into the table, off the table or out of the arm's reach.
+`scene_dict` and `save_scene` write a scene back
 (``load_scene(scene_dict(s)) == s``); `load_named` reads the scenes shipped with the package.
 """
 
@@ -23,8 +24,10 @@ from tamp.scene import PALETTE, Body, Pose, SceneConfig
 from tamp.sim.base import Camera
 from tamp.world.geometry import (
     TIGHT,
+    Solid,
     Tolerances,
     fixed_solids,
+    footprint_gap,
     of_movable,
     penetration,
     support,
@@ -48,6 +51,8 @@ from task.problem import TABLE
 # height. An object's centre must lie between these horizontal distances from the base axis.
 MIN_REACH = 0.25  # m
 MAX_REACH = 0.78  # m
+
+MARK_THICKNESS = 0.001  # m, the drawn patch of a region without walls (`scene_config`)
 
 SCENES_DIR = Path(__file__).resolve().parent / "scenes"
 NAME = re.compile(r"^[a-z][a-z0-9_-]*$")
@@ -108,15 +113,28 @@ def scene_config(scene: Scene, base: SceneConfig = SceneConfig()) -> SceneConfig
     scene's name, its obstacles followed by its regions' walls and base slabs as fixed boxes,
     its slot grid (``base``'s grid when the scene has none) and, when it has movable objects,
     each object's solid (``bodies``, `tamp.scene.Body` from its kind and half extents) and
-    colour (``palette``: object i, in the scene's order, has colour i)."""
+    colour (``palette``: object i, in the scene's order, has colour i). Each region without
+    walls is also a visual-only mark (``marks``, `_mark`) so that camera images show it."""
     grid = {} if scene.slots is None else {"slot_xs": scene.slots.xs, "slot_ys": scene.slots.ys}
     boxes = [b for r in scene.regions for b in (*r.walls(), r.slab()) if b is not None]
-    config = replace(base, name=scene.name, obstacles=(*scene.obstacles, *boxes), **grid)
+    marks = tuple(_mark(r) for r in scene.regions if r.wall_height <= 0)
+    config = replace(
+        base, name=scene.name, obstacles=(*scene.obstacles, *boxes), marks=marks, **grid
+    )
     if not scene.objects:  # a workcell: the loop's blocks keep base's bodies and colours
         return config
     bodies = tuple((o.name, Body(o.kind, o.half)) for o in scene.objects)
     palette = tuple((o.name, o.rgb) for o in scene.objects)
     return replace(config, bodies=bodies, palette=palette)
+
+
+def _mark(r: Region) -> Obstacle:
+    """The flat patch drawn over a region without walls, in its colour: its rectangle,
+    `MARK_THICKNESS` thick, from 1 mm above its surface (PyBullet's table is drawn up to
+    z = 0.001). Visual only: the simulators give it no collision."""
+    centre = ((r.lo[0] + r.hi[0]) / 2, (r.lo[1] + r.hi[1]) / 2, r.surface + 0.001)
+    half = ((r.hi[0] - r.lo[0]) / 2, (r.hi[1] - r.lo[1]) / 2, MARK_THICKNESS / 2)
+    return Obstacle(f"{r.name}:mark", (*centre[:2], centre[2] + half[2]), half, rgb=r.rgb)
 
 
 class _Fault(Exception):
@@ -326,6 +344,7 @@ def _check(scene: Scene, tol: Tolerances) -> None:
                     f"table (x {scene.table.lo[0]}..{scene.table.hi[0]}, "
                     f"y {scene.table.lo[1]}..{scene.table.hi[1]} m)"
                 )
+        _region_reach(r, f"regions[{i}] ({r.name})")
     if scene.slots is not None:
         for x in scene.slots.xs:
             for y in scene.slots.ys:
@@ -343,10 +362,10 @@ def _check(scene: Scene, tol: Tolerances) -> None:
             depth = penetration(solids[i], other)
             if depth <= tol.overlap:
                 continue
-            if j < len(solids) and other.centre[2] > solids[i].top:  # the other sits too low
+            if j < len(solids) and _sunk(other, solids[i]):  # the other sits too low
                 here = f"objects[{j}] ({other.name}).pose.xyz"
                 raise _Fault(f"{here}: {other.name} sunk into {o.name} by {_mm(depth)}")
-            what = "sunk into" if o.pose.xyz[2] > other.top else "overlaps"
+            what = "sunk into" if _sunk(solids[i], other) else "overlaps"
             raise _Fault(f"{where}: {o.name} {what} {other.name} by {_mm(depth)}")
         rest = support(scene, o, tol)
         if not rest.faces:
@@ -358,6 +377,28 @@ def _check(scene: Scene, tol: Tolerances) -> None:
                 f"{where}: out of the arm's reach, {o.reach:.3f} m from the robot base's axis "
                 f"(the Panda reaches {MIN_REACH} to {MAX_REACH} m)"
             )
+
+
+def _sunk(upper: Solid, lower: Solid) -> bool:
+    """True when ``upper`` interpenetrates ``lower`` from above: its centre above ``lower``'s
+    top and their overlap in height no deeper than on the table. Beside a low wall or object,
+    overlapping it from the side, an object is not sunk into it but overlaps it."""
+    dz = min(upper.top, lower.top) - max(upper.bottom, lower.bottom)
+    return upper.centre[2] > lower.top and dz <= -footprint_gap(upper, lower)
+
+
+def _region_reach(r: Region, where: str) -> None:
+    """Refuse a region none of whose rectangle lies between `MIN_REACH` and `MAX_REACH` from
+    the robot base's axis (a region partly within reach is fine)."""
+    near = math.hypot(*(min(max(0.0, r.lo[k]), r.hi[k]) for k in range(2)))
+    far = max(math.hypot(x, y) for x in (r.lo[0], r.hi[0]) for y in (r.lo[1], r.hi[1]))
+    if near <= MAX_REACH and far >= MIN_REACH:
+        return
+    what = f"its nearest point {near:.3f} m" if near > MAX_REACH else f"its farthest {far:.3f} m"
+    raise _Fault(
+        f"{where}: out of the arm's reach, {what} from the robot base's axis "
+        f"(the Panda reaches {MIN_REACH} to {MAX_REACH} m)"
+    )
 
 
 def _unique(scene: Scene) -> None:

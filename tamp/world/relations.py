@@ -3,7 +3,9 @@
 Every object gets exactly one support fact from where it rests (`tamp.world.geometry.support`):
 
 - ``(in x r)`` when x rests on region r's surface with its whole footprint inside the
-  rectangle (inside the walls, when r has walls); nested regions give one fact each;
+  rectangle (inside the walls, when r has walls); nested regions give one fact each (an
+  object in an alcove marked inside a larger area is in both), and its support is the
+  innermost of them (`innermost`: the smallest), whatever order the file lists them in;
 - ``(on x y)`` when x rests on object y alone;
 - ``(ontable x)`` when x rests on the table (on a region's rectangle without being inside it
   counts as the table when the region is a marked area at table height);
@@ -63,7 +65,7 @@ def read_facts(scene: Scene, tolerances: Tolerances = TIGHT) -> Facts:
         objects = [f for f in rest.faces if f in names]
         if regions:
             atoms |= {("in", o.name, r) for r in regions}
-            supports.append((o.name, regions[0]))
+            supports.append((o.name, innermost(scene, regions)))
         elif len(objects) == 1 and len(rest.faces) == 1:
             atoms.add(("on", o.name, objects[0]))
             supports.append((o.name, objects[0]))
@@ -75,6 +77,18 @@ def read_facts(scene: Scene, tolerances: Tolerances = TIGHT) -> Facts:
             issues.append(f"object {o.name} rests on {_faces(rest.faces)}: {_why(scene, rest)}")
     atoms |= {("clear", o.name) for o in scene.objects if o.name not in below}
     return Facts(frozenset(atoms), tuple(supports), tuple(unexplained), tuple(issues))
+
+
+def innermost(scene: Scene, regions: list[str]) -> str:
+    """Of the regions (names) an object stands in, the one that is its support: the smallest
+    by area (a region nested in another is the smaller), ties to the first name in sorted
+    order, so the file's order of its regions never decides."""
+
+    def key(name: str) -> tuple[float, str]:
+        r = scene.region(name)
+        return (r.hi[0] - r.lo[0]) * (r.hi[1] - r.lo[1]), name
+
+    return min(regions, key=key)
 
 
 def _flat(scene: Scene, faces: tuple[str, ...]) -> bool:

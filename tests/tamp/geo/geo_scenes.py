@@ -36,6 +36,25 @@ def scene(*objects, regions=(GOAL,), obstacles=(), slots=None) -> Scene:
     return load_scene(data)
 
 
+DESK = {"name": "desk", "min": [0.35, -0.30], "max": [0.65, 0.30]}  # a marked area
+ALCOVE = {"name": "alcove", "min": [0.465, 0.115], "max": [0.535, 0.185]}  # in it: one cube
+
+
+def alcove(*objects, inner_first: bool) -> Scene:
+    """Region ``alcove`` (room for one cube) marked inside region ``desk``, listed first when
+    ``inner_first``; no parking, so an object goes into a region or onto an object."""
+    regions = [ALCOVE, DESK] if inner_first else [DESK, ALCOVE]
+    data = {
+        "schema": 1,
+        "name": "alcove-test",
+        "table": {"min": [-0.3, -0.7], "max": [1.0, 0.7]},
+        "regions": regions,
+        "objects": list(objects),
+        "parking": False,
+    }
+    return load_scene(data)
+
+
 def blocked() -> Scene:
     """Target ``t`` hemmed in 1 cm apart by ``w`` (-x), ``e`` (+x) and ``n`` (+y): no grasp
     reaches it until ``n`` (or ``w`` and ``e``) moves; region ``goal`` beside them."""

@@ -9,7 +9,7 @@ from tamp.geo.baseline import apply_symbolic, plan_search_then_check, symbolic_m
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoStatus
 from tamp.world.goal import parse_goal
-from tests.tamp.geo.geo_scenes import blocked, cube, hemmed, scene, tools
+from tests.tamp.geo.geo_scenes import alcove, blocked, cube, hemmed, scene, tools
 
 SMALL = SearchConfig(choices=("top",), places=4, max_time_s=60.0)
 
@@ -47,3 +47,18 @@ def test_the_baseline_says_unsolvable_when_every_symbolic_plan_is_forbidden():
     plan = plan_search_then_check(s, parse_goal("(in a small)", s), tools(), SMALL)
     assert plan.status is GeoStatus.UNSOLVABLE
     assert "no symbolic plan left" in plan.reason
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("inner_first", [False, True])
+def test_the_baseline_places_into_nested_regions_whatever_their_order(inner_first):
+    """An object moved from the desk into the alcove marked inside it, and another into the
+    alcove once the first has gone to the desk's free part (no parking)."""
+    s = alcove(cube("a", 0.5, -0.15), inner_first=inner_first)
+    plan = plan_search_then_check(s, parse_goal("(in a alcove)", s), tools(), SMALL)
+    assert plan.status is GeoStatus.SOLVED, plan.reason
+    s = alcove(cube("a", 0.5, 0.15), cube("b", 0.5, -0.15), inner_first=inner_first)
+    goal = parse_goal("(and (in b alcove) (in a desk))", s)
+    plan = plan_search_then_check(s, goal, tools(), SMALL)
+    assert plan.status is GeoStatus.SOLVED, plan.reason
+    assert [(m.obj, m.place.target) for m in plan.moves] == [("a", "desk"), ("b", "alcove")]

@@ -13,7 +13,7 @@ from tamp.geo.search import SearchConfig, heuristic, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoStatus
 from tamp.world.goal import parse_goal
 from tamp.world.relations import read_facts
-from tests.tamp.geo.geo_scenes import blocked, cube, scene, tools
+from tests.tamp.geo.geo_scenes import alcove, blocked, cube, scene, tools
 
 pytestmark = pytest.mark.sim
 TOP = SearchConfig(choices=("top",), max_time_s=60.0)  # top-down grasps: a small test
@@ -39,6 +39,22 @@ def test_blocked_is_solved_by_moving_a_neighbour_first():
     assert plan.stats["failures"] >= 1 and plan.stats["checks"] > plan.stats["failures"]
 
 
+@pytest.mark.parametrize("inner_first", [False, True])
+def test_nested_regions_are_solved_whatever_order_the_file_lists_them(inner_first):
+    """Into the alcove from the desk around it; then a second object into the alcove, the
+    first moved out of it into the desk's free part (no parking): the file's order of the two
+    regions used to decide which of them an object in the alcove stood in."""
+    s = alcove(cube("a", 0.5, -0.15), inner_first=inner_first)
+    plan = plan_search(s, parse_goal("(in a alcove)", s), tools(), TOP)
+    assert plan.status is GeoStatus.SOLVED, plan.reason
+    assert [(m.obj, m.place.target) for m in plan.moves] == [("a", "alcove")]
+    s = alcove(cube("a", 0.5, 0.15), cube("b", 0.5, -0.15), inner_first=inner_first)
+    goal = parse_goal("(and (in b alcove) (in a desk))", s)
+    plan = plan_search(s, goal, tools(), TOP)
+    assert plan.status is GeoStatus.SOLVED, plan.reason
+    assert [(m.obj, m.place.target) for m in plan.moves] == [("a", "desk"), ("b", "alcove")]
+
+
 def test_a_region_too_small_for_the_object_is_unsolvable_at_once():
     small = {"name": "small", "min": [0.45, -0.3], "max": [0.49, -0.26]}
     s = scene(cube("a", 0.5, 0.0), regions=[small])
@@ -49,7 +65,9 @@ def test_a_region_too_small_for_the_object_is_unsolvable_at_once():
 
 
 def test_a_region_out_of_reach_is_unsolvable():
-    far = {"name": "far", "min": [0.9, 0.45], "max": [1.0, 0.6]}
+    """Only the region's near edge lies within the loader's reach (0.78 m from the base's
+    axis, so the file loads); no place in it is reachable."""
+    far = {"name": "far", "min": [0.78, -0.1], "max": [0.95, 0.1]}
     s = scene(cube("a", 0.5, 0.0), regions=[far])
     plan = plan_search(s, parse_goal("(in a far)", s), tools(), TOP)
     assert plan.status is GeoStatus.UNSOLVABLE

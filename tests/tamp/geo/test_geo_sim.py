@@ -85,3 +85,40 @@ def test_open_sim_builds_the_scene_s_objects_where_they_are_and_the_tray_holds_i
     others = load_scene({**SCENE, "regions": [], "objects": SCENE["objects"][1:]})
     with open_sim(others, backend) as sim:
         assert sim.truth.state(sim.entities, sim.scene) == (TABLE, TABLE, "box")
+
+
+MAT = {"name": "mat", "min": [0.4, -0.5], "max": [0.6, -0.3], "colour": [0.9, 0.2, 0.2]}
+
+
+def test_a_region_without_walls_is_a_visual_mark_in_its_colour():
+    config = scene_config(load_scene({**SCENE, "regions": [TRAY, MAT]}))
+    assert "mat:mark" not in [o.name for o in config.obstacles]  # nothing collides with it
+    (mark,) = config.marks  # the tray has walls: no mark
+    assert mark.name == "mat:mark" and mark.rgb == (0.9, 0.2, 0.2)
+    assert mark.centre[:2] == pytest.approx((0.5, -0.4)) and mark.half[:2] == pytest.approx(
+        (0.1, 0.1)
+    )
+    bottom, top = mark.centre[2] - mark.half[2], mark.centre[2] + mark.half[2]
+    assert bottom > 0.0 and top < 0.005  # on the table, under any object's tolerance
+
+
+@pytest.mark.sim
+@pytest.mark.parametrize("backend", SIMULATORS)
+def test_a_region_without_walls_shows_in_camera_images_and_collides_with_nothing(backend):
+    """Looking straight down at the mat: its colour where it lies, the table's grey without
+    it; a cube standing on the table inside the mat's patch (its bottom 2 mm under the patch's
+    top) stays at z = its half size: nothing pushes it up onto the patch."""
+    camera = Camera(eye=(0.5, -0.4, 0.6), target=(0.5, -0.4, 0.0), up=(1.0, 0.0, 0.0),
+                    fovy=20.0, width=32, height=32)  # fmt: skip
+    cube = _object("cube", "cube", 0.04, (0.5, -0.4, 0.02))
+    seen = {}
+    for regions in ([MAT], []):
+        scene = load_scene({**SCENE, "regions": regions, "objects": [cube]})
+        with open_sim(scene, backend, camera=camera) as sim:
+            image = np.asarray(sim.render(), dtype=float)[..., :3] / 255.0
+            seen[bool(regions)] = image[4, 16]  # between the image's edge and the cube
+            sim.run(JointTrajectory.hold(PANDA.q_home, 0.5, sim.dt), "open")
+            assert sim.truth.block_poses()["cube"].xyz[2] == pytest.approx(0.02, abs=0.001)
+    table, mat = seen[False], seen[True]
+    assert np.ptp(table) < 0.05  # grey
+    assert mat[0] - mat[1] > 0.3 and mat[0] - mat[2] > 0.3  # the mat's red

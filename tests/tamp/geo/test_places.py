@@ -14,7 +14,7 @@ from tamp.scene import Pose
 from tamp.world.geometry import footprint_gap, inside, of_movable
 from tamp.world.relations import read_facts
 from tamp.world.schema import SceneFileError
-from tests.tamp.geo.geo_scenes import blocked, cube, scene
+from tests.tamp.geo.geo_scenes import alcove, blocked, cube, scene
 
 TRAY = {
     "name": "tray",
@@ -56,6 +56,26 @@ def test_region_places_pack_against_walls_and_objects_then_grid_then_samples():
         return math.dist(p.xyz[:2], (0.55, 0.25))
 
     assert [far(p) for p in grid] == sorted(far(p) for p in grid)
+
+
+@pytest.mark.parametrize("inner_first", [False, True])
+def test_nested_regions_offer_the_inner_one_and_the_outer_ones_free_part(inner_first):
+    """Places in the alcove rest in it (and in the desk around it); places in the desk keep
+    out of the alcove, so each place's support is the region it was asked for."""
+    s = alcove(cube("a", 0.5, -0.15), cube("b", 0.6, 0.25), inner_first=inner_first)
+    into = candidate_places(s, "a", "alcove", n=20)
+    assert into
+    for p in into:
+        facts = read_facts(moved(s, "a", p.pose))
+        assert dict(facts.supports)["a"] == "alcove"
+        assert facts.holds(("in", "a", "alcove")) and facts.holds(("in", "a", "desk"))
+    s = moved(s, "a", into[0].pose)
+    out = candidate_places(s, "a", "desk", n=40)
+    assert len(out) >= 10
+    for p in out:
+        after = moved(s, "a", p.pose)
+        assert not inside(after.region("alcove"), after.object("a"))
+        assert dict(read_facts(after).supports)["a"] == "desk"
 
 
 def test_a_region_that_holds_one_object_places_it_centred_on_the_tight_axis():

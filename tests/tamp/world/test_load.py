@@ -195,6 +195,64 @@ def test_bad_geometry_gets_one_line_naming_the_object(objects, expected):
     assert re.search(expected, _fault(scene(*objects, regions=[TRAY])))
 
 
+@pytest.mark.parametrize(
+    ("lo", "hi", "expected"),
+    [
+        (
+            [0.85, -0.1],
+            [0.95, 0.1],
+            r"regions\[0\] \(far\): out of the arm's reach, its nearest "
+            r"point 0\.850 m from the robot base's axis \(the Panda reaches 0\.25 to 0\.78 m\)",
+        ),
+        ([0.6, 0.55], [0.9, 0.65], r"\(far\): out of the arm's reach, its nearest point 0\.814 m"),
+        ([0.0, -0.1], [0.15, 0.1], r"\(far\): out of the arm's reach, its farthest 0\.180 m"),
+    ],
+)
+def test_a_region_wholly_out_of_reach_is_refused(lo, hi, expected):
+    import re
+
+    region = {"name": "far", "min": lo, "max": hi}
+    assert re.search(expected, _fault(scene(cube("a", 0.5, 0.0, 0.025), regions=[region])))
+
+
+@pytest.mark.parametrize(
+    ("lo", "hi"),
+    [([0.7, -0.1], [0.95, 0.1]), ([0.1, -0.3], [0.3, -0.2]), ([0.0, -0.25], [0.15, 0.25])],
+)
+def test_a_region_partly_within_reach_loads(lo, hi):
+    region = {"name": "part", "min": lo, "max": hi}
+    assert load_scene(scene(cube("a", 0.5, 0.0, 0.025), regions=[region])).regions[0].lo == tuple(
+        lo
+    )
+
+
+BIN = {"name": "bin", "min": [0.45, 0.15], "max": [0.65, 0.35], "wall_height": 0.01}  # low
+
+
+@pytest.mark.parametrize("x", [0.45 - 0.025, 0.45 - 0.024, 0.46 + 0.025, 0.46 + 0.024])
+def test_an_object_touching_a_bins_wall_from_the_side_loads(x):
+    """A cube taller than the bin's wall, beside it outside or inside, touching its x0 wall
+    exactly or 1 mm into it (within the overlap tolerance)."""
+    loaded = load_scene(scene(cube("a", x, 0.25, 0.025), regions=[BIN]))
+    assert loaded.objects[0].pose.xyz[0] == x
+
+
+@pytest.mark.parametrize(
+    ("x", "z", "expected"),
+    [
+        (0.45 - 0.021, 0.025, r"\(a\)\.pose\.xyz: a overlaps bin:wall_x0 by 4 mm"),
+        (0.46 + 0.021, 0.025, r"\(a\)\.pose\.xyz: a overlaps bin:wall_x0 by 4 mm"),
+        (0.455, 0.031, r"\(a\)\.pose\.xyz: a sunk into bin:wall_x0 by 4 mm"),
+    ],
+)
+def test_a_bins_wall_overlapped_from_the_side_or_sunk_into_from_above(x, z, expected):
+    """Beside the low wall, 4 mm into it: an overlap (not "sunk into", though the cube's centre
+    is above the wall's top); standing on the wall with its bottom 4 mm inside it: sunk."""
+    import re
+
+    assert re.search(expected, _fault(scene(cube("a", x, 0.25, z), regions=[BIN])))
+
+
 def test_the_reach_bounds_come_from_the_arm():
     """Out to the far row of ``cramped`` (0.72 m) is reachable; the Panda's top-down IK fails
     beyond 0.8 m at table height (see `tamp.world.load`)."""

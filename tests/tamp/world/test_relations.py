@@ -45,6 +45,21 @@ def test_a_block_on_a_block_in_a_tray_is_on_it_not_in_the_tray():
     assert f.atoms == {("in", "a", "tray"), ("on", "b", "a"), ("clear", "b")}
 
 
+@pytest.mark.parametrize("inner_first", [False, True])
+def test_nested_regions_read_the_same_whatever_their_order(inner_first):
+    """An object in an alcove marked inside a larger area is in both, its support the alcove
+    (the inner one); one in the area's free part is in the area alone."""
+    desk = {"name": "desk", "min": [0.35, -0.3], "max": [0.65, 0.3]}
+    nook = {"name": "nook", "min": [0.45, 0.1], "max": [0.55, 0.2]}
+    regions = [nook, desk] if inner_first else [desk, nook]
+    f = facts_of(cube("a", 0.5, 0.15, 0.025), cube("b", 0.5, -0.15, 0.025), regions=regions)
+    assert f.atoms == {("in", "a", "nook"), ("in", "a", "desk"), ("in", "b", "desk")} | {
+        ("clear", "a"),
+        ("clear", "b"),
+    }
+    assert f.supports == (("a", "nook"), ("b", "desk"))
+
+
 def test_an_object_on_a_trays_wall_is_not_in_it():
     """A wide cuboid lying across the tray's x0 wall top (its centre over the wall)."""
     lid = {
