@@ -36,11 +36,13 @@ import lark
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 from pddl.exceptions import PDDLError as LibraryPDDLError
+from pddl.logic.predicates import Predicate
+from pddl.logic.terms import Constant
 from pddl.parser import GRAMMAR_FILE, PARSERS_DIRECTORY
 from pddl.parser.domain import DomainTransformer
 from pddl.parser.problem import ProblemTransformer
 
-from task.errors import PDDLError
+from task.errors import PDDLError, one_of
 from task.problem import Action, Move
 
 _NUMBER = re.compile(r"^\d+\s*[:.]\s*")  # "0: (pick-up a)" (LPG, LLM plans)
@@ -436,7 +438,51 @@ def parse_problem(
             f"{source}: problem {problem.name} is for domain {str(problem.domain_name)!r}, "
             f"not {str(domain.name)!r}"
         )
+    if domain is not None:
+        _check_names(problem, domain, object_order(text), source)
     return problem
+
+
+def _predicates_in(formula: object) -> Iterable[Predicate]:
+    """Every atom of a formula (through and, or, not, imply, quantifiers), in file order."""
+    if isinstance(formula, Predicate):
+        yield formula
+        return
+    for part in getattr(formula, "operands", ()):
+        yield from _predicates_in(part)
+    for name in ("argument", "condition"):
+        if hasattr(formula, name):
+            yield from _predicates_in(getattr(formula, name))
+
+
+def _check_names(problem: PDDLProblem, domain: Domain, order: tuple[str, ...], source: str) -> None:
+    """PDDLError (one line naming ``source``) for an ``:init`` or ``:goal`` atom whose predicate
+    the domain lacks or takes another number of arguments, or that names an object neither in
+    ``:objects`` nor a domain constant: a typo in the goal is bad input, not an unsolvable
+    problem. Variables (under a quantifier) are not objects; ``order``: the objects in file order
+    (`object_order`), as the valid ones are listed."""
+    arity = {str(p.name).lower(): p.arity for p in domain.predicates}
+    declared = [str(o.name).lower() for o in (*problem.objects, *domain.constants)]
+    objects = list(dict.fromkeys([*order, *sorted(declared)]))
+    init = [atom for fact in sorted(problem.init, key=str) for atom in _predicates_in(fact)]
+    for where, atoms in (("init", init), ("goal", list(_predicates_in(problem.goal)))):
+        for atom in atoms:
+            name, terms = str(atom.name).lower(), list(atom.terms)
+            text = "(" + " ".join([name, *(str(t.name).lower() for t in terms)]) + ")"
+            if name not in arity:
+                known = one_of(name, sorted(arity))
+                raise PDDLError(f"{source}: {where} atom {text}: unknown predicate {known}")
+            if len(terms) != arity[name]:
+                raise PDDLError(
+                    f"{source}: {where} atom {text}: {name} takes {arity[name]} argument(s), "
+                    f"not {len(terms)}"
+                )
+            for term in terms:
+                if isinstance(term, Constant) and str(term.name).lower() not in objects:
+                    raise PDDLError(
+                        f"{source}: {where} atom {text} names unknown object "
+                        f"{one_of(str(term.name).lower(), objects)}"
+                    )
 
 
 def load_domain(path: str | Path) -> Domain:

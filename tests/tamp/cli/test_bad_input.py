@@ -143,3 +143,26 @@ def test_empty_plan_runs_to_exit_1(capsys, files, tmp_path):
     assert main(argv) == 1
     report = json.loads(capsys.readouterr().out)
     assert not report["reached_goal"] and report["config"]["plan"] == str(empty)
+
+
+@pytest.mark.parametrize(
+    ("typo", "needle"),
+    [
+        ("(shiny d)", "unknown predicate 'shiny' (valid: clear, handempty"),
+        ("(on a z)", "'z' (valid: a, b, c, d, e)"),
+    ],
+)
+def test_a_typo_in_the_goal_is_exit_2_not_unsolvable(capsys, files, tmp_path, typo, needle):
+    """`tamp plan` read a goal typo as an unsolvable problem (exit 1); the same typo in :init
+    was bad input (exit 2). Both are now."""
+    text = data.read_text(data.EXAMPLE_FILE)
+    goal = text.index(":goal")
+    for where, edited in (
+        ("goal", text[:goal] + text[goal:].replace("(and", f"(and {typo}", 1)),
+        ("init", text.replace("(handempty)", f"(handempty) {typo}", 1)),
+    ):
+        problem = tmp_path / f"{where}.pddl"
+        problem.write_text(edited)
+        assert main(["plan", files[0], str(problem)]) == 2
+        line = one_line_error(capsys)
+        assert f"{where} atom {typo}" in line and needle in line

@@ -173,3 +173,26 @@ def test_the_compiled_grammar_is_cached_on_disk_and_parses_alike(
     assert parsed() == plain  # a corrupt file is rebuilt
     assert cached.read_bytes() != b"not a grammar\n"
     pddl_io._grammar.cache_clear()
+
+
+@pytest.mark.parametrize(
+    ("edit", "parts"),
+    [
+        (("(on a b)", "(shiny a)"), ("goal atom (shiny a): unknown predicate 'shiny'", "ontable")),
+        (
+            ("(on a b)", "(on a e)"),
+            ("goal atom (on a e) names unknown object 'e'", "(valid: c, a, b)"),
+        ),
+        (("(on a b)", "(on a)"), ("goal atom (on a): on takes 2 argument(s), not 1",)),
+        (("(handempty)", "(handempty) (shiny c)"), ("init atom (shiny c): unknown predicate",)),
+        (("(and (on a b))", "(and (on a b) (not (shiny a)))"), ("goal atom (shiny a)",)),
+    ],
+)
+def test_a_typo_in_the_goal_or_init_is_bad_input_naming_it(bw_domain_path, edit, parts):
+    """A goal typo was read as an unsolvable problem (exit 1); the reader refuses it as it
+    refuses the same typo in :init, listing the valid predicates or objects."""
+    domain = pddl_io.load_domain(bw_domain_path)
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_problem(PROBLEM.replace(*edit), "typo.pddl", domain)
+    _error(excinfo, "typo.pddl: ", *parts)
+    assert pddl_io.parse_problem(PROBLEM, "ok.pddl", domain).name == "tiny"
