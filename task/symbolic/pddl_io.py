@@ -7,7 +7,9 @@ not match the domain. Plans are written in the PlanBench / VAL / Fast Downward f
 the one plan reader of the project (``tamp validate`` and ``tamp run --plan`` both use it): that
 format with ``;`` comments, optional step numbers (``0: (pick-up a)``, LPG and LLM plans) and
 ``[duration]`` suffixes, or relational moves (``move(a -> b)``, the form `task.problem.Move`
-prints, or ``move(a, b)`` or ``a -> b``), one kind per plan.
+prints, or ``move(a, b)`` or ``a -> b``), one kind per plan. One step per line: a step after
+the ``;`` of a step's line (``(unstack c b); (put-down c)``, the one-line form `bench
+executability` reads) is refused rather than read as a comment.
 
 PDDL as other tools write it is read as they mean it before the library's grammar sees it
 (`_domain_style`, `_problem_style`): keywords in any case, empty sections (Tarski's writer
@@ -528,9 +530,16 @@ def parse_plan_lines(text: str, source: str = "<plan>") -> tuple[PlanLine, ...]:
     line or a plan that mixes actions and moves. An empty plan is an empty tuple."""
     entries = []
     for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = _NUMBER.sub("", raw.split(";", 1)[0].strip()).lower()
+        line, _, comment = raw.partition(";")
+        line = _NUMBER.sub("", line.strip()).lower()
         if not line:
             continue
+        if _is_step(comment.partition(";")[0].strip()):
+            raise PDDLError(
+                f"{source}: line {lineno}: several actions on one line joined by ';' "
+                f"({raw.strip()!r}): a plan file holds one action per line, and ';' starts a "
+                "comment"
+            )
         if m := _ACTION.match(line):
             entries.append(PlanLine(lineno, Action(m.group(1), tuple(m.group(2).split()))))
         elif m := _MOVE.match(line) or _ARROW.match(line):
@@ -545,6 +554,12 @@ def parse_plan_lines(text: str, source: str = "<plan>") -> tuple[PlanLine, ...]:
         lineno = entries[kinds.index(not kinds[0])].lineno
         raise PDDLError(f"{source}: line {lineno}: the plan mixes 4-op actions and moves")
     return tuple(entries)
+
+
+def _is_step(text: str) -> bool:
+    """Whether comment text reads as a plan step (an action or a move), not a remark."""
+    line = _NUMBER.sub("", text)
+    return bool(_ACTION.match(line) or _MOVE.match(line))
 
 
 def parse_plan(text: str, source: str = "<plan>") -> tuple[Action, ...]:
