@@ -84,13 +84,10 @@ def summary_lines(report: EpisodeReport) -> list[str]:
 
 
 def _given_steps(path: str | None, problem: Problem):
-    """The steps of ``--plan`` (None: plan instead); an empty plan file is a plan of no steps
-    (it reaches the goal only if the goal already holds: exit 1 otherwise, as `validate`)."""
+    """The steps of ``--plan`` (None: plan instead); a plan file without steps is bad input
+    (`tamp.loop.given.read_given`: one line, exit 2), as docs/guide/evaluating.md says."""
     if path is None:
         return None
-    text = pddl_io.read_text(path)
-    if not any(line.split(";", 1)[0].strip() for line in text.splitlines()):
-        return ()
     return read_given(path, problem)
 
 

@@ -125,24 +125,25 @@ def test_a_file_that_is_not_a_checkpoint_is_one_line(capsys, tmp_path, argv):
     assert str(bad) in line and "not a perception checkpoint" in line
 
 
-def test_an_empty_plan_is_exit_1_in_validate_as_in_run(capsys, files, tmp_path):
-    """An empty plan file is a plan that does not reach the goal: exit 1 (`validate`; `run
-    --plan` alike, tested with the simulator in test_empty_plan_runs_to_exit_1)."""
+def test_an_empty_plan_is_exit_1_in_validate(capsys, files, tmp_path):
+    """An empty plan file is a plan that does not reach the goal: `validate`'s verdict, exit 1
+    (`run --plan` has nothing to execute: bad input, test_an_empty_plan_file_to_run_is_exit_2)."""
     empty = tmp_path / "empty.plan"
     empty.write_text("; nothing\n")
     assert main(["validate", *files, str(empty)]) == 1
     assert capsys.readouterr().out.startswith("NON_GOAL_REACHING")
 
 
-@pytest.mark.sim
-def test_empty_plan_runs_to_exit_1(capsys, files, tmp_path):
+@pytest.mark.parametrize("text", ["", "; nothing\n; cost = 0 (unit cost)\n"])
+def test_an_empty_plan_file_to_run_is_exit_2(capsys, files, tmp_path, text):
+    """`run --plan EMPTY` ran a whole episode (exit 1); docs/guide/evaluating.md promises a
+    one-line error, exit 2, before any simulator starts."""
     empty = tmp_path / "empty.plan"
-    empty.write_text("; nothing\n")
+    empty.write_text(text)
     out = tmp_path / "out"
-    argv = ["run", files[1], "--plan", str(empty), "--no-video", "--out", str(out), "--json"]
-    assert main(argv) == 1
-    report = json.loads(capsys.readouterr().out)
-    assert not report["reached_goal"] and report["config"]["plan"] == str(empty)
+    argv = ["run", files[1], "--plan", str(empty), "--no-video", "--out", str(out)]
+    assert main(argv) == 2
+    assert f"{empty}: the plan is empty (no action or move lines)" in one_line_error(capsys)
 
 
 @pytest.mark.parametrize(
