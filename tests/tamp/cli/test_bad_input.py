@@ -5,6 +5,7 @@ checked before any work, Ctrl-C at any moment, a file that is not a checkpoint: 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -167,3 +168,39 @@ def test_a_typo_in_the_goal_is_exit_2_not_unsolvable(capsys, files, tmp_path, ty
         assert main(["plan", files[0], str(problem)]) == 2
         line = one_line_error(capsys)
         assert f"{where} atom {typo}" in line and needle in line
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["plan", "DOMAIN", "PROBLEM", "--out", "/proc/x", "--improve", "10"],
+        ["bench", "random", "--blocks", "3", "--n", "1", "--out", "/proc/x/y"],
+        ["run", "--no-video", "--out", "/proc/x/y"],
+        ["example", "--out", "/proc/x"],
+    ],
+)
+def test_an_out_path_that_cannot_be_created_is_refused_before_the_work(
+    capsys, files, monkeypatch, argv
+):
+    """Under /proc nothing can be created, though a permission check passes for root: `plan
+    --out /proc/x` threw away its planning, `bench planbench --out /proc/x/y` planned all its
+    instances, then failed. The path is now tried (created and written, then removed) first."""
+
+    def no_work(*args, **kw):
+        raise AssertionError("worked before checking --out")
+
+    monkeypatch.setattr("tamp.cli.plan.plan", no_work)
+    monkeypatch.setattr(planning, "run", no_work)
+    monkeypatch.setattr("tamp.cli.run.Episode", no_work)
+    given = [{"DOMAIN": files[0], "PROBLEM": files[1]}.get(a, a) for a in argv]
+    assert main(given) == 2
+    assert "cannot be created or written" in one_line_error(capsys)
+
+
+def test_an_out_path_is_tried_and_left_as_it_was(tmp_path):
+    from tamp.cli.recorded import out_file, out_folder
+
+    out_folder(str(tmp_path / "a" / "b"))
+    out_file(str(tmp_path / "c" / "plan.txt"))
+    assert list(tmp_path.iterdir()) == []
