@@ -69,7 +69,7 @@ def load_problem(problem: str | None, domain: str | None) -> Problem:
 def summary_lines(report: EpisodeReport) -> list[str]:
     moves = report.moves
     ok = sum(r.ok for r in moves)
-    per_move = report.wall_time_s / max(len(moves), 1)
+    per_move = f"{report.wall_time_s / len(moves):.2f} s per move, " if moves else ""
     return [
         *(step.line() for step in report.steps),
         f"{report.problem} in {report.sim}: {report.status.value}"
@@ -78,7 +78,7 @@ def summary_lines(report: EpisodeReport) -> list[str]:
         f"moves {ok}/{len(moves)} ok, {report.replans} replans, faults injected: "
         f"{', '.join(report.faults) or 'none'}",
         f"sim {report.sim_time_s:.1f} s, wall {report.wall_time_s:.1f} s "
-        f"({per_move:.2f} s per move, {report.sim_time_s / max(report.wall_time_s, 1e-9):.1f}x "
+        f"({per_move}{report.sim_time_s / max(report.wall_time_s, 1e-9):.1f}x "
         f"real time), planning {report.plan_time_s:.2f} s",
     ]
 

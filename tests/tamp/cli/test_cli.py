@@ -260,3 +260,28 @@ def test_plan_motion_aware_says_a_goal_tower_too_tall_for_the_scene_is_unsolvabl
         "(SceneConfig.max_height)\n"
     )
     assert main(["plan", str(domain), str(problem), *FAST]) == 0
+
+
+def test_an_episode_of_no_moves_prints_no_time_per_move():
+    """'0.00 s per move' was printed for an episode that made no move."""
+    from types import SimpleNamespace
+
+    from tamp.cli.run import summary_lines
+
+    report = SimpleNamespace(
+        steps=(),
+        problem="p",
+        sim="pybullet",
+        status=SimpleNamespace(value="goal_reached"),
+        reason="",
+        reached_goal=True,
+        moves=(),
+        replans=0,
+        faults=(),
+        sim_time_s=0.0,
+        wall_time_s=0.5,
+        plan_time_s=0.1,
+    )
+    assert "per move" not in summary_lines(report)[-1]
+    report.moves = (SimpleNamespace(ok=True), SimpleNamespace(ok=False))
+    assert "(0.25 s per move, 0.0x real time)" in summary_lines(report)[-1]
