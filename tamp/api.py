@@ -33,11 +33,32 @@ What each function wraps, for reading further: `task.instances` (PDDL in), `task
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from tamp.api_args import (
+    BOOL,
+    CALLBACK,
+    COSTS,
+    GOAL,
+    IMAGE,
+    INT,
+    INTS,
+    LOOP_CONFIG,
+    PATH,
+    PLAN,
+    PLANNER_CONFIG,
+    SCENE,
+    SCENE_FILE,
+    SOURCE,
+    SUITE,
+    TEXT,
+    TEXTS,
+    Kind,
+    checked,
+)
 from task import data
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
@@ -152,6 +173,7 @@ def domain_names() -> tuple[str, ...]:
     return names()
 
 
+@checked(domain=SOURCE)
 def domain_rules(domain: Source) -> str:
     """The name of the rules that plan a PDDL domain: a hand-written domain it matches
     (``blocksworld``, ``logistics``, ``sokoban``), else ``strips`` (the generic soft lift).
@@ -160,6 +182,7 @@ def domain_rules(domain: Source) -> str:
     return recognise(pddl_io.parse_domain(text, label))
 
 
+@checked(problem=SOURCE, domain=SOURCE.optional(), rules=TEXT.optional())
 def load_problem(
     problem: Source, domain: Source | None = None, rules: str | None = None
 ) -> PddlTask:
@@ -170,6 +193,12 @@ def load_problem(
     parsed = pddl_io.parse_domain(domain_text, domain_label)
     text, label = _text(problem, "problem")
     return PddlTask(parsed, from_text(parsed, text, label, rules=rules))
+
+
+PROBLEM = Kind(
+    "a PddlTask, a Problem, PDDL text (str) or a PDDL file (pathlib.Path)",
+    lambda v: isinstance(v, PddlTask | Problem | str | Path),
+)  # the problem argument of every function that plans or runs one
 
 
 def _task(problem: PddlTask | Problem | Source, domain: Source | None = None) -> PddlTask:
@@ -236,6 +265,13 @@ def _report(task: PddlTask, result: PlanResult) -> PlanReport:
     return PlanReport(task, replace(result, validation=verdict), actions)
 
 
+@checked(
+    problem=PROBLEM,
+    domain=SOURCE.optional(),
+    config=PLANNER_CONFIG.optional(),
+    seed=INT,
+    costs=COSTS.optional(),
+)
 def plan(
     problem: PddlTask | Problem | Source,
     domain: Source | None = None,
@@ -260,13 +296,17 @@ def plan(
     return _report(task, soft_plan(task.problem, config, seed, costs=costs))
 
 
+@checked(problem=PROBLEM, plan=PLAN, domain=SOURCE.optional())
 def validate(
     problem: PddlTask | Problem | Source, plan: PlanSource, domain: Source | None = None
 ) -> Validation:
     """Check a plan from any source against a problem's PDDL: valid, or the first failing step
     and why (``Validation.step``, 1-based; ``reason``; ``failed`` atoms). ``plan``: plan text
-    (``str``), a plan file (`pathlib.Path`), or the steps (`Action` or Blocksworld `Move`)."""
+    (``str``), a plan file (`pathlib.Path`), or the steps (`Action` or Blocksworld `Move`, or
+    their text: ``["(unstack c b)", "(put-down c)"]``)."""
     task = _task(problem, domain)
+    if not isinstance(plan, str | Path) and any(isinstance(step, str) for step in plan):
+        plan = "\n".join(str(step) for step in plan)  # steps as strings: read as plan text
     if isinstance(plan, str | Path):
         text, label = (
             (pddl_io.read_text(plan), str(plan)) if isinstance(plan, Path) else (plan, "<plan>")
@@ -337,6 +377,14 @@ def _loop_config(config: LoopConfig | None, sim: str | None) -> LoopConfig:
     return config if sim is None else replace(config, sim=sim)
 
 
+@checked(
+    problem=PROBLEM,
+    domain=SOURCE.optional(),
+    sim=TEXT.optional(),
+    config=LOOP_CONFIG.optional(),
+    seed=INT,
+    on_event=CALLBACK.optional(),
+)
 def run_episode(
     problem: PddlTask | Problem | Source,
     domain: Source | None = None,
@@ -369,6 +417,16 @@ def _steps(plan: PlanSource, problem: Problem):
     return parse_given("\n".join(str(step) for step in plan), "<plan>", problem)
 
 
+@checked(
+    problem=PROBLEM,
+    domain=SOURCE.optional(),
+    sim=TEXT.optional(),
+    config=LOOP_CONFIG.optional(),
+    seed=INT,
+    plan=PLAN,
+    replan=BOOL,
+    stop_at_invalid=BOOL,
+)
 def execute_plan(
     problem: PddlTask | Problem | Source,
     plan: PlanSource,
@@ -396,17 +454,33 @@ def execute_plan(
     return episode.run()
 
 
-def load_scene(scene: str | Path) -> Scene:
-    """A checked scene file (`tamp.world`): a path to a JSON file (schema version 1) or a
+@checked(scene=SCENE)
+def load_scene(scene: str | Path | Mapping) -> Scene:
+    """A checked scene file (`tamp.world`): a path to a JSON file (schema version 1), a
     shipped scene's name (``tamp.world.named_scenes()``: tabletop, shelf, clutter, cramped,
-    tower, ...). A bad file raises one `tamp.world.SceneFileError` line naming the field."""
-    from tamp.world import load_named, load_scene, named_scenes
+    tower, ...) or the file's content as a dict. A bad file raises one
+    `tamp.world.SceneFileError` line naming the field."""
+    from tamp.world import load_scene
+
+    return load_scene(scene if isinstance(scene, Mapping) else _scene_path(scene))
+
+
+def _scene_path(scene: str | Path) -> Path:
+    """The file of a shipped scene's name, or the path given; a str that is neither an
+    existing file nor a shipped scene is one line listing the shipped scenes."""
+    from tamp.world import SceneFileError, named_scenes
+    from tamp.world.load import SCENES_DIR
 
     if isinstance(scene, str) and scene in named_scenes():
-        return load_named(scene)
-    return load_scene(Path(scene))
+        return SCENES_DIR / f"{scene}.json"
+    if isinstance(scene, str) and not Path(scene).exists():
+        raise SceneFileError(
+            f"{scene}: no such scene file, nor a shipped scene {one_of(scene, named_scenes())}"
+        )
+    return Path(scene)
 
 
+@checked(scene=SCENE_FILE, goal=GOAL, sim=TEXT.optional(), config=LOOP_CONFIG.optional(), seed=INT)
 def run_scene(
     scene: str | Path,
     goal: str | Path,
@@ -421,16 +495,24 @@ def run_scene(
     ``scene``: a path or a shipped scene's name. ``sim``, ``config``, ``seed``: as
     `run_episode` (the table, obstacles and slot grid are the file's)."""
     from tamp.loop import Episode
-    from tamp.world import named_scenes
     from tamp.world.blocks import scene_task
-    from tamp.world.load import SCENES_DIR
 
-    path = SCENES_DIR / f"{scene}.json" if scene in named_scenes() else Path(scene)
-    found = scene_task(path, goal)
+    found = scene_task(_scene_path(scene), goal)
     chosen = replace(_loop_config(config, sim), scene=found.config)
     return Episode(found.problem, chosen, seed, poses=dict(found.poses)).run()
 
 
+@checked(
+    scene=SCENE_FILE,
+    goal=GOAL.optional(),
+    planner=TEXT,
+    sim=TEXT,
+    seed=INT,
+    video=PATH.optional(),
+    observation=TEXT,
+    domain=PATH.optional(),
+    binding=PATH.optional(),
+)
 def run_geometric(
     scene: str | Path,
     goal: str | Path | None = None,
@@ -480,6 +562,15 @@ def run_geometric(
 # ------------------------------------------------------------------------------- images
 
 
+@checked(
+    init=IMAGE,
+    goal=IMAGE,
+    scene=TEXT,
+    perception=TEXT,
+    checkpoint=PATH.optional(),
+    config=PLANNER_CONFIG.optional(),
+    seed=INT,
+)
 def plan_images(
     init: str | Path | np.ndarray,
     goal: str | Path | np.ndarray,
@@ -542,6 +633,7 @@ class PlanningBenchmark:
     summary: tuple[Summary, ...] = field(default=())
 
 
+@checked(blocks=INTS, n=INT, seed=INT)
 def random_suite(blocks: Sequence[int] = (3, 4), n: int = 5, seed: int = 0) -> Suite:
     """``n`` seeded random Blocksworld problems per block count, with optimal lengths from A*
     (``tamp bench random``)."""
@@ -550,6 +642,7 @@ def random_suite(blocks: Sequence[int] = (3, 4), n: int = 5, seed: int = 0) -> S
     return generated(tuple(blocks), n, seed)
 
 
+@checked(folder=PATH, limit=INT.optional(), rules=TEXT.optional())
 def folder_suite(folder: str | Path, limit: int | None = None, rules: str | None = None) -> Suite:
     """Every problem file of a folder holding ``domain.pddl`` and problems (``tamp bench pddl``);
     ``limit``: a spread of that many; ``rules``: as `load_problem`."""
@@ -558,6 +651,7 @@ def folder_suite(folder: str | Path, limit: int | None = None, rules: str | None
     return pddl_folder(folder, limit, rules=rules)
 
 
+@checked(data_dir=PATH, domain=TEXT, limit=INT.optional())
 def planbench_suite(
     data_dir: str | Path, domain: str = "blocksworld", limit: int | None = None
 ) -> Suite:
@@ -569,6 +663,7 @@ def planbench_suite(
     return planbench(data_dir, limit, domain=domain)
 
 
+@checked(suite=SUITE, config=PLANNER_CONFIG.optional(), seeds=INTS, horizons=INTS.optional())
 def benchmark(
     suite: Suite,
     config: PlannerConfig | None = None,
@@ -587,6 +682,7 @@ def benchmark(
     return PlanningBenchmark(bench, tuple(summary.main_rows(bench)))
 
 
+@checked(suite=SUITE, sims=TEXTS, config=LOOP_CONFIG.optional(), seed=INT, workers=INT)
 def benchmark_motion(
     suite: Suite,
     sims: Sequence[str] = ("pybullet",),

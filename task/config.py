@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import math
 import re
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 # moves per window (horizon, lookahead): far beyond any plan the windows decode, and the window's
 # (B, T, N, A) logits and T-step rollout graph grow with it (1_000_000 hung before planning)
@@ -135,6 +136,10 @@ class PlannerConfig:
     def __post_init__(self) -> None:
         from task.errors import TampError
 
+        for item in fields(self):  # nan slips through every comparison below; inf is no setting
+            value = getattr(self, item.name)
+            if isinstance(value, float) and not math.isfinite(value):
+                raise TampError(f"PlannerConfig.{item.name} must be a finite number, got {value}")
         if self.park_from is not None and self.park_from < 1:
             raise TampError(f"PlannerConfig.park_from must be >= 1 or None, got {self.park_from}")
         if self.safe_from is not None and self.safe_from < 1:

@@ -37,9 +37,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Protocol
 
+import torch
 from torch import Tensor
 
 from task.domains.base import State
+from task.errors import TampError
 
 # a move costing this much or more is one the source says cannot be executed (the arm cannot
 # reach it, it failed there before): the decoder refuses it like an illegal move
@@ -80,3 +82,16 @@ class CostSource(Protocol):
     def __call__(
         self, indices: Sequence[int], states: Sequence[State], restarts: int
     ) -> WindowCosts: ...
+
+
+def finite_costs(costs: Tensor) -> Tensor:
+    """``costs`` (any shape) when every value is a number, else TampError (one line): a NaN or
+    infinite cost would steer the optimiser nowhere and the planner would report a solvable
+    problem as unsolvable. Rule a move out with a finite cost at or above `IMPOSSIBLE`."""
+    if not bool(torch.isfinite(costs).all()):
+        bad = costs[~torch.isfinite(costs)].flatten()[0].item()  # the first non-finite value
+        raise TampError(
+            f"move costs from the cost source must be finite numbers, got {bad} in a matrix of "
+            f"shape {tuple(costs.shape)} (rule a move out with a cost >= IMPOSSIBLE = {IMPOSSIBLE})"
+        )
+    return costs

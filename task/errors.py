@@ -20,8 +20,9 @@ class ProblemError(TampError):
 
 
 def one_of(name: str, valid: object) -> str:
-    """Format ``'x' (valid: a, b, c)`` for error messages."""
-    items = ", ".join(str(v) for v in valid)
+    """Format ``'x' (valid: a, b, c)`` for error messages; ``'x' (valid: none)`` when nothing
+    is."""
+    items = ", ".join(str(v) for v in valid) or "none"
     return f"{name!r} (valid: {items})"
 
 

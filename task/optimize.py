@@ -15,7 +15,7 @@ from torch import Tensor
 
 from task.beliefs import WindowBeliefs
 from task.config import PlannerConfig
-from task.costs import WindowCosts
+from task.costs import WindowCosts, finite_costs
 from task.domains.base import STAY_PRIOR, Domain, SoftBatch
 from task.errors import TampError
 from task.rollout import Rollout, check_deadline, rollout
@@ -153,7 +153,7 @@ def with_costs(batch: SoftBatch, costs: WindowCosts | None) -> Tensor | None:
     repeated for each problem's restart rows, or its own (B, N, Y) per-row matrices."""
     if costs is None:
         return None
-    c = costs.compute()  # (P, N, Y), or (B, N, Y) per row
+    c = finite_costs(costs.compute())  # (P, N, Y), or (B, N, Y) per row
     rows = batch.F0.shape[0]
     if c.shape[1:] != batch.F0.shape[1:] or rows % c.shape[0]:
         raise TampError(

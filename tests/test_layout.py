@@ -40,7 +40,7 @@ TAMP_LAYERS = (
     ("geo",),
     ("loop",),
     ("bench",),
-    ("api", "cli"),
+    ("api", "api_args", "cli"),
 )
 
 

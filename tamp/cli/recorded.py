@@ -535,7 +535,8 @@ def validate_config(args: argparse.Namespace) -> dict:
 
 # --- checks before the work ------------------------------------------------------------------
 def out_file(path: str | None, option: str = "--out") -> None:
-    """``path`` can be written as a file: not a folder, its folder creatable (TampError)."""
+    """``path`` can be written as a file: not a folder, its folder created and written to for
+    a try, and left as it was (TampError)."""
     if path is None:
         return
     target = Path(path)
@@ -546,8 +547,7 @@ def out_file(path: str | None, option: str = "--out") -> None:
         parent = parent.parent
     if not parent.is_dir():
         raise TampError(f"{option} {target}: {parent} is a file, not a folder")
-    if not _writable(parent):
-        raise TampError(f"{option} {target}: cannot write in {parent}")
+    _probe(target, option)
 
 
 def out_folder(path: str | None, option: str = "--out") -> None:
@@ -560,10 +560,28 @@ def out_folder(path: str | None, option: str = "--out") -> None:
     out_file(str(target / "results.json"), option)
 
 
-def _writable(folder: Path) -> bool:
-    import os
+def _probe(target: Path, option: str) -> None:
+    """Create ``target``'s missing folders and a file in its folder, then remove what was made
+    (TampError when either fails): a permission check alone says yes to root anywhere, also
+    under /proc, where nothing can be created, and the work was lost at the end."""
+    import contextlib
+    import tempfile
 
-    return os.access(folder, os.W_OK | os.X_OK)
+    missing = [p for p in target.parents if not p.exists()][::-1]  # outermost first
+    made = []
+    try:
+        for folder in missing:
+            folder.mkdir()
+            made.append(folder)
+        with tempfile.TemporaryFile(dir=target.parent):
+            pass
+    except OSError as exc:
+        why = exc.strerror or exc
+        raise TampError(f"{option} {target}: cannot be created or written ({why})") from None
+    finally:
+        for folder in reversed(made):
+            with contextlib.suppress(OSError):
+                folder.rmdir()
 
 
 def checkpoint(path: str | Path | None) -> None:

@@ -72,7 +72,7 @@ def load_problem(problem: str | None, domain: str | None) -> Problem:
 def summary_lines(report: EpisodeReport) -> list[str]:
     moves = report.moves
     ok = sum(r.ok for r in moves)
-    per_move = report.wall_time_s / max(len(moves), 1)
+    per_move = f"{report.wall_time_s / len(moves):.2f} s per move, " if moves else ""
     return [
         *(step.line() for step in report.steps),
         f"{report.problem} in {report.sim}: {report.status.value}"
@@ -81,19 +81,16 @@ def summary_lines(report: EpisodeReport) -> list[str]:
         f"moves {ok}/{len(moves)} ok, {report.replans} replans, faults injected: "
         f"{', '.join(report.faults) or 'none'}",
         f"sim {report.sim_time_s:.1f} s, wall {report.wall_time_s:.1f} s "
-        f"({per_move:.2f} s per move, {report.sim_time_s / max(report.wall_time_s, 1e-9):.1f}x "
+        f"({per_move}{report.sim_time_s / max(report.wall_time_s, 1e-9):.1f}x "
         f"real time), planning {report.plan_time_s:.2f} s",
     ]
 
 
 def _given_steps(path: str | None, problem: Problem):
-    """The steps of ``--plan`` (None: plan instead); an empty plan file is a plan of no steps
-    (it reaches the goal only if the goal already holds: exit 1 otherwise, as `validate`)."""
+    """The steps of ``--plan`` (None: plan instead); a plan file without steps is bad input
+    (`tamp.loop.given.read_given`: one line, exit 2), as docs/guide/evaluating.md says."""
     if path is None:
         return None
-    text = pddl_io.read_text(path)
-    if not any(line.split(";", 1)[0].strip() for line in text.splitlines()):
-        return ()
     return read_given(path, problem)
 
 

@@ -51,6 +51,11 @@ def load_goal(spec: str | Path, scene: Scene) -> Goal:
     if isinstance(spec, str) and spec.lstrip().startswith("("):
         return parse_goal(spec, scene)
     path = Path(spec)
+    if isinstance(spec, str) and not path.exists() and " " in spec.strip():
+        raise SceneFileError(
+            f"goal {spec!r}: a goal is a parenthesised PDDL formula, e.g. '({spec.strip()})', "
+            "or the path of a goal file"
+        )
     try:
         text = path.read_text()
     except OSError as exc:

@@ -15,7 +15,7 @@ import torch
 
 from task.beliefs import BeliefSource
 from task.config import PlannerConfig
-from task.costs import IMPOSSIBLE, CostSource, WindowCosts
+from task.costs import IMPOSSIBLE, CostSource, WindowCosts, finite_costs
 from task.domains.base import Domain, State
 from task.errors import TampError
 from task.problem import Move, Problem
@@ -54,11 +54,11 @@ def cost_checks(domain: Domain, problem: Problem, costs: CostSource, index: int)
         if state not in ruled_out:
             windows[state] = costs([index], [state], 1)
             with torch.no_grad():
-                matrix = windows[state].compute()[0]  # (N, A - 1) action columns of row 0
+                matrix = finite_costs(windows[state].compute()[0])  # (N, A - 1) of row 0
             rows = matrix.shape[0]
             ruled_out[state] = {
                 domain.decode(problem, r, c, rows)
-                for r, c in (~(matrix < IMPOSSIBLE)).nonzero().tolist()  # NaN too
+                for r, c in (matrix >= IMPOSSIBLE).nonzero().tolist()
             }
         return move not in ruled_out[state]
 

@@ -7,7 +7,9 @@ not match the domain. Plans are written in the PlanBench / VAL / Fast Downward f
 the one plan reader of the project (``tamp validate`` and ``tamp run --plan`` both use it): that
 format with ``;`` comments, optional step numbers (``0: (pick-up a)``, LPG and LLM plans) and
 ``[duration]`` suffixes, or relational moves (``move(a -> b)``, the form `task.problem.Move`
-prints, or ``move(a, b)`` or ``a -> b``), one kind per plan.
+prints, or ``move(a, b)`` or ``a -> b``), one kind per plan. One step per line: a step after
+the ``;`` of a step's line (``(unstack c b); (put-down c)``, the one-line form `bench
+executability` reads) is refused rather than read as a comment.
 
 PDDL as other tools write it is read as they mean it before the library's grammar sees it
 (`_domain_style`, `_problem_style`): keywords in any case, empty sections (Tarski's writer
@@ -35,11 +37,13 @@ import lark
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 from pddl.exceptions import PDDLError as LibraryPDDLError
+from pddl.logic.predicates import Predicate
+from pddl.logic.terms import Constant
 from pddl.parser import GRAMMAR_FILE, PARSERS_DIRECTORY
 from pddl.parser.domain import DomainTransformer
 from pddl.parser.problem import ProblemTransformer
 
-from task.errors import PDDLError
+from task.errors import PDDLError, one_of
 from task.problem import Action, Move
 
 _NUMBER = re.compile(r"^\d+\s*[:.]\s*")  # "0: (pick-up a)" (LPG, LLM plans)
@@ -419,7 +423,51 @@ def parse_problem(
             f"{source}: problem {problem.name} is for domain {str(problem.domain_name)!r}, "
             f"not {str(domain.name)!r}"
         )
+    if domain is not None:
+        _check_names(problem, domain, object_order(text), source)
     return problem
+
+
+def _predicates_in(formula: object) -> Iterable[Predicate]:
+    """Every atom of a formula (through and, or, not, imply, quantifiers), in file order."""
+    if isinstance(formula, Predicate):
+        yield formula
+        return
+    for part in getattr(formula, "operands", ()):
+        yield from _predicates_in(part)
+    for name in ("argument", "condition"):
+        if hasattr(formula, name):
+            yield from _predicates_in(getattr(formula, name))
+
+
+def _check_names(problem: PDDLProblem, domain: Domain, order: tuple[str, ...], source: str) -> None:
+    """PDDLError (one line naming ``source``) for an ``:init`` or ``:goal`` atom whose predicate
+    the domain lacks or takes another number of arguments, or that names an object neither in
+    ``:objects`` nor a domain constant: a typo in the goal is bad input, not an unsolvable
+    problem. Variables (under a quantifier) are not objects; ``order``: the objects in file order
+    (`object_order`), as the valid ones are listed."""
+    arity = {str(p.name).lower(): p.arity for p in domain.predicates}
+    declared = [str(o.name).lower() for o in (*problem.objects, *domain.constants)]
+    objects = list(dict.fromkeys([*order, *sorted(declared)]))
+    init = [atom for fact in sorted(problem.init, key=str) for atom in _predicates_in(fact)]
+    for where, atoms in (("init", init), ("goal", list(_predicates_in(problem.goal)))):
+        for atom in atoms:
+            name, terms = str(atom.name).lower(), list(atom.terms)
+            text = "(" + " ".join([name, *(str(t.name).lower() for t in terms)]) + ")"
+            if name not in arity:
+                known = one_of(name, sorted(arity))
+                raise PDDLError(f"{source}: {where} atom {text}: unknown predicate {known}")
+            if len(terms) != arity[name]:
+                raise PDDLError(
+                    f"{source}: {where} atom {text}: {name} takes {arity[name]} argument(s), "
+                    f"not {len(terms)}"
+                )
+            for term in terms:
+                if isinstance(term, Constant) and str(term.name).lower() not in objects:
+                    raise PDDLError(
+                        f"{source}: {where} atom {text} names unknown object "
+                        f"{one_of(str(term.name).lower(), objects)}"
+                    )
 
 
 def load_domain(path: str | Path) -> Domain:
@@ -465,9 +513,16 @@ def parse_plan_lines(text: str, source: str = "<plan>") -> tuple[PlanLine, ...]:
     line or a plan that mixes actions and moves. An empty plan is an empty tuple."""
     entries = []
     for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = _NUMBER.sub("", raw.split(";", 1)[0].strip()).lower()
+        line, _, comment = raw.partition(";")
+        line = _NUMBER.sub("", line.strip()).lower()
         if not line:
             continue
+        if _is_step(comment.partition(";")[0].strip()):
+            raise PDDLError(
+                f"{source}: line {lineno}: several actions on one line joined by ';' "
+                f"({raw.strip()!r}): a plan file holds one action per line, and ';' starts a "
+                "comment"
+            )
         if m := _ACTION.match(line):
             entries.append(PlanLine(lineno, Action(m.group(1), tuple(m.group(2).split()))))
         elif m := _MOVE.match(line) or _ARROW.match(line):
@@ -482,6 +537,12 @@ def parse_plan_lines(text: str, source: str = "<plan>") -> tuple[PlanLine, ...]:
         lineno = entries[kinds.index(not kinds[0])].lineno
         raise PDDLError(f"{source}: line {lineno}: the plan mixes 4-op actions and moves")
     return tuple(entries)
+
+
+def _is_step(text: str) -> bool:
+    """Whether comment text reads as a plan step (an action or a move), not a remark."""
+    line = _NUMBER.sub("", text)
+    return bool(_ACTION.match(line) or _MOVE.match(line))
 
 
 def parse_plan(text: str, source: str = "<plan>") -> tuple[Action, ...]:

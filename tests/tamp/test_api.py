@@ -116,7 +116,7 @@ def test_a_shipped_scene_loads_by_name():
     ("call", "words"),
     [
         (lambda: api.load_problem("problem.pddl"), "not PDDL text"),
-        (lambda: api.load_problem(42), "expected PDDL text"),
+        (lambda: api.load_problem(42), "problem must be PDDL text (str) or a PDDL file"),
         (lambda: api.load_problem(Path("/nonexistent/p.pddl")), "/nonexistent/p.pddl"),
         (lambda: api.load_problem(api.EXAMPLE, rules="towers"), "valid: blocksworld"),
         (lambda: api.validate(SMALL, "(fly a)"), "fly"),
@@ -174,3 +174,88 @@ def test_importing_the_api_loads_no_benchmark():
         cwd=Path(__file__).parents[2],
     )
     assert out.stdout.strip() == "[]"
+
+
+TASK = api.load_problem(SMALL_PDDL)
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: api.plan(TASK, seed="0"), "api.plan: seed must be an int, got '0' (str)"),
+        (lambda: api.plan(TASK, seed=1.5), "api.plan: seed must be an int, got 1.5 (float)"),
+        (
+            lambda: api.plan(TASK, config={"horizon": 3}),
+            "api.plan: config must be a task.config.PlannerConfig or None, got {'horizon': 3}",
+        ),
+        (lambda: api.validate(TASK, 5), "api.validate: plan must be plan text (str), a plan file"),
+        (
+            lambda: api.run_episode(TASK, config=api.PlannerConfig()),
+            "api.run_episode: config must be a tamp.loop.LoopConfig or None, got PlannerConfig(",
+        ),
+        (lambda: api.load_scene({"schema": 1}), "scene: name: missing (required: name, schema"),
+        (lambda: api.load_scene(3.0), "api.load_scene: scene must be a scene file"),
+        (
+            lambda: api.run_scene("tower", 5),
+            "api.run_scene: goal must be a PDDL goal (str) or a goal file (pathlib.Path), got 5",
+        ),
+        (
+            lambda: api.benchmark(api.random_suite((3,), 1), seeds=()),
+            "api.benchmark: seeds must be a non-empty list or tuple of ints, got () (tuple)",
+        ),
+        (
+            lambda: api.benchmark(SMALL),
+            "api.benchmark: suite must be a tamp.bench.suites.Suite (api.random_suite, ...)",
+        ),
+        (
+            lambda: api.plan(TASK, costs=api.FixedCosts(torch.zeros(1, 3, 4))),
+            "api.plan: costs must be a CostSource: a callable (indices, states, restarts)",
+        ),
+        (lambda: api.plan(TASK, sed=1), "api.plan: got an unexpected keyword argument 'sed'"),
+        (lambda: api.random_suite(3), "api.random_suite: blocks must be a non-empty list"),
+        (
+            lambda: api.execute_plan(TASK, "", replan="yes"),
+            "api.execute_plan: replan must be a bool",
+        ),
+    ],
+)
+def test_arguments_of_the_wrong_kind_are_one_line_naming_them(call, words, monkeypatch):
+    """Every public function checks its arguments' kinds at the edge (`tamp.api_args`): one
+    line naming the function, the argument, what was given and what is expected, never a
+    Python error from inside (manual_seed, 'dict' has no attribute, not iterable)."""
+    import tamp.bench.planning
+    import task.planner
+
+    def no_work(*args, **kw):
+        raise AssertionError("worked before checking the arguments")
+
+    monkeypatch.setattr(task.planner, "plan", no_work)
+    monkeypatch.setattr(tamp.bench.planning, "run", no_work)
+    with pytest.raises(TampError) as caught:
+        call()
+    message = str(caught.value)
+    assert words in message and "\n" not in message
+
+
+def test_a_plan_given_as_step_strings_is_validated_as_a_plan():
+    steps = ["(unstack b a)", "(stack b c)", "(pick-up a)", "(stack a b)"]
+    planned = api.validate(SMALL, steps)
+    assert planned.valid and planned.length == 4
+    assert not api.validate(SMALL, steps[1:]).valid
+    assert api.validate(SMALL, ["move(b -> c)", api.Move("a", "b")]).valid
+
+
+def test_an_unknown_scene_name_lists_the_shipped_scenes():
+    with pytest.raises(TampError) as caught:
+        api.load_scene("towerz")
+    assert "towerz: no such scene file, nor a shipped scene 'towerz' (valid: " in str(caught.value)
+    assert "tower, tray" in str(caught.value)
+    assert [o.name for o in api.load_scene({**_tower_dict()}).objects] == ["a", "b", "c"]
+
+
+def _tower_dict() -> dict:
+    import json
+
+    from tamp.world.load import SCENES_DIR
+
+    return json.loads((SCENES_DIR / "tower.json").read_text())

@@ -107,7 +107,11 @@ GOAL = "(on a b)\n(on d a))"
         (INIT.replace("(clear d)\n", ""), GOAL, "nothing is on d but (clear d) is missing"),
         (INIT + "(on d b)\n", GOAL, "init: c and d are both on b"),
         (INIT + "(on z a)\n", GOAL, "init atom (on z a) names unknown object 'z'"),
-        (INIT + "(heavy a)\n", GOAL, "init atom (heavy a) is not a blocksworld atom"),
+        (
+            INIT + "(heavy a)\n",
+            GOAL,
+            "init atom (heavy a): unknown predicate 'heavy' (valid: clear, handempty",
+        ),
         (INIT, "(clear a))", "(clear a) in the goal cannot be expressed as a support relation"),
         (INIT, "(holding a))", "(holding a) in the goal cannot be expressed"),
         (INIT, "(on a q))", "goal atom (on a q) names unknown object 'q' (valid: d, a, b, c)"),

@@ -262,3 +262,21 @@ def test_a_move_that_fails_the_check_ahead_is_replaced_before_anything_runs():
     off = plan(UNSTACK, replace(config, own_state_costs=False), seed=0, costs=CheckedCosts())
     # the prices alone choose a onto d: the check ahead rides on own_state_costs
     assert off.plan.moves[0] == Move("a", "d")
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), float("-inf")])
+@pytest.mark.parametrize("fallback", [False, True])
+def test_a_non_finite_cost_is_refused_where_it_enters_the_planner(bad, fallback):
+    """NaN or inf from a source made a solvable problem 'unsolvable' after a minute of windows
+    (the windows' loss) or quietly ruled the move out (the fallback search): one line now."""
+    from task.costs import finite_costs
+    from task.errors import TampError
+
+    matrix = torch.ones((1, 4, 5))
+    matrix[0, A, D] = bad
+    config = PlannerConfig(lambda_motion=0.05, restarts=2, iters=5, fallback=fallback)
+    with pytest.raises(TampError, match=r"must be finite numbers, got (nan|inf|-inf)"):
+        plan(UNSTACK, config, seed=0, costs=FixedCosts(matrix))
+    with pytest.raises(TampError, match="shape \\(1, 4, 5\\)"):
+        finite_costs(matrix)
+    assert finite_costs(torch.full((2, 3), IMPOSSIBLE)).shape == (2, 3)

@@ -370,3 +370,13 @@ def test_with_move_costs_a_window_stops_early_only_with_proof_costs_and_never_on
     banned = _flat_costs(problem, {("a", "b")})
     refused = plan(problem, replace(config, proof_costs=True, max_windows=2), costs=banned)
     assert "move(a -> b)" not in [str(m) for m in refused.plan.moves]
+
+
+@pytest.mark.parametrize("name", ["tau_end", "lr", "tau", "decode_tau", "threshold", "improve_s"])
+@pytest.mark.parametrize("bad", [float("nan"), float("inf")])
+def test_a_non_finite_float_setting_is_refused(name, bad):
+    """tau_end=nan planned for a minute and reported 'no plan': nan passes every comparison."""
+    with pytest.raises(TampError, match=f"PlannerConfig.{name} must be a finite number, got"):
+        PlannerConfig(**{name: bad})
+    with pytest.raises(TampError, match="time_limit_s must be a finite number"):
+        PlannerConfig(time_limit_s=float("nan"))

@@ -5,6 +5,7 @@ checked before any work, Ctrl-C at any moment, a file that is not a checkpoint: 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -125,21 +126,81 @@ def test_a_file_that_is_not_a_checkpoint_is_one_line(capsys, tmp_path, argv):
     assert str(bad) in line and "not a perception checkpoint" in line
 
 
-def test_an_empty_plan_is_exit_1_in_validate_as_in_run(capsys, files, tmp_path):
-    """An empty plan file is a plan that does not reach the goal: exit 1 (`validate`; `run
-    --plan` alike, tested with the simulator in test_empty_plan_runs_to_exit_1)."""
+def test_an_empty_plan_is_exit_1_in_validate(capsys, files, tmp_path):
+    """An empty plan file is a plan that does not reach the goal: `validate`'s verdict, exit 1
+    (`run --plan` has nothing to execute: bad input, test_an_empty_plan_file_to_run_is_exit_2)."""
     empty = tmp_path / "empty.plan"
     empty.write_text("; nothing\n")
     assert main(["validate", *files, str(empty)]) == 1
     assert capsys.readouterr().out.startswith("NON_GOAL_REACHING")
 
 
-@pytest.mark.sim
-def test_empty_plan_runs_to_exit_1(capsys, files, tmp_path):
+@pytest.mark.parametrize("text", ["", "; nothing\n; cost = 0 (unit cost)\n"])
+def test_an_empty_plan_file_to_run_is_exit_2(capsys, files, tmp_path, text):
+    """`run --plan EMPTY` ran a whole episode (exit 1); docs/guide/evaluating.md promises a
+    one-line error, exit 2, before any simulator starts."""
     empty = tmp_path / "empty.plan"
-    empty.write_text("; nothing\n")
+    empty.write_text(text)
     out = tmp_path / "out"
-    argv = ["run", files[1], "--plan", str(empty), "--no-video", "--out", str(out), "--json"]
-    assert main(argv) == 1
-    report = json.loads(capsys.readouterr().out)
-    assert not report["reached_goal"] and report["config"]["plan"] == str(empty)
+    argv = ["run", files[1], "--plan", str(empty), "--no-video", "--out", str(out)]
+    assert main(argv) == 2
+    assert f"{empty}: the plan is empty (no action or move lines)" in one_line_error(capsys)
+
+
+@pytest.mark.parametrize(
+    ("typo", "needle"),
+    [
+        ("(shiny d)", "unknown predicate 'shiny' (valid: clear, handempty"),
+        ("(on a z)", "'z' (valid: a, b, c, d, e)"),
+    ],
+)
+def test_a_typo_in_the_goal_is_exit_2_not_unsolvable(capsys, files, tmp_path, typo, needle):
+    """`tamp plan` read a goal typo as an unsolvable problem (exit 1); the same typo in :init
+    was bad input (exit 2). Both are now."""
+    text = data.read_text(data.EXAMPLE_FILE)
+    goal = text.index(":goal")
+    for where, edited in (
+        ("goal", text[:goal] + text[goal:].replace("(and", f"(and {typo}", 1)),
+        ("init", text.replace("(handempty)", f"(handempty) {typo}", 1)),
+    ):
+        problem = tmp_path / f"{where}.pddl"
+        problem.write_text(edited)
+        assert main(["plan", files[0], str(problem)]) == 2
+        line = one_line_error(capsys)
+        assert f"{where} atom {typo}" in line and needle in line
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["plan", "DOMAIN", "PROBLEM", "--out", "/proc/x", "--improve", "10"],
+        ["bench", "random", "--blocks", "3", "--n", "1", "--out", "/proc/x/y"],
+        ["run", "--no-video", "--out", "/proc/x/y"],
+        ["example", "--out", "/proc/x"],
+    ],
+)
+def test_an_out_path_that_cannot_be_created_is_refused_before_the_work(
+    capsys, files, monkeypatch, argv
+):
+    """Under /proc nothing can be created, though a permission check passes for root: `plan
+    --out /proc/x` threw away its planning, `bench planbench --out /proc/x/y` planned all its
+    instances, then failed. The path is now tried (created and written, then removed) first."""
+
+    def no_work(*args, **kw):
+        raise AssertionError("worked before checking --out")
+
+    monkeypatch.setattr("tamp.cli.plan.plan", no_work)
+    monkeypatch.setattr(planning, "run", no_work)
+    monkeypatch.setattr("tamp.cli.run.Episode", no_work)
+    given = [{"DOMAIN": files[0], "PROBLEM": files[1]}.get(a, a) for a in argv]
+    assert main(given) == 2
+    assert "cannot be created or written" in one_line_error(capsys)
+
+
+def test_an_out_path_is_tried_and_left_as_it_was(tmp_path):
+    from tamp.cli.recorded import out_file, out_folder
+
+    out_folder(str(tmp_path / "a" / "b"))
+    out_file(str(tmp_path / "c" / "plan.txt"))
+    assert list(tmp_path.iterdir()) == []

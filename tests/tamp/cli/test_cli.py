@@ -288,3 +288,28 @@ def test_tamp_run_runs_its_episode_on_one_torch_thread(monkeypatch):
     finally:
         torch.set_num_threads(before)
     assert code == 2 and seen == [1] and after == 2
+
+
+def test_an_episode_of_no_moves_prints_no_time_per_move():
+    """'0.00 s per move' was printed for an episode that made no move."""
+    from types import SimpleNamespace
+
+    from tamp.cli.run import summary_lines
+
+    report = SimpleNamespace(
+        steps=(),
+        problem="p",
+        sim="pybullet",
+        status=SimpleNamespace(value="goal_reached"),
+        reason="",
+        reached_goal=True,
+        moves=(),
+        replans=0,
+        faults=(),
+        sim_time_s=0.0,
+        wall_time_s=0.5,
+        plan_time_s=0.1,
+    )
+    assert "per move" not in summary_lines(report)[-1]
+    report.moves = (SimpleNamespace(ok=True), SimpleNamespace(ok=False))
+    assert "(0.25 s per move, 0.0x real time)" in summary_lines(report)[-1]

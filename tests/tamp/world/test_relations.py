@@ -180,6 +180,17 @@ def test_a_missing_goal_file(tmp_path):
         load_goal(tmp_path / "none.pddl", TRAY_SCENE)
 
 
+def test_a_goal_without_parentheses_says_what_a_goal_is(tmp_path, monkeypatch):
+    """``--goal 'on a b'`` was read as a missing goal file's name."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneFileError) as err:
+        load_goal("on a b", TRAY_SCENE)
+    message = str(err.value)
+    assert "goal 'on a b': a goal is a parenthesised PDDL formula, e.g. '(on a b)'" in message
+    assert "or the path of a goal file" in message and "\n" not in message
+    assert load_goal(" (on a b)", TRAY_SCENE).atoms == (("on", "a", "b"),)
+
+
 def test_scene_lookups_list_the_valid_names():
     s: Scene = TRAY_SCENE
     with pytest.raises(SceneFileError, match=r"unknown object 'z' \(valid: a, b\)"):

@@ -177,3 +177,44 @@ def test_parsing_writes_nothing_to_the_users_home(bw_domain_path, tmp_path):
     )
     assert out.stdout.strip()
     assert list(tmp_path.rglob("*")) == []
+
+
+@pytest.mark.parametrize(
+    ("edit", "parts"),
+    [
+        (("(on a b)", "(shiny a)"), ("goal atom (shiny a): unknown predicate 'shiny'", "ontable")),
+        (
+            ("(on a b)", "(on a e)"),
+            ("goal atom (on a e) names unknown object 'e'", "(valid: c, a, b)"),
+        ),
+        (("(on a b)", "(on a)"), ("goal atom (on a): on takes 2 argument(s), not 1",)),
+        (("(handempty)", "(handempty) (shiny c)"), ("init atom (shiny c): unknown predicate",)),
+        (("(and (on a b))", "(and (on a b) (not (shiny a)))"), ("goal atom (shiny a)",)),
+    ],
+)
+def test_a_typo_in_the_goal_or_init_is_bad_input_naming_it(bw_domain_path, edit, parts):
+    """A goal typo was read as an unsolvable problem (exit 1); the reader refuses it as it
+    refuses the same typo in :init, listing the valid predicates or objects."""
+    domain = pddl_io.load_domain(bw_domain_path)
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_problem(PROBLEM.replace(*edit), "typo.pddl", domain)
+    _error(excinfo, "typo.pddl: ", *parts)
+    assert pddl_io.parse_problem(PROBLEM, "ok.pddl", domain).name == "tiny"
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["(unstack c b); (put-down c)", "0: (unstack c b) ; 1: (put-down c)", "a -> b; move(b -> c)"],
+)
+def test_steps_joined_by_semicolons_on_one_line_are_refused(text):
+    """The one-line form `bench executability` reads was read as its first step, the rest a
+    comment."""
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.parse_plan_lines(f"(pick-up a)\n{text}\n", "one.plan")
+    _error(excinfo, "one.plan: line 2: several actions on one line joined by ';'", "one action")
+
+
+def test_a_comment_after_a_step_that_is_no_step_is_still_a_comment():
+    text = "(unstack c b) ; clears b\n(put-down c) ; cost = 2 (unit cost)\n; (stack c a)\n"
+    steps = [line.step for line in pddl_io.parse_plan_lines(text)]
+    assert steps == [Action("unstack", ("c", "b")), Action("put-down", ("c",))]

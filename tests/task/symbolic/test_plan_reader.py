@@ -82,7 +82,8 @@ def test_a_move_needs_the_blocksworld_actions(tmp_path):
     domain = data.read_text("logistics-strips.pddl")
     (tmp_path / "d.pddl").write_text(domain)
     name = pddl_io.parse_domain(domain).name
-    (tmp_path / "p.pddl").write_text(PROBLEM.replace("blocksworld-4ops", str(name)))
+    problem = f"(define (problem p) (:domain {name}) (:objects a b c) (:init (obj a) (at a b)) "
+    (tmp_path / "p.pddl").write_text(problem + "(:goal (at a c)))")  # read against the domain
     (tmp_path / "plan.txt").write_text("a -> c\n")
     with pytest.raises(ProblemError) as excinfo:
         validate_files(tmp_path / "d.pddl", tmp_path / "p.pddl", tmp_path / "plan.txt")
