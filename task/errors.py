@@ -6,6 +6,11 @@ Outcomes the loop must react to (no plan found, invalid plan) are values, not ex
 
 from __future__ import annotations
 
+import enum
+from typing import TypeVar
+
+Mode = TypeVar("Mode", bound=enum.StrEnum)
+
 
 class TampError(Exception):
     """Base class of every error soft-tamp raises on bad input."""
@@ -24,6 +29,16 @@ def one_of(name: str, valid: object) -> str:
     is."""
     items = ", ".join(str(v) for v in valid) or "none"
     return f"{name!r} (valid: {items})"
+
+
+def member(kind: type[Mode], value: object, what: str, error: type[TampError] = TampError) -> Mode:
+    """``value`` (a member of the mode enum ``kind``, or its string) as that member: the one
+    place a mode's name becomes its enum. An unknown ``value`` raises ``error`` (a `TampError`)
+    ``unknown <what> 'x' (valid: a, b, c)``."""
+    try:
+        return kind(value)
+    except ValueError:
+        raise error(f"unknown {what} {one_of(value, [m.value for m in kind])}") from None
 
 
 class DataError(TampError):
