@@ -25,14 +25,13 @@ from tamp.cli.types import (
     window,
     window_list,
 )
+from tamp.geo.types import GeoPlanner, Observation
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains import names
 from task.errors import TampError
 
 SCENES = ("tabletop", "shelf", "clutter", "cramped")  # `tamp.obstacles` (no simulator import)
-# `tamp.geo.episode.PLANNERS`, ours first (the parser imports no planner; a test keeps them equal)
-GEO_PLANNERS = ("motion-aware", "search-then-check", "search", "soft", "motion-aware-sampled")
 IMAGE_SCENES = ("cubes", "latplan")  # whose blocks an image shows (`tamp.camera.image_pair`)
 
 # every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
@@ -272,7 +271,7 @@ def episode_options(
     p.add_argument("--max-replans", type=nonnegative, metavar="N", help="replanning budget (8)")
     p.add_argument(
         "--observe",
-        choices=("state", "camera"),
+        choices=[m.value for m in Observation],
         default="state",
         help="state from block poses or from the camera image (state)",
     )
@@ -413,7 +412,7 @@ def run_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--geo-planner",
-        choices=GEO_PLANNERS,
+        choices=[m.value for m in GeoPlanner],
         help="--scene FILE.json or a canonical problem: run the geometric TAMP episode with "
         "this planner (motion-aware where the Blocksworld loop cannot run the scene: regions, "
         "shapes, parking rules; else the loop)",

@@ -18,7 +18,7 @@ goes to, and a move's feasibility is decided by the arm (IK and collision checks
 - `tamp.geo.execute`: `run_move`, one checked move run in a simulator with its failures read
   from the gripper.
 - `tamp.geo.episode`: `run_geo_episode`, observe, plan, check, run and replan with one of the
-  planners (`PLANNERS`), a `GeoReport` scored on ground truth.
+  planners (`GeoPlanner`), a `GeoReport` scored on ground truth.
 - `tamp.geo.scene_file`: `scene_episode`, which episode runs a scene file (``tamp run
   --scene``): the Blocksworld loop's `SceneTask` or a `GeoRun` for `run_geo_episode`.
 """

@@ -1,7 +1,7 @@
 """A geometric TAMP episode: observe -> plan -> check -> run -> observe -> replan, in one
 simulator, with one of three planners side by side.
 
-Planners (`PLANNERS`):
+Planners (`tamp.geo.types.GeoPlanner`):
 
 - ``"search-then-check"``: `tamp.geo.baseline.plan_search_then_check`;
 - ``"search"``: `tamp.geo.search.plan_search`, the complete best-first search alone;
@@ -47,7 +47,16 @@ from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import (
+    TABLE,
+    GeoLimits,
+    GeoMove,
+    GeoPlan,
+    GeoPlanner,
+    GeoStatus,
+    Observation,
+    moved,
+)
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
@@ -55,10 +64,8 @@ from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
 from tamp.world.schema import Scene
-from task.errors import TampError, one_of
+from task.errors import TampError, member
 
-PLANNERS = ("soft", "motion-aware", "search-then-check", "search", "motion-aware-sampled")
-OBSERVATIONS = ("state", "camera")  # the pose sensors: motion capture, or RGB-D cameras
 # settled poses as the motion-capture sensor reads them: `SceneConfig.tol_z`'s 12 mm; an
 # object counts as in a region when its footprint crosses the edge by at most 2 mm (a tight
 # packing sets boxes flush with the edge, and a placement lands within about a millimetre)
@@ -107,7 +114,7 @@ class GeoReport:
     plan_length: int = 0  # moves of the first plan (0: none)
     replans: int = 0
     plan_stats: tuple[dict, ...] = ()  # each planner call's stats
-    observation: str = "state"  # the pose sensor (one of `OBSERVATIONS`)
+    observation: str = "state"  # the pose sensor (an `Observation`)
     # camera: the estimates' errors against ground truth (scored, never acted on), `_scored`
     pose_errors: dict = field(default_factory=dict)
 
@@ -121,22 +128,21 @@ Planner = Callable[[Scene, Goal, Tools, SearchConfig], GeoPlan]
 
 
 def planner_by_name(name: str) -> Planner:
-    """The planner called ``name`` (one of `PLANNERS`)."""
-    if name == "search-then-check":
+    """The planner called ``name`` (a `GeoPlanner` or its name)."""
+    name = member(GeoPlanner, name, "planner")
+    if name is GeoPlanner.SEARCH_THEN_CHECK:
         return plan_search_then_check
-    if name == "motion-aware":
+    if name is GeoPlanner.MOTION_AWARE:
         from tamp.geo.ours import plan_motion_aware
 
         return plan_motion_aware
-    if name == "motion-aware-sampled":  # ours, cells placed by rejection sampling
+    if name is GeoPlanner.MOTION_AWARE_SAMPLED:  # ours, cells placed by rejection sampling
         from tamp.geo.ours import plan_motion_aware_sampled
 
         return plan_motion_aware_sampled
-    if name == "soft":
+    if name is GeoPlanner.SOFT:
         return plan_soft
-    if name == "search":
-        return plan_search
-    raise TampError(f"unknown planner {one_of(name, PLANNERS)}")
+    return plan_search  # GeoPlanner.SEARCH, the last of the five
 
 
 def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> GeoPlan:
@@ -224,7 +230,7 @@ def run_geo_episode(
     observation: str = "state",
     on_event: Callable[[str], None] | None = None,
 ) -> GeoReport:
-    """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
+    """Run ``planner`` (a `GeoPlanner`) on ``scene`` toward ``goal`` in simulator
     ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
     `SearchConfig` with ``seed`` and `GeoLimits`' ``planning_s``); ``max_moves`` and
     ``max_replans``: the episode's limits (`GeoLimits`' defaults); ``video``: a file path to
@@ -233,17 +239,16 @@ def run_geo_episode(
     collision model (else built and closed here); ``domain``: ``(pddl_domain_text,
     binding_text)`` the motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower
     of Hanoi by its rules); refused for the other planners, which plan over the moves the
-    geometry allows. ``observation``: the pose sensor, one of `OBSERVATIONS` (``"camera"``:
+    geometry allows. ``observation``: the pose sensor, an `Observation` (``"camera"``:
     `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
     and each move (progress, e.g. for ``tamp run``); what it is told is also in the report.
     Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an episode
     on one thread (`tamp.sweep.torch_threads`)."""
     say = on_event or (lambda line: None)
-    if observation not in OBSERVATIONS:
-        raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
+    member(Observation, observation, "observation")
     plan_fn = planner_by_name(planner)
     if domain is not None:
-        if planner != "motion-aware":
+        if planner != GeoPlanner.MOTION_AWARE:
             raise TampError(
                 f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
             )
@@ -262,14 +267,14 @@ def run_geo_episode(
         guard=replace(tools.guard, plan=True),
         choices=config.choices,
     )
-    if planner == "soft":
+    if planner == GeoPlanner.SOFT:
         runner.choices = ("top",)  # today's executor: top-down grasps only
     from tamp.geo.sim import open_sim
 
     sim = open_sim(scene, backend, video=video is not None, grasp=grasp)
     sim.truth.lock()
     camera = None
-    if observation == "camera":
+    if observation == Observation.CAMERA:
         from tamp.camera.scene_poses import ScenePoses
 
         camera = ScenePoses(sim, scene)

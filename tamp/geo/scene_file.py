@@ -15,16 +15,17 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from tamp.geo.types import GeoPlanner
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 
-DEFAULT_PLANNER = "motion-aware"  # ours, where the loop cannot run the scene
+DEFAULT_PLANNER = GeoPlanner.MOTION_AWARE  # ours, where the loop cannot run the scene
 
 
 @dataclass(frozen=True)
 class GeoRun:
     """A scene file for the geometric TAMP episode with ``planner`` (one of
-    `tamp.geo.episode.PLANNERS`). ``why``: why not the loop (the loop's `BeyondLoop` line, a
+    `tamp.geo.types.GeoPlanner`). ``why``: why not the loop (the loop's `BeyondLoop` line, a
     canonical problem, or the planner named); ``domain``: the PDDL domain and binding the
     motion-aware planner plans through (the shipped Tower of Hanoi's, as ``tamp bench tamp``
     does), else None."""

@@ -29,12 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from tamp.geo.types import GeoLimits
+from tamp.geo.types import GeoLimits, GeoPlanner, Observation
 from tamp.sweep import run_items, torch_threads
-from task.errors import TampError
+from task.errors import TampError, member
 
-PLANNERS = ("soft", "motion-aware", "search-then-check")  # the issue's three, side by side
-OBSERVE = ("state", "camera")  # `tamp.geo.episode.OBSERVATIONS`
+# the issue's three, side by side
+PLANNERS = (GeoPlanner.SOFT, GeoPlanner.MOTION_AWARE, GeoPlanner.SEARCH_THEN_CHECK)
 LIMITS = GeoLimits()  # every episode's limits (`run_geo_episode`): the documented defaults
 ROW_COLUMNS = (
     "problem",
@@ -69,15 +69,20 @@ ROW_COLUMNS = (
 @dataclass(frozen=True)
 class Item:
     """One episode to play: variant ``variant`` of ``problem`` by ``planner`` in ``sim``;
-    ``video``: a file to record it to (None: no video)."""
+    ``video``: a file to record it to (None: no video); ``observe``: the pose sensor.
+    ``planner`` and ``observe`` may be given by name."""
 
     problem: str
     variant: int
-    planner: str
+    planner: GeoPlanner
     sim: str
     seed: int
     video: str | None = None
-    observe: str = "state"
+    observe: Observation = Observation.STATE
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "planner", member(GeoPlanner, self.planner, "planner"))
+        object.__setattr__(self, "observe", member(Observation, self.observe, "observation"))
 
 
 def items(
@@ -91,7 +96,7 @@ def items(
 ) -> list[Item]:
     """Every episode of the benchmark, problem-major; with ``videos``, the first variant of
     each problem gets a video per planner and simulator in that folder; ``observe``: every
-    episode's pose sensor (one of `OBSERVE`)."""
+    episode's pose sensor (an `Observation`)."""
     out = []
     for problem in problems:
         for k in range(n):
@@ -115,7 +120,7 @@ def play(item: Item) -> dict:
     made = generate(item.problem, item.variant)
     t0 = time.perf_counter()
     # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
-    domain = made.domain if item.planner == "motion-aware" else None
+    domain = made.domain if item.planner is GeoPlanner.MOTION_AWARE else None
     try:
         with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
             report = run_geo_episode(
@@ -137,9 +142,9 @@ def play(item: Item) -> dict:
     return {
         "problem": item.problem,
         "variant": item.variant,
-        "planner": item.planner,
+        "planner": item.planner.value,
         "sim": item.sim,
-        "observe": item.observe,
+        "observe": item.observe.value,
         "status": report.status.value,
         "reached": report.reached,
         "clean": report.reached and report.motion_failures == 0,
@@ -182,8 +187,8 @@ def _error_row(item: Item, note: str, why: str, wall: float) -> dict:
     """The row (`ROW_COLUMNS`) of an episode that ended in an error: not reached, nothing
     run, the error as its reason."""
     row = dict.fromkeys(ROW_COLUMNS)
-    row |= {"problem": item.problem, "variant": item.variant, "planner": item.planner}
-    row |= {"sim": item.sim, "observe": item.observe, "status": "error", "reason": why}
+    row |= {"problem": item.problem, "variant": item.variant, "planner": item.planner.value}
+    row |= {"sim": item.sim, "observe": item.observe.value, "status": "error", "reason": why}
     row |= {"reached": False, "clean": False, "note": note, "wall_s": wall}
     row |= dict.fromkeys(("plan_length", "moves", "motion_failures", "replans", "collisions"), 0)
     row |= dict.fromkeys(("planning_time_s", "execution_time_s", "arm_path_rad"), 0.0)
@@ -208,7 +213,9 @@ def camera_summary(rows: Sequence[dict]) -> dict:
     """The camera's pose errors over ``rows`` (episodes observed by the camera): the mean of
     their mean position errors (mm), the largest position (mm) and yaw (deg) errors, and the
     unseen looks; {} when none was."""
-    mine = [r for r in rows if r.get("observe") == "camera" and r["pose_mm_mean"] is not None]
+    mine = [
+        r for r in rows if r.get("observe") == Observation.CAMERA and r["pose_mm_mean"] is not None
+    ]
     if not mine:
         return {}
     yaws = [r["yaw_deg_max"] for r in mine if r["yaw_deg_max"] is not None]

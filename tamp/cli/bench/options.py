@@ -25,7 +25,9 @@ from tamp.cli.types import (
     seed,
     threads,
 )
+from tamp.geo.types import GeoPlanner, Observation
 from tamp.sim.base import SIMULATORS
+from tamp.world.canonical import PROBLEMS
 
 
 def perception_bench_options(p: argparse.ArgumentParser, checkpoint: str) -> None:
@@ -160,20 +162,14 @@ def suite_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-# `tamp.world.canonical.PROBLEMS` and `tamp.bench.geo.run.PLANNERS` (a test keeps them equal),
-# named here so the parser imports neither
-TAMP_PROBLEMS = ("blocked", "packed", "nonmonotonic", "sorting", "tall", "hanoi")
-TAMP_PLANNERS = ("soft", "motion-aware", "search-then-check", "search", "motion-aware-sampled")
-
-
 def tamp_bench_options(p: argparse.ArgumentParser) -> None:
     """What ``bench tamp`` runs: problems, variants, planners, simulators."""
     p.add_argument(
         "--problems",
-        type=name_list("problem", TAMP_PROBLEMS),
-        default=",".join(TAMP_PROBLEMS),
+        type=name_list("problem", PROBLEMS),
+        default=",".join(PROBLEMS),
         metavar="P[,P]",
-        help=f"canonical problems, comma-separated ({','.join(TAMP_PROBLEMS)}; default: all)",
+        help=f"canonical problems, comma-separated ({','.join(PROBLEMS)}; default: all)",
     )
     p.add_argument(
         "--n",
@@ -187,7 +183,7 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--planner",
         dest="planners",
-        type=name_list("planner", TAMP_PLANNERS),
+        type=name_list("planner", [m.value for m in GeoPlanner]),
         default="soft,motion-aware,search-then-check",
         metavar="NAME[,NAME]",
         help="planners side by side (soft: task-only with execution; motion-aware: ours; "
@@ -208,7 +204,7 @@ def tamp_bench_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--observe",
-        choices=("state", "camera"),
+        choices=[m.value for m in Observation],
         default="state",
         help="object poses from motion capture, or estimated from three RGB-D cameras and "
         "the objects' known models, with their errors against ground truth (state)",

@@ -10,23 +10,28 @@ import pytest
 from tamp.bench.geo import run as bench
 from tamp.bench.tables import tamp_table
 from tamp.cli import main
-from tamp.cli.bench.options import TAMP_PLANNERS, TAMP_PROBLEMS
-from tamp.cli.options import GEO_PLANNERS
+from tamp.geo.types import GeoPlanner, Observation
+from task.errors import TampError
 
 
 def test_the_parser_names_what_the_library_has():
-    from tamp.geo.episode import PLANNERS
     from tamp.world.canonical import PROBLEMS
 
-    assert TAMP_PROBLEMS == PROBLEMS
-    assert TAMP_PLANNERS == PLANNERS
-    assert set(bench.PLANNERS) <= set(PLANNERS)
-    assert set(GEO_PLANNERS) == set(PLANNERS)  # tamp run --geo-planner
+    assert set(bench.PLANNERS) <= set(GeoPlanner)
     from tamp.cli import build_parser
 
     run = build_parser()._subparsers._group_actions[0].choices["run"]
     scene = next(a for a in run._actions if a.dest == "scene")
     assert all(name in scene.help for name in PROBLEMS)  # tamp run --scene NAME
+    geo = next(a for a in run._actions if a.dest == "geo_planner")
+    assert geo.choices == [m.value for m in GeoPlanner]  # tamp run --geo-planner, ours first
+
+
+def test_an_item_holds_its_planner_and_sensor_as_modes_and_refuses_unknown_names():
+    item = bench.Item("blocked", 0, "motion-aware", "pybullet", 0, observe="camera")
+    assert item.planner is GeoPlanner.MOTION_AWARE and item.observe is Observation.CAMERA
+    with pytest.raises(TampError, match=r"^unknown planner 'ours' \(valid: motion-aware, "):
+        bench.Item("blocked", 0, "ours", "pybullet", 0)
 
 
 def test_items_give_every_planner_and_simulator_the_same_variants(tmp_path):
