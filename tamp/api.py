@@ -529,7 +529,7 @@ def run_geometric(
     Blocksworld loop cannot run it, or with ``--geo-planner``): objects of any shape, regions
     as targets (``(in a tray)``), grasps and placements chosen, each move checked before it
     runs. ``scene``: a path, a shipped scene's name or a canonical problem's (``"packed"``, its
-    goal file the default ``goal``); ``planner``: a `tamp.geo.types.GeoPlanner` (the
+    goal file the default ``goal``); ``planner``: a `tamp.geo.modes.GeoPlanner` (the
     motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
     ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
     (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through

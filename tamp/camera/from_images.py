@@ -38,15 +38,12 @@ import torch
 from torch import Tensor
 
 from perception.perceive import Perceiver, blur, kl_rows
+from tamp.camera.modes import Adapt, Crisp, Perception
 from tamp.camera.render import block_colours
 from tamp.camera.states import most_likely_state
 from task.domains.base import State
-from task.errors import TampError, one_of
+from task.errors import TampError, member
 from task.problem import Problem
-
-MODES = ("state", "frozen", "optimised")
-ADAPT = ("head", "all")
-CRISP = ("true", "perceived")  # what decoded moves are checked against: the truth, the image
 
 Observe = Callable[[int, State], np.ndarray]  # (problem index, true state) -> RGB image
 Colours = Sequence[Sequence[float]]  # RGB in [0, 1] of each block, in entity order
@@ -56,21 +53,18 @@ Colours = Sequence[Sequence[float]]  # RGB in [0, 1] of each block, in entity or
 class PerceptionMode:
     """How the planner gets its states. ``lr`` and ``kl_weight`` matter in ``optimised`` only."""
 
-    mode: str = "frozen"
+    mode: Perception = Perception.FROZEN
     lr: float = 1e-4  # Adam learning rate of the perception weights (the paper's value)
     kl_weight: float = 10.0  # weight of each KL anchor (chosen on the 100-subset, BENCHMARKS.md)
     blur: int = 0  # Gaussian blur radius (pixels) applied to every image; 0 = clear
-    adapt: str = "head"  # which weights ``optimised`` updates: "head" or "all"
-    crisp: str = "true"  # decode against the true state (the paper's) or the "perceived" one
+    adapt: Adapt = Adapt.HEAD  # which weights ``optimised`` updates: "head" or "all"
+    crisp: Crisp = Crisp.TRUE  # decode against the true state (the paper's) or the perceived one
 
     def __post_init__(self) -> None:
-        if self.mode not in MODES:
-            raise TampError(f"unknown perception mode {one_of(self.mode, MODES)}")
-        if self.adapt not in ADAPT:
-            raise TampError(f"unknown adapt setting {one_of(self.adapt, ADAPT)}")
-        if self.crisp not in CRISP:
-            raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
-        if self.mode == "state" and self.crisp != "true":
+        object.__setattr__(self, "mode", member(Perception, self.mode, "perception mode"))
+        object.__setattr__(self, "adapt", member(Adapt, self.adapt, "adapt setting"))
+        object.__setattr__(self, "crisp", member(Crisp, self.crisp, "crisp protocol"))
+        if self.mode is Perception.STATE and self.crisp is not Crisp.TRUE:
             raise TampError("perception mode 'state' reads no image: it needs crisp 'true'")
         if self.lr <= 0 or self.kl_weight < 0 or self.blur < 0:
             raise TampError("PerceptionMode needs lr > 0, kl_weight >= 0 and blur >= 0")
@@ -128,7 +122,7 @@ class _Adapted:
         return _Frozen(F0, torch.stack([self.anchors[r][1] for r in rows]), crisp)
 
     def parameters(self) -> list[Tensor]:
-        if self.mode.adapt == "head":
+        if self.mode.adapt is Adapt.HEAD:
             return [p for m in self.models for p in m.head_parameters()]
         return [p for m in self.models for p in m.parameters()]
 
@@ -153,7 +147,7 @@ class ImageBeliefs:
         mode: PerceptionMode,
         colours: Sequence[Colours] | None = None,
     ) -> None:
-        if mode.mode == "state":
+        if mode.mode is Perception.STATE:
             raise TampError("ImageBeliefs needs mode 'frozen' or 'optimised'")
         self.problems, self.perceiver, self.observe, self.mode = problems, perceiver, observe, mode
         self.colours = [block_colours(p.n) for p in problems] if colours is None else list(colours)
@@ -179,24 +173,26 @@ class ImageBeliefs:
                 for f, (images, boxes, mask) in zip(features, inputs, strict=True)
             ]
         crisp = None
-        if self.mode.crisp == "perceived":  # (N, Y) reading of the current image per problem
+        if self.mode.crisp is Crisp.PERCEIVED:  # (N, Y) reading of the current image per problem
             crisp = [
                 most_likely_state(self.problems[i], a[0])
                 for i, a in zip(indices, anchors, strict=True)
             ]
         self.perception_s += time.perf_counter() - t0
-        if self.mode.mode == "frozen":
+        if self.mode.mode is Perception.FROZEN:
             return _Frozen(
                 torch.stack([a[0] for a in anchors]), torch.stack([a[1] for a in anchors]), crisp
             )
         models = []
         for _ in indices:  # a fresh copy of the trained weights for every problem and window
             model = copy.deepcopy(self.perceiver.model)
-            trained = model.head_parameters() if self.mode.adapt == "head" else model.parameters()
+            trained = (
+                model.head_parameters() if self.mode.adapt is Adapt.HEAD else model.parameters()
+            )
             for param in trained:
                 param.requires_grad_(True)
             models.append(model)
-        if self.mode.adapt == "all":
+        if self.mode.adapt is Adapt.ALL:
             features = [None] * len(inputs)  # each step reruns the adapted backbone
         return _Adapted(models, inputs, features, anchors, self.mode, crisp)
 

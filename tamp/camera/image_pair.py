@@ -24,6 +24,7 @@ import torch
 from perception.perceive import Perceiver
 from perception.segment import present
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
+from tamp.camera.modes import Crisp
 from tamp.scene import CAMERA_COLOURS, PALETTE
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
@@ -156,7 +157,7 @@ def plan_from_images(
     init, _ = perceived_state(blank, perceiver, init_image, colours=colours)
     problem = perceived_goal(replace(blank, init=init), perceiver, goal_image, colours=colours)
     read_s = time.perf_counter() - t0
-    perception = PerceptionMode(mode, crisp="perceived")
+    perception = PerceptionMode(mode, crisp=Crisp.PERCEIVED)
     beliefs = ImageBeliefs(
         [problem], perceiver, lambda i, s: init_image, [goal_image], perception, [colours]
     )

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 
 from tamp.bench.official import OFFICIAL, default_data
+from tamp.camera.modes import Crisp, Perception
 from tamp.cli.types import (
     MAX_ITERS,
     MAX_RESTARTS,
@@ -25,7 +26,7 @@ from tamp.cli.types import (
     window,
     window_list,
 )
-from tamp.geo.types import GeoPlanner, Observation
+from tamp.geo.modes import GeoPlanner, Observation
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains import names
@@ -277,7 +278,7 @@ def episode_options(
     )
     p.add_argument(
         "--perception",
-        choices=("frozen", "optimised"),
+        choices=[Perception.FROZEN.value, Perception.OPTIMISED.value],
         default="frozen",
         help="camera: frozen or planning-optimised perception (frozen)",
     )
@@ -293,7 +294,7 @@ def episode_options(
     )
     p.add_argument(
         "--crisp",
-        choices=("perceived", "true"),
+        choices=[Crisp.PERCEIVED.value, Crisp.TRUE.value],
         default="perceived",
         help="decode moves against the observed state, or the simulator's true "
         "state (an oracle) (perceived)",

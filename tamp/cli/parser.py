@@ -10,6 +10,7 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.official import DEFAULT_DATA
+from tamp.camera.modes import Perception
 from tamp.cli.bench.options import (
     executability_options,
     perception_bench_options,
@@ -153,7 +154,7 @@ def _images_command(sub, plan_opts: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--perception",
-        choices=("frozen", "optimised"),
+        choices=[Perception.FROZEN.value, Perception.OPTIMISED.value],
         default="frozen",
         help="frozen or planning-optimised perception (frozen)",
     )

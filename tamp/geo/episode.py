@@ -1,7 +1,7 @@
 """A geometric TAMP episode: observe -> plan -> check -> run -> observe -> replan, in one
 simulator, with one of three planners side by side.
 
-Planners (`tamp.geo.types.GeoPlanner`):
+Planners (`tamp.geo.modes.GeoPlanner`):
 
 - ``"search-then-check"``: `tamp.geo.baseline.plan_search_then_check`;
 - ``"search"``: `tamp.geo.search.plan_search`, the complete best-first search alone;
@@ -45,18 +45,10 @@ import numpy as np
 from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.execute import RunConfig, rests_of, run_move
+from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import (
-    TABLE,
-    GeoLimits,
-    GeoMove,
-    GeoPlan,
-    GeoPlanner,
-    GeoStatus,
-    Observation,
-    moved,
-)
+from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import Pose
 from tamp.sim.base import Simulator

@@ -28,38 +28,7 @@ from task.problem import TABLE
 if TYPE_CHECKING:
     from motion.grasps import Grasp
 
-__all__ = [
-    "TABLE",
-    "GeoLimits",
-    "GeoMove",
-    "GeoPlan",
-    "GeoPlanner",
-    "GeoStatus",
-    "Observation",
-    "Place",
-    "moved",
-]
-
-
-class GeoPlanner(enum.StrEnum):
-    """The geometric episode's planners by name (`tamp.geo.episode.planner_by_name`), in the
-    order ``tamp run --geo-planner`` lists them: ours, the baseline, the complete search alone,
-    task-only planning, ours with rejection-sampled region cells (an ablation)."""
-
-    MOTION_AWARE = "motion-aware"
-    SEARCH_THEN_CHECK = "search-then-check"
-    SEARCH = "search"
-    SOFT = "soft"
-    MOTION_AWARE_SAMPLED = "motion-aware-sampled"
-
-
-class Observation(enum.StrEnum):
-    """An episode's pose sensor: STATE, the motion-capture oracle (`tamp.loop.sensors`); CAMERA,
-    poses estimated from RGB-D images (the loop's `CameraPoses`, the geometric episode's
-    `tamp.camera.scene_poses.ScenePoses`)."""
-
-    STATE = "state"
-    CAMERA = "camera"
+__all__ = ["TABLE", "GeoLimits", "GeoMove", "GeoPlan", "GeoStatus", "Place", "moved"]
 
 
 @dataclass(frozen=True)

@@ -5,15 +5,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tamp.camera.from_images import CRISP, PerceptionMode
-from tamp.loop.execute import ExecConfig
+from tamp.camera.from_images import PerceptionMode
+from tamp.camera.modes import Crisp, Perception
+from tamp.geo.modes import Observation
+from tamp.loop.execute import CollisionMode, ExecConfig
 from tamp.loop.faults import Injection
 from tamp.scene import SceneConfig
 from tamp.sim.base import Camera
 from task.config import PlannerConfig
-from task.errors import TampError, one_of
-
-OBSERVE = ("state", "camera")
+from task.errors import TampError, member
 
 
 @dataclass(frozen=True)
@@ -34,10 +34,10 @@ class LoopConfig:
     scene: SceneConfig = SceneConfig()
     camera: Camera = Camera()
     inject: Injection = Injection()
-    observe: str = "state"
+    observe: Observation = Observation.STATE
     perception: PerceptionMode = PerceptionMode()  # camera only: frozen or optimised
     checkpoint: str | None = None  # camera only: perception weights (None: the shipped ones)
-    crisp: str = "perceived"  # decode against the observed state; "true": against the truth
+    crisp: Crisp = Crisp.PERCEIVED  # decode against the observed state; "true": against the truth
     placements: float = 0.0  # m: motion-aware, state: a block may go this far from a place's
     # centre, where the planner's Adam puts it (continuous placements; 0: the centre)
     # motion-aware, state, fixed places: the planner's windows check each move they keep with
@@ -47,24 +47,22 @@ class LoopConfig:
     check_ahead: bool = False
 
     def __post_init__(self) -> None:
-        if self.observe not in OBSERVE:
-            raise TampError(f"unknown observation {one_of(self.observe, OBSERVE)}")
-        if self.crisp not in CRISP:
-            raise TampError(f"unknown crisp protocol {one_of(self.crisp, CRISP)}")
+        object.__setattr__(self, "observe", member(Observation, self.observe, "observation"))
+        object.__setattr__(self, "crisp", member(Crisp, self.crisp, "crisp protocol"))
         if not 0.0 <= self.placements <= 0.03:
             raise TampError(
                 f"placements must lie in [0, 0.03] m (a block stays on its slot), "
                 f"got {self.placements}"
             )
         if self.check_ahead and (
-            self.observe != "state"
+            self.observe is not Observation.STATE
             or self.placements > 0
             or self.planner.lambda_motion <= 0
-            or self.execution.collision == "off"
+            or self.execution.collision is CollisionMode.OFF
         ):
             raise TampError(
                 "check_ahead needs motion-aware planning (lambda_motion > 0) with state "
                 "observation, fixed places (placements 0) and the collision model on"
             )
-        if self.observe == "camera" and self.perception.mode == "state":
+        if self.observe is Observation.CAMERA and self.perception.mode is Perception.STATE:
             raise TampError("camera observation needs perception mode 'frozen' or 'optimised'")

@@ -37,8 +37,11 @@ from motion.guard import guard_free_move
 from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
+from tamp.camera.modes import Crisp
+from tamp.geo.modes import Observation
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import (
+    CollisionMode,
     ExecutionResult,
     Fallback,
     execute_move,
@@ -106,7 +109,7 @@ class Episode:
         self.status_text = ""
         self.target = problem  # what the robot plans for and tests: the goal it perceives
         perceiver = self.goal_image = None
-        if config.observe == "camera":
+        if config.observe is Observation.CAMERA:
             if problem.n > CAMERA_COLOURS:
                 raise SceneError(
                     f"{problem.n} blocks, but the camera tells at most {CAMERA_COLOURS} apart "
@@ -118,7 +121,7 @@ class Episode:
         )
         self.sim.truth.lock()  # simulator ground truth only scores episodes
         self.collision = None  # the arm's own collision model: robot geometry + known boxes
-        if config.execution.collision != "off":
+        if config.execution.collision is not CollisionMode.OFF:
             from motion.sphere_check import Screened
             from robots.collision import PandaCollision
 
@@ -179,7 +182,7 @@ class Episode:
         read from the first image, not given (a stop when it is unreadable)."""
         init = self.problem.init
         p = Progress(init, self.domain.is_goal(self.target, init))
-        if self.config.observe != "camera":
+        if self.config.observe is not Observation.CAMERA:
             return p
         reading = self.observe()
         p.state = reading.state
@@ -252,10 +255,10 @@ class Episode:
             self.recorder.planned(self.sim, len(p.plans), result)
         if len(p.plans) == 1:
             p.first_solved, p.first_plan = result.solved, result.plan.moves
-        window = self.config.observe == "camera" and len(result.plan) > 0
+        window = self.config.observe is Observation.CAMERA and len(result.plan) > 0
         p.stalls = 0 if window or result.solved else p.stalls + 1
         if not (result.solved or window):
-            if self.config.observe == "state" or p.stalls > self.config.max_replans:
+            if self.config.observe is Observation.STATE or p.stalls > self.config.max_replans:
                 why = result.stats.get("reason")
                 p.stop(
                     EpisodeStatus.NO_PLAN, "the planner found no plan" + (f": {why}" if why else "")
@@ -270,7 +273,11 @@ class Episode:
         its geometric fallback (`tamp.loop.geo_fallback.CHOICES`) when it has one (collision mode
         "plan" and ``execution.geo_fallback``), else none."""
         execution = self.config.execution
-        if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
+        if (
+            self.collision is None
+            or execution.collision is not CollisionMode.PLAN
+            or not execution.geo_fallback
+        ):
             return ()
         from tamp.loop.geo_fallback import CHOICES
 
@@ -280,7 +287,11 @@ class Episode:
         """The executor's geometric fallback (`tamp.loop.geo_fallback.GeoFallback` over the
         episode's IK solver and collision model) when it has one (as `_grasps`), else None."""
         execution = self.config.execution
-        if self.collision is None or execution.collision != "plan" or not execution.geo_fallback:
+        if (
+            self.collision is None
+            or execution.collision is not CollisionMode.PLAN
+            or not execution.geo_fallback
+        ):
             return None
         from tamp.loop.geo_fallback import geo_fallback
 
@@ -317,7 +328,7 @@ class Episode:
         the default: a robot has no oracle) or, with ``crisp="true"``, the simulator's true
         state, read through ``GroundTruth.oracle()`` (the observed one if the truth forms no
         state)."""
-        if self.config.crisp != "true":
+        if self.config.crisp is not Crisp.TRUE:
             return observed
         with self.sim.truth.oracle():
             truth = self.sim.truth.state(self.problem.entities, self.config.scene)
@@ -331,7 +342,7 @@ class Episode:
         costs = None  # motion-aware planning: the arm's cost of each move, from what it sees
         if self.config.planner.lambda_motion > 0:
             poses, scene, q = self._poses(), self.config.scene, self.sim.arm_q()
-            if self.config.observe == "state":
+            if self.config.observe is Observation.STATE:
                 return plan_on_places(
                     current,
                     poses,
@@ -355,7 +366,7 @@ class Episode:
                 avoid=self._avoid,
                 failed=self._failed,
             )
-        if self.config.observe == "state":
+        if self.config.observe is Observation.STATE:
             return plan(current, self.config.planner, seed=seed, costs=costs)
         image = self.eyes.image
         mode = dataclasses.replace(self.config.perception, crisp="true")  # checked against init

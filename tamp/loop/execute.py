@@ -18,6 +18,7 @@ the experimenter's contact scoring counts every other touch of the arm or the ca
 
 from __future__ import annotations
 
+import enum
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
@@ -34,10 +35,20 @@ from tamp.obstacles import ceiling
 from tamp.outcome import Failure
 from tamp.scene import Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Expected, Simulator, holding
-from task.errors import TampError, one_of
+from task.errors import member
 from task.problem import TABLE, Move
 
-COLLISION_MODES = ("plan", "check", "off")
+
+class CollisionMode(enum.StrEnum):
+    """What the executor does with the arm's collision model: PLAN, check every trajectory and
+    reroute blocked free-space phases with the motion planner; CHECK, a predicted collision
+    fails the move; OFF, run unchecked."""
+
+    PLAN = "plan"
+    CHECK = "check"
+    OFF = "off"
+
+
 # what the top-down executor failed with that the geometric room's grasps may still make
 GEO_RETRIED = frozenset({Failure.IK_INFEASIBLE, Failure.COLLISION, Failure.NO_CLEARANCE})
 
@@ -52,9 +63,7 @@ class ExecConfig:
     place_tol_xy: float = 0.015  # m: post-place check
     place_tol_z: float = 0.008  # m
     max_tracking: float = 0.3  # rad: beyond this the arm is blocked
-    # "plan": check every trajectory, reroute blocked free-space phases with the motion
-    # planner; "check": a predicted collision fails the move; "off": run unchecked
-    collision: str = "plan"
+    collision: CollisionMode = CollisionMode.PLAN  # a `CollisionMode` or its name
     margin: float = 0.01  # m: a trajectory passing closer than this to anything is a collision
     guard: GuardConfig = GuardConfig()
     slot_tries: int = 3  # free table slots a move to the table tries before it fails
@@ -65,8 +74,9 @@ class ExecConfig:
     geo_fallback: bool = True
 
     def __post_init__(self) -> None:
-        if self.collision not in COLLISION_MODES:
-            raise TampError(f"unknown collision mode {one_of(self.collision, COLLISION_MODES)}")
+        object.__setattr__(
+            self, "collision", member(CollisionMode, self.collision, "collision mode")
+        )
 
 
 @dataclass(frozen=True)
@@ -214,10 +224,10 @@ def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
         if not planned.ok:
             last = (Failure(planned.failure), ik, planned.evidence)
             continue
-        if collision is None or config.collision == "off":
+        if collision is None or config.collision is CollisionMode.OFF:
             return target, planned.phases, ik, ()
         world = _world(move, poses, target, scene)
-        guard = replace(config.guard, plan=config.collision == "plan")
+        guard = replace(config.guard, plan=config.collision is CollisionMode.PLAN)
         checked = guard_pick_place(planned.phases, collision, world, guard, seed)
         times[0] += checked.check_time_s
         times[1] += checked.plan_time_s
@@ -245,7 +255,7 @@ def _geo_retries(failure: Failure, config: ExecConfig, fallback: Fallback | None
         fallback is not None
         and failure in GEO_RETRIED
         and config.geo_fallback
-        and config.collision == "plan"
+        and config.collision is CollisionMode.PLAN
     )
 
 

@@ -33,6 +33,7 @@ from tamp.bench.suites import DEFAULT_DATA, spread
 from tamp.bench.summary import is_optimal
 from tamp.bench.tables import LATPLAN_CITED as CITED
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
+from tamp.camera.modes import Perception
 from task.config import PlannerConfig
 from task.errors import DataError, PDDLError, ProblemError, TampError
 from task.instances import Instance, from_text
@@ -45,7 +46,6 @@ DEFAULT = DEFAULT_DATA / "latplan"
 INSTANCES = "prob-cylinders-4"
 OPTIMAL = "opt_len_4op"  # manifest column: optimal 4-op plan length (2 x optimal moves)
 FILES = {"150x100": ("image_tr/init.png", "image_tr/goal.png"), "45x30": ("init.png", "goal.png")}
-MODES = ("state", "frozen", "optimised")
 SCENE = "latplan"  # the image scene of these images (`tamp.camera.image_pair.blocks_in`)
 FIX = "get it as ../shared/data/latplan/README.md describes and pass --data DIR"
 
@@ -189,9 +189,9 @@ def run(
     """Per-instance rows of every (resolution, mode, seed), ``state`` first and once."""
     rows = []
     for mode in modes:
-        for res in ("-",) if mode == "state" else resolutions:
+        for res in ("-",) if mode == Perception.STATE else resolutions:
             for seed in seeds:
-                if mode == "state":
+                if mode == Perception.STATE:
                     rows += _state_rows(data, config, seed)
                     if progress is not None:
                         progress(len(data.instances))
@@ -235,7 +235,7 @@ def summaries(rows: Sequence[dict]) -> list[dict]:
                 "seeds": seeds,
                 "valid": _spread([len(v) for v in valid]),
                 "optimal": _spread(optimal),
-                "read_right": None if mode == "state" else _spread(read),
+                "read_right": None if mode == Perception.STATE else _spread(read),
                 "statuses": dict(Counter(r["status"] for r in group)),
                 "time_s_per_instance": sum(r["time_s"] for r in group) / len(group),
             }

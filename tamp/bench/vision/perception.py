@@ -35,7 +35,8 @@ from perception.perceive import Perceiver, blur
 from perception.segment import find_boxes
 from tamp.bench.planning import STATUSES, check
 from tamp.bench.summary import is_optimal
-from tamp.camera.from_images import CRISP, MODES, ImageBeliefs, PerceptionMode, perceived_goal
+from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal
+from tamp.camera.modes import Crisp, Perception
 from tamp.camera.render import StateRenderer, block_colours
 from tamp.camera.states import complete_goal
 from task.config import PlannerConfig
@@ -132,12 +133,12 @@ def parse_corruption(text: str) -> Corruption:
 
 def parse_modes(text: str) -> tuple[str, ...]:
     """``state,frozen,optimised`` as a tuple; TampError naming an unknown mode."""
-    return choices(text, MODES, "--modes", "mode")
+    return choices(text, [m.value for m in Perception], "--modes", "mode")
 
 
 def parse_crisp(text: str) -> tuple[str, ...]:
     """``true,perceived`` as a tuple; TampError naming an unknown crisp protocol."""
-    return choices(text, CRISP, "--crisp", "crisp protocol")
+    return choices(text, [m.value for m in Crisp], "--crisp", "crisp protocol")
 
 
 def choices(text: str, valid: Sequence[str], option: str, noun: str) -> tuple[str, ...]:
@@ -155,7 +156,7 @@ def _goals(problems, mode: PerceptionMode, perceiver, goal_images) -> tuple[list
     """The goals the planner sees (perceived from goal images unless ``state``), and the
     problems whose goal image hides a block."""
     planned, failed = list(problems), set()
-    if mode.mode == "state":
+    if mode.mode is Perception.STATE:
         return planned, failed
     for i, p in enumerate(problems):
         try:
@@ -202,10 +203,10 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
     problems = [inst.problem for inst in chosen]
     render0, served0, t0 = camera.render_s, Counter(camera.served), time.perf_counter()
     beliefs = goal_images = None
-    if mode.mode != "state":
+    if mode.mode is not Perception.STATE:
         goal_images = [camera.goal(i) for i in range(len(problems))]
     planned, failed_goal = _goals(problems, mode, perceiver, goal_images)
-    if mode.mode != "state":
+    if mode.mode is not Perception.STATE:
         beliefs = ImageBeliefs(planned, perceiver, camera.image, goal_images, mode)
     keep = [i for i in range(len(problems)) if i not in failed_goal]
     results = _plan(planned, keep, config, seed, beliefs)
@@ -220,14 +221,15 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
                 "instance": inst.name,
                 "blocks": inst.blocks,
                 "optimal": inst.optimal,
-                "mode": mode.mode,
-                "crisp": mode.crisp,
+                "mode": mode.mode.value,
+                "crisp": mode.crisp.value,
                 "blur": mode.blur,
                 "horizon": horizon,
                 "status": status,
                 "length": length,
                 "windows": stats.get("windows"),
-                "goal_misread": mode.mode != "state" and planned[i].goal != _full_goal(problems[i]),
+                "goal_misread": mode.mode is not Perception.STATE
+                and planned[i].goal != _full_goal(problems[i]),
                 "misread_windows": stats.get("misread_windows", 0),
                 "redrawn": camera.served[i] - served0[i],
                 "illegal": stats.get("illegal"),
@@ -240,8 +242,8 @@ def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, per
         if r["optimal"] is not None
     ]
     summary = {
-        "mode": mode.mode,
-        "crisp": mode.crisp,
+        "mode": mode.mode.value,
+        "crisp": mode.crisp.value,
         "blur": mode.blur,
         "horizon": horizon,
         "n": len(rows),

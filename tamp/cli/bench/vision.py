@@ -12,6 +12,7 @@ import time
 from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
+from tamp.camera.modes import Crisp, Perception
 from tamp.cli.bench import bar, interrupted
 from tamp.cli.options import planner_config
 from tamp.cli.recorded import (
@@ -51,12 +52,12 @@ def perception_command(args: argparse.Namespace) -> int:
             kl_weight=args.kl_weight,
             blur=r,
             adapt=args.adapt,
-            crisp="true" if m == "state" else c,
+            crisp=Crisp.TRUE if m == Perception.STATE else c,
         )
         for r in args.blur
         for m in names
         for c in crisps
-        if not (m == "state" and (r != args.blur[0] or c != crisps[0]))
+        if not (m == Perception.STATE and (r != args.blur[0] or c != crisps[0]))
     ]
     with tqdm(
         total=len(modes) * len(horizons),
@@ -131,11 +132,11 @@ def latplan_command(args: argparse.Namespace) -> int:
     recorded = latplan_config(args)
     output_folder(args.out)
     res = choices(args.res, tuple(latplan.FILES), "--res", "resolution")
-    modes = choices(args.modes, latplan.MODES, "--modes", "mode")
-    if any(m != "state" for m in modes):
+    modes = choices(args.modes, [m.value for m in Perception], "--modes", "mode")
+    if any(m != Perception.STATE for m in modes):
         checkpoint(args.checkpoint)
     data = latplan.load(args.data, args.limit)
-    images = any(m != "state" for m in modes)
+    images = any(m != Perception.STATE for m in modes)
     config = planner_config(args, "blocksworld")
     perceiver = latplan.load_perceiver(args.checkpoint, config.device) if images else None
     torch.set_num_threads(args.threads)

@@ -10,13 +10,15 @@ import pytest
 from tamp.bench.geo import run as bench
 from tamp.bench.tables import tamp_table
 from tamp.cli import main
-from tamp.geo.types import GeoPlanner, Observation
+from tamp.cli.bench.options import TAMP_PROBLEMS
+from tamp.geo.modes import GeoPlanner, Observation
 from task.errors import TampError
 
 
 def test_the_parser_names_what_the_library_has():
     from tamp.world.canonical import PROBLEMS
 
+    assert TAMP_PROBLEMS == PROBLEMS
     assert set(bench.PLANNERS) <= set(GeoPlanner)
     from tamp.cli import build_parser
 

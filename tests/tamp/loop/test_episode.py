@@ -128,6 +128,25 @@ def test_loop_config_rejects_what_it_cannot_observe(fields, message):
         LoopConfig(**fields)
 
 
+def test_configs_hold_their_modes_as_enums_given_by_name():
+    from tamp.camera.from_images import PerceptionMode
+    from tamp.camera.modes import Adapt, Crisp, Perception
+    from tamp.geo.modes import Observation
+    from tamp.loop.execute import CollisionMode, ExecConfig
+
+    config = LoopConfig(observe="camera", crisp="true", execution=ExecConfig(collision="off"))
+    assert config.observe is Observation.CAMERA and config.crisp is Crisp.TRUE
+    assert config.execution.collision is CollisionMode.OFF
+    assert LoopConfig().observe is Observation.STATE and LoopConfig().crisp is Crisp.PERCEIVED
+    mode = PerceptionMode("optimised", adapt="all", crisp="perceived")
+    assert (mode.mode, mode.adapt, mode.crisp) == (Perception.OPTIMISED, Adapt.ALL, Crisp.PERCEIVED)
+    assert all(type(v) is not str for v in (mode.mode, mode.adapt, mode.crisp))
+    with pytest.raises(
+        TampError, match=r"^unknown collision mode 'of' \(valid: plan, check, off\)$"
+    ):
+        ExecConfig(collision="of")
+
+
 # --- whole episodes in a simulator ----------------------------------------------------------
 @pytest.mark.sim
 @pytest.mark.parametrize("sim_name", SIMULATORS)
