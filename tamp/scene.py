@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from motion.grasps import KINDS
 from task.errors import ProblemError, TampError, one_of
 from task.problem import TABLE, Move
 
@@ -42,7 +43,7 @@ PALETTE: tuple[tuple[str, tuple[float, float, float]], ...] = (
 )
 CAMERA_COLOURS = 8  # blocks that camera perception can tell apart by colour
 SHAPES = ("cube", "cylinder")
-BODY_KINDS = ("cube", "cuboid", "cylinder")
+BODY_KINDS = KINDS  # the solids the grasps know (`motion.grasps.KINDS`)
 XY = tuple[float, float]  # a position on the table (x, y), m
 
 

@@ -424,3 +424,57 @@ def test_library_code_leaves_the_import_machinery_alone():
         w for p in PACKAGES for path in (ROOT / p).rglob("*.py") for w in _sys_modules_writes(path)
     ]
     assert not found, found
+
+
+# Module-level tuples, lists, sets or frozensets of the same string values that may stand in two
+# modules: coincidences of names, not a mode defined twice (a mode is one `enum.StrEnum` in the
+# module that owns it). Keyed by the sorted values; each names why it may repeat.
+SAME_STRINGS_ALLOWED = {
+    # Logistics' and Sokoban's goal losses: each domain lists its own, and two agree
+    ("atoms", "potential"),
+    # the canonical problems' names: `tamp.cli.bench.options.TAMP_PROBLEMS` names them without
+    # importing their generators, `tests/tamp/bench/test_tamp_bench.py` keeps the two equal
+    ("blocked", "hanoi", "nonmonotonic", "packed", "sorting", "tall"),
+    # file names a PDDL folder's domain may have: the suites' and the peers' readers
+    ("domain.pddl", "generated_domain.pddl"),
+    # the Panda's finger links: the MuJoCo model's bodies and the sphere model's links
+    ("panda_leftfinger", "panda_rightfinger"),
+    # Blocksworld's operators: the crisp side (`task.symbolic.validate`) must not import the
+    # domains (`ROOM_FORBIDDEN`), which name them again for their PDDL
+    ("pick-up", "put-down", "stack", "unstack"),
+}
+
+
+def _string_collections(path: Path) -> list[tuple[str, tuple[str, ...]]]:
+    """``(name, sorted values)`` of each module-level assignment in ``path`` of a tuple, list,
+    set or frozenset (``frozenset(...)`` too) of two or more string constants."""
+    found = []
+    for node in ast.parse(path.read_text(), filename=str(path)).body:
+        if not isinstance(node, ast.Assign | ast.AnnAssign) or node.value is None:
+            continue
+        value = node.value
+        if isinstance(value, ast.Call) and getattr(value.func, "id", "") in ("frozenset", "set"):
+            value = value.args[0] if value.args else value
+        if not isinstance(value, ast.Tuple | ast.List | ast.Set) or len(value.elts) < 2:
+            continue
+        if all(isinstance(e, ast.Constant) and isinstance(e.value, str) for e in value.elts):
+            target = node.targets[0] if isinstance(node, ast.Assign) else node.target
+            if getattr(target, "id", "") != "__all__":
+                found.append(
+                    (getattr(target, "id", "?"), tuple(sorted(e.value for e in value.elts)))
+                )
+    return found
+
+
+def test_no_mode_is_defined_twice():
+    where: dict[tuple[str, ...], list[str]] = {}
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            for name, values in _string_collections(path):
+                where.setdefault(values, []).append(f"{path.relative_to(ROOT)}:{name}")
+    twice = {v: w for v, w in where.items() if len(w) > 1 and v not in SAME_STRINGS_ALLOWED}
+    assert not twice, "the same strings defined in two places (one StrEnum instead): " + "; ".join(
+        f"{values} in {', '.join(w)}" for values, w in sorted(twice.items())
+    )
+    stale = SAME_STRINGS_ALLOWED - {v for v, w in where.items() if len(w) > 1}
+    assert not stale, f"allowed repeats that no longer repeat: {sorted(stale)}"

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from motion.grasps import FAMILIES
 from tamp.outcome import Failure
 from tamp.scene import PALETTE, Pose, SceneConfig, read_state, towers
 from task.problem import TABLE, Move, Problem
@@ -47,7 +48,7 @@ if TYPE_CHECKING:
 
 # the named scenes' table top (`tamp/world/scenes/*.json`), m: (x, y) low and high corners
 TABLE_LO, TABLE_HI = (-0.3, -0.7), (1.0, 0.7)
-CHOICES = ("top", "side", "tilt")  # the grasp families the loop's geometric moves try
+CHOICES = FAMILIES  # the grasp families the loop's geometric moves try: every one
 # the order they are tried in (each family in `tamp.geo.check.grasp_order`): side grasps last,
 # as the open fingers of a side grasp beside a block on the table reach the table top (a
 # 7-block tower's top moved to a near slot: the side grasp touched the table for 137 physics

@@ -19,6 +19,7 @@ from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 
+from motion.grasps import KINDS
 from tamp.obstacles import Obstacle
 from tamp.scene import PALETTE, Body, Pose, SceneConfig
 from tamp.sim.base import Camera
@@ -33,7 +34,6 @@ from tamp.world.geometry import (
     support,
 )
 from tamp.world.schema import (
-    KINDS,
     SCHEMA,
     Movable,
     Region,

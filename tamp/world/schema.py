@@ -64,7 +64,6 @@ from tamp.sim.base import Camera
 from task.errors import TampError, one_of
 
 SCHEMA = 1  # the version this code reads and writes
-KINDS = ("cube", "cuboid", "cylinder")
 
 
 class SceneFileError(TampError):
@@ -137,9 +136,9 @@ class Region:
 
 @dataclass(frozen=True)
 class Movable:
-    """A movable object standing upright: ``kind`` (one of `KINDS`), ``size`` as in the file
-    (cube: (edge,); cuboid: (x, y, z) full extents; cylinder: (diameter, height)), colour and
-    the pose of its centre."""
+    """A movable object standing upright: ``kind`` (one of `motion.grasps.KINDS`), ``size`` as
+    in the file (cube: (edge,); cuboid: (x, y, z) full extents; cylinder: (diameter, height)),
+    colour and the pose of its centre."""
 
     name: str
     kind: str
