@@ -27,6 +27,7 @@ from motion.ik import IKSolver, pose_yaw, top_down_pose
 from motion.pick_place import PickPlaceRequest, waypoint_targets
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
+from tamp.geo.modes import Observation
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
 from tamp.rerun_log import recorder_for
 from tamp.sweep import run_items, torch_threads
@@ -166,7 +167,10 @@ def run(
     every, n = run_items(_episode, items, workers, ray_address, done), len(suite.instances)
     summary = {
         s: summarise(
-            every[j * n : (j + 1) * n], suite.instances, suite.domain, base.observe == "camera"
+            every[j * n : (j + 1) * n],
+            suite.instances,
+            suite.domain,
+            base.observe == Observation.CAMERA,
         )
         for j, s in enumerate(sims)
     }

@@ -381,7 +381,7 @@ def check_workcell(args: argparse.Namespace, executes: bool) -> None:
     take effect: a one-line usage error (TampError) in any other combination. ``executes``:
     the command runs the arm (its scene's obstacles matter without ``--motion-aware``)."""
     aware = bool(getattr(args, "lambda_motion", None))
-    camera = getattr(args, "observe", "state") == "camera"
+    camera = getattr(args, "observe", "state") == Observation.CAMERA
     if getattr(args, "placements", 0.0) and not aware:
         raise TampError("--placements needs --motion-aware (it places the planned moves)")
     if getattr(args, "placements", 0.0) and camera:

@@ -22,6 +22,7 @@ from perception import CHECKPOINT
 from tamp.bench.official import default_data
 from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
+from tamp.geo.modes import Observation
 from tamp.rerun_log import check_record_path
 from task.errors import TampError
 
@@ -125,7 +126,7 @@ def scene_run(args: argparse.Namespace):
     task = scene_episode(name, goal, geo, rules)
     if getattr(args, "plan", None) is not None:
         raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
-    if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == "camera":
+    if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == Observation.CAMERA:
         raise TampError(
             "--observe camera with a Blocksworld scene file: the camera's goal image is "
             "laid out from a PDDL problem (yet); use --observe state, or --geo-planner "

@@ -36,6 +36,7 @@ from tamp.cli.recorded import (
     run_config,
     scene_run,
 )
+from tamp.geo.modes import Observation
 from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.rerun_log import RerunRecorder, require_rerun
@@ -113,7 +114,7 @@ def run_command(args: argparse.Namespace) -> int:
         return geo_run(args, task, recorded)
     problem = load_problem(args.problem, args.domain) if task is None else task.problem
     config = loop_config(args)
-    if config.observe == "camera":
+    if config.observe == Observation.CAMERA:
         checkpoint(config.checkpoint)
     steps = _given_steps(args.plan, problem)
     out = _out_dir(args.out)
@@ -152,7 +153,7 @@ def run_command(args: argparse.Namespace) -> int:
     if not quiet:
         head = f"running {problem.name} ({problem.n} blocks) in {config.sim}, grasp {config.grasp}"
         seen = config.observe
-        if seen == "camera":
+        if seen == Observation.CAMERA:
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
         given = f", given plan {args.plan} ({len(steps)} steps)" if steps is not None else ""
         if task is not None:

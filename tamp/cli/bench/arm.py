@@ -24,6 +24,7 @@ from tamp.cli.recorded import (
 )
 from tamp.cli.recorded import out_folder as output_folder
 from tamp.cli.types import sim_list
+from tamp.geo.modes import Observation
 from tamp.rerun_log import require_rerun
 from task.errors import TampError
 
@@ -40,7 +41,7 @@ def motion_command(args: argparse.Namespace) -> int:
     output_folder(args.out)
     if args.record:
         require_rerun()  # the optional extra: a one-line error naming it
-    if args.observe == "camera":
+    if args.observe == Observation.CAMERA:
         checkpoint(args.checkpoint)
     sims, base = sim_list(args.sim), loop_config(args)
     if args.blocks:
@@ -87,7 +88,7 @@ def motion_command(args: argparse.Namespace) -> int:
         print(json.dumps(body, indent=2))
         return 0
     seen = base.observe + (
-        f" ({base.perception.mode} perception)" if base.observe == "camera" else ""
+        f" ({base.perception.mode} perception)" if base.observe == Observation.CAMERA else ""
     )
     kind = "PlanBench" if not args.blocks else f"random ({base.scene.name} scene)"
     print(
@@ -125,7 +126,7 @@ def _motion_partial(out, recorded: dict, suite, done: list, sims, base, total: i
         mine = [r for r in done if r.sim == sim]
         if mine:
             instances = [named[r.problem] for r in mine]
-            camera = base.observe == "camera"
+            camera = base.observe == Observation.CAMERA
             summary[sim] = motion.summarise(mine, instances, suite.domain, camera)
     folder = results.out_folder(out)
     body = {

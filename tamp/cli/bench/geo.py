@@ -14,6 +14,7 @@ from tamp.bench import results, tables
 from tamp.cli.bench import interrupted
 from tamp.cli.recorded import out_folder, tamp_bench_config
 from tamp.cli.types import sim_list
+from tamp.geo.modes import Observation
 
 
 def tamp_command(args: argparse.Namespace) -> int:
@@ -60,7 +61,7 @@ def tamp_command(args: argparse.Namespace) -> int:
         tables.tamp_table(summary, sims),
         sep="\n",
     )
-    if args.observe == "camera":
+    if args.observe == Observation.CAMERA:
         print(_camera_line(bench.camera_summary(rows)))
     if args.out:
         print(f"wrote results.json, episodes.csv to {args.out}")
@@ -84,7 +85,7 @@ def _write(args, recorded: dict, rows, summary, wall: float | None, total: int |
     from tamp.bench.geo.run import ROW_COLUMNS, camera_summary
 
     body = {"config": recorded, "machine": results.machine(args.argv), "summary": summary}
-    if args.observe == "camera":
+    if args.observe == Observation.CAMERA:
         body["camera"] = camera_summary(rows)
     if wall is not None:
         body["wall_s"] = wall
