@@ -48,3 +48,8 @@ class EpisodeStatus(enum.Enum):
     OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
     INVALID_PLAN = "invalid_plan"  # a given plan stopped at a step it could not attempt
     PLAN_ENDED = "plan_ended"  # a given plan ran to its end without reaching the goal
+
+
+def time_limit_reached(limit_s: float) -> str:
+    """How a ``no_plan`` reason says that the planner's time limit stopped it (both episodes)."""
+    return f"time limit ({limit_s:g} s) reached"

@@ -51,7 +51,7 @@ from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
-from tamp.outcome import EpisodeStatus, Failure
+from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
@@ -257,6 +257,9 @@ class Episode:
         if not (result.solved or window):
             if self.config.observe == "state" or p.stalls > self.config.max_replans:
                 why = result.stats.get("reason")
+                if "time_limit" in result.stats:  # the planner's time limit stopped it
+                    limit = time_limit_reached(self.config.planner.time_limit_s)
+                    why = f"{limit}: {result.stats['time_limit']}"
                 p.stop(
                     EpisodeStatus.NO_PLAN, "the planner found no plan" + (f": {why}" if why else "")
                 )

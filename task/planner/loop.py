@@ -177,6 +177,7 @@ def _run(
                 moves[i] = list(better)
     on_done(len(active))
     elapsed = time.perf_counter() - start
+    late = deadline is not None and start + elapsed >= deadline  # the fallback ran out of time
     results = []
     for i, p in enumerate(problems):
         stats = {
@@ -186,7 +187,8 @@ def _run(
             "misread_windows": misread[i],  # windows decoded against a state not the world's
         }
         status = PlanStatus.SOLVED if solved[i] else PlanStatus.NO_PLAN
-        if timed_out and not solved[i] and illegal[i] is None:
+        exhausted = i in searched and searched[i].status is SearchStatus.UNSOLVABLE
+        if (timed_out or late) and not solved[i] and illegal[i] is None and not exhausted:
             left = domain.lower_bound(p, states[i])
             stats["time_limit"] = (
                 f"stopped at the {limit:g} s time limit after {windows[i]} "
