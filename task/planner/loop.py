@@ -217,8 +217,11 @@ def plan_batch(
     progress: Callable[[int], None] | None = None,
     beliefs: BeliefSource | None = None,
     costs: CostSource | None = None,
+    on_result: Callable[[int, PlanResult], None] | None = None,
 ) -> list[PlanResult]:
-    """Plan every problem (all of one domain). ``progress(k)``: k more problems finished.
+    """Plan every problem (all of one domain). ``progress(k)``: k more problems finished;
+    ``on_result(i, result)`` as problem i's result is final (after its shape group's program,
+    or after it alone when not batched): what an interrupted caller keeps.
 
     Returns one PlanResult per problem, in order; ``stats["time_s"]`` is the wall time per
     problem (the batch's time divided among its problems when batched). ``beliefs`` gives
@@ -239,11 +242,13 @@ def plan_batch(
     torch_device(config.device)  # refused in one line where this machine lacks it
     generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
     report = progress or (lambda k: None)
+    final = on_result or (lambda i, result: None)
     if not config.batched:
-        return [
-            _run(domain, [p], config, generator, report, beliefs, [i], costs)[0]
-            for i, p in enumerate(problems)
-        ]
+        alone = []
+        for i, p in enumerate(problems):
+            alone.append(_run(domain, [p], config, generator, report, beliefs, [i], costs)[0])
+            final(i, alone[-1])
+        return alone
     # one tensor program per shape key (the domain's: sizes that pad alike), per-key times
     results: list[PlanResult | None] = [None] * len(problems)
     keys = [domain.shape_key(p) for p in problems]
@@ -253,6 +258,7 @@ def plan_batch(
         planned = _run(domain, subset, config, generator, report, beliefs, group, costs)
         for i, result in zip(group, planned, strict=True):
             results[i] = result
+            final(i, result)
     return results
 
 
