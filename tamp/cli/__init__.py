@@ -23,6 +23,7 @@ import os
 import sys
 from collections.abc import Sequence
 
+from tamp.cli.stdout import document_only
 from task.errors import TampError
 
 __all__ = ["build_parser", "main"]
@@ -53,7 +54,8 @@ def _main(argv: Sequence[str] | None) -> int:
         return exc.code if isinstance(exc.code, int) else 2
     args.argv = list(sys.argv[1:] if argv is None else argv)  # recorded in results.json
     try:
-        return args.func(args)
+        with document_only(getattr(args, "json", False)):  # --json: stdout is the document
+            return args.func(args)
     except TampError as exc:
         print(f"tamp: error: {exc}", file=sys.stderr)
         return 2
