@@ -1,5 +1,5 @@
 """``--json``: stdout holds only the document, even where native code writes on descriptor 1
-(pybullet's EGL renderer; `tamp.cli.stdout.document_only`)."""
+(pybullet's EGL renderer; `tamp.cli.document_only`)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[3]
 NATIVE = """
 import os, sys
-from tamp.cli.stdout import document_only
+from tamp.cli import document_only
 with document_only({enabled}):
     os.write(1, b"Loaded EGL 1.5 after reload.\\n")  # as native code does
     print('{{"document": 1}}')
