@@ -38,7 +38,7 @@ from task.symbolic.proofs import Proof, prove_unsolvable
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
 
-PROOF_FIRST_S = 3.0  # seconds the proofs before planning may take (h^2; grounding is unbounded)
+PROOF_FIRST_S = 3.0  # seconds h^2 before planning may take (grounding: only --time-limit bounds it)
 PROOF_AFTER_S = 10.0  # seconds the proofs after a failed plan may take (h^2, exhaustive search)
 
 
