@@ -36,8 +36,8 @@ class Failure(enum.Enum):
 class EpisodeStatus(enum.Enum):
     """Why an episode stopped. The geometric episode ends with one of the first five; the
     Blocksworld loop with ``goal_reached``, ``no_plan``, ``replan_budget`` or one of the last
-    four. Whether the goal holds on ground truth is
-    reported beside the status, never read from it."""
+    five (``interrupted``: Ctrl-C, the report carried by `EpisodeInterrupted`). Whether the goal
+    holds on ground truth is reported beside the status, never read from it."""
 
     GOAL_REACHED = "goal_reached"  # the observed state satisfies the goal
     NOT_REACHED = "not_reached"  # the plans ran out, or only the robot saw the goal
@@ -48,3 +48,19 @@ class EpisodeStatus(enum.Enum):
     OUT_OF_REACH = "out_of_reach"  # the same move had no IK solution twice in a row
     INVALID_PLAN = "invalid_plan"  # a given plan stopped at a step it could not attempt
     PLAN_ENDED = "plan_ended"  # a given plan ran to its end without reaching the goal
+    INTERRUPTED = "interrupted"  # Ctrl-C: the report holds what was done until then
+
+
+class EpisodeInterrupted(KeyboardInterrupt):
+    """Ctrl-C during an episode, with its ``report`` so far (status ``interrupted``). Still a
+    KeyboardInterrupt: a benchmark's sweep stops on it as on any Ctrl-C; ``tamp run`` writes
+    the report."""
+
+    def __init__(self, report: object) -> None:
+        super().__init__("interrupted")
+        self.report = report
+
+
+def time_limit_reached(limit_s: float) -> str:
+    """How a ``no_plan`` reason says that the planner's time limit stopped it (both episodes)."""
+    return f"time limit ({limit_s:g} s) reached"

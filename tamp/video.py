@@ -14,6 +14,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import queue
+import signal
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -173,7 +174,11 @@ def _next(frames):
 
 def _render(path: Path, fps: float, size: tuple[int, int], frames, result) -> None:
     """The renderer process: a world from the first message, then one frame per message until
-    None; puts the number of frames written, or an error message, on ``result``."""
+    None; puts the number of frames written, or an error message, on ``result``. It ignores
+    Ctrl-C (the terminal sends it to the whole process group): the episode's process stops
+    and closes the video, whose frames so far this process then finishes into a playable
+    file."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the episode's: it closes the file
     quiet = os.open(os.devnull, os.O_WRONLY)
     os.dup2(quiet, 1)  # stdout belongs to the episode (--json); the EGL plugin prints on it
     os.dup2(quiet, 2)

@@ -151,30 +151,39 @@ def run_once(
     seed: int,
     progress: Callable[[int], None] | None = None,
     instances: Sequence[Instance] | None = None,
+    on_row: Callable[[Row], None] | None = None,
 ) -> Run:
-    """Plan ``instances`` (default: the whole suite) with one config and seed; validate all."""
+    """Plan ``instances`` (default: the whole suite) with one config and seed; validate all.
+    ``on_row(row)`` as each instance's row is final (`plan_batch`'s ``on_result``: what
+    Ctrl-C keeps of a run not complete)."""
     chosen = tuple(suite.instances if instances is None else instances)
     start = time.perf_counter()
-    results = plan_batch([i.problem for i in chosen], config, seed, progress)
-    wall = time.perf_counter() - start
-    rows = []
-    for instance, result in zip(chosen, results, strict=True):
+
+    def row(instance: Instance, result: PlanResult, wall: float) -> Row:
         status, length = check(suite.domain, instance, result)
-        rows.append(
-            Row(
-                instance.name,
-                instance.size,
-                instance.optimal,
-                instance.reference,
-                config.horizon,
-                seed,
-                length,
-                status,
-                float(result.stats.get("time_s", wall / max(len(chosen), 1))),
-                int(result.stats.get("windows", 0)),
-            )
+        return Row(
+            instance.name,
+            instance.size,
+            instance.optimal,
+            instance.reference,
+            config.horizon,
+            seed,
+            length,
+            status,
+            float(result.stats.get("time_s", wall / max(len(chosen), 1))),
+            int(result.stats.get("windows", 0)),
         )
-    return Run(config.horizon, seed, wall, tuple(rows))
+
+    kept: dict[int, Row] = {}
+
+    def final(i: int, result: PlanResult) -> None:
+        kept[i] = row(chosen[i], result, time.perf_counter() - start)
+        if on_row is not None:
+            on_row(kept[i])
+
+    plan_batch([i.problem for i in chosen], config, seed, progress, on_result=final)
+    wall = time.perf_counter() - start
+    return Run(config.horizon, seed, wall, tuple(kept[i] for i in range(len(chosen))))
 
 
 def run(
@@ -185,9 +194,11 @@ def run(
     sequential: int = 0,
     progress: Callable[[int], None] | None = None,
     on_run: Callable[[Run], None] | None = None,
+    on_row: Callable[[Row], None] | None = None,
 ) -> Bench:
     """Plan the suite for every horizon and seed (horizons default to ``config.horizon``);
-    ``on_run(run)`` as each (horizon, seed) run is complete (what Ctrl-C keeps).
+    ``on_run(run)`` as each (horizon, seed) run is complete, ``on_row(row)`` as each of its
+    rows is (what Ctrl-C keeps).
 
     With ``sequential > 0`` the first ``sequential`` instances are also planned once batched and
     once with ``PlannerConfig(batched=False)`` (first horizon, first seed) to time batching.
@@ -201,7 +212,7 @@ def run(
     runs = []
     for h in horizons:
         for s in seeds:
-            runs.append(run_once(suite, replace(config, horizon=h), s, progress))
+            runs.append(run_once(suite, replace(config, horizon=h), s, progress, on_row=on_row))
             if on_run is not None:
                 on_run(runs[-1])
     runs = tuple(runs)

@@ -19,13 +19,15 @@ stderr: ``tamp: error: ...``; argparse errors read ``tamp plan: error: ...``), 1
 
 from __future__ import annotations
 
+import io
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 
 from task.errors import TampError
 
-__all__ = ["build_parser", "main"]
+__all__ = ["build_parser", "document_only", "main"]
 
 
 def build_parser():
@@ -53,10 +55,44 @@ def _main(argv: Sequence[str] | None) -> int:
         return exc.code if isinstance(exc.code, int) else 2
     args.argv = list(sys.argv[1:] if argv is None else argv)  # recorded in results.json
     try:
-        return args.func(args)
+        with document_only(getattr(args, "json", False)):  # --json: stdout is the document
+            return args.func(args)
     except TampError as exc:
         print(f"tamp: error: {exc}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # stdout closed early (e.g. piped into head): stop quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 1
+
+
+@contextmanager
+def document_only(enabled: bool) -> Iterator[None]:
+    """``--json``: stdout holds only the document. While the block runs (``enabled``), native
+    writes on descriptor 1 (pybullet's EGL renderer prints ``Loaded EGL 1.5 after reload.``,
+    ``GL_VENDOR=...``) go to stderr, and ``sys.stdout`` has a descriptor of its own onto the
+    real stdout, so what the command prints (the document) is all stdout gets; both are
+    restored afterwards. A no-op when ``sys.stdout`` is not a file descriptor's stream (e.g.
+    captured by a test)."""
+    try:
+        fd = sys.stdout.fileno() if enabled else None
+    except (AttributeError, OSError, ValueError):  # io.UnsupportedOperation: a stream in memory
+        fd = None
+    if fd is None:
+        yield
+        return
+    stdout = sys.stdout
+    stdout.flush()
+    saved = os.dup(fd)  # the real stdout
+    os.dup2(sys.stderr.fileno(), fd)
+    sys.stdout = io.TextIOWrapper(
+        io.FileIO(saved, "w", closefd=False), encoding=stdout.encoding, line_buffering=True
+    )
+    try:
+        yield
+    finally:
+        try:
+            sys.stdout.flush()
+        finally:
+            sys.stdout = stdout
+            os.dup2(saved, fd)
+            os.close(saved)

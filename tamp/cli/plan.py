@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -26,6 +27,7 @@ from tamp.cli.options import check_workcell, planner_config
 from tamp.cli.recorded import out_file, out_folder, plan_config
 from task import data
 from task.config import PlannerConfig
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.instances import Instance, example, from_files
@@ -36,7 +38,7 @@ from task.symbolic.proofs import Proof, prove_unsolvable
 from task.symbolic.search import optimal_moves
 from task.symbolic.validate import Validation, validate, validate_files
 
-PROOF_FIRST_S = 3.0  # seconds the proofs before planning may take (h^2; grounding is unbounded)
+PROOF_FIRST_S = 3.0  # seconds h^2 before planning may take (grounding: only --time-limit bounds it)
 PROOF_AFTER_S = 10.0  # seconds the proofs after a failed plan may take (h^2, exhaustive search)
 
 
@@ -48,9 +50,12 @@ def _write(path: Path, text: str) -> None:
         raise TampError(f"cannot write {path} ({exc.strerror or exc})") from None
 
 
-def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
+def _solve(
+    domain: Domain, instance: Instance, args: argparse.Namespace, deadline: Deadline = NO_DEADLINE
+):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan);
-    ``(recorded config, config, result, actions, validation)``."""
+    ``(recorded config, config, result, actions, validation)``. ``deadline``: the command's,
+    which the planner stops at too."""
     from tamp.sweep import torch_threads
 
     recorded = plan_config(args, instance.problem.domain)
@@ -59,7 +64,7 @@ def _solve(domain: Domain, instance: Instance, args: argparse.Namespace):
         if getattr(args, "lambda_motion", None):
             result = _plan_on_table(instance.problem, config, args)
         else:
-            result = plan(instance.problem, config, args.seed)
+            result = plan(instance.problem, config, args.seed, deadline=deadline)
     actions: tuple = ()
     validation = None
     if result.solved:
@@ -187,7 +192,7 @@ def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
     return [a for a in strips.goal_atoms(instance.pddl) if a not in holds]
 
 
-def _proved_first(args: argparse.Namespace) -> tuple[str, Proof]:
+def _proved_first(args: argparse.Namespace, deadline: Deadline = NO_DEADLINE) -> tuple[str, Proof]:
     """The problem's name and the cheap proofs (`prove_unsolvable` without search) on the
     PDDL files, after they parse and stay within the STRIPS the planners plan (else
     `TampError`, exit code 2)."""
@@ -197,14 +202,16 @@ def _proved_first(args: argparse.Namespace) -> tuple[str, Proof]:
     problem_text = pddl_io.read_text(args.problem)
     problem = pddl_io.parse_problem(problem_text, str(args.problem), domain)
     pddl_io.check_strips(problem_text, str(args.problem))
-    return str(problem.name), prove_unsolvable(domain, problem, time_limit_s=PROOF_FIRST_S)
+    proof = prove_unsolvable(domain, problem, time_limit_s=PROOF_FIRST_S, deadline=deadline)
+    return str(problem.name), proof
 
 
-def _proved_after(domain: Domain, instance: Instance, args: argparse.Namespace) -> Proof:
-    """Exhaustive search too, once the planner found no plan (within the time limit when
-    one is given, else `PROOF_AFTER_S`)."""
-    limit = min(PROOF_AFTER_S, getattr(args, "time_limit_s", None) or PROOF_AFTER_S)
-    return prove_unsolvable(domain, instance.pddl, exhaustive=True, time_limit_s=limit)
+def _proved_after(domain: Domain, instance: Instance, deadline: Deadline = NO_DEADLINE) -> Proof:
+    """Exhaustive search too, once the planner found no plan (`PROOF_AFTER_S` at most, and
+    never past the command's ``deadline``)."""
+    return prove_unsolvable(
+        domain, instance.pddl, exhaustive=True, time_limit_s=PROOF_AFTER_S, deadline=deadline
+    )
 
 
 def _proof_json(name: str, proof: Proof, seed: int) -> str:
@@ -228,7 +235,9 @@ def plan_command(args: argparse.Namespace) -> int:
     REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
     check_workcell(args, executes=False)
     out_file(args.out)
-    name, proof = _proved_first(args)
+    start = time.perf_counter()  # the reported time: the whole command's work, wall clock
+    deadline = Deadline.after(getattr(args, "time_limit_s", None), start)
+    name, proof = _proved_first(args, deadline)
     if proof.unsolvable:
         if args.json:
             print(_proof_json(name, proof, args.seed))
@@ -238,11 +247,14 @@ def plan_command(args: argparse.Namespace) -> int:
     domain, instance = from_files(args.domain, args.problem, args.domain_rules)
     if instance.note and not args.json:  # a near miss of a hand-written domain: the lift plans
         print(f"note: {instance.note}", file=sys.stderr)
-    recorded, config, result, actions, validation = _solve(domain, instance, args)
+    recorded, config, result, actions, validation = _solve(domain, instance, args, deadline)
     valid = validation is not None and validation.valid
     said = result.stats.get("reason") if result.status is PlanStatus.UNSOLVABLE else None
     searched = validation is not None or said is not None  # no proof needed after either
-    after = None if searched else _proved_after(domain, instance, args)
+    after = None if searched else _proved_after(domain, instance, deadline)
+    wall = time.perf_counter() - start
+    stats = {**result.stats, "plan_time_s": result.stats.get("time_s"), "time_s": wall}
+    result = replace(result, stats=stats)
     if args.out is not None and valid:
         _write(Path(args.out), pddl_io.format_plan(actions))
     if args.json:

@@ -39,6 +39,7 @@ from tamp.cli.recorded import (
 from tamp.geo.modes import Observation
 from tamp.loop import Episode, EpisodeReport
 from tamp.loop.given import GivenPlanEpisode, read_given
+from tamp.outcome import EpisodeInterrupted
 from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads
 from tamp.video import EpisodeVideo
@@ -162,8 +163,12 @@ def run_command(args: argparse.Namespace) -> int:
             f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
             file=sys.stderr,
         )
+    interrupted = False
     with torch_threads(EPISODE_THREADS):
-        report = episode.run()
+        try:
+            report = episode.run()
+        except EpisodeInterrupted as stop:  # Ctrl-C: the video and report of what was done
+            report, interrupted = stop.report, True
     written = []
     if video is not None:
         try:
@@ -186,6 +191,9 @@ def run_command(args: argparse.Namespace) -> int:
             print(
                 f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
             )
+    if interrupted:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
     return 0 if report.reached_goal else 1
 
 

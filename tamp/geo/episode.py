@@ -49,7 +49,7 @@ from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
-from tamp.outcome import EpisodeStatus, Failure
+from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
 from tamp.world.geometry import Tolerances
@@ -292,6 +292,9 @@ def run_geo_episode(
             )
             if not plan.solved:
                 status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
+                limit = _time_limit_s(config)
+                if plan.status is GeoStatus.BUDGET and limit and plan_times[-1] >= limit:
+                    reason = f"{time_limit_reached(limit)}; {reason}"
                 break
             if not first_len:
                 first_len = len(plan.moves)
@@ -356,6 +359,12 @@ def run_geo_episode(
         observation=observation,
         pose_errors=_scored(camera),
     )
+
+
+def _time_limit_s(config) -> float | None:
+    """The planner's wall-clock limit in seconds (a `SearchConfig`'s, or the search config a
+    planner's own config holds); None without one."""
+    return getattr(getattr(config, "search", config), "max_time_s", None)
 
 
 def _act(

@@ -54,7 +54,7 @@ from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
-from tamp.outcome import EpisodeStatus, Failure
+from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
@@ -161,14 +161,25 @@ class Episode:
         """The closed loop: `start`, then `step` until the goal or a stop; scores the goal on
         ground truth, closes the simulator and returns the `report`."""
         wall0 = time.perf_counter()
+        p = None
         try:
             p = self.start()
             while not self.finished(p):
                 self.step(p)
             reached = self.score.reached(self.domain)
+        except KeyboardInterrupt:
+            if p is None:
+                raise
+            raise self.interrupted(p, wall0) from None
         finally:
             self.close()
         return self.report(p, reached, wall0)
+
+    def interrupted(self, p: Progress, wall0: float) -> EpisodeInterrupted:
+        """Ctrl-C: tally ``p`` stopped as ``interrupted`` and reported as it stands, the goal
+        scored on ground truth where the world is now (before the simulator closes)."""
+        p.stop(EpisodeStatus.INTERRUPTED, f"Ctrl-C after {len(p.moves)} moves")
+        return EpisodeInterrupted(self.report(p, self.score.reached(self.domain), wall0))
 
     def _home_guard(self, way):
         """The trip home to look again, checked against the scene's obstacles (the blocks are
@@ -260,6 +271,9 @@ class Episode:
         if not (result.solved or window):
             if self.config.observe is Observation.STATE or p.stalls > self.config.max_replans:
                 why = result.stats.get("reason")
+                if "time_limit" in result.stats:  # the planner's time limit stopped it
+                    limit = time_limit_reached(self.config.planner.time_limit_s)
+                    why = f"{limit}: {result.stats['time_limit']}"
                 p.stop(
                     EpisodeStatus.NO_PLAN, "the planner found no plan" + (f": {why}" if why else "")
                 )

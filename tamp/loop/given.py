@@ -34,7 +34,7 @@ import numpy as np
 from tamp.loop.config import LoopConfig
 from tamp.loop.episode import Episode
 from tamp.loop.report import EpisodeReport, Progress
-from tamp.outcome import EpisodeStatus
+from tamp.outcome import EpisodeInterrupted, EpisodeStatus
 from tamp.scene import SceneConfig, read_state
 from task import data
 from task.domains.blocksworld import moves_to_actions, to_atoms, to_pddl
@@ -228,6 +228,10 @@ class GivenPlanEpisode(Episode):
             while handed and not self.finished(p):
                 self.step(p)
             reached = self.score.reached(self.domain)
+        except KeyboardInterrupt:
+            stopped = self.interrupted(p, wall0)
+            steps = tuple(self.records)
+            raise EpisodeInterrupted(replace(stopped.report, steps=steps)) from None
         finally:
             self.close()
         if not (p.stopped or handed or reached):

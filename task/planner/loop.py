@@ -34,6 +34,7 @@ import torch
 from task.beliefs import BeliefSource
 from task.config import PlannerConfig, torch_device
 from task.costs import CostSource
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains import get_domain
 from task.domains.base import Domain, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
@@ -64,8 +65,10 @@ def _run(
     source: BeliefSource | None = None,
     indices: Sequence[int] = (),
     costs: CostSource | None = None,
+    until: Deadline = NO_DEADLINE,
 ) -> list[PlanResult]:
     """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems.
+    ``until``: a caller's deadline (a command's), kept as well as ``config.time_limit_s``.
 
     ``indices``: the problems' positions in the caller's list (what ``source`` and ``costs``
     are told). ``config.time_limit_s`` holds inside a window too: a window the limit cuts
@@ -73,11 +76,14 @@ def _run(
     ``config.window_share`` of the limit, the fallback searching in the rest."""
     start = time.perf_counter()
     limit = config.time_limit_s
-    deadline = None if limit is None else start + limit
+    ends = [t for t in (None if limit is None else start + limit, until.at) if t is not None]
+    deadline = min(ends) if ends else None
+    if limit is None:
+        limit = until.limit_s  # what the messages name
     fallback = fallback_on(config, source, costs)
     windows_end = deadline
-    if limit is not None and fallback:
-        windows_end = start + config.window_share * limit
+    if deadline is not None and fallback:
+        windows_end = start + config.window_share * (deadline - start)
     states = [domain.initial_state(p) for p in problems]  # the world
     visited = [{s} for s in states]  # per problem, every world state its plan passed through
     moves: list[list] = [[] for _ in problems]
@@ -177,6 +183,7 @@ def _run(
                 moves[i] = list(better)
     on_done(len(active))
     elapsed = time.perf_counter() - start
+    late = deadline is not None and start + elapsed >= deadline  # the fallback ran out of time
     results = []
     for i, p in enumerate(problems):
         stats = {
@@ -186,7 +193,8 @@ def _run(
             "misread_windows": misread[i],  # windows decoded against a state not the world's
         }
         status = PlanStatus.SOLVED if solved[i] else PlanStatus.NO_PLAN
-        if timed_out and not solved[i] and illegal[i] is None:
+        exhausted = i in searched and searched[i].status is SearchStatus.UNSOLVABLE
+        if (timed_out or late) and not solved[i] and illegal[i] is None and not exhausted:
             left = domain.lower_bound(p, states[i])
             stats["time_limit"] = (
                 f"stopped at the {limit:g} s time limit after {windows[i]} "
@@ -215,8 +223,13 @@ def plan_batch(
     progress: Callable[[int], None] | None = None,
     beliefs: BeliefSource | None = None,
     costs: CostSource | None = None,
+    on_result: Callable[[int, PlanResult], None] | None = None,
+    deadline: Deadline = NO_DEADLINE,
 ) -> list[PlanResult]:
-    """Plan every problem (all of one domain). ``progress(k)``: k more problems finished.
+    """Plan every problem (all of one domain). ``progress(k)``: k more problems finished;
+    ``on_result(i, result)`` as problem i's result is final (after its shape group's program,
+    or after it alone when not batched): what an interrupted caller keeps. ``deadline``: a
+    command's (`task.deadline`), at which planning stops as at ``config.time_limit_s``.
 
     Returns one PlanResult per problem, in order; ``stats["time_s"]`` is the wall time per
     problem (the batch's time divided among its problems when batched). ``beliefs`` gives
@@ -237,20 +250,24 @@ def plan_batch(
     torch_device(config.device)  # refused in one line where this machine lacks it
     generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
     report = progress or (lambda k: None)
+    final = on_result or (lambda i, result: None)
     if not config.batched:
-        return [
-            _run(domain, [p], config, generator, report, beliefs, [i], costs)[0]
-            for i, p in enumerate(problems)
-        ]
+        alone = []
+        for i, p in enumerate(problems):
+            ran = _run(domain, [p], config, generator, report, beliefs, [i], costs, deadline)
+            alone.append(ran[0])
+            final(i, alone[-1])
+        return alone
     # one tensor program per shape key (the domain's: sizes that pad alike), per-key times
     results: list[PlanResult | None] = [None] * len(problems)
     keys = [domain.shape_key(p) for p in problems]
     for key in sorted(set(keys)):
         group = [i for i, k in enumerate(keys) if k == key]
         subset = [problems[i] for i in group]
-        planned = _run(domain, subset, config, generator, report, beliefs, group, costs)
+        planned = _run(domain, subset, config, generator, report, beliefs, group, costs, deadline)
         for i, result in zip(group, planned, strict=True):
             results[i] = result
+            final(i, result)
     return results
 
 
@@ -260,7 +277,8 @@ def plan(
     seed: int = 0,
     beliefs: BeliefSource | None = None,
     costs: CostSource | None = None,
+    deadline: Deadline = NO_DEADLINE,
 ) -> PlanResult:
-    """Plan one problem (``beliefs``: soft inputs from perception; ``costs``: move costs; see
-    `plan_batch`)."""
-    return plan_batch([problem], config, seed, beliefs=beliefs, costs=costs)[0]
+    """Plan one problem (``beliefs``: soft inputs from perception; ``costs``: move costs;
+    ``deadline``: a command's; see `plan_batch`)."""
+    return plan_batch([problem], config, seed, beliefs=beliefs, costs=costs, deadline=deadline)[0]

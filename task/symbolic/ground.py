@@ -32,9 +32,12 @@ from pddl.logic.functions import FunctionExpression
 from pddl.logic.predicates import EqualTo, Predicate
 from pddl.logic.terms import Variable
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.errors import PDDLError
 from task.problem import Action
 from task.symbolic.strips import Atom, GroundAction, initial_state, is_subtype, object_types
+
+CHECK_EVERY = 1024  # bindings between two looks at the deadline (a look costs ~0.1 us)
 
 _FEATURES = (
     (Not, "negative precondition"),
@@ -222,10 +225,11 @@ def _substitute(atoms: tuple[Atom, ...], binding: dict[str, str]) -> frozenset[A
     return frozenset((a[0], *(binding.get(t, t) for t in a[1:])) for a in atoms)
 
 
-def reachable(domain: Domain, problem: PDDLProblem) -> Grounding:
+def reachable(domain: Domain, problem: PDDLProblem, deadline: Deadline = NO_DEADLINE) -> Grounding:
     """Ground ``problem`` by relaxed reachability (see the module docstring).
 
-    Raises PDDLError for a domain or problem that is not STRIPS in the supported fragment.
+    Raises PDDLError for a domain or problem that is not STRIPS in the supported fragment, and
+    `TimeLimitReached` when ``deadline`` passes first (checked every `CHECK_EVERY` bindings).
     """
     schemas = _schemas(domain)
     types = object_types(domain, problem)
@@ -245,10 +249,14 @@ def reachable(domain: Domain, problem: PDDLProblem) -> Grounding:
                 if not wanted or any(is_subtype(t, w, parents) for t in types[o] for w in wanted)
             )
     found: dict[tuple[str, tuple[str, ...]], GroundAction] = {}
+    bound = 0
     while True:
         new_atoms = []
         for schema in schemas:
             for binding in _bindings(schema, facts, allowed[schema.name]):
+                if bound % CHECK_EVERY == 0:
+                    deadline.check("grounding")
+                bound += 1
                 args = tuple(binding[p] for p in schema.params)
                 if (schema.name, args) in found:
                     continue

@@ -38,19 +38,20 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
     horizons, seeds = args.horizons or (config.horizon,), tuple(range(args.seeds))
     total = planning.total(len(suite.instances), len(seeds), len(horizons), args.sequential)
     runs: list[planning.Run] = []
+    done: list[planning.Row] = []  # every row final so far, of complete runs and the current
     with bar(total, f"{suite.name} ({len(suite.instances)} instances)", args.progress) as update:
         try:
             result = planning.run(
-                suite, config, seeds, horizons, args.sequential, update, runs.append
+                suite, config, seeds, horizons, args.sequential, update, runs.append, done.append
             )
         except KeyboardInterrupt:
-            done = [row for run in runs for row in run.rows]
             if args.out is not None:
                 out = results.out_folder(args.out)
                 partial = {
                     "done": len(done),
                     "of": len(suite.instances) * len(seeds) * len(horizons),
-                    "complete_runs": len(runs),  # a batched run keeps nothing until complete
+                    "complete_runs": len(runs),  # a batched run's rows come a shape at a time
+                    "interrupted": True,
                 }
                 body = {
                     "config": recorded,
@@ -58,8 +59,9 @@ def _run(suite: suites.Suite, args: argparse.Namespace, lengths: bool = False) -
                     "machine": results.machine(args.argv, getattr(args, "device", None)),
                 }
                 results.write_json(out / "results.json", body)
-                results.write_csv(out / "instances.csv", done)
-            return interrupted(args.out, len(done), total, "plans (complete horizon-seed runs)")
+                rows = [planning.beside_best(row) for row in done]
+                results.write_csv(out / "instances.csv", rows, planning.INSTANCE_COLUMNS)
+            return interrupted(args.out, len(done), total, "plans")
     if getattr(args, "lama", False):
         result = _lama(suite, result, config.time_limit_s or 60.0, args.progress)
     if getattr(args, "baselines", None):

@@ -19,12 +19,12 @@ rules plan it; a problem beyond the STRIPS fragment that `ground` reads proves n
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
+from task.deadline import NO_DEADLINE, Deadline, TimeLimitReached
 from task.errors import TampError
 from task.symbolic import ground, strips
 from task.symbolic.proofs import exhaust, mutex
@@ -50,19 +50,23 @@ def prove_unsolvable(
     max_states: int = 100_000,
     time_limit_s: float | None = 10.0,
     max_atoms: int = 2_000,
+    deadline: Deadline = NO_DEADLINE,
 ) -> Proof:
     """Try the proofs of the module docstring on a parsed PDDL problem.
 
     ``exhaustive``: also search every reachable state (at most ``max_states``); h^2 runs on
     tasks of at most ``max_atoms`` fluent atoms; ``time_limit_s`` bounds h^2 and the search
-    (None: no limit). Grounding itself is not bounded (the planners ground anyway).
+    (None: no limit). ``deadline``: the command's (`task.deadline`), which bounds every step,
+    grounding included; one that passes proves nothing ("time limit (N s) reached while ...").
     """
-    deadline = None if time_limit_s is None else time.perf_counter() + time_limit_s
+    ends = deadline.within(time_limit_s)
     try:
-        grounding = ground.reachable(domain, problem)
+        grounding = ground.reachable(domain, problem, deadline)
         goal = strips.goal_atoms(problem)
     except TampError as exc:
         return Proof(False, f"no proof beyond STRIPS ({exc})")
+    except TimeLimitReached as exc:
+        return Proof(False, f"not proved unsolvable; {exc}")
     reached = set(grounding.atoms)
     missing = [a for a in goal if a not in reached]
     if missing:
@@ -75,7 +79,7 @@ def prove_unsolvable(
     tried = ["relaxed reachability"]
     if len(task.atoms) > max_atoms:
         tried.append(f"h^2 skipped ({len(task.atoms)} atoms > {max_atoms})")
-    elif (pairs := mutex.h2(task, deadline)) is None:
+    elif (pairs := mutex.h2(task, ends)) is None:
         tried.append("h^2 ran out of time")
     else:
         tried.append("h^2")
@@ -84,7 +88,7 @@ def prove_unsolvable(
         if why := mutex.goal_cycle(task, pairs, goal):
             return Proof(True, why, "invariant")
     if exhaustive:
-        found = exhaust.exhaust(task, max_states, deadline)
+        found = exhaust.exhaust(task, max_states, ends)
         if found.outcome is exhaust.Outcome.UNSOLVABLE:
             return Proof(
                 True,

@@ -102,9 +102,40 @@ def test_ctrl_c_in_a_benchmark_writes_what_is_done_marked_partial(capsys, tmp_pa
     err = capsys.readouterr().err
     assert "interrupted after 2 of 4 plans" in err and "marked partial" in err
     report = json.loads((out / "results.json").read_text())
-    assert report["partial"] == {"done": 2, "of": 4, "complete_runs": 1}
+    assert report["partial"] == {"done": 2, "of": 4, "complete_runs": 1, "interrupted": True}
     assert report["config"]["seeds"] == 2
     assert len((out / "instances.csv").read_text().strip().splitlines()) == 1 + 2
+
+
+def test_ctrl_c_inside_a_batched_run_keeps_the_rows_already_final(capsys, tmp_path, monkeypatch):
+    """A batched run's results come a shape group at a time: Ctrl-C in the second group
+    keeps the first group's rows (not the 0 a run kept before it was complete)."""
+    real = planning.plan_batch
+
+    def plan_batch(problems, config, seed, progress=None, on_result=None, **kw):
+        if on_result is None:  # the untimed warm-up
+            return real(problems, config, seed, progress, **kw)
+        kept = []
+
+        def then_interrupt(i, result):
+            on_result(i, result)
+            kept.append(i)
+            if len(kept) == 2:  # the first shape group (the 3-block problems) is final
+                raise KeyboardInterrupt
+
+        return real(problems, config, seed, progress, on_result=then_interrupt, **kw)
+
+    monkeypatch.setattr(planning, "plan_batch", plan_batch)
+    out = tmp_path / "out"
+    argv = ["bench", "random", "--blocks", "3,4", "--n", "2", "--out", str(out)]
+    assert main([*argv, "--restarts", "4", "--iters", "20", "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted after 2 of 4 plans" in err and "marked partial" in err
+    report = json.loads((out / "results.json").read_text())
+    assert report["partial"] == {"done": 2, "of": 4, "complete_runs": 0, "interrupted": True}
+    rows = (out / "instances.csv").read_text().strip().splitlines()
+    assert rows[0].split(",") == list(planning.INSTANCE_COLUMNS)
+    assert [r.split(",")[1] for r in rows[1:]] == ["3", "3"]
 
 
 @pytest.mark.parametrize(

@@ -123,3 +123,18 @@ def test_the_episode_limits_default_to_geo_limits():
     limits = GeoLimits()
     assert params["max_moves"].default == limits.max_moves
     assert params["max_replans"].default == limits.max_replans
+
+
+@pytest.mark.sim
+def test_a_plan_stopped_by_the_time_limit_says_so_in_the_no_plan_reason():
+    s = hemmed()
+    report = run_geo_episode(
+        s,
+        parse_goal("(in t goal)", s),
+        "search-then-check",
+        "pybullet",
+        planner_config=SearchConfig(choices=("top",), places=4, max_time_s=1e-9),
+        tools=tools(),
+    )
+    assert report.status is EpisodeStatus.NO_PLAN, report
+    assert report.reason.startswith("time limit (1e-09 s) reached; budget:"), report.reason

@@ -295,3 +295,36 @@ def test_an_episode_leaves_torchs_thread_count_to_its_caller(solver):
         torch.set_num_threads(before)
     assert report.reached_goal, report.reason
     assert seen and set(seen) == {2} and after == 2
+
+
+@pytest.mark.sim
+def test_a_no_plan_stopped_by_the_time_limit_says_so(solver):
+    planner = replace(LoopConfig().planner, time_limit_s=1e-9, fallback=False)
+    report = run_episode(THREE, LoopConfig(planner=planner), seed=0, solver=solver)
+    assert report.status is EpisodeStatus.NO_PLAN and not report.moves
+    assert "time limit (1e-09 s) reached: stopped at the 1e-09 s time limit" in report.reason
+
+
+def test_a_fallback_the_deadline_stops_says_time_limit_in_its_stats(monkeypatch):
+    import time
+    from types import SimpleNamespace
+
+    import task.planner.loop as loop
+    from task.config import PlannerConfig
+    from task.planner import plan
+    from task.symbolic.lazy_search import LazyResult, SearchStatus
+
+    late = [0.0]  # seconds the planner's clock is ahead of the real one
+    monkeypatch.setattr(
+        loop, "time", SimpleNamespace(perf_counter=lambda: time.perf_counter() + late[0])
+    )
+
+    def out_of_time(*args, **kwargs):  # the fallback search runs past the deadline
+        late[0] = 100.0
+        return LazyResult(SearchStatus.BUDGET, (), 1, 0, 0, 100.0, "the deadline ran out")
+
+    monkeypatch.setattr(loop, "fall_back", out_of_time)
+    config = PlannerConfig(horizon=1, iters=2, max_windows=1, time_limit_s=60.0, fallback=True)
+    result = plan(THREE, config)
+    assert not result.solved and result.stats["fallback"]["trigger"] == "windows"
+    assert result.stats["time_limit"].startswith("stopped at the 60 s time limit")

@@ -319,7 +319,7 @@ def test_tamp_plan_never_prints_a_plan_that_does_not_validate(moves, capsys, tmp
     """A planner that claims success with a plan that misses the goal (or breaks a rule):
     the validator's line, exit 1, and no plan on stdout or in ``--out``."""
 
-    def claims_success(problem, config, seed, costs=None):
+    def claims_success(problem, config, seed, costs=None, deadline=None):
         return PlanResult(
             PlanStatus.SOLVED, Plan(moves), problem, None, {"windows": 1, "time_s": 0}
         )
