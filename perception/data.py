@@ -16,6 +16,7 @@ test time.
 from __future__ import annotations
 
 import json
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -71,13 +72,23 @@ def load(path: str | Path) -> SupportData:
     path = Path(path)
     if not path.is_file():
         raise PerceptionError(f"no dataset at {path} (make one with `tamp perception dataset`)")
+    expected = (
+        "expected a .npz archive of images, colours, supports, palette and meta, as "
+        "`tamp perception dataset` writes"
+    )
+    if not zipfile.is_zipfile(path):  # an image, a checkpoint, text: np.load would unpickle
+        raise PerceptionError(f"{path} is not a support dataset file ({expected})")
     try:
-        with np.load(path) as z:
+        with np.load(path, allow_pickle=False) as z:
             data = SupportData(
                 z["images"], z["colours"], z["supports"], z["palette"], json.loads(str(z["meta"]))
             )
-    except (KeyError, ValueError, OSError) as err:
-        raise PerceptionError(f"{path} is not a support dataset: {err}") from None
+    except KeyError as err:
+        raise PerceptionError(
+            f"{path} is not a support dataset: {err.args[0]} ({expected})"
+        ) from None
+    except (ValueError, OSError, zipfile.BadZipFile) as err:
+        raise PerceptionError(f"{path} is not a support dataset: {err} ({expected})") from None
     if data.images.ndim != 4 or data.colours.shape != data.supports.shape:
         raise PerceptionError(f"{path}: arrays of inconsistent shapes")
     return data

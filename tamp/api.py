@@ -593,14 +593,23 @@ def plan_images(
     from perception import CHECKPOINT
     from perception.perceive import Perceiver
     from perception.train import load_checkpoint
-    from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
+    from tamp.camera.image_pair import (
+        blocks_in,
+        check_sizes,
+        fit_image,
+        plan_from_images,
+        read_image,
+    )
     from task.domains import blocksworld_pddl
 
     scenes = ("cubes", "latplan")
     if scene not in scenes:
         raise TampError(f"unknown image scene {one_of(scene, scenes)}")
     given = {"init": init, "goal": goal}
-    pair = [im if isinstance(im, np.ndarray) else read_image(im) for im in given.values()]
+    pair = [
+        fit_image(im, scene) if isinstance(im, np.ndarray) else read_image(im, scene)
+        for im in given.values()
+    ]
     labels = [f"<{k} image>" if isinstance(im, np.ndarray) else str(im) for k, im in given.items()]
     if checkpoint is None:
         name = "support-latplan.pt" if scene == "latplan" else CHECKPOINT.name

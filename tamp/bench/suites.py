@@ -279,7 +279,9 @@ def generated(
     they must fit); optimal lengths from A* within ``max_nodes``. Instance ``i`` of ``b``
     blocks uses the ``i``-th kept seed drawn from ``Random(f"{seed}:{b}")``, so adding a block
     count leaves the others unchanged. Each problem goes through its PDDL text. DataError when
-    no problem of a block count is kept (a benchmark of zero episodes)."""
+    no problem of a block count is kept (a benchmark of zero episodes), or ``n`` < 1."""
+    if n < 1:
+        raise DataError(f"n={n}: a random suite needs at least one problem per block count")
     report = progress or (lambda k: None)
     domain = data.domain()
     instances = []

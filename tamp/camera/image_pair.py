@@ -33,6 +33,7 @@ from task.planner import plan
 from task.problem import TABLE, Action, PlanResult, Problem
 
 RGB = tuple[float, float, float]
+IMAGE_SCENES = ("cubes", "latplan")  # the scenes whose images `scene_colours` names
 
 
 def scene_colours(scene: str) -> tuple[tuple[str, RGB], ...]:
@@ -44,9 +45,34 @@ def scene_colours(scene: str) -> tuple[tuple[str, RGB], ...]:
     return PALETTE[:CAMERA_COLOURS]
 
 
-def read_image(path: str | Path) -> np.ndarray:
-    """An RGB uint8 image (H, W, 3) from a PNG or JPG file (RGBA: alpha dropped); one-line
-    TampError otherwise."""
+def input_size(scene: str) -> tuple[int, int]:
+    """(H, W): the size of the images the scene's perception model reads (its renders: the
+    camera's 320x240 for ``cubes``, LatPlan's 150x100 for ``latplan``)."""
+    if scene == "latplan":
+        from tamp.camera.latplan import SIZES
+
+        return SIZES[0][1], SIZES[0][0]
+    from tamp.sim.base import Camera
+
+    return Camera().height, Camera().width
+
+
+def fit_image(image: np.ndarray, scene: str) -> np.ndarray:
+    """``image`` (H, W, 3) shrunk, aspect kept (pixel-area averaging), to fit the scene's
+    `input_size`; unchanged when it fits already (never enlarged). A photograph of thousands
+    of pixels a side is read at the size the model reads, not segmented at full size."""
+    h, w = input_size(scene)
+    scale = min(h / image.shape[0], w / image.shape[1])
+    if scale >= 1.0:
+        return image
+    size = (max(1, round(image.shape[1] * scale)), max(1, round(image.shape[0] * scale)))
+    return cv2.resize(image, size, interpolation=cv2.INTER_AREA)  # (h', w', 3)
+
+
+def read_image(path: str | Path, scene: str | None = None) -> np.ndarray:
+    """An RGB uint8 image (H, W, 3) from a PNG or JPG file (RGBA: alpha dropped), shrunk to
+    fit ``scene``'s `input_size` when a scene is given (`fit_image`); one-line TampError
+    otherwise."""
     path = str(path)
     if not Path(path).is_file():
         raise TampError(f"no image file at {path}")
@@ -60,7 +86,8 @@ def read_image(path: str | Path) -> np.ndarray:
     if raw.ndim == 2 or raw.shape[2] not in (3, 4):
         raise TampError(f"{path} is not a colour image: blocks are told apart by colour")
     code = cv2.COLOR_BGRA2RGB if raw.shape[2] == 4 else cv2.COLOR_BGR2RGB
-    return np.ascontiguousarray(cv2.cvtColor(raw, code))
+    image = np.ascontiguousarray(cv2.cvtColor(raw, code))
+    return image if scene is None else fit_image(image, scene)
 
 
 def check_sizes(images: Sequence[np.ndarray], paths: Sequence[str], model) -> None:
@@ -76,11 +103,44 @@ def check_sizes(images: Sequence[np.ndarray], paths: Sequence[str], model) -> No
         )
 
 
+def check_scene(images: Sequence[np.ndarray], paths: Sequence[str], scene: str) -> None:
+    """One-line TampError when an image shows blocks of a colour ``scene`` cannot name but
+    another image scene can (cube renders read as ``latplan`` would lose the orange cube, a
+    LatPlan pair read as ``cubes`` the black cylinder), naming the colours found and the scene
+    that reads them. The images are segmented for every image scene's colours at once (the
+    chosen scene's own colours first, so a name both share is looked for as this scene's)."""
+    looked = dict(scene_colours(scene))
+    for other in IMAGE_SCENES:
+        for name, rgb in scene_colours(other):
+            looked.setdefault(name, rgb)
+    names, rgbs = list(looked), list(looked.values())
+    looked_for = [name for name, _ in scene_colours(scene)]
+    mine = set(looked_for)
+    for path, image in zip(paths, images, strict=True):
+        seen = [name for name, found in zip(names, present(image, rgbs), strict=True) if found]
+        foreign = [name for name in seen if name not in mine]
+        if not foreign:
+            continue
+        readers = [
+            s for s in IMAGE_SCENES if s != scene and set(seen) <= dict(scene_colours(s)).keys()
+        ]
+        fix = (
+            f"read them with --image-scene {readers[0]}"
+            if readers
+            else "no image scene names all of them"
+        )
+        raise TampError(
+            f"{path} shows {', '.join(seen)}: the {scene} scene has no {', '.join(foreign)} "
+            f"block (its colours: {', '.join(looked_for)}); {fix}"
+        )
+
+
 def blocks_in(
     images: Sequence[np.ndarray], paths: Sequence[str], scene: str
 ) -> tuple[tuple[str, ...], list[RGB]]:
     """Names and colours of the scene's blocks found in both images; one-line errors for a
     block found in one image only and for images with no block."""
+    check_scene(images, paths, scene)
     palette = scene_colours(scene)
     rgbs = [rgb for _, rgb in palette]
     seen = [present(im, rgbs) for im in images]

@@ -61,7 +61,7 @@ def images_command(args: argparse.Namespace) -> int:
     recorded = images_config(args)
     out_file(args.out)
     paths = (args.init, args.goal)
-    images = [read_image(p) for p in paths]
+    images = [read_image(p, args.image_scene) for p in paths]  # shrunk to the model's size
     checkpoint = _checkpoint(args)
     check_checkpoint(checkpoint)
     model, meta = load_checkpoint(checkpoint, args.image_scene)  # refuses another scene

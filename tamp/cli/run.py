@@ -43,6 +43,7 @@ from tamp.outcome import EpisodeInterrupted
 from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads
 from tamp.video import EpisodeVideo
+from tamp.world.goal_check import UnsolvableGoal
 from task import data
 from task.errors import TampError
 from task.instances import example, from_files, from_text
@@ -105,7 +106,10 @@ def _out_dir(out: str | None) -> Path | None:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    recorded = run_config(args)  # refused combinations: before any work
+    try:
+        recorded = run_config(args)  # refused combinations: before any work
+    except UnsolvableGoal as exc:  # a scene file's goal no plan can reach: before planning
+        return unsolvable(args, exc.reason)
     out_folder(args.out)
     out_file(args.record, "--record")
     if args.record is not None:
@@ -195,6 +199,18 @@ def run_command(args: argparse.Namespace) -> int:
         print("tamp: interrupted", file=sys.stderr)
         return 130
     return 0 if report.reached_goal else 1
+
+
+def unsolvable(args: argparse.Namespace, reason: str) -> int:
+    """The ``unsolvable`` outcome of a scene file's goal the static check
+    (`tamp.world.goal_check`) proved unreachable, as ``tamp plan`` reports a PDDL problem's:
+    ``unsolvable: REASON`` (or its ``--json`` report), exit code 1, nothing planned or run."""
+    if args.json:
+        body = {"status": "unsolvable", "reason": reason, "reached_goal": False}
+        print(json.dumps({**body, "scene_file": args.scene, "goal": args.goal}, indent=2))
+    else:
+        print(f"unsolvable: {reason}")
+    return 1
 
 
 def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:

@@ -101,6 +101,7 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
     PDDL domain."""
     from tamp.world.blocks import explained_scene
     from tamp.world.goal import load_goal
+    from tamp.world.goal_check import check_goal
 
     scene, _ = explained_scene(path)
     domain = None
@@ -109,7 +110,9 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
 
         domain = (rules.domain_text(), rules.BINDING)
     name = None if domain is None else rules.DOMAIN
-    return GeoRun(str(path), scene, load_goal(goal, scene), planner, why, domain, name)
+    return GeoRun(
+        str(path), scene, check_goal(scene, load_goal(goal, scene)), planner, why, domain, name
+    )
 
 
 def _binding_json(path: Path) -> str:
@@ -132,13 +135,14 @@ def user_domain(path: Path, goal: str | Path, domain: str | Path, binding: str |
     `tamp.world.scene_pddl` writes from the scene and ``goal`` (one line for each)."""
     from tamp.world.blocks import explained_scene
     from tamp.world.goal import load_goal
+    from tamp.world.goal_check import check_goal
     from tamp.world.scene_pddl import problem_text
     from task.domains.strips import problem_from_text
     from task.symbolic import pddl_io
     from task.symbolic.pickplace import binding as binder
 
     scene, _ = explained_scene(path)
-    target = load_goal(goal, scene)
+    target = check_goal(scene, load_goal(goal, scene))
     domain_text = pddl_io.read_text(domain)
     parsed = pddl_io.parse_domain(domain_text, str(domain))
     binding_text = _binding_json(Path(binding))

@@ -12,7 +12,10 @@ and movable objects; the symbolic state is read from that geometry, never given.
 - ``tamp.world.relations``: `read_facts`, the ``on`` / ``in`` / ``ontable`` / ``clear`` facts
   read from the poses, and the objects the geometry cannot explain;
 - ``tamp.world.goal``: `load_goal` / `parse_goal`, a PDDL goal over the scene's objects and
-  regions, checked against the scene.
+  regions, checked against the scene;
+- ``tamp.world.goal_check``: `check_goal`, the static check of a goal no plan can reach (two
+  supports, two objects on one, a cycle, an object a region cannot hold, regions that do not
+  nest), run before any planning: ``tamp run`` reports ``unsolvable: REASON`` at once.
 - ``tamp.world.scene_pddl``: `problem_text`, a scene and a goal as the PDDL problem of a
   user's pick-and-place domain, its state read from the geometry through the binding's scene
   section (``tamp run --scene FILE --domain D.pddl --binding B.json``);

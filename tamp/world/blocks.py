@@ -23,6 +23,7 @@ from pathlib import Path
 
 from tamp.scene import Pose, SceneConfig, read_state
 from tamp.world.goal import Goal, load_goal
+from tamp.world.goal_check import check_goal
 from tamp.world.load import load_scene, scene_config
 from tamp.world.relations import Facts, read_facts
 from tamp.world.schema import Scene, SceneFileError
@@ -67,7 +68,7 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
             f"{label}: {', '.join(in_regions)}: objects in regions are beyond the Blocksworld "
             "loop (its supports are the table and blocks)"
         )
-    wanted = load_goal(goal, scene)
+    wanted = check_goal(scene, load_goal(goal, scene))  # unsolvable: before any planning
     for atom in wanted.atoms:
         if atom[0] not in GOAL_PREDICATES:
             why = (

@@ -91,6 +91,22 @@ def test_dataset_round_trip_and_tensors(tmp_path):
     assert t["target"][0].tolist() == [4, 0, 4, 4]  # the table is column S = 4
 
 
+@pytest.mark.parametrize("kind", ["png", "npz of other arrays"])
+def test_a_file_that_is_no_dataset_says_what_a_dataset_file_is(tmp_path, kind):
+    """Never numpy's advice to unpickle the file: what was given is not a dataset file."""
+    if kind == "png":
+        path = tmp_path / "picture.png"
+        cv2.imwrite(str(path), np.zeros((8, 8, 3), np.uint8))
+    else:
+        path = tmp_path / "other.npz"
+        np.savez(path, x=np.zeros(3))
+    with pytest.raises(PerceptionError) as caught:
+        pdata.load(path)
+    text = str(caught.value)
+    assert "is not a support dataset" in text and "`tamp perception dataset` writes" in text
+    assert "pickle" not in text and "\n" not in text
+
+
 def test_a_missing_dataset_or_checkpoint_is_a_one_line_error(tmp_path):
     with pytest.raises(PerceptionError, match="no dataset at"):
         pdata.load(tmp_path / "none.npz")

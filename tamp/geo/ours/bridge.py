@@ -41,14 +41,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tamp.geo.ours.pack import PackConfig, PackResult, pack_sampled, pack_tries
+from tamp.geo.ours.pack import PackConfig, PackError, PackResult, pack_sampled, pack_tries
 from tamp.geo.places import PACK_MARGIN, TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose
 from tamp.world.geometry import footprint_gap, of_movable
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
-from tamp.world.schema import Movable, Scene, SceneFileError
+from tamp.world.schema import Movable, Region, Scene, SceneFileError
 from task.domains.blocksworld import with_slots
 from task.problem import TABLE, Move, Problem
 
@@ -162,6 +162,17 @@ def footprint(o: Movable) -> tuple[float, float]:
 SAMPLERS = ("gradient", "sampled")  # how region cells are placed: `pack`, `pack_sampled`
 
 
+def _too_small(scene: Scene, r: Region, name: str) -> SceneFileError:
+    """The one line for object ``name``, whose footprint region ``r``'s inner rectangle
+    cannot hold however it is turned."""
+    o = scene.object(name)
+    (x0, y0), (x1, y1) = r.inner()
+    return SceneFileError(
+        f"(in {name} {r.name}): {name}'s footprint ({2 * o.half[0]:g} x {2 * o.half[1]:g} m) "
+        f"does not fit region {r.name}'s inner rectangle ({x1 - x0:g} x {y1 - y0:g} m)"
+    )
+
+
 def bridge(
     scene: Scene,
     goal: Goal,
@@ -230,16 +241,23 @@ def bridge(
         step = 1 if sampler == "sampled" else PACK_BATCH
         for k in range(0, len(tries), step):
             batch = tries[k : k + step]
-            if sampler == "sampled":
-                margin, attempt = batch[0]
-                budget = config.restarts * config.steps  # `pack`'s row-steps
-                at = replace(config, margin=margin)
-                results = [
-                    pack_sampled(*args, budget, seed + attempt, at, walled=r.wall_height > 0)
-                ]
-            else:
-                at = [(replace(config, margin=margin), seed + a) for margin, a in batch]
-                results = pack_tries(*args, at, walled=r.wall_height > 0)
+            try:
+                if sampler == "sampled":
+                    margin, attempt = batch[0]
+                    budget = config.restarts * config.steps  # `pack`'s row-steps
+                    at = replace(config, margin=margin)
+                    results = [
+                        pack_sampled(*args, budget, seed + attempt, at, walled=r.wall_height > 0)
+                    ]
+                else:
+                    at = [(replace(config, margin=margin), seed + a) for margin, a in batch]
+                    results = pack_tries(*args, at, walled=r.wall_height > 0)
+            except PackError as exc:
+                if exc.index is None:
+                    raise
+                if batch[0][0] > 0:  # too wide for the margin: flush with the edges may fit
+                    continue
+                raise _too_small(scene, r, movers[exc.index]) from None
             result = next((x for x in results if x.ok), results[-1])
             if result.ok:
                 break

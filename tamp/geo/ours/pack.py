@@ -54,7 +54,12 @@ Rect = tuple[tuple[float, float], tuple[float, float]]  # ((x0, y0), (x1, y1)), 
 
 
 class PackError(TampError):
-    """Bad input to the packer (shapes, a footprint larger than the region)."""
+    """Bad input to the packer (shapes, a footprint larger than the region); ``index``: the
+    footprint that does not fit (None for other input), so a caller can name its object."""
+
+    def __init__(self, message: str, index: int | None = None):
+        super().__init__(message)
+        self.index = index
 
 
 @dataclass(frozen=True)
@@ -110,7 +115,12 @@ def _check(inner: Rect, half, fixed_xy, fixed_half) -> tuple[np.ndarray, np.ndar
     (x0, y0), (x1, y1) = inner
     room = min(x1 - x0, y1 - y0)
     if len(half) and 2 * half.min(1).max() > room:
-        raise PackError(f"a footprint of half extents {half.min(1).max():g} m exceeds the region")
+        i = int(half.min(1).argmax())
+        raise PackError(
+            f"footprint {i} ({2 * half[i, 0]:g} x {2 * half[i, 1]:g} m) does not fit the "
+            f"region's inner rectangle ({x1 - x0:g} x {y1 - y0:g} m) however it is turned",
+            index=i,
+        )
     return half, fxy, fh
 
 

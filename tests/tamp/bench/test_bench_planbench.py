@@ -157,3 +157,10 @@ def test_one_at_a_time_runs_report_latency_percentiles_per_size():
     assert "planning latency by blocks" in tables.lengths_table(alone)
     batched = dataclasses.replace(alone, config=PlannerConfig())
     assert latency_rows(batched) == [] and "latency" not in tables.lengths_table(batched)
+
+
+@pytest.mark.parametrize("n", [0, -1])
+def test_a_random_suite_of_no_problems_is_refused_naming_n(n):
+    """Not "none of 0 random problems fits the scene": n itself is the bad input."""
+    with pytest.raises(DataError, match=f"n={n}: a random suite needs at least one problem"):
+        suites.generated([3], n, seed=0)

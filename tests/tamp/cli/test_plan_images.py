@@ -148,3 +148,69 @@ def test_missing_checkpoints(tmp_path, capsys, monkeypatch):
     assert main(["plan-images", grey, grey, "--image-scene", "latplan"]) == 2
     err = one_line_error(capsys, "tamp: error:")
     assert "support-latplan.pt" in err and "--checkpoint" in err
+
+
+@pytest.fixture(scope="module")
+def latplan_pair(tmp_path_factory):
+    """PNG paths of two LatPlan-like renders (red, blue, green and black cylinders), made here
+    by the project's own generator (`tamp.camera.latplan.generate`)."""
+    from tamp.camera import latplan
+
+    root = tmp_path_factory.mktemp("latplan")
+    images = latplan.generate(2, seed=0, sims=("pybullet",))[latplan.SIZES[0]].images
+    return [_save(root / f"{k}.png", im) for k, im in enumerate(images)]
+
+
+@pytest.mark.sim
+def test_cube_renders_read_as_latplan_are_refused_naming_the_colours_and_the_scene(scenes, capsys):
+    """Not a VALID plan of two of the three cubes: LatPlan has no purple block."""
+    argv = ["plan-images", scenes["init"], scenes["goal"], "--image-scene", "latplan"]
+    assert main(argv) == 2
+    err = one_line_error(capsys, "tamp: error:")
+    assert "shows red, green, purple" in err and "the latplan scene has no purple block" in err
+    assert err.endswith("read them with --image-scene cubes"), err
+
+
+@pytest.mark.sim
+def test_a_latplan_pair_read_as_cubes_is_refused_naming_black_and_latplan(latplan_pair, capsys):
+    """Not a 1-move plan of three cylinders: the black one would be lost."""
+    assert main(["plan-images", *latplan_pair]) == 2
+    err = one_line_error(capsys, "tamp: error:")
+    assert "shows red, blue, green, black" in err and "the cubes scene has no black block" in err
+    assert err.endswith("read them with --image-scene latplan"), err
+
+
+@pytest.mark.sim
+def test_a_huge_photograph_is_read_at_the_models_size_as_its_downscaled_copy(
+    scenes, capsys, monkeypatch
+):
+    """A 3200x2400 copy of each render (the renders upscaled tenfold) reads the same states as
+    the renders; every image the segmentation sees fits the model's 320x240 input."""
+    from perception import perceive
+    from tamp.camera import image_pair
+
+    huge = []
+    for key in ("init", "goal"):
+        big = cv2.resize(cv2.imread(scenes[key]), (3200, 2400), interpolation=cv2.INTER_NEAREST)
+        huge.append(str(scenes["root"] / f"huge_{key}.png"))
+        cv2.imwrite(huge[-1], big)
+    sizes = []
+
+    def spy(real):
+        def seen(image, *args, **kwargs):
+            sizes.append(image.shape[:2])
+            return real(image, *args, **kwargs)
+
+        return seen
+
+    monkeypatch.setattr(image_pair, "present", spy(image_pair.present))
+    monkeypatch.setattr(perceive, "find_boxes", spy(perceive.find_boxes))
+    readings = []
+    for pair in ([scenes["init"], scenes["goal"]], huge):
+        args = ["plan-images", *pair, "--horizon", "1", "--threads", "1", "--json"]
+        main(args)
+        record = json.loads(capsys.readouterr().out)
+        readings.append((record["blocks"], record["perceived_init"], record["perceived_goal"]))
+    assert readings[0] == readings[1]
+    assert readings[1][1] == dict(zip(NAMES, INIT, strict=True))
+    assert sizes and all(h <= 240 and w <= 320 for h, w in sizes), sorted(set(sizes))

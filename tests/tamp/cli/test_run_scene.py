@@ -73,6 +73,31 @@ def test_what_a_scene_file_run_cannot_do_is_refused_in_one_line(tmp_path, capsys
     assert not (tmp_path / "out").exists()  # refused before any work
 
 
+@pytest.mark.parametrize(
+    ("scene_name", "goal", "expected"),
+    [
+        ("tower", "(and (on a c) (on b c))", "a and b are both on c"),  # the Blocksworld loop's
+        ("tower", "(and (on a b) (on b a))", "cycle a on b on a"),
+        ("tray", "(and (on a b) (on b a))", "cycle a on b on a"),
+        ("tray", "(and (in a tray) (on a b))", "a has two supports: b, region tray"),  # geometric
+    ],
+)
+def test_a_scene_goal_no_plan_can_reach_is_unsolvable_before_planning(
+    tmp_path, capsys, scene_name, goal, expected
+):
+    """As ``tamp plan`` says of the same goal as PDDL: the static check fires before any
+    planning or simulation, so nothing is written under --out."""
+    out = tmp_path / "out"
+    assert main(["run", "--scene", scene_name, "--goal", goal, "--out", str(out)]) == 1
+    text = capsys.readouterr().out.strip()
+    assert text == f"unsolvable: {expected}", text
+    assert not out.exists()
+    assert main(["run", "--scene", scene_name, "--goal", goal, "--json"]) == 1
+    report = json.loads(capsys.readouterr().out)
+    assert report["status"] == "unsolvable" and report["reason"] == expected
+    assert report["reached_goal"] is False
+
+
 def recorded(argv):
     """What ``tamp run ARGV`` records as its config (its refusals raise), without running it."""
     args = build_parser().parse_args(["run", *argv])

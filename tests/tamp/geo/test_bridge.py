@@ -126,3 +126,23 @@ def test_a_tight_tray_is_packed_from_seeds_where_four_flush_tries_failed():
     made = generate("packed", 3)
     bridged = bridge(made.scene, made.goal, None, seed=3 * 100_003)
     assert [(r, p.ok) for r, p in bridged.packs] == [("tray", True)]
+
+
+def test_an_object_that_fits_a_region_only_flush_with_its_edges_is_packed_there():
+    """5.1 cm inside the walls: too narrow for the packing margin, wide enough flush."""
+    slot = {"name": "slot", "min": [0.5, 0.15], "max": [0.551, 0.35]}
+    s = scene(cube("a", 0.45, -0.2), regions=[slot])
+    b = bridge(s, parse_goal("(in a slot)", s))
+    assert [x for x, cell in b.cells] == ["a"]
+
+
+def test_a_region_too_small_for_the_object_names_both_and_their_sizes():
+    slot = {"name": "slot", "min": [0.5, 0.15], "max": [0.54, 0.35]}
+    s = scene(cube("a", 0.45, -0.2), regions=[slot])
+    with pytest.raises(SceneFileError) as caught:
+        bridge(s, parse_goal("(in a slot)", s))
+    text = str(caught.value)
+    assert (
+        "a's footprint (0.05 x 0.05 m)" in text
+        and "region slot's inner rectangle (0.04 x 0.2 m)" in text
+    )

@@ -98,8 +98,9 @@ def test_pack_sampled_is_the_same_kind_of_answer_and_refuses_what_cannot_fit():
     assert result.ok and result.tries <= 2000
     assert _free_and_inside(loose, SQUARES, result.positions, 0.002)
     assert not pack_sampled(TIGHT, [(0.025, 0.025)] * 7, budget=300, seed=0).ok
-    with pytest.raises(PackError, match="exceeds the region"):
-        pack(TIGHT, [(0.06, 0.06)])
+    with pytest.raises(PackError, match=r"footprint 1 \(0.12 x 0.12 m\) does not fit") as caught:
+        pack(TIGHT, [(0.02, 0.02), (0.06, 0.06)])
+    assert caught.value.index == 1  # so the bridge can name the object
     assert math.isinf(pack_sampled(TIGHT, [(0.025, 0.025)] * 7, budget=300).overlap)
 
 

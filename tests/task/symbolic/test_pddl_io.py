@@ -151,6 +151,27 @@ def test_a_binary_file_is_one_line_naming_it(tmp_path, loader):
     _error(excinfo, str(path), "not a text file")
 
 
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-le", "utf-16-be", "utf-8-sig"])
+def test_a_file_saved_as_utf16_or_with_a_bom_reads_as_its_utf8_text(
+    bw_domain_path, tmp_path, encoding
+):
+    """As some Windows editors save PDDL: UTF-16 with its byte-order mark, CRLF line ends."""
+    text = Path(bw_domain_path).read_text(encoding="utf-8")
+    path = tmp_path / "domain.pddl"
+    bom = {"utf-16-le": "\ufeff", "utf-16-be": "\ufeff"}.get(encoding, "")
+    path.write_bytes((bom + text.replace("\n", "\r\n")).encode(encoding))
+    assert pddl_io.read_text(path) == text
+    assert pddl_io.load_domain(path) == pddl_io.load_domain(bw_domain_path)
+
+
+def test_utf16_without_a_byte_order_mark_is_not_text(tmp_path):
+    path = tmp_path / "domain.pddl"
+    path.write_bytes("(define (domain d))".encode("utf-16-le"))
+    with pytest.raises(PDDLError) as excinfo:
+        pddl_io.read_text(path)
+    _error(excinfo, str(path), "not a text file")
+
+
 def test_parsing_writes_nothing_to_the_users_home(bw_domain_path, tmp_path):
     """The compiled grammar is kept in memory only: a fresh process that parses a domain and
     a problem, its home and cache folders pointed at an empty folder, leaves that folder
