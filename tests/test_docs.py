@@ -83,8 +83,7 @@ def test_the_readme_results_table_is_benchmarks_md_current_table():
     readme = README.read_text(encoding="utf-8")
     benchmarks = (ROOT / "BENCHMARKS.md").read_text(encoding="utf-8")
     assert record.block_of(readme) == record.block_of(benchmarks), (
-        "README.md's current-results table differs from BENCHMARKS.md's: run "
-        "tamp bench record --markdown README.md"
+        "README.md's current-results table differs from BENCHMARKS.md's: run tamp bench record"
     )
 
 

@@ -1,17 +1,21 @@
-"""The current results: one compact record per benchmark, and the table generated from them.
+"""The record of results: one typed record per benchmark run, and BENCHMARKS.md generated from them.
 
 ``tamp bench record --results DIR...`` reads benchmark results folders (each with the
 ``results.json`` its benchmark wrote through `tamp.bench.results`) and writes one `Record` per
-folder into a committed folder (``results/current/<folder name>.json``): the summary figures the
-benchmark's table shows, the command that produced them, the commit it ran at and whether the
-checkout had uncommitted changes, the machine and the date. `render` turns every record of that
-folder into the "Current results" table, and `replace_block` puts it between the `START` and
-`END` markers of BENCHMARKS.md, so that table is regenerated, never typed, and a test checks
-that it still equals what the records give.
+folder into a committed folder (``results/current/<folder name>.json``): its `Family` (planning,
+latplan, motion, tamp), the summary figures that family's table shows (`FIGURES`), the command
+that produced them, the commit it ran at and whether the checkout had uncommitted changes, the
+machine and the date. `render` turns every record of that folder into the "Current results"
+block (one table per family, the paper's or peers' figures beside ours), and `page` into the
+whole of BENCHMARKS.md: that block, the families measured only in ``docs/experiments/`` so far
+(`STUDIED`: the command that would record each, the studies holding its latest figures) and
+the index of those studies. The README carries the same block between the same markers
+(`replace_block`). Both are regenerated, never typed, and tests check that they still equal
+what the records give.
 
 A results folder that names no commit (written before results recorded one, or run outside a
-git checkout) is refused: its code cannot be named. One run on uncommitted changes is recorded,
-and its row says so.
+git checkout) is refused: its code cannot be named; so is a partial (interrupted) run. One run
+on uncommitted changes is recorded, and its row says so.
 """
 
 from __future__ import annotations
@@ -20,12 +24,23 @@ import json
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import asdict, dataclass
+from enum import StrEnum
 from pathlib import Path
 
 from task.errors import DataError
 
 START = "<!-- current results: written by `tamp bench record`; do not edit by hand -->"
 END = "<!-- end of current results -->"
+
+
+class Family(StrEnum):
+    """A benchmark family: which results.json layout a record reads and which table it joins."""
+
+    PLANNING = "planning"  # bench planbench, bench pddl, bench random
+    LATPLAN = "latplan"  # bench latplan
+    MOTION = "motion"  # bench motion
+    TAMP = "tamp"  # bench tamp
+
 
 PLANNING_FIGURES = (  # of a planning benchmark's summary row, the figures a record keeps
     "horizon",
@@ -45,6 +60,51 @@ PLANNING_FIGURES = (  # of a planning benchmark's summary row, the figures a rec
     "ratio",
 )
 LATPLAN_FIGURES = ("resolution", "mode", "n", "valid", "optimal", "read_right")
+MOTION_FIGURES = (  # of `tamp.bench.motion.summarise`'s figures per simulator (its key: "sim")
+    "sim",
+    "episodes",
+    "plans_valid",
+    "executed_valid",
+    "goal_reached",
+    "moves",
+    "moves_ok",
+    "failures",
+    "replans",
+    "with_faults",
+    "recovered",
+    "collided",
+    "rerouted",
+    "geo_moves",
+    "wall_per_move_s",
+    "plan_per_episode_s",
+    "arm_path_rad",
+)
+TAMP_FIGURES = (  # of `tamp.bench.geo.run.summarise`'s row per (problem, planner, simulator)
+    "problem",
+    "planner",
+    "sim",
+    "episodes",
+    "solved",
+    "clean",
+    "collided",
+    "plan_length",
+    "planning_p50_s",
+    "planning_p90_s",
+    "execution_s",
+    "arm_path_rad",
+)
+FIGURES = {
+    Family.PLANNING: PLANNING_FIGURES,
+    Family.LATPLAN: LATPLAN_FIGURES,
+    Family.MOTION: MOTION_FIGURES,
+    Family.TAMP: TAMP_FIGURES,
+}
+TITLES = {  # each family's table heading in the "Current results" block
+    Family.PLANNING: "Planning (`tamp bench planbench`, `bench pddl`, `bench random`)",
+    Family.LATPLAN: "Planning from LatPlan's images (`tamp bench latplan`)",
+    Family.MOTION: "Motion-level episodes (`tamp bench motion`)",
+    Family.TAMP: "Geometric TAMP (`tamp bench tamp`)",
+}
 MACHINE = ("cores", "processor", "python", "torch", "torch_threads", "device", "load_1min")
 
 LABELS = {  # results.json "benchmark" -> the table's name for it (the instance count follows)
@@ -61,16 +121,140 @@ CITED = {  # (benchmark, instances) -> the paper's figures (Wei & AbdAlmageed 20
     ("latplan-40", 40): "paper 40/40, 31/40 optimal; LatPlan AMA+4 33/40",
 }
 
+EXPERIMENTS = "docs/experiments"  # the studies, one file each, and their index.md
+
+
+@dataclass(frozen=True)
+class Studied:
+    """A benchmark family measured so far only in studies under ``docs/experiments/``."""
+
+    name: str  # the record it would have: results/current/<name>.json
+    title: str
+    command: str  # what produces it, as the studies last ran it (from the repository root)
+    studies: tuple[str, ...]  # the files under docs/experiments/ that hold its latest figures
+    readable: bool  # `extract` reads its results.json (a Family), so `bench record` records it
+
+
+STUDIED = (
+    Studied(
+        "motion",
+        "Motion-level episodes, PlanBench instances in both simulators",
+        "tamp bench motion --n 100 --sim pybullet,mujoco --out results/motion",
+        ("arm-moves.md", "executability.md", "hard-scenes.md"),
+        True,
+    ),
+    Studied(
+        "executability",
+        "Motion-level executability of anyone's plans",
+        "tamp bench executability --plans ../shared/data/planbench/llm_plans "
+        "--data ../shared/data/planbench/blocksworld --n 600 --sim pybullet,mujoco --workers 2 "
+        "--no-progress --out results/executability",
+        ("executability.md",),
+        False,
+    ),
+    Studied(
+        "perception",
+        "Planning from rendered images",
+        "tamp bench perception --n 600 --modes frozen,optimised --crisp true,perceived "
+        "--out results/perception",
+        ("perception.md", "camera.md"),
+        False,
+    ),
+    Studied(
+        "latplan",
+        "LatPlan-40 from its own images",
+        "tamp bench latplan --threads 1 --out results/latplan",
+        ("latplan.md",),
+        True,
+    ),
+    Studied(
+        "tamp",
+        "Geometric TAMP: the six canonical problems",
+        "tamp bench tamp --n 20 --sim pybullet,mujoco --planner motion-aware --workers 2 "
+        "--no-progress --out results/tamp",
+        ("geometric-tamp.md", "hard-scenes.md", "user-domain.md"),
+        True,
+    ),
+    Studied(
+        "big",
+        "Big problems: 50 and 100 random Blocksworld blocks",
+        "tamp bench random --blocks 100 --n 20 --seed 0 --max-nodes 1 --time-limit 120 "
+        "--max-windows 1000 --one-at-a-time --baselines us,gn1 --lama --threads 1 --no-progress "
+        "--out results/big",
+        ("big-problems.md", "long-problems.md", "latency.md"),
+        True,
+    ),
+    Studied(
+        "lift",
+        "The generic STRIPS lift on IPC domains",
+        "tamp bench pddl --data ../shared/data/ipc/miconic --threads 1 --out results/lift",
+        ("strips-lift.md", "cross-domain.md"),
+        True,
+    ),
+    Studied(
+        "checker",
+        "Collision checking: the sphere checker",
+        "tamp bench checker --out results/checker",
+        ("sphere-checker.md",),
+        False,
+    ),
+)
+
+HEADER = (  # BENCHMARKS.md's opening paragraph (each item a line of the file)
+    "# Benchmarks",
+    "",
+    "This file is generated whole by `tamp bench record` (`tamp.bench.record`) from the records "
+    "in `results/current/` and the index of `docs/experiments/`; do not edit it by hand, and a "
+    "test fails when it differs from what they give. **Current results** is the record to quote: "
+    "one table per benchmark family, each row with the commit it ran at, the machine, the date "
+    "and the command that reproduces it, the paper's or peers' figures beside ours. Each record "
+    "(`results/current/NAME.json`, committed; the rest of `results/` is not) is written from a "
+    "benchmark's `--out` folder; a run whose checkout had uncommitted changes is marked in its "
+    "row, and a results folder that names no commit is refused. To refresh a row, run its "
+    "command from the repository root, then `tamp bench record --results results/NAME`.",
+)
+NOTES = (  # the notes under the current results, one bullet a line
+    "- **Machine and load.** The machine has 2 cores, shared with other people's work; the "
+    '"load" column is the 1-minute load average as each run ended (above 2, every core was '
+    "contended), so times per instance are upper bounds for this CPU. The paper's times are on "
+    "an A100: different hardware, not a like-for-like speed ratio. No GPU run has been made.",
+    "- **What is counted.** Every plan is converted to PDDL actions and checked by "
+    "`task.symbolic.validate`, a STRIPS simulator over the PDDL files, cross-checked against "
+    'unified-planning\'s `SequentialPlanValidator` in the tests. "Optimal" means a valid plan '
+    "as long as the known optimum (`tamp.bench.summary.is_optimal`); its percentage is over the "
+    "valid plans whose instance has a known optimum. Blocksworld-600 is PlanBench's official "
+    "zero-shot set (`generated_basic/instance-1..500` and `generated_basic_3/instance-1..100`; "
+    "100 x 3, 445 x 4, 55 x 5 blocks; optima from the manifest's BFS, which our A* reproduces "
+    "on all 600). Logistics and Sokoban optima come from the manifest and, when the `bench` "
+    "extra (Fast Downward) is installed, from `tamp.bench.fast_downward`. The Logistics and "
+    "Sokoban rows at `cce0d0b` ran with it installed: every Logistics instance and 43 of the 55 "
+    "Sokoban instances have a proven optimum (Fast Downward's search runs inside the "
+    "benchmark's wall time, which is why Sokoban's whole process took 27 min against 542 s of "
+    "planning). Without the extra, Logistics has no proven optimum and the row gives the share "
+    "of valid plans no longer than PlanBench's reference plan instead.",
+    "- **Tuning.** The planner's defaults were developed while looking at PlanBench-600, and "
+    "Sokoban's domain defaults on the official 55 (the only Sokoban instances PlanBench has); "
+    'see the caveats in the studies ("What these numbers mean" in '
+    f"[{EXPERIMENTS}/planbench-blocksworld.md]({EXPERIMENTS}/planbench-blocksworld.md), the "
+    f"cross-domain notes in [{EXPERIMENTS}/cross-domain.md]({EXPERIMENTS}/cross-domain.md)). "
+    '"0 inexecutable" holds by construction: the decoder stops a window at its first illegal '
+    "move.",
+)
+
 
 @dataclass(frozen=True)
 class Record:
     """What one benchmark run gave and what produced it (``results/current/<name>.json``)."""
 
     name: str  # the results folder's name, e.g. planbench, logistics
-    benchmark: str  # results.json "benchmark": planbench, planbench-logistics, latplan-40, ...
-    instances: int
+    family: Family  # which results.json layout it was read from; its figures are FIGURES[family]
+    benchmark: (
+        str  # planning: results.json "benchmark" (planbench, ...); else latplan-40, motion, tamp
+    )
+    instances: int  # planning, latplan: instances; motion: episodes per simulator; tamp: variants
     seeds: tuple[int, ...]
-    figures: tuple[Mapping, ...]  # planning: a row per horizon; latplan: per resolution, mode
+    figures: tuple[Mapping, ...]  # planning: per horizon; latplan: per resolution and mode;
+    # motion: per simulator; tamp: per problem, planner and simulator
     command: str  # "tamp bench ..." as it was typed
     commit: str  # the git commit the code ran at
     dirty: bool  # the checkout had changes not in ``commit``
@@ -78,11 +262,17 @@ class Record:
     date: str  # when the run ended (UTC, ISO 8601)
 
     def to_json(self) -> dict:
-        return asdict(self)
+        return {**asdict(self), "family": self.family.value}
 
     @classmethod
     def from_json(cls, body: Mapping) -> Record:
-        return cls(**{**body, "seeds": tuple(body["seeds"]), "figures": tuple(body["figures"])})
+        try:
+            family = Family(body["family"])
+        except ValueError:
+            valid = ", ".join(f.value for f in Family)
+            raise DataError(f"family {body['family']!r} is not one of {valid}") from None
+        seeds, figures = tuple(body["seeds"]), tuple(body["figures"])
+        return cls(**{**body, "family": family, "seeds": seeds, "figures": figures})
 
 
 def _read(path: Path) -> dict:
@@ -103,6 +293,34 @@ def _planning_figures(body: dict) -> tuple[Mapping, ...]:
     several = len(body["seeds"]) > 1
     chosen = [r for r in rows if (r["seed"] is None) == several]
     return tuple({k: r.get(k) for k in PLANNING_FIGURES} for r in chosen)
+
+
+def _family(body: dict, path: Path) -> tuple[Family, str, int, tuple, tuple[Mapping, ...]]:
+    """``(family, benchmark, instances, seeds, figures)`` of a results.json, told apart by its
+    layout: latplan's "benchmark", the planning suites' "horizons", the motion benchmark's
+    summary per simulator beside its "ik_batch", the TAMP benchmark's rows per problem."""
+    summary, config = body.get("summary"), body.get("config") or {}
+    if body.get("benchmark") == "latplan-40":
+        figures = tuple({k: s.get(k) for k in LATPLAN_FIGURES} for s in summary)
+        return Family.LATPLAN, "latplan-40", body["n"], tuple(body["seeds"]), figures
+    if isinstance(summary, list) and "horizons" in body:
+        figures = _planning_figures(body)
+        return Family.PLANNING, body["benchmark"], body["instances"], tuple(body["seeds"]), figures
+    if isinstance(summary, dict) and summary and "ik_batch" in body:
+        figures = tuple(
+            {"sim": sim, **{k: s.get(k) for k in MOTION_FIGURES if k != "sim"}}
+            for sim, s in summary.items()
+        )
+        episodes = figures[0]["episodes"]
+        return Family.MOTION, "motion", episodes, (config.get("seed"),), figures
+    if isinstance(summary, list) and summary and all("planner" in s for s in summary):
+        figures = tuple({k: s.get(k) for k in TAMP_FIGURES} for s in summary)
+        return Family.TAMP, "tamp", config.get("n"), (config.get("seed"),), figures
+    valid = ", ".join(f.value for f in Family)
+    raise DataError(
+        f"{path}: not the results of a benchmark a record summarises (families: {valid}; "
+        "planning is bench planbench, pddl and random)"
+    )
 
 
 def extract(folder: str | Path) -> Record:
@@ -127,19 +345,16 @@ def extract(folder: str | Path) -> Record:
             f"{path}: records no git commit (run outside a git checkout), so its code cannot "
             "be named; rerun it in a checkout"
         )
-    benchmark = body.get("benchmark")
-    if benchmark == "latplan-40":
-        figures = tuple({k: s.get(k) for k in LATPLAN_FIGURES} for s in body["summary"])
-        instances, seeds = body["n"], body["seeds"]
-    elif isinstance(body.get("summary"), list) and "horizons" in body:
-        figures, instances, seeds = _planning_figures(body), body["instances"], body["seeds"]
-    else:
+    if body.get("partial"):
+        part = body["partial"]
         raise DataError(
-            f"{path}: not a planning (planbench, pddl, random) or latplan benchmark's results; "
-            "those are the ones a record summarises"
+            f"{path}: a partial run ({part.get('done')} of {part.get('of')} done, interrupted); "
+            "record a finished one"
         )
+    family, benchmark, instances, seeds, figures = _family(body, path)
     return Record(
         name=name,
+        family=family,
         benchmark=str(benchmark),
         instances=int(instances),
         seeds=tuple(seeds),
@@ -187,6 +402,8 @@ def load_all(into: str | Path) -> list[Record]:
             records.append(Record.from_json(_read(path)))
         except (KeyError, TypeError) as exc:
             raise DataError(f"{path}: not a record ({exc})") from None
+        except DataError as exc:
+            raise DataError(f"{path}: {exc}") from None
     order = list(LABELS)
     return sorted(
         records,
@@ -243,10 +460,42 @@ def _latplan(rows: Sequence[Mapping]) -> str:
     return "; ".join(parts)
 
 
+def _motion(row: Mapping) -> str:
+    e = row["episodes"]
+    text = (
+        f"{row['sim']}: {row['goal_reached']}/{e} goal reached, {row['moves_ok']}/{row['moves']} "
+        f"moves ok, {row['collided']} collided, {row['replans']} replans"
+    )
+    if row["plans_valid"] is not None:
+        text += f", {row['plans_valid']}/{e} first plans valid"
+    if row["with_faults"]:
+        text += f", {row['recovered']}/{row['with_faults']} with injected faults recovered"
+    return text + f", {row['wall_per_move_s']:.3g} s wall/move"
+
+
+def _tamp(rows: Sequence[Mapping]) -> str:
+    """Per planner and simulator: solved over every problem, then each problem's count."""
+    groups: dict[tuple[str, str], list[Mapping]] = {}
+    for r in rows:
+        groups.setdefault((r["planner"], r["sim"]), []).append(r)
+    parts = []
+    for (planner, sim), mine in groups.items():
+        solved, episodes = sum(r["solved"] for r in mine), sum(r["episodes"] for r in mine)
+        each = ", ".join(f"{r['problem']} {r['solved']}/{r['episodes']}" for r in mine)
+        collided = sum(r["collided"] for r in mine)
+        parts.append(f"{planner}, {sim}: {solved}/{episodes} solved ({each}), {collided} collided")
+    return "; ".join(parts)
+
+
 def ours(record: Record) -> str:
-    """The table's "ours" cell: valid, optimal, time (planning), or per input kind (latplan)."""
-    if record.benchmark == "latplan-40":
+    """The table's "ours" cell: valid, optimal, time (planning), per input kind (latplan), per
+    simulator (motion), per planner and simulator (tamp)."""
+    if record.family is Family.LATPLAN:
         text = _latplan(record.figures)
+    elif record.family is Family.MOTION:
+        text = "; ".join(_motion(r) for r in record.figures)
+    elif record.family is Family.TAMP:
+        text = _tamp(record.figures)
     elif len(record.figures) == 1:
         text = _planning(record.figures[0])
     else:
@@ -256,6 +505,10 @@ def ours(record: Record) -> str:
 
 
 def label(record: Record) -> str:
+    if record.family is Family.MOTION:
+        return f"Motion, {record.instances} episodes per simulator"
+    if record.family is Family.TAMP:
+        return f"Canonical problems, {record.instances} variants each"
     return f"{LABELS.get(record.benchmark, record.benchmark)}-{record.instances}"
 
 
@@ -268,10 +521,8 @@ def _machine(m: Mapping) -> str:
     )
 
 
-def render(records: Sequence[Record]) -> str:
-    """The "Current results" block, markers included (the same records give the same text)."""
+def _table(records: Sequence[Record]) -> list[str]:
     lines = [
-        START,
         "| benchmark | ours | cited beside it | commit, date | machine, load at end | command |",
         "|---|---|---|---|---|---|",
     ]
@@ -282,15 +533,26 @@ def render(records: Sequence[Record]) -> str:
             f"| {label(r)} | {ours(r)} | {cited} | {commit}, {r.date[:10]} | "
             f"{_machine(r.machine)} | `{r.command}` |"
         )
+    return lines
+
+
+def render(records: Sequence[Record]) -> str:
+    """The "Current results" block, markers included: one table per family that has records
+    (the same records give the same text)."""
+    lines = [START]
+    for family in Family:
+        mine = [r for r in records if r.family is family]
+        if mine:
+            lines += ["", f"**{TITLES[family]}**", "", *_table(mine)]
     if not records:
-        lines.append("| (no records yet: run `tamp bench record --results DIR`) | | | | | |")
+        lines += ["", "(no records yet: run `tamp bench record --results DIR`)"]
     if any(r.dirty for r in records):
         lines += [
             "",
             "**+ uncommitted changes**: that run's checkout had changes not in the commit named, "
             "so the commit alone does not reproduce it.",
         ]
-    lines.append(END)
+    lines += ["", END]
     return "\n".join(lines)
 
 
@@ -310,22 +572,99 @@ def block_of(text: str) -> str:
     return text[start : end + len(END)]
 
 
-def update(paths: Iterable[str | Path], into: str | Path, markdown: str | Path) -> list[Record]:
-    """Record each results folder of ``paths`` into ``into``, then regenerate the table in
-    ``markdown`` from every record there. Everything is read and checked before anything is
-    written. Returns the records written."""
+def studied(records: Sequence[Record]) -> list[str]:
+    """The "Families without a current record" section: each `STUDIED` family whose record
+    name is not among ``records``, the command that would record it, and its studies."""
+    names = {r.name for r in records}
+    lines = [
+        "## Families without a current record",
+        "",
+        "These families were measured, but no run of theirs has a record yet, so their figures",
+        "stand only in the studies under `docs/experiments/`, at the commits those name. To",
+        "record one, run its command (from the repository root, on a clean checkout), then",
+        "`tamp bench record --results results/NAME`. Where `bench record` cannot read the",
+        "family's results yet, the row says so.",
+        "",
+        "| family | record | command that would produce it | latest measured figures |",
+        "|---|---|---|---|",
+    ]
+    missing = [s for s in STUDIED if s.name not in names]
+    for s in missing:
+        where = ", ".join(f"[{f}]({EXPERIMENTS}/{f})" for f in s.studies)
+        reads = f"`{s.name}`" + ("" if s.readable else " (not yet readable by `bench record`)")
+        lines.append(f"| {s.title} | {reads} | `{s.command}` | {where} |")
+    if not missing:
+        lines.append("| (every family has a record) | | | |")
+    return lines
+
+
+def experiments_index(root: str | Path = ".") -> list[str]:
+    """The list of ``docs/experiments/index.md`` (its ``- [title](file): ...`` lines), the
+    links made relative to the repository root; DataError when it cannot be read."""
+    path = Path(root) / EXPERIMENTS / "index.md"
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise DataError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    items = [line for line in text.splitlines() if line.startswith("- [")]
+    return [re.sub(r"\]\(([^)/]+\.md)\)", rf"]({EXPERIMENTS}/\1)", line) for line in items]
+
+
+def page(records: Sequence[Record], root: str | Path = ".") -> str:
+    """The whole of BENCHMARKS.md: the header, `render`'s block, the notes on it, `studied`,
+    and the index of ``root``'s ``docs/experiments/``."""
+    lines = [
+        *HEADER,
+        "",
+        "## Current results",
+        "",
+        render(records),
+        "",
+        *NOTES,
+        "",
+        *studied(records),
+        "",
+        "## Experiments",
+        "",
+        f"Studies, ablations, negative results and profiles, one file per study under "
+        f"[{EXPERIMENTS}/]({EXPERIMENTS}/index.md); each names the commits its runs used and the "
+        "records it reads.",
+        "",
+        *experiments_index(root),
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def update(
+    paths: Iterable[str | Path],
+    into: str | Path,
+    markdown: str | Path,
+    readme: str | Path | None = None,
+) -> list[Record]:
+    """Record each results folder of ``paths`` into ``into``, then write ``markdown`` whole
+    (`page`, with the experiments index under ``markdown``'s folder) and regenerate the block
+    in ``readme`` (None: no README) from every record there. Everything is read and checked
+    before anything is written. Returns the records written."""
     records = [extract(f) for f in folders(paths)]
     names = [r.name for r in records]
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:
         raise DataError(f"two results folders named {', '.join(twice)}: a record is per name")
+    text = None
+    if readme is not None:
+        readme = Path(readme)
+        try:
+            text = readme.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise DataError(f"{readme}: cannot read ({exc.strerror or exc})") from None
+        block_of(text)
     markdown = Path(markdown)
-    try:
-        text = markdown.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise DataError(f"{markdown}: cannot read ({exc.strerror or exc})") from None
-    block_of(text)
+    root = markdown.parent
+    experiments_index(root)
     for r in records:
         write(r, into)
-    markdown.write_text(replace_block(text, render(load_all(into))), encoding="utf-8")
+    every = load_all(into)
+    markdown.write_text(page(every, root), encoding="utf-8")
+    if readme is not None:
+        readme.write_text(replace_block(text, render(every)), encoding="utf-8")
     return records

@@ -485,7 +485,8 @@ def _segmentation_benchmark(bench) -> None:
 def _record_command(bench) -> None:
     p = bench.add_parser(
         "record",
-        help="record benchmark results folders and regenerate BENCHMARKS.md's current table",
+        help="record benchmark results folders and regenerate BENCHMARKS.md and the README's "
+        "results table",
     )
     p.add_argument(
         "--results",
@@ -504,7 +505,14 @@ def _record_command(bench) -> None:
         "--markdown",
         default="BENCHMARKS.md",
         metavar="FILE.md",
-        help="the file whose current-results table is regenerated (%(default)s)",
+        help="the page written whole from the records and docs/experiments/index.md beside it "
+        "(%(default)s)",
+    )
+    p.add_argument(
+        "--readme",
+        default="README.md",
+        metavar="FILE.md",
+        help="the file whose current-results block is regenerated (%(default)s; '' for none)",
     )
     p.add_argument("--json", action="store_true", help="the records written, as JSON")
     p.set_defaults(func=_lazy("tamp.cli.bench.record", "record_command"))

@@ -1,8 +1,9 @@
 """``tamp bench ...``: options in, `tamp.bench` runs, tables out. One module per kind of
 benchmark: `planning` (planbench, pddl, random), `vision` (perception, latplan, poses,
 segmentation), `arm` (motion, executability), `geo` (tamp), `checker` (the sphere collision
-checker) and `record` (BENCHMARKS.md's current table); `options` holds the option groups of the
-benchmarks that sweep episodes or images (the parser's, imported without torch).
+checker) and `record` (BENCHMARKS.md and the README's results block); `options` holds the
+option groups of the benchmarks that sweep episodes or images (the parser's, imported without
+torch).
 
 Each handler turns options into configs, runs its benchmark from `tamp.bench` with a progress
 bar on stderr, prints its table (``--json``: ``results.json``'s content), and with ``--out DIR``

@@ -1,5 +1,5 @@
-"""``tamp bench record``: benchmark results folders in, committed records and BENCHMARKS.md's
-"Current results" table out (`tamp.bench.record`). Exit 0; 2 on bad input."""
+"""``tamp bench record``: benchmark results folders in, committed records, BENCHMARKS.md (whole)
+and the README's "Current results" block out (`tamp.bench.record`). Exit 0; 2 on bad input."""
 
 from __future__ import annotations
 
@@ -10,13 +10,16 @@ from tamp.bench import record
 
 
 def record_command(args: argparse.Namespace) -> int:
-    """Record ``--results`` folders into ``--into`` and regenerate ``--markdown``'s table."""
-    written = record.update(args.results, args.into, args.markdown)
+    """Record ``--results`` folders into ``--into``, write ``--markdown`` and regenerate
+    ``--readme``'s block."""
+    readme = args.readme or None
+    written = record.update(args.results, args.into, args.markdown, readme)
     if args.json:
         print(json.dumps([r.to_json() for r in written], indent=2))
         return 0
     for r in written:
         dirty = " (uncommitted changes)" if r.dirty else ""
         print(f"{r.name}: {record.label(r)} at {r.commit[:7]}{dirty}: {record.ours(r)}")
-    print(f"wrote {len(written)} record(s) to {args.into}; table regenerated in {args.markdown}")
+    also = f" and the table in {readme}" if readme else ""
+    print(f"wrote {len(written)} record(s) to {args.into}; regenerated {args.markdown}{also}")
     return 0

@@ -154,7 +154,7 @@ def test_other_folders_are_refused_in_one_line(tmp_path):
         record.extract(tmp_path / "motion")
     body = {"summary": {}, "machine": {"command": "tamp bench motion", "commit": COMMIT}}
     (tmp_path / "motion" / "results.json").write_text(json.dumps(body))
-    with pytest.raises(DataError, match=r"not a planning .* or latplan"):
+    with pytest.raises(DataError, match=r"not the results of a benchmark .*families: planning"):
         record.extract(tmp_path / "motion")
     (tmp_path / "motion" / "results.json").write_bytes(b"\x89PNG\x00")
     with pytest.raises(DataError, match="not JSON"):
@@ -203,43 +203,144 @@ def test_a_latplan_record_reads_true_states_and_images_apart(tmp_path):
     assert "31/40 optimal" in record.render([r])  # the paper's figure beside ours
 
 
-def test_bench_record_writes_records_and_regenerates_only_the_block(tmp_path, capsys):
+def _experiments(root: Path) -> None:
+    """An experiments index under ``root`` (what `record.page` lists last)."""
+    (root / "docs" / "experiments").mkdir(parents=True)
+    index = "# Experiments\n\nintro\n\n- [A study](a.md): what it measured.\n"
+    (root / "docs" / "experiments" / "index.md").write_text(index)
+
+
+def test_bench_record_writes_the_page_whole_and_only_the_readme_block(tmp_path, capsys):
     _results(tmp_path / "runs" / "blocks")
     _results(tmp_path / "runs" / "more", seeds=(0, 1))
-    md = tmp_path / "B.md"
-    md.write_text(f"# Title\n\nbefore\n{record.START}\nstale\n{record.END}\nafter\n")
+    _experiments(tmp_path)
+    md, readme = tmp_path / "B.md", tmp_path / "R.md"
+    md.write_text("stale, hand-typed\n")
+    readme.write_text(f"# Title\n\nbefore\n{record.START}\nstale\n{record.END}\nafter\n")
     into = tmp_path / "current"
     argv = ["bench", "record", "--results", str(tmp_path / "runs"), "--into", str(into)]
-    assert main([*argv, "--markdown", str(md)]) == 0  # a parent folder: each subfolder
+    files = ["--markdown", str(md), "--readme", str(readme)]
+    assert main([*argv, *files]) == 0  # a parent folder: each subfolder
     assert sorted(p.name for p in into.iterdir()) == ["blocks.json", "more.json"]
-    text = md.read_text()
+    records = record.load_all(into)
+    page = md.read_text()
+    assert page == record.page(records, tmp_path) and "stale" not in page
+    assert record.block_of(page) == record.render(records)
+    assert "[A study](docs/experiments/a.md): what it measured." in page  # links from the root
+    text = readme.read_text()
     assert text.startswith("# Title\n\nbefore\n") and text.endswith("\nafter\n")
-    assert "stale" not in text and record.block_of(text) == record.render(record.load_all(into))
+    assert "stale" not in text and record.block_of(text) == record.render(records)
     assert "wrote 2 record(s)" in capsys.readouterr().out
-    assert main(["bench", "record", "--into", str(into), "--markdown", str(md)]) == 0
-    assert md.read_text() == text  # regenerating from the same records changes nothing
+    assert main(["bench", "record", "--into", str(into), *files]) == 0
+    assert (md.read_text(), readme.read_text()) == (page, text)  # same records, same text
 
 
 def test_bench_record_checks_everything_before_writing(tmp_path, capsys):
     _results(tmp_path / "blocks")
-    md = tmp_path / "B.md"
-    md.write_text("# no markers\n")
+    _experiments(tmp_path)
+    md, readme = tmp_path / "B.md", tmp_path / "R.md"
+    readme.write_text("# no markers\n")
     into = tmp_path / "current"
     argv = ["bench", "record", "--results", str(tmp_path / "blocks"), "--into", str(into)]
-    assert main([*argv, "--markdown", str(md)]) == 2
+    assert main([*argv, "--markdown", str(md), "--readme", str(readme)]) == 2
     assert "no current-results markers" in capsys.readouterr().err
-    assert not into.exists() and md.read_text() == "# no markers\n"
-    assert main([*argv, "--markdown", str(tmp_path / "missing.md")]) == 2
+    assert not into.exists() and not md.exists() and readme.read_text() == "# no markers\n"
+    assert main([*argv, "--markdown", str(md), "--readme", str(tmp_path / "missing.md")]) == 2
+    elsewhere = tmp_path / "elsewhere" / "B.md"  # no docs/experiments/index.md beside it
+    elsewhere.parent.mkdir()
+    assert main([*argv, "--markdown", str(elsewhere), "--readme", ""]) == 2
+    assert "index.md: cannot read" in capsys.readouterr().err and not into.exists()
     assert main(["bench", "record", "--results", str(tmp_path / "nothing")]) == 2
     assert "no results.json" in capsys.readouterr().err
 
 
-def test_the_current_table_in_benchmarks_md_is_the_one_the_records_give():
-    """BENCHMARKS.md's current table cannot drift from ``results/current``: regenerate it with
-    ``tamp bench record`` (from the repository root) after changing a record."""
+def test_benchmarks_md_is_the_page_the_records_give():
+    """BENCHMARKS.md, all of it, cannot drift from ``results/current`` and the experiments
+    index: regenerate it with ``tamp bench record`` (from the repository root) after changing
+    a record or a study."""
     records = record.load_all(REPO / "results" / "current")
     assert records, "results/current holds no records"
     for r in records:
         assert r.command.startswith("tamp bench ") and len(r.commit) == 40, r.name
     text = (REPO / "BENCHMARKS.md").read_text(encoding="utf-8")
-    assert record.block_of(text) == record.render(records)
+    assert text == record.page(records, REPO), "BENCHMARKS.md differs: run tamp bench record"
+
+
+def test_the_readme_results_block_is_the_one_the_records_give():
+    records = record.load_all(REPO / "results" / "current")
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    assert record.block_of(text) == record.render(records), "run tamp bench record"
+
+
+def test_every_study_is_indexed_and_every_family_without_a_record_names_studies_that_exist():
+    folder = REPO / record.EXPERIMENTS
+    studies = {p.name for p in folder.glob("*.md")} - {"index.md"}
+    listed = record.experiments_index(REPO)
+    assert sorted(studies) == sorted(
+        line.split("](docs/experiments/")[1].split(")")[0] for line in listed
+    )
+    for s in record.STUDIED:
+        assert s.command.startswith("tamp bench ") and f"--out results/{s.name}" in s.command
+        assert set(s.studies) <= studies, s.name
+    for path in folder.glob("*.md"):  # each study opens with a title and a header paragraph
+        lines = path.read_text(encoding="utf-8").splitlines()
+        assert lines[0].startswith("# ") and lines[1] == "" and lines[2], path.name
+
+
+@pytest.mark.sim
+def test_a_motion_run_is_recorded_with_its_figures_per_simulator(tmp_path):
+    """A real (tiny) `bench motion` run: one random 3-block episode in PyBullet, about 10 s."""
+    out = tmp_path / "motion"
+    argv = ["bench", "motion", "--blocks", "3", "--n", "1", "--sim", "pybullet"]
+    assert main([*argv, "--no-progress", "--out", str(out)]) == 0
+    summary = json.loads((out / "results.json").read_text())["summary"]["pybullet"]
+    r = record.extract(out)
+    assert (r.family, r.benchmark, r.instances, r.seeds) == (
+        record.Family.MOTION,
+        "motion",
+        1,
+        (0,),
+    )
+    (row,) = r.figures
+    assert row["sim"] == "pybullet" and set(row) == set(record.MOTION_FIGURES)
+    assert all(row[k] == summary[k] for k in record.MOTION_FIGURES if k != "sim")
+    goal = f"pybullet: {summary['goal_reached']}/1 goal reached"
+    assert record.ours(r).startswith(goal) and f"{summary['moves_ok']}/{summary['moves']}" in (
+        record.ours(r)
+    )
+    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+    table = record.render([r])
+    assert record.TITLES[record.Family.MOTION] in table and "Planning" not in table
+
+
+@pytest.mark.sim
+def test_a_tamp_run_is_recorded_with_its_figures_per_problem_planner_and_simulator(tmp_path):
+    """A real (tiny) `bench tamp` run: one variant of `blocked`, ours, PyBullet, about 6 s."""
+    out = tmp_path / "tamp"
+    argv = ["bench", "tamp", "--problems", "blocked", "--n", "1", "--sim", "pybullet"]
+    argv += ["--planner", "motion-aware", "--workers", "1", "--no-progress", "--out", str(out)]
+    assert main(argv) == 0
+    (summary,) = json.loads((out / "results.json").read_text())["summary"]
+    r = record.extract(out)
+    assert (r.family, r.benchmark, r.instances, r.seeds) == (record.Family.TAMP, "tamp", 1, (0,))
+    assert r.figures == ({k: summary[k] for k in record.TAMP_FIGURES},)
+    solved, collided = summary["solved"], summary["collided"]
+    assert record.ours(r) == (
+        f"motion-aware, pybullet: {solved}/1 solved (blocked {solved}/1), {collided} collided"
+    )
+    assert record.label(r) == "Canonical problems, 1 variants each"
+    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+
+
+def test_a_partial_run_and_a_record_of_an_unknown_family_are_refused(tmp_path):
+    folder = _results(tmp_path / "cut")
+    body = json.loads((folder / "results.json").read_text()) | {"partial": {"done": 2, "of": 4}}
+    (folder / "results.json").write_text(json.dumps(body))
+    with pytest.raises(DataError, match=r"a partial run \(2 of 4 done"):
+        record.extract(folder)
+    into = tmp_path / "current"
+    record.write(record.extract(_results(tmp_path / "blocks")), into)
+    body = json.loads((into / "blocks.json").read_text()) | {"family": "dance"}
+    (into / "blocks.json").write_text(json.dumps(body))
+    with pytest.raises(DataError, match=r"blocks\.json: family 'dance' is not one of planning"):
+        record.load_all(into)
