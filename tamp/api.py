@@ -59,6 +59,7 @@ from tamp.api_args import (
     Kind,
     checked,
 )
+from tamp.camera.modes import ImageScene
 from task import data
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
@@ -602,7 +603,7 @@ def plan_images(
     )
     from task.domains import blocksworld_pddl
 
-    scenes = ("cubes", "latplan")
+    scenes = [s.value for s in ImageScene]
     if scene not in scenes:
         raise TampError(f"unknown image scene {one_of(scene, scenes)}")
     given = {"init": init, "goal": goal}
@@ -612,7 +613,7 @@ def plan_images(
     ]
     labels = [f"<{k} image>" if isinstance(im, np.ndarray) else str(im) for k, im in given.items()]
     if checkpoint is None:
-        name = "support-latplan.pt" if scene == "latplan" else CHECKPOINT.name
+        name = "support-latplan.pt" if scene == ImageScene.LATPLAN else CHECKPOINT.name
         checkpoint = CHECKPOINT.with_name(name)
     model, meta = load_checkpoint(checkpoint, scene)
     check_sizes(pair, labels, model)

@@ -24,7 +24,7 @@ import torch
 from perception.perceive import Perceiver
 from perception.segment import present
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
-from tamp.camera.modes import Crisp
+from tamp.camera.modes import Crisp, ImageScene
 from tamp.scene import CAMERA_COLOURS, PALETTE
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
@@ -33,12 +33,11 @@ from task.planner import plan
 from task.problem import TABLE, Action, PlanResult, Problem
 
 RGB = tuple[float, float, float]
-IMAGE_SCENES = ("cubes", "latplan")  # the scenes whose images `scene_colours` names
 
 
 def scene_colours(scene: str) -> tuple[tuple[str, RGB], ...]:
     """The block colours a scene's images may show, (name, RGB in [0, 1]) in palette order."""
-    if scene == "latplan":
+    if scene == ImageScene.LATPLAN:
         from tamp.camera.latplan import COLOURS
 
         return COLOURS
@@ -48,7 +47,7 @@ def scene_colours(scene: str) -> tuple[tuple[str, RGB], ...]:
 def input_size(scene: str) -> tuple[int, int]:
     """(H, W): the size of the images the scene's perception model reads (its renders: the
     camera's 320x240 for ``cubes``, LatPlan's 150x100 for ``latplan``)."""
-    if scene == "latplan":
+    if scene == ImageScene.LATPLAN:
         from tamp.camera.latplan import SIZES
 
         return SIZES[0][1], SIZES[0][0]
@@ -110,7 +109,7 @@ def check_scene(images: Sequence[np.ndarray], paths: Sequence[str], scene: str) 
     that reads them. The images are segmented for every image scene's colours at once (the
     chosen scene's own colours first, so a name both share is looked for as this scene's)."""
     looked = dict(scene_colours(scene))
-    for other in IMAGE_SCENES:
+    for other in ImageScene:
         for name, rgb in scene_colours(other):
             looked.setdefault(name, rgb)
     names, rgbs = list(looked), list(looked.values())
@@ -122,7 +121,7 @@ def check_scene(images: Sequence[np.ndarray], paths: Sequence[str], scene: str) 
         if not foreign:
             continue
         readers = [
-            s for s in IMAGE_SCENES if s != scene and set(seen) <= dict(scene_colours(s)).keys()
+            s for s in ImageScene if s != scene and set(seen) <= dict(scene_colours(s)).keys()
         ]
         fix = (
             f"read them with --image-scene {readers[0]}"

@@ -30,3 +30,11 @@ class Crisp(enum.StrEnum):
 
     TRUE = "true"
     PERCEIVED = "perceived"
+
+
+class ImageScene(enum.StrEnum):
+    """Whose objects an image shows, and so which colours the reading names: CUBES, the
+    project's rendered cubes; LATPLAN, LatPlan's blocks-world renders (cubes and cylinders)."""
+
+    CUBES = "cubes"
+    LATPLAN = "latplan"

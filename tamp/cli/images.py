@@ -19,6 +19,7 @@ from perception import CHECKPOINT
 from perception.perceive import Perceiver
 from perception.train import load_checkpoint
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
+from tamp.camera.modes import ImageScene
 from tamp.cli import report
 from tamp.cli.options import planner_config
 from tamp.cli.recorded import checkpoint as check_checkpoint
@@ -39,7 +40,7 @@ def _checkpoint(args: argparse.Namespace) -> Path:
         if not path.is_file():
             raise TampError(f"no perception checkpoint at {path} (--checkpoint)")
         return path
-    if args.image_scene == "latplan":
+    if args.image_scene == ImageScene.LATPLAN:
         if not LATPLAN_CHECKPOINT.is_file():
             raise TampError(
                 f"no LatPlan perception checkpoint at {LATPLAN_CHECKPOINT} (is the package "

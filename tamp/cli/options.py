@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 
 from tamp.bench.official import OFFICIAL, default_data
-from tamp.camera.modes import Crisp, Perception
+from tamp.camera.modes import Crisp, ImageScene, Perception
 from tamp.cli.types import (
     MAX_ITERS,
     MAX_RESTARTS,
@@ -33,7 +33,7 @@ from task.domains import names
 from task.errors import TampError
 
 SCENES = ("tabletop", "shelf", "clutter", "cramped")  # `tamp.obstacles` (no simulator import)
-IMAGE_SCENES = ("cubes", "latplan")  # whose blocks an image shows (`tamp.camera.image_pair`)
+IMAGE_SCENES = [s.value for s in ImageScene]  # whose blocks an image shows
 
 # every domain's goal-loss kinds: "default" (the domain's own), "atoms" (the paper's CE), then
 # Blocksworld's "towers", Logistics' and Sokoban's "potential", the STRIPS lift's "ff" (its

@@ -13,6 +13,7 @@ from pathlib import Path
 from tqdm import tqdm
 
 from perception import CHECKPOINT
+from tamp.camera.modes import ImageScene
 from tamp.cli.recorded import checkpoint, dataset_config, eval_config, out_file, train_config
 from task.errors import TampError
 
@@ -28,7 +29,7 @@ def dataset_command(args: argparse.Namespace) -> int:
     recorded = dataset_config(args)  # refused combinations: before any work
     out_file(args.out)
     sims = tuple(recorded["sims"])
-    if args.image_scene == "latplan":
+    if args.image_scene == ImageScene.LATPLAN:
         return _latplan_dataset(args, sims)
     with tqdm(
         total=args.n, desc="render", unit="image", file=sys.stderr, disable=not args.progress

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from perception import CHECKPOINT
 from tamp.bench.official import default_data
+from tamp.camera.modes import ImageScene
 from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
 from tamp.geo.modes import Observation
@@ -492,7 +493,7 @@ def segmentation_config(args: argparse.Namespace) -> dict:
 
 def dataset_config(args: argparse.Namespace) -> dict:
     """``perception dataset``."""
-    if args.image_scene == "latplan" and (args.min_blocks, args.max_blocks) != (3, 6):
+    if args.image_scene == ImageScene.LATPLAN and (args.min_blocks, args.max_blocks) != (3, 6):
         raise TampError("--min-blocks/--max-blocks with --image-scene latplan: it has 4 blocks")
     if args.min_blocks > args.max_blocks:
         raise TampError(
@@ -503,7 +504,9 @@ def dataset_config(args: argparse.Namespace) -> dict:
         "seed": args.seed,
         "sims": list(sim_list(args.sim)),
         "image_scene": args.image_scene,
-        "blocks": None if args.image_scene == "latplan" else [args.min_blocks, args.max_blocks],
+        "blocks": None
+        if args.image_scene == ImageScene.LATPLAN
+        else [args.min_blocks, args.max_blocks],
     }
 
 
