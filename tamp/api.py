@@ -534,29 +534,24 @@ def run_geometric(
     ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
     (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through
     by the motion-aware planner. Returns a `tamp.geo.episode.GeoReport`."""
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.scene_file import scene_episode
-    from tamp.geo.search import SearchConfig
-    from tamp.geo.types import GeoLimits
 
     if (domain is None) != (binding is None):
         raise TampError("run_geometric: domain and binding go together (a bound domain)")
     rules = None if domain is None else (domain, binding)
     task = scene_episode(str(scene), goal, planner, rules)
-    limits = GeoLimits()  # tamp run's and bench tamp's
-    return run_geo_episode(
-        task.scene,
-        task.goal,
-        task.planner,
-        sim,
+    # the limits are GeoLimits' defaults, tamp run's and bench tamp's
+    config = GeoEpisodeConfig(
+        planner=task.planner,
+        sim=sim,
         seed=seed,
-        planner_config=SearchConfig(seed=seed, max_time_s=limits.planning_s),
-        video=video,
-        max_moves=limits.max_moves,
-        max_replans=limits.max_replans,
-        domain=task.domain,
         observation=observation,
+        video=video,
+        domain=task.domain,
     )
+    return run_geo_episode(task.scene, task.goal, config)
 
 
 # ------------------------------------------------------------------------------- images

@@ -194,8 +194,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     the goal is reached (ground truth)."""
     import numpy as np
 
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.search import SearchConfig
+    from tamp.geo.types import GeoLimits
     from tamp.loop.faults import Injection
 
     out = _out_dir(args.out)
@@ -206,7 +208,20 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     # index from the seed before the episode (the episode's `inject` takes the indices)
     p = Injection.parse(args.inject).drop
     draws = np.random.default_rng(args.seed).random(recorded["max_moves"])
-    drops = [k for k, u in enumerate(draws) if u < p]
+    drops = tuple(k for k, u in enumerate(draws) if u < p)
+    limit_s = recorded["time_limit_s"]
+    config = GeoEpisodeConfig(
+        planner=task.planner,
+        sim=args.sim,
+        seed=args.seed,
+        limits=GeoLimits(recorded["max_moves"], recorded["max_replans"], limit_s),
+        search=SearchConfig(seed=args.seed, max_time_s=limit_s),
+        observation=args.observe,
+        grasp=args.grasp,
+        drops=drops,
+        video=video,
+        domain=task.domain,
+    )
     if not args.json:
         print(
             f"running {task.scene.name} ({len(task.scene.objects)} objects) in {args.sim} "
@@ -219,20 +234,7 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         )
     with torch_threads(EPISODE_THREADS):
         report = run_geo_episode(
-            task.scene,
-            task.goal,
-            task.planner,
-            args.sim,
-            seed=args.seed,
-            planner_config=SearchConfig(seed=args.seed, max_time_s=recorded["time_limit_s"]),
-            video=video,
-            max_moves=recorded["max_moves"],
-            max_replans=recorded["max_replans"],
-            inject={"drop": drops},
-            grasp=args.grasp,
-            domain=task.domain,
-            observation=args.observe,
-            on_event=None if args.json else _say,
+            task.scene, task.goal, config, on_event=None if args.json else _say
         )
     body = {"report": _jsonable(asdict(report)), "config": recorded}
     written = []

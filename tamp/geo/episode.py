@@ -44,10 +44,11 @@ import numpy as np
 
 from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
+from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
@@ -210,34 +211,22 @@ def _with_poses(scene: Scene, poses: dict[str, Pose]) -> Scene:
 def run_geo_episode(
     scene: Scene,
     goal: Goal,
-    planner: str,
-    backend: str = "pybullet",
-    seed: int = 0,
-    planner_config: SearchConfig | None = None,
-    video: str | Path | None = None,
-    max_moves: int = GeoLimits.max_moves,
-    max_replans: int = GeoLimits.max_replans,
-    inject: dict | None = None,
+    config: GeoEpisodeConfig = GeoEpisodeConfig(),
+    *,
     tools: Tools | None = None,
-    grasp: str = "friction",
-    domain: tuple[str, ...] | None = None,
-    observation: str = "state",
     on_event: Callable[[str], None] | None = None,
 ) -> GeoReport:
-    """Run ``planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
-    ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
-    `SearchConfig` with ``seed`` and `GeoLimits`' ``planning_s``); ``max_moves`` and
-    ``max_replans``: the episode's limits (`GeoLimits`' defaults); ``video``: a file path to
-    record the episode to (.mp4 or .gif); ``inject``: fault injection, ``{"drop": [k, ...]}``
-    opens the gripper mid-transit on those move indices; ``tools``: reuse an IK solver and
-    collision model (else built and closed here); ``domain``: ``(pddl_domain_text,
-    binding_text)`` the motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower
-    of Hanoi by its rules); refused for the other planners, which plan over the moves the
-    geometry allows. ``observation``: the pose sensor, one of `OBSERVATIONS` (``"camera"``:
-    `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
-    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report.
-    Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an episode
-    on one thread (`tamp.sweep.torch_threads`)."""
+    """Run ``config.planner`` (one of `PLANNERS`) on ``scene`` toward ``goal`` in simulator
+    ``config.sim`` (see the module docstring) with the settings of ``config`` (a
+    `GeoEpisodeConfig`: seed, limits, planner budgets, pose sensor, grasp, injected drops,
+    video, a PDDL domain for the motion-aware planner). ``tools``: reuse an IK solver and
+    collision model (else built and closed here). ``on_event``: called with a line after each
+    plan and each move (progress, e.g. for ``tamp run``); what it is told is also in the
+    report. Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an
+    episode on one thread (`tamp.sweep.torch_threads`)."""
+    planner, backend, seed = config.planner, config.sim, config.seed
+    observation, domain, video = config.observation, config.domain, config.video
+    max_moves, max_replans = config.limits.max_moves, config.limits.max_replans
     say = on_event or (lambda line: None)
     if observation not in OBSERVATIONS:
         raise TampError(f"unknown observation {one_of(observation, OBSERVATIONS)}")
@@ -248,9 +237,8 @@ def run_geo_episode(
                 f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
             )
         plan_fn = partial(plan_fn, domain=domain)
-    config = planner_config or SearchConfig(seed=seed, max_time_s=GeoLimits.planning_s)
-    inject = inject or {}
-    drops = set(inject.get("drop", ()))
+    search = config.search_config()
+    drops = set(config.drops)
     wall0 = time.perf_counter()
     own = tools is None
     tools = tools or Tools()
@@ -260,13 +248,13 @@ def run_geo_episode(
         tools.collision,
         pick_place=tools.pick_place,
         guard=replace(tools.guard, plan=True),
-        choices=config.choices,
+        choices=search.choices,
     )
     if planner == "soft":
         runner.choices = ("top",)  # today's executor: top-down grasps only
     from tamp.geo.sim import open_sim
 
-    sim = open_sim(scene, backend, video=video is not None, grasp=grasp)
+    sim = open_sim(scene, backend, video=video is not None, grasp=config.grasp)
     sim.truth.lock()
     camera = None
     if observation == "camera":
@@ -286,7 +274,7 @@ def run_geo_episode(
                 status = EpisodeStatus.GOAL_REACHED
                 break
             t0 = time.perf_counter()
-            plan = plan_fn(world, goal, tools, config)
+            plan = plan_fn(world, goal, tools, search)
             plan_times.append(time.perf_counter() - t0)
             plan_stats.append(dict(plan.stats))
             say(

@@ -108,29 +108,26 @@ def items(
 
 def play(item: Item) -> dict:
     """One episode's row (`ROW_COLUMNS`), in the process that runs it."""
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
-    from tamp.geo.search import SearchConfig
     from tamp.world.canonical import generate
 
     made = generate(item.problem, item.variant)
     t0 = time.perf_counter()
     # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
     domain = made.domain if item.planner == "motion-aware" else None
+    config = GeoEpisodeConfig(
+        planner=item.planner,
+        sim=item.sim,
+        seed=item.seed,
+        limits=LIMITS,
+        observation=item.observe,
+        video=item.video,
+        domain=domain,
+    )
     try:
         with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
-            report = run_geo_episode(
-                made.scene,
-                made.goal,
-                item.planner,
-                item.sim,
-                seed=item.seed,
-                planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS.planning_s),
-                video=item.video,
-                max_moves=LIMITS.max_moves,
-                max_replans=LIMITS.max_replans,
-                domain=domain,
-                observation=item.observe,
-            )
+            report = run_geo_episode(made.scene, made.goal, config)
     except TampError as exc:  # the episode's error is its row; the other episodes go on
         return _error_row(item, made.note, str(exc), time.perf_counter() - t0)
     errors = report.pose_errors

@@ -46,12 +46,13 @@ def test_items_carry_the_pose_sensor():
 
 
 def test_an_unknown_observation_is_refused_naming_the_valid_ones():
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.world.canonical import generate
 
     made = generate("blocked", 0)
     with pytest.raises(TampError, match="state, camera"):
-        run_geo_episode(made.scene, made.goal, "soft", observation="lidar")
+        run_geo_episode(made.scene, made.goal, GeoEpisodeConfig("soft", observation="lidar"))
 
 
 @pytest.mark.sim
