@@ -533,7 +533,7 @@ def run_geometric(
     motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
     ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
     (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through
-    by the motion-aware planner. Returns a `tamp.geo.episode.GeoReport`."""
+    by the motion-aware planner. Returns the `tamp.loop.EpisodeReport` both episodes report in."""
     from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.scene_file import scene_episode

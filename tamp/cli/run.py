@@ -25,7 +25,6 @@ import json
 import math
 import sys
 import time
-from dataclasses import asdict
 from pathlib import Path
 
 from tamp.cli.recorded import (
@@ -36,7 +35,8 @@ from tamp.cli.recorded import (
     run_config,
     scene_run,
 )
-from tamp.loop import Episode, EpisodeReport
+from tamp.episode_report import EpisodeReport
+from tamp.loop import Episode
 from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads
@@ -170,13 +170,12 @@ def run_command(args: argparse.Namespace) -> int:
                 written.append(video.path.name)
         except TampError as exc:  # the episode's outcome and report stand without the video
             print(f"warning: {exc}", file=sys.stderr)
-    body = report.to_json()
-    body["config"] = recorded
+    body = report_json(report, recorded)
     if out is not None:
-        (out / "report.json").write_text(json.dumps(body, indent=2))
+        (out / "report.json").write_text(body)
         written.append("report.json")
     if args.json:
-        print(json.dumps(body, indent=2))
+        print(body)
     else:
         print("\n".join(summary_lines(report)))
         if written:
@@ -236,29 +235,36 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         report = run_geo_episode(
             task.scene, task.goal, config, on_event=None if args.json else _say
         )
-    body = {"report": _jsonable(asdict(report)), "config": recorded}
+    body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
         written.append(video.name)
     if out is not None:
-        (out / "report.json").write_text(json.dumps(body, indent=2, allow_nan=False, default=str))
+        (out / "report.json").write_text(body)
         written.append("report.json")
     if args.json:
-        print(json.dumps(body, indent=2, allow_nan=False, default=str))
+        print(body)
     else:
         print("\n".join(geo_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
-    return 0 if report.reached else 1
+    return 0 if report.reached_goal else 1
 
 
 def _say(text: str) -> None:
     print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
 
-def geo_lines(report) -> list[str]:
-    """A `tamp.geo.episode.GeoReport` as the lines ``tamp run`` prints: one per move, then the
-    outcome."""
+def report_json(report: EpisodeReport, recorded: dict) -> str:
+    """``report.json`` of either episode: the report's fields (`EpisodeReport.to_json`, the
+    same top-level keys for both) and ``config``, the recorded configuration."""
+    body = {**report.to_json(), "config": recorded}
+    return json.dumps(_jsonable(body), indent=2, allow_nan=False, default=str)
+
+
+def geo_lines(report: EpisodeReport) -> list[str]:
+    """A geometric episode's `EpisodeReport` as the lines ``tamp run`` prints: one per move,
+    then the outcome."""
     lines = []
     for k, m in enumerate(report.moves, 1):
         lines.append(f"  {k:2d}. {m.move}: {'ok' if m.ok else 'FAILED ' + m.failure.value}")
@@ -267,11 +273,11 @@ def geo_lines(report) -> list[str]:
     return [
         *lines,
         f"{report.status.value}{reason}; goal reached (ground truth): "
-        f"{'yes' if report.reached else 'no'}",
+        f"{'yes' if report.reached_goal else 'no'}",
         f"moves {ok}/{len(report.moves)} ok, {report.replans} replans, motion failures "
         f"{report.motion_failures}, collisions {report.collisions}",
-        f"planning {report.planning_time_s:.2f} s ({len(report.plan_times_s)} calls), sim "
-        f"{report.execution_time_s:.1f} s, wall {report.wall_s:.1f} s, arm path "
+        f"planning {report.plan_time_s:.2f} s ({len(report.plan_times_s)} calls), sim "
+        f"{report.sim_time_s:.1f} s, wall {report.wall_time_s:.1f} s, arm path "
         f"{report.arm_path_rad:.2f} rad",
     ]
 

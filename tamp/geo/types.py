@@ -72,6 +72,9 @@ class GeoMove:
         x, y, _ = self.place.xyz
         return f"move {self.obj} -> {self.place.target} at ({x:.3f}, {y:.3f}){how}"
 
+    def __str__(self) -> str:
+        return self.text()
+
 
 class GeoStatus(enum.Enum):
     """How a planner ended: SOLVED; UNSOLVABLE (no plan exists within the discretised grasp and

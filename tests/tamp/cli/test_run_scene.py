@@ -148,9 +148,9 @@ def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
     argv = ["run", "--scene", str(path), "--goal", "(in a tray)", "--out", str(out), "--no-video"]
     assert main(argv) == 0
     report = json.loads((out / "report.json").read_text())
-    assert report["report"]["reached"] and report["report"]["collisions"] == 0
-    assert report["report"]["status"] == "goal_reached"  # as the Blocksworld loop spells it
-    assert [m["move"].split(" at ")[0] for m in report["report"]["moves"]] == ["move a -> tray"]
+    assert report["reached_goal"] and report["collisions"] == 0
+    assert report["status"] == "goal_reached"  # as the Blocksworld loop spells it
+    assert [m["move"].split(" at ")[0] for m in report["moves"]] == ["move a -> tray"]
     assert report["config"]["executor"] == "geometric"
     printed = capsys.readouterr()
     assert "goal reached (ground truth): yes" in printed.out and "wrote report.json" in printed.out
@@ -188,6 +188,6 @@ def test_the_python_api_runs_the_same_geometric_episode(tmp_path):
     path = tmp_path / "s.json"
     path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
     report = api.run_geometric(path, "(in a tray)", sim="mujoco")
-    assert report.reached and report.backend == "mujoco" and report.planner == "motion-aware"
+    assert report.reached_goal and report.sim == "mujoco" and report.planner == "motion-aware"
     with pytest.raises(api.TampError, match="needs --goal"):
         api.run_geometric(path)

@@ -99,7 +99,7 @@ def test_ours_reaches_the_goal_in_pybullet_without_a_collision(problem):
         domain=made.domain,
     )
     report = run_geo_episode(made.scene, made.goal, config, tools=tools())
-    assert report.reached, (report.status, report.reason)
+    assert report.reached_goal, (report.status, report.reason)
     assert report.collisions == 0 and report.touched == {}
 
 

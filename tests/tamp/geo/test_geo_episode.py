@@ -24,13 +24,13 @@ def test_search_then_check_reaches_the_goal_in_pybullet_without_a_collision():
     s = hemmed()
     config = GeoEpisodeConfig("search-then-check", "pybullet", search=SMALL)
     report = run_geo_episode(s, parse_goal("(in t goal)", s), config, tools=tools())
-    assert report.reached and report.status is EpisodeStatus.GOAL_REACHED, report
+    assert report.reached_goal and report.status is EpisodeStatus.GOAL_REACHED, report
     assert report.collisions == 0 and report.touched == {}
     assert report.motion_failures == 0
     assert [m.move.split()[1] for m in report.moves][-1] == "t"
     assert report.moves[0].move.split()[1] in {"w", "n"}
     assert report.plan_length == 2 and report.arm_path_rad > 0
-    assert report.execution_time_s > 0 and len(report.plan_times_s) == 1
+    assert report.sim_time_s > 0 and len(report.plan_times_s) == 1
 
 
 @pytest.mark.sim
@@ -38,7 +38,7 @@ def test_task_only_planning_fails_on_it_and_says_why():
     s = hemmed()
     config = GeoEpisodeConfig("soft", "pybullet", limits=GeoLimits(max_replans=1), search=SMALL)
     report = run_geo_episode(s, parse_goal("(in t goal)", s), config, tools=tools())
-    assert not report.reached and report.status is EpisodeStatus.REPLAN_BUDGET
+    assert not report.reached_goal and report.status is EpisodeStatus.REPLAN_BUDGET
     assert {m.failure for m in report.moves} == {Failure.COLLISION}
     assert all(m.move.startswith("move t -> goal") for m in report.moves)
     assert report.collisions == 0 and report.arm_path_rad == 0  # refused before moving
