@@ -184,10 +184,17 @@ def test_the_episode_starts_where_the_scene_file_puts_the_objects(tmp_path):
 @pytest.mark.sim
 def test_the_python_api_runs_the_same_geometric_episode(tmp_path):
     from tamp import api
+    from tamp.geo.config import GeoEpisodeConfig
 
     path = tmp_path / "s.json"
     path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
-    report = api.run_geometric(path, "(in a tray)", sim="mujoco")
+    report = api.run(path, "(in a tray)", sim="mujoco")
     assert report.reached_goal and report.sim == "mujoco" and report.planner == "motion-aware"
+    # a loaded Scene, with the geometric episode's config: its simulator and its planner
+    loaded = api.load_scene(path)
+    report = api.run(loaded, "(in a tray)", GeoEpisodeConfig(sim="pybullet"))
+    assert report.reached_goal and report.sim == "pybullet" and report.problem == "test"
+    report = api.run(loaded, "(in a tray)", GeoEpisodeConfig(planner="search-then-check"))
+    assert report.planner == "search-then-check"
     with pytest.raises(api.TampError, match="needs --goal"):
-        api.run_geometric(path)
+        api.run(path)

@@ -92,7 +92,7 @@ def test_a_goal_the_binding_cannot_write_is_refused(tmp_path, capsys):
 def test_the_python_api_runs_the_example_domain_in_mujoco():
     from tamp import api
 
-    report = api.run_geometric("tray", GOAL, sim="mujoco", domain=DOMAIN, binding=BINDING)
+    report = api.run("tray", GOAL, sim="mujoco", domain=DOMAIN, binding=BINDING)
     assert report.reached_goal and report.collisions == 0
 
 
@@ -101,4 +101,4 @@ def test_the_api_refuses_a_domain_without_its_binding():
     from task.errors import TampError
 
     with pytest.raises(TampError, match="domain and binding go together"):
-        api.run_geometric("tray", GOAL, domain=DOMAIN)
+        api.run("tray", GOAL, domain=DOMAIN)

@@ -102,7 +102,7 @@ def test_a_corrected_place_runs_only_where_the_guard_finds_it_free():
 
 
 def test_the_episode_limits_default_to_geo_limits():
-    """One home for the limits ``tamp run``, ``tamp bench tamp`` and `tamp.api.run_geometric`
+    """One home for the limits ``tamp run``, ``tamp bench tamp`` and `tamp.api.run`
     run with: the episode config's defaults are `GeoLimits`', and its planner's time too."""
     import inspect
 
