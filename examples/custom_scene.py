@@ -56,7 +56,7 @@ def main(sim: str = "pybullet") -> None:
         print(f"{scene.name}: {len(scene.objects)} objects, {len(scene.obstacles)} obstacle")
         atoms = " ".join(facts.text().splitlines())  # (on b a) (ontable a) ...
         print(f"read from the geometry: {atoms}")
-        report = api.run_scene(path, GOAL, sim=sim, seed=0)
+        report = api.run(path, GOAL, sim=sim, seed=0)  # cubes: the Blocksworld loop runs it
     print(f"{sim}: {report.status.value}; goal reached (ground truth): {report.reached_goal}")
     print(f"moves: {', '.join(str(m.move) for m in report.moves)}; touched: {report.touched}")
     assert report.reached_goal

@@ -1,9 +1,10 @@
 """Run one closed-loop episode in PyBullet and in MuJoCo, and read its report.
 
 The simulated Panda plans a window, executes each move as a pick-and-place, observes the block
-poses, and replans on a failure. `tamp.api.run_episode` returns a frozen
-`tamp.loop.EpisodeReport`; ``report.to_json()`` is what ``tamp run --out DIR`` writes as
-report.json. Run: ``python examples/episode_both_simulators.py`` (about 15 s, headless).
+poses, and replans on a failure. `tamp.api.run` returns a frozen `tamp.loop.EpisodeReport`
+(the one report type of every episode, a scene file's too); ``report.to_json()`` is what
+``tamp run --out DIR`` writes as report.json. Run:
+``python examples/episode_both_simulators.py`` (about 15 s, headless).
 """
 
 from __future__ import annotations
@@ -24,9 +25,10 @@ PROBLEM = api.Problem(
 
 def main() -> None:
     for sim in ("pybullet", "mujoco"):
-        report = api.run_episode(PROBLEM, sim=sim, seed=0)
+        report = api.run(PROBLEM, sim=sim, seed=0)
         ok = sum(move.ok for move in report.moves)
-        print(f"{sim}: {report.status.value}, goal reached (ground truth): {report.reached_goal}")
+        reached = f"goal reached (ground truth): {report.reached_goal}"
+        print(f"{sim} ({report.planner} planner): {report.status.value}, {reached}")
         print(f"  moves {ok}/{len(report.moves)} ok, {report.replans} replans")
         for move in report.moves:
             failure = move.failure.value if move.failure else "ok"

@@ -8,13 +8,15 @@ plan, a closed-loop episode in PyBullet or MuJoCo, or a benchmark table::
     task = api.load_problem(api.EXAMPLE)  # PDDL text; a pathlib.Path is read as a file
     planned = api.plan(task)  # an api.PlanReport: status, moves, PDDL actions, validation
     print(planned.text(), planned.validation.reason)
-    report = api.run_episode(task, sim="mujoco")  # a tamp.loop.EpisodeReport
+    report = api.run(task, sim="mujoco")  # a tamp.loop.EpisodeReport
+    report = api.run("tray", "(in a tray)")  # a scene file's episode: the same report type
 
 Everything in and out is a frozen dataclass (`PddlTask`, `PlanReport`, `PlanningBenchmark` here;
 `task.problem.Problem` / `PlanResult`, `task.symbolic.validate.Validation`,
 `tamp.loop.EpisodeReport`, `tamp.world.Scene` from the packages), configured by the components'
-own ``*Config`` dataclasses (`task.config.PlannerConfig`, `tamp.loop.LoopConfig`), overridden
-with `dataclasses.replace`. Bad input raises one line of the `task.errors.TampError` family.
+own ``*Config`` dataclasses (`task.config.PlannerConfig`, `tamp.loop.LoopConfig`,
+`tamp.geo.config.GeoEpisodeConfig`), overridden with `dataclasses.replace`. Bad input raises
+one line of the `task.errors.TampError` family.
 
 Inputs that may be PDDL are read by one rule: a `pathlib.Path` is a file, a ``str`` is PDDL
 text (a plan ``str`` is plan text: ``(unstack a b)`` lines or moves ``move(a -> b)``). Units:
@@ -26,9 +28,10 @@ wrap a call in ``tamp.sweep.torch_threads(1)`` (or call ``torch.set_num_threads(
 the same.
 
 What each function wraps, for reading further: `task.instances` (PDDL in), `task.planner`
-(the soft-T_P planner), `task.symbolic.validate` (the crisp validator), `tamp.loop` (episodes;
-`tamp.loop.given` for a given plan), `tamp.world` (scene files), `tamp.camera.image_pair`
-(planning from two images), `tamp.bench` (benchmarks), `task.costs` (move costs).
+(the soft-T_P planner), `task.symbolic.validate` (the crisp validator), `tamp.loop` and
+`tamp.geo.episode` (episodes; `tamp.loop.given` for a given plan), `tamp.world` (scene
+files), `tamp.camera.image_pair` (planning from two images), `tamp.bench` (benchmarks),
+`task.costs` (move costs).
 """
 
 from __future__ import annotations
@@ -42,6 +45,7 @@ from tamp.api_args import (
     BOOL,
     CALLBACK,
     COSTS,
+    EPISODE_CONFIG,
     GOAL,
     IMAGE,
     INT,
@@ -51,7 +55,6 @@ from tamp.api_args import (
     PLAN,
     PLANNER_CONFIG,
     SCENE,
-    SCENE_FILE,
     SOURCE,
     SUITE,
     TEXT,
@@ -82,6 +85,7 @@ if TYPE_CHECKING:  # heavy modules load when a function needs them
     from tamp.bench.planning import Bench
     from tamp.bench.suites import Suite
     from tamp.bench.summary import Summary
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.loop import EpisodeReport, LoopConfig
     from tamp.world import Scene
 
@@ -123,9 +127,7 @@ __all__ = [
     "plan_images",
     "planbench_suite",
     "random_suite",
-    "run_episode",
-    "run_geometric",
-    "run_scene",
+    "run",
     "validate",
 ]
 
@@ -378,36 +380,6 @@ def _loop_config(config: LoopConfig | None, sim: str | None) -> LoopConfig:
     return config if sim is None else replace(config, sim=sim)
 
 
-@checked(
-    problem=PROBLEM,
-    domain=SOURCE.optional(),
-    sim=TEXT.optional(),
-    config=LOOP_CONFIG.optional(),
-    seed=INT,
-    on_event=CALLBACK.optional(),
-)
-def run_episode(
-    problem: PddlTask | Problem | Source,
-    domain: Source | None = None,
-    *,
-    sim: str | None = None,
-    config: LoopConfig | None = None,
-    seed: int = 0,
-    on_event: Callable[[str], None] | None = None,
-) -> EpisodeReport:
-    """One closed-loop episode of a Blocksworld problem with the simulated Panda, headless:
-    the blocks (5 cm cubes) laid out on table slots with ``seed``, then observe, plan a window,
-    execute each move as a pick-and-place, check, and replan on a failure, until the goal or a
-    stop. ``sim``: ``pybullet`` or ``mujoco`` (overrides ``config.sim``); ``config``: the
-    episode's `LoopConfig` (observation, grasp, faults, planner, scene); ``on_event(text)``:
-    progress lines. The report's ``reached_goal`` is scored on simulator ground truth;
-    ``sim_time_s`` and ``wall_time_s`` are seconds."""
-    from tamp.loop import Episode
-
-    chosen = _loop_config(config, sim)
-    return Episode(_blocksworld(problem, domain), chosen, seed, on_event=on_event).run()
-
-
 def _steps(plan: PlanSource, problem: Problem):
     from tamp.loop.given import parse_given
 
@@ -445,7 +417,8 @@ def execute_plan(
     one `tamp.loop.given.StepReport` per step (task-level verdict, motion outcome, what else
     moved, where the carried block came to rest). ``replan``: the planner takes over after a
     failed or invalid step; ``stop_at_invalid``: the experimenter stops at the first step
-    invalid in the true state. ``sim``, ``config``, ``seed``: as `run_episode`."""
+    invalid in the true state. ``sim``, ``config`` (a `tamp.loop.LoopConfig`), ``seed``: as
+    `run`."""
     from tamp.loop.given import GivenPlanEpisode
 
     chosen = _loop_config(config, sim)
@@ -481,83 +454,144 @@ def _scene_path(scene: str | Path) -> Path:
     return Path(scene)
 
 
-@checked(scene=SCENE_FILE, goal=GOAL, sim=TEXT.optional(), config=LOOP_CONFIG.optional(), seed=INT)
-def run_scene(
-    scene: str | Path,
-    goal: str | Path,
-    *,
-    sim: str | None = None,
-    config: LoopConfig | None = None,
-    seed: int = 0,
-) -> EpisodeReport:
-    """A closed-loop episode of a scene file of cubes (``tamp run --scene FILE --goal GOAL``):
-    the objects start at the file's poses, the initial state is read from their geometry, and
-    ``goal`` is a PDDL goal over the objects (``(and (on a b) (on b c))``, inline or a file).
-    ``scene``: a path or a shipped scene's name. ``sim``, ``config``, ``seed``: as
-    `run_episode` (the table, obstacles and slot grid are the file's)."""
-    from tamp.loop import Episode
-    from tamp.world.blocks import scene_task
+RUNNABLE = Kind(
+    "a PddlTask, a Problem, PDDL text (str), a PDDL file (pathlib.Path), a scene file (str or "
+    "pathlib.Path), a shipped scene's, workcell's or canonical problem's name (str) or a "
+    "tamp.world.Scene",
+    lambda v: isinstance(v, PddlTask | Problem | str | Path) or _is_scene(v),
+)  # what `run` runs
 
-    found = scene_task(_scene_path(scene), goal)
-    chosen = replace(_loop_config(config, sim), scene=found.config)
-    return Episode(found.problem, chosen, seed, poses=dict(found.poses)).run()
+
+def _is_scene(value: object) -> bool:
+    from tamp.world import Scene
+
+    return isinstance(value, Scene)
+
+
+def _kind(problem: object) -> str:
+    """What ``problem`` is to `run`: ``"pddl"`` (a PddlTask, a Problem, PDDL text or a .pddl
+    file), ``"workcell"`` (a named workcell, `tamp.obstacles.SCENES`) or ``"scene"`` (anything
+    else: a scene file, a shipped scene's or canonical problem's name, a loaded Scene)."""
+    from tamp.obstacles import SCENES as WORKCELLS
+
+    if isinstance(problem, PddlTask | Problem):
+        return "pddl"
+    if isinstance(problem, Path):
+        return "pddl" if problem.suffix.lower() == ".pddl" else "scene"
+    if isinstance(problem, str):
+        if "(define" in problem.lower():
+            return "pddl"
+        return "workcell" if problem in WORKCELLS else "scene"
+    return "scene"
 
 
 @checked(
-    scene=SCENE_FILE,
+    problem=RUNNABLE,
     goal=GOAL.optional(),
-    planner=TEXT,
-    sim=TEXT,
-    seed=INT,
-    video=PATH.optional(),
-    observation=TEXT,
-    domain=PATH.optional(),
+    config=EPISODE_CONFIG.optional(),
+    domain=SOURCE.optional(),
     binding=PATH.optional(),
+    sim=TEXT.optional(),
+    seed=INT.optional(),
+    on_event=CALLBACK.optional(),
 )
-def run_geometric(
-    scene: str | Path,
+def run(
+    problem: PddlTask | Problem | Source | Scene,
     goal: str | Path | None = None,
+    config: LoopConfig | GeoEpisodeConfig | None = None,
     *,
-    planner: str = "motion-aware",
-    sim: str = "pybullet",
-    seed: int = 0,
-    video: str | Path | None = None,
-    observation: str = "state",
-    domain: str | Path | None = None,
+    domain: Source | None = None,
     binding: str | Path | None = None,
-):
-    """A geometric TAMP episode of a scene file (``tamp run --scene FILE --goal GOAL`` where the
-    Blocksworld loop cannot run it, or with ``--geo-planner``): objects of any shape, regions
-    as targets (``(in a tray)``), grasps and placements chosen, each move checked before it
-    runs. ``scene``: a path, a shipped scene's name or a canonical problem's (``"packed"``, its
-    goal file the default ``goal``); ``planner``: a `tamp.geo.modes.GeoPlanner` (the
-    motion-aware planner plans the canonical ``hanoi`` by its PDDL rules, as ``tamp run``).
-    ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
-    (``tamp run --domain D.pddl --binding B.json``, `tamp.world.scene_pddl`), planned through
-    by the motion-aware planner. Returns a `tamp.geo.episode.GeoReport`."""
+    sim: str | None = None,
+    seed: int | None = None,
+    on_event: Callable[[str], None] | None = None,
+) -> EpisodeReport:
+    """One episode with the simulated Panda, headless, whatever is given
+    (``tamp run``); the `EpisodeReport` both episodes return (``reached_goal`` scored on
+    simulator ground truth, ``planner`` and ``sim`` recorded, times in seconds).
+
+    ``problem`` is one of:
+
+    - a Blocksworld problem: a `PddlTask`, a `Problem`, PDDL text or a ``.pddl`` file (of
+      ``domain``; None: the embedded 4-op domain). It runs in the closed Blocksworld loop
+      (`tamp.loop`): the blocks (5 cm cubes) laid out on table slots with ``seed``, then
+      observe, plan a window, execute each move as a pick-and-place, check, and replan on a
+      failure, until the goal or a stop;
+    - a named workcell (`tamp.obstacles.SCENES`: ``tabletop``, ``shelf``, ``clutter``,
+      ``cramped``): the embedded example (`EXAMPLE`) in the loop among its obstacles (``tamp
+      run --scene shelf``);
+    - a scene: a scene file (str or Path), a shipped scene's name (``tower``, ``tray``), a
+      canonical problem's (``packed``, its goal file the default ``goal``) or a loaded
+      `tamp.world.Scene`, toward ``goal`` (a PDDL goal over its objects, inline or a file:
+      ``(and (on a b) (on b c))``, ``(in a tray)``). A scene of cubes with ``on`` /
+      ``ontable`` goals runs in the loop from the file's poses; any other (regions as targets,
+      other shapes, a canonical problem), or any scene with a `GeoEpisodeConfig`, runs as a
+      geometric TAMP episode (`tamp.geo.episode`: grasps and placements chosen, each move
+      checked before it runs) with the config's planner (ours, ``motion-aware``, by default).
+      ``domain`` and ``binding``: your own pick-and-place PDDL domain and its binding file
+      (``tamp run --domain D.pddl --binding B.json``), planned through by the motion-aware
+      planner.
+
+    ``config``: a `tamp.loop.LoopConfig` for the loop (observation, grasp, faults, planner,
+    workcell) or a `tamp.geo.config.GeoEpisodeConfig` for the geometric episode (planner,
+    limits, observation, grasp, video); None: the defaults of the episode that runs.
+    ``sim`` (``pybullet`` or ``mujoco``) and ``seed`` override the config's (None: the
+    config's; the loop's seed is 0 by default). ``on_event(text)``: progress lines."""
+    kind = _kind(problem)
+    if kind == "scene":
+        return _run_scene(problem, goal, config, domain, binding, sim, seed, on_event)
+    from tamp.loop import Episode, LoopConfig
+
+    what = "a workcell" if kind == "workcell" else "a PDDL problem"
+    if goal is not None or binding is not None:
+        given = "goal" if goal is not None else "binding"
+        raise TampError(
+            f"api.run: {given} is for a scene file (the objects it names); {what} has its own goal"
+        )
+    if config is not None and not isinstance(config, LoopConfig):
+        raise TampError(
+            f"api.run: {what} runs in the Blocksworld loop: config must be a "
+            f"tamp.loop.LoopConfig, got {type(config).__name__}"
+        )
+    chosen = _loop_config(config, sim)
+    if kind == "workcell":
+        from tamp.world import load_named, scene_config
+
+        chosen = replace(chosen, scene=scene_config(load_named(problem)))
+        target = _blocksworld(EXAMPLE, domain)
+    else:
+        target = _blocksworld(problem, domain)
+    return Episode(target, chosen, seed or 0, on_event=on_event).run()
+
+
+def _run_scene(scene, goal, config, domain, binding, sim, seed, on_event) -> EpisodeReport:
+    """`run` of a scene: the loop's `SceneTask` or the geometric episode's `GeoRun`."""
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
-    from tamp.geo.scene_file import scene_episode
-    from tamp.geo.search import SearchConfig
-    from tamp.geo.types import GeoLimits
+    from tamp.geo.scene_file import GeoRun, scene_episode
+    from tamp.loop import Episode
 
     if (domain is None) != (binding is None):
-        raise TampError("run_geometric: domain and binding go together (a bound domain)")
+        raise TampError("api.run: domain and binding go together (a bound domain)")
+    geo = isinstance(config, GeoEpisodeConfig)
     rules = None if domain is None else (domain, binding)
-    task = scene_episode(str(scene), goal, planner, rules)
-    limits = GeoLimits()  # tamp run's and bench tamp's
-    return run_geo_episode(
-        task.scene,
-        task.goal,
-        task.planner,
-        sim,
-        seed=seed,
-        planner_config=SearchConfig(seed=seed, max_time_s=limits.planning_s),
-        video=video,
-        max_moves=limits.max_moves,
-        max_replans=limits.max_replans,
-        domain=task.domain,
-        observation=observation,
-    )
+    name = scene if _is_scene(scene) else str(scene)
+    task = scene_episode(name, goal, config.planner if geo else None, rules)
+    if not isinstance(task, GeoRun):  # a scene of cubes: the Blocksworld loop
+        chosen = replace(_loop_config(config, sim), scene=task.config)
+        poses = dict(task.poses)
+        return Episode(task.problem, chosen, seed or 0, poses=poses, on_event=on_event).run()
+    if config is not None and not geo:
+        raise TampError(
+            f"api.run: {task.path} runs as a geometric episode ({task.why}): config must be a "
+            f"tamp.geo.config.GeoEpisodeConfig, got {type(config).__name__}"
+        )
+    chosen = replace(config or GeoEpisodeConfig(), planner=task.planner, domain=task.domain)
+    if sim is not None:
+        chosen = replace(chosen, sim=sim)
+    if seed is not None:
+        chosen = replace(chosen, seed=seed)
+    return run_geo_episode(task.scene, task.goal, chosen, on_event=on_event)
 
 
 # ------------------------------------------------------------------------------- images

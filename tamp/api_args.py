@@ -90,6 +90,11 @@ PLAN = Kind(
 )
 PLANNER_CONFIG = lazy("a task.config.PlannerConfig", "task.config", "PlannerConfig")
 LOOP_CONFIG = lazy("a tamp.loop.LoopConfig", "tamp.loop", "LoopConfig")
+GEO_CONFIG = lazy("a tamp.geo.config.GeoEpisodeConfig", "tamp.geo.config", "GeoEpisodeConfig")
+EPISODE_CONFIG = Kind(
+    "a tamp.loop.LoopConfig or a tamp.geo.config.GeoEpisodeConfig",
+    lambda v: LOOP_CONFIG.test(v) or GEO_CONFIG.test(v),
+)
 SUITE = lazy("a tamp.bench.suites.Suite (api.random_suite, ...)", "tamp.bench.suites", "Suite")
 COSTS = Kind(
     "a CostSource: a callable (indices, states, restarts) -> WindowCosts, e.g. "

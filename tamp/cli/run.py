@@ -25,7 +25,6 @@ import json
 import math
 import sys
 import time
-from dataclasses import asdict
 from pathlib import Path
 
 from tamp.cli.recorded import (
@@ -36,8 +35,9 @@ from tamp.cli.recorded import (
     run_config,
     scene_run,
 )
+from tamp.episode_report import EpisodeReport
 from tamp.geo.modes import Observation
-from tamp.loop import Episode, EpisodeReport
+from tamp.loop import Episode
 from tamp.loop.given import GivenPlanEpisode, read_given
 from tamp.outcome import EpisodeInterrupted
 from tamp.rerun_log import RerunRecorder, require_rerun
@@ -180,13 +180,12 @@ def run_command(args: argparse.Namespace) -> int:
                 written.append(video.path.name)
         except TampError as exc:  # the episode's outcome and report stand without the video
             print(f"warning: {exc}", file=sys.stderr)
-    body = report.to_json()
-    body["config"] = recorded
+    body = report_json(report, recorded)
     if out is not None:
-        (out / "report.json").write_text(json.dumps(body, indent=2))
+        (out / "report.json").write_text(body)
         written.append("report.json")
     if args.json:
-        print(json.dumps(body, indent=2))
+        print(body)
     else:
         print("\n".join(summary_lines(report)))
         if written:
@@ -219,8 +218,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     the goal is reached (ground truth)."""
     import numpy as np
 
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.geo.search import SearchConfig
+    from tamp.geo.types import GeoLimits
     from tamp.loop.faults import Injection
 
     out = _out_dir(args.out)
@@ -231,7 +232,20 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     # index from the seed before the episode (the episode's `inject` takes the indices)
     p = Injection.parse(args.inject).drop
     draws = np.random.default_rng(args.seed).random(recorded["max_moves"])
-    drops = [k for k, u in enumerate(draws) if u < p]
+    drops = tuple(k for k, u in enumerate(draws) if u < p)
+    limit_s = recorded["time_limit_s"]
+    config = GeoEpisodeConfig(
+        planner=task.planner,
+        sim=args.sim,
+        seed=args.seed,
+        limits=GeoLimits(recorded["max_moves"], recorded["max_replans"], limit_s),
+        search=SearchConfig(seed=args.seed, max_time_s=limit_s),
+        observation=args.observe,
+        grasp=args.grasp,
+        drops=drops,
+        video=video,
+        domain=task.domain,
+    )
     if not args.json:
         print(
             f"running {task.scene.name} ({len(task.scene.objects)} objects) in {args.sim} "
@@ -244,44 +258,38 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         )
     with torch_threads(EPISODE_THREADS):
         report = run_geo_episode(
-            task.scene,
-            task.goal,
-            task.planner,
-            args.sim,
-            seed=args.seed,
-            planner_config=SearchConfig(seed=args.seed, max_time_s=recorded["time_limit_s"]),
-            video=video,
-            max_moves=recorded["max_moves"],
-            max_replans=recorded["max_replans"],
-            inject={"drop": drops},
-            grasp=args.grasp,
-            domain=task.domain,
-            observation=args.observe,
-            on_event=None if args.json else _say,
+            task.scene, task.goal, config, on_event=None if args.json else _say
         )
-    body = {"report": _jsonable(asdict(report)), "config": recorded}
+    body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
         written.append(video.name)
     if out is not None:
-        (out / "report.json").write_text(json.dumps(body, indent=2, allow_nan=False, default=str))
+        (out / "report.json").write_text(body)
         written.append("report.json")
     if args.json:
-        print(json.dumps(body, indent=2, allow_nan=False, default=str))
+        print(body)
     else:
         print("\n".join(geo_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
-    return 0 if report.reached else 1
+    return 0 if report.reached_goal else 1
 
 
 def _say(text: str) -> None:
     print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
 
-def geo_lines(report) -> list[str]:
-    """A `tamp.geo.episode.GeoReport` as the lines ``tamp run`` prints: one per move, then the
-    outcome."""
+def report_json(report: EpisodeReport, recorded: dict) -> str:
+    """``report.json`` of either episode: the report's fields (`EpisodeReport.to_json`, the
+    same top-level keys for both) and ``config``, the recorded configuration."""
+    body = {**report.to_json(), "config": recorded}
+    return json.dumps(_jsonable(body), indent=2, allow_nan=False, default=str)
+
+
+def geo_lines(report: EpisodeReport) -> list[str]:
+    """A geometric episode's `EpisodeReport` as the lines ``tamp run`` prints: one per move,
+    then the outcome."""
     lines = []
     for k, m in enumerate(report.moves, 1):
         lines.append(f"  {k:2d}. {m.move}: {'ok' if m.ok else 'FAILED ' + m.failure.value}")
@@ -290,11 +298,11 @@ def geo_lines(report) -> list[str]:
     return [
         *lines,
         f"{report.status.value}{reason}; goal reached (ground truth): "
-        f"{'yes' if report.reached else 'no'}",
+        f"{'yes' if report.reached_goal else 'no'}",
         f"moves {ok}/{len(report.moves)} ok, {report.replans} replans, motion failures "
         f"{report.motion_failures}, collisions {report.collisions}",
-        f"planning {report.planning_time_s:.2f} s ({len(report.plan_times_s)} calls), sim "
-        f"{report.execution_time_s:.1f} s, wall {report.wall_s:.1f} s, arm path "
+        f"planning {report.plan_time_s:.2f} s ({len(report.plan_times_s)} calls), sim "
+        f"{report.sim_time_s:.1f} s, wall {report.wall_time_s:.1f} s, arm path "
         f"{report.arm_path_rad:.2f} rad",
     ]
 

@@ -17,8 +17,10 @@ goes to, and a move's feasibility is decided by the arm (IK and collision checks
   geometry, failed moves forbidden, replanning.
 - `tamp.geo.execute`: `run_move`, one checked move run in a simulator with its failures read
   from the gripper.
+- `tamp.geo.config`: `GeoEpisodeConfig`, the settings of one episode.
 - `tamp.geo.episode`: `run_geo_episode`, observe, plan, check, run and replan with one of the
-  planners (`GeoPlanner`), a `GeoReport` scored on ground truth.
+  planners (`GeoPlanner`), an `EpisodeReport` (`tamp.episode_report`, the loop's too) scored on
+  ground truth.
 - `tamp.geo.scene_file`: `scene_episode`, which episode runs a scene file (``tamp run
   --scene``): the Blocksworld loop's `SceneTask` or a `GeoRun` for `run_geo_episode`.
 """

@@ -42,13 +42,15 @@ from pathlib import Path
 
 import numpy as np
 
+from tamp.episode_report import EpisodeReport
 from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
+from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.execute import RunConfig, rests_of, run_move
 from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
-from tamp.geo.types import TABLE, GeoLimits, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
@@ -81,39 +83,16 @@ class MoveRecord:
     failure: Failure | None = None
     evidence: dict = field(default_factory=dict)
 
-
-@dataclass(frozen=True)
-class GeoReport:
-    """An episode's outcome. ``status`` (`tamp.outcome.EpisodeStatus`, the loop's vocabulary):
-    ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
-    saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET``,
-    ``MOVE_BUDGET``. ``reached`` is scored on ground truth."""
-
-    reached: bool
-    planner: str
-    backend: str
-    status: EpisodeStatus
-    reason: str = ""
-    moves: tuple[MoveRecord, ...] = ()
-    motion_failures: int = 0  # moves whose check or run failed
-    collisions: int = 0  # things the arm or the held object touched unexpectedly
-    touched: dict = field(default_factory=dict)  # thing -> physics steps in contact
-    planning_time_s: float = 0.0
-    plan_times_s: tuple[float, ...] = ()  # per planner call
-    execution_time_s: float = 0.0  # simulated
-    wall_s: float = 0.0
-    arm_path_rad: float = 0.0
-    plan_length: int = 0  # moves of the first plan (0: none)
-    replans: int = 0
-    plan_stats: tuple[dict, ...] = ()  # each planner call's stats
-    observation: str = "state"  # the pose sensor (an `Observation`)
-    # camera: the estimates' errors against ground truth (scored, never acted on), `_scored`
-    pose_errors: dict = field(default_factory=dict)
-
-    @property
-    def solved_clean(self) -> bool:
-        """Reached without a motion failure and without a collision."""
-        return self.reached and self.motion_failures == 0 and self.collisions == 0
+    def to_json(self) -> dict:
+        """The record as JSON values (`tamp.episode_report.EpisodeReport`; the evidence as
+        it stands: numpy values are the writer's to convert)."""
+        return {
+            "move": self.move,
+            "grasp": self.grasp,
+            "ok": self.ok,
+            "failure": self.failure.value if self.failure else None,
+            "evidence": self.evidence,
+        }
 
 
 Planner = Callable[[Scene, Goal, Tools, SearchConfig], GeoPlan]
@@ -208,34 +187,26 @@ def _with_poses(scene: Scene, poses: dict[str, Pose]) -> Scene:
 def run_geo_episode(
     scene: Scene,
     goal: Goal,
-    planner: str,
-    backend: str = "pybullet",
-    seed: int = 0,
-    planner_config: SearchConfig | None = None,
-    video: str | Path | None = None,
-    max_moves: int = GeoLimits.max_moves,
-    max_replans: int = GeoLimits.max_replans,
-    inject: dict | None = None,
+    config: GeoEpisodeConfig = GeoEpisodeConfig(),
+    *,
     tools: Tools | None = None,
-    grasp: str = "friction",
-    domain: tuple[str, ...] | None = None,
-    observation: str = "state",
     on_event: Callable[[str], None] | None = None,
-) -> GeoReport:
-    """Run ``planner`` (a `GeoPlanner`) on ``scene`` toward ``goal`` in simulator
-    ``backend`` (see the module docstring). ``planner_config``: budgets and choices (default
-    `SearchConfig` with ``seed`` and `GeoLimits`' ``planning_s``); ``max_moves`` and
-    ``max_replans``: the episode's limits (`GeoLimits`' defaults); ``video``: a file path to
-    record the episode to (.mp4 or .gif); ``inject``: fault injection, ``{"drop": [k, ...]}``
-    opens the gripper mid-transit on those move indices; ``tools``: reuse an IK solver and
-    collision model (else built and closed here); ``domain``: ``(pddl_domain_text,
-    binding_text)`` the motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower
-    of Hanoi by its rules); refused for the other planners, which plan over the moves the
-    geometry allows. ``observation``: the pose sensor, an `Observation` (``"camera"``:
-    `tamp.camera.scene_poses.ScenePoses`). ``on_event``: called with a line after each plan
-    and each move (progress, e.g. for ``tamp run``); what it is told is also in the report.
-    Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an episode
-    on one thread (`tamp.sweep.torch_threads`)."""
+) -> EpisodeReport:
+    """Run ``config.planner`` (a `GeoPlanner`) on ``scene`` toward ``goal`` in simulator
+    ``config.sim`` (see the module docstring) with the settings of ``config`` (a
+    `GeoEpisodeConfig`: seed, limits, planner budgets, pose sensor, grasp, injected drops,
+    video, a PDDL domain for the motion-aware planner). ``tools``: reuse an IK solver and
+    collision model (else built and closed here). ``on_event``: called with a line after each
+    plan and each move (progress, e.g. for ``tamp run``); what it is told is also in the
+    report. Returns the `tamp.episode_report.EpisodeReport` both stacks report in: ``status``
+    ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
+    saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET`` or
+    ``MOVE_BUDGET``; ``reached_goal`` scored on ground truth; one `MoveRecord` per move.
+    Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an
+    episode on one thread (`tamp.sweep.torch_threads`)."""
+    planner, backend, seed = config.planner, config.sim, config.seed
+    observation, domain, video = config.observation, config.domain, config.video
+    max_moves, max_replans = config.limits.max_moves, config.limits.max_replans
     say = on_event or (lambda line: None)
     member(Observation, observation, "observation")
     plan_fn = planner_by_name(planner)
@@ -245,9 +216,8 @@ def run_geo_episode(
                 f"planner {planner} plans without a PDDL domain; only motion-aware takes one"
             )
         plan_fn = partial(plan_fn, domain=domain)
-    config = planner_config or SearchConfig(seed=seed, max_time_s=GeoLimits.planning_s)
-    inject = inject or {}
-    drops = set(inject.get("drop", ()))
+    search = config.search_config()
+    drops = set(config.drops)
     wall0 = time.perf_counter()
     own = tools is None
     tools = tools or Tools()
@@ -257,13 +227,13 @@ def run_geo_episode(
         tools.collision,
         pick_place=tools.pick_place,
         guard=replace(tools.guard, plan=True),
-        choices=config.choices,
+        choices=search.choices,
     )
     if planner == GeoPlanner.SOFT:
         runner.choices = ("top",)  # today's executor: top-down grasps only
     from tamp.geo.sim import open_sim
 
-    sim = open_sim(scene, backend, video=video is not None, grasp=grasp)
+    sim = open_sim(scene, backend, video=video is not None, grasp=config.grasp)
     sim.truth.lock()
     camera = None
     if observation == Observation.CAMERA:
@@ -273,7 +243,9 @@ def run_geo_episode(
     recorder, on_frame = _recorder(video)
     records: list[MoveRecord] = []
     plan_times, plan_stats = [], []
-    path, first_len, replans, failures = 0.0, 0, 0, 0
+    plans: list[tuple[str, ...]] = []  # every plan made, as move strings
+    first_plan: tuple[GeoMove, ...] = ()  # the first solved plan's moves
+    path, replans = 0.0, 0
     status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
         _settle(sim, on_frame)
@@ -283,7 +255,7 @@ def run_geo_episode(
                 status = EpisodeStatus.GOAL_REACHED
                 break
             t0 = time.perf_counter()
-            plan = plan_fn(world, goal, tools, config)
+            plan = plan_fn(world, goal, tools, search)
             plan_times.append(time.perf_counter() - t0)
             plan_stats.append(dict(plan.stats))
             say(
@@ -292,12 +264,13 @@ def run_geo_episode(
             )
             if not plan.solved:
                 status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
-                limit = _time_limit_s(config)
+                limit = _time_limit_s(search)
                 if plan.status is GeoStatus.BUDGET and limit and plan_times[-1] >= limit:
                     reason = f"{time_limit_reached(limit)}; {reason}"
                 break
-            if not first_len:
-                first_len = len(plan.moves)
+            plans.append(tuple(m.text() for m in plan.moves))
+            if not first_plan:
+                first_plan = plan.moves
             replan = False
             for move in plan.moves:
                 if len(records) >= max_moves:
@@ -313,7 +286,6 @@ def run_geo_episode(
                     f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
                 )
                 path += ran
-                failures += record.failure not in (None, Failure.UNEXPECTED)
                 if not record.ok:
                     replan = True
                     break
@@ -338,25 +310,28 @@ def run_geo_episode(
     if status is EpisodeStatus.GOAL_REACHED and not reached:
         status = EpisodeStatus.NOT_REACHED
         reason = "the robot saw the goal; the ground truth does not hold it"
-    return GeoReport(
-        reached=reached,
-        planner=planner,
-        backend=backend,
+    return EpisodeReport(
+        problem=scene.name,
+        sim=backend,
         status=status,
-        reason=reason,
+        reached_goal=reached,
         moves=tuple(records),
-        motion_failures=failures,
-        collisions=len(sim.touched),
-        touched=dict(sim.touched),
-        planning_time_s=sum(plan_times),
-        plan_times_s=tuple(plan_times),
-        execution_time_s=sim.time,
-        wall_s=time.perf_counter() - wall0,
-        arm_path_rad=path,
-        plan_length=first_len,
+        plans=tuple(plans),
         replans=replans,
-        plan_stats=tuple(plan_stats),
+        faults=tuple(f"drop@{k}" for k in sorted(drops) if k < len(records)),
+        disturbed=0,
+        sim_time_s=sim.time,
+        wall_time_s=time.perf_counter() - wall0,
+        plan_time_s=sum(plan_times),
+        initial_plan_solved=bool(first_plan),
+        reason=reason,
+        first_plan=first_plan,
+        touched=dict(sim.touched),
+        planner=planner,
         observation=observation,
+        plan_times_s=tuple(plan_times),
+        plan_stats=tuple(plan_stats),
+        arm_path_rad=path,
         pose_errors=_scored(camera),
     )
 

@@ -1,7 +1,7 @@
 """Which episode runs a scene file: the Blocksworld loop or the geometric TAMP episode.
 
 `scene_episode` resolves what ``tamp run --scene NAME|FILE.json [--goal GOAL] [--geo-planner
-P]`` and `tamp.api.run_geometric` are given. A scene of 5 cm cubes with ``on`` / ``ontable``
+P]`` and `tamp.api.run` are given. A scene of 5 cm cubes with ``on`` / ``ontable``
 goals is a `tamp.world.blocks.SceneTask` for the closed Blocksworld loop (`tamp.loop`). What the
 loop cannot run (`tamp.world.blocks.BeyondLoop`: regions as targets, other shapes, no parking on
 the bare table), a canonical problem by its name (`tamp.world.canonical.PROBLEMS`: its shipped
@@ -58,21 +58,24 @@ def scene_path(name: str) -> tuple[Path, bool]:
 
 
 def scene_episode(
-    name: str,
+    name: str | Scene,
     goal: str | Path | None,
     planner: str | None = None,
     rules: tuple[str | Path, str | Path] | None = None,
 ):
-    """The episode of scene ``name`` toward ``goal`` (inline PDDL or a file; None: a canonical
-    problem's goal file): a `tamp.world.blocks.SceneTask` when the loop can run it and no
-    ``planner`` is named, else a `GeoRun` (``planner`` or `DEFAULT_PLANNER`). ``rules``: a
-    user's ``(DOMAIN.pddl, BINDING.json|toml)``, planned through by the motion-aware planner
-    (`user_domain`). One-line SceneFileError (or the domain's or binding's error) for a scene,
-    goal or domain neither can run (see `tamp.world.blocks`)."""
+    """The episode of scene ``name`` (or a loaded `Scene`) toward ``goal`` (inline PDDL or a
+    file; None: a canonical problem's goal file): a `tamp.world.blocks.SceneTask` when the loop
+    can run it and no ``planner`` is named, else a `GeoRun` (``planner`` or
+    `DEFAULT_PLANNER`). ``rules``: a user's ``(DOMAIN.pddl, BINDING.json|toml)``, planned
+    through by the motion-aware planner (`user_domain`). One-line SceneFileError (or the
+    domain's or binding's error) for a scene, goal or domain neither can run (see
+    `tamp.world.blocks`)."""
     from tamp.world.blocks import BeyondLoop, scene_task
     from tamp.world.canonical import SCENES_DIR as CANONICAL_DIR
 
-    path, canonical = scene_path(name)
+    path, canonical = (name, False) if isinstance(name, Scene) else scene_path(name)
+    if isinstance(name, Scene):
+        name = name.name  # what the messages name
     if goal is None:
         if not canonical:
             raise SceneFileError(
@@ -95,7 +98,7 @@ def scene_episode(
     return geo_run(path, goal, planner or DEFAULT_PLANNER, why, canonical and name == "hanoi")
 
 
-def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -> GeoRun:
+def geo_run(path: Path | Scene, goal: str | Path, planner: str, why: str, hanoi: bool) -> GeoRun:
     """The `GeoRun` of the scene file at ``path`` (its geometry must explain every object);
     ``hanoi``: the canonical Tower of Hanoi, which the motion-aware planner plans through its
     PDDL domain."""
@@ -110,8 +113,9 @@ def geo_run(path: Path, goal: str | Path, planner: str, why: str, hanoi: bool) -
 
         domain = (rules.domain_text(), rules.BINDING)
     name = None if domain is None else rules.DOMAIN
+    where = scene.name if isinstance(path, Scene) else str(path)
     return GeoRun(
-        str(path), scene, check_goal(scene, load_goal(goal, scene)), planner, why, domain, name
+        where, scene, check_goal(scene, load_goal(goal, scene)), planner, why, domain, name
     )
 
 
@@ -127,7 +131,9 @@ def _binding_json(path: Path) -> str:
     return text if fmt == "json" else json.dumps(data)
 
 
-def user_domain(path: Path, goal: str | Path, domain: str | Path, binding: str | Path) -> GeoRun:
+def user_domain(
+    path: Path | Scene, goal: str | Path, domain: str | Path, binding: str | Path
+) -> GeoRun:
     """The `GeoRun` of the scene file at ``path`` through a user's pick-and-place PDDL
     ``domain`` and its ``binding`` (`task.symbolic.pickplace.binding`, with a ``scene``
     section: how the geometry reads as the domain's state). Everything is checked here, before
@@ -149,6 +155,7 @@ def user_domain(path: Path, goal: str | Path, domain: str | Path, binding: str |
     bound = binder.bind_text(binding_text, parsed, source=str(binding))
     problem_from_text(domain_text, problem_text(scene, target, bound), scene.name)
     why = f"--domain {Path(domain).name}: a user's pick-and-place domain ({bound.domain})"
+    where = scene.name if isinstance(path, Scene) else str(path)
     return GeoRun(
-        str(path), scene, target, DEFAULT_PLANNER, why, (domain_text, binding_text), bound.domain
+        where, scene, target, DEFAULT_PLANNER, why, (domain_text, binding_text), bound.domain
     )

@@ -6,7 +6,7 @@ with `tamp.world.relations.read_facts`, never given.
 
 `GeoLimits` are an episode's limits (`tamp.geo.episode.run_geo_episode`): moves run, plans after
 the first and each planner call's wall clock; ``tamp run``, ``tamp bench tamp`` and
-`tamp.api.run_geometric` run with its defaults.
+`tamp.api.run` run with its defaults.
 
 A `Place` is where an object's centre goes: on top of another object, in a region, or on the
 table, with its yaw. A `GeoMove` is one pick-and-place: the object, the grasp the hand holds it
@@ -71,6 +71,9 @@ class GeoMove:
         how = "" if self.grasp is None else f" [{self.grasp.name}]"
         x, y, _ = self.place.xyz
         return f"move {self.obj} -> {self.place.target} at ({x:.3f}, {y:.3f}){how}"
+
+    def __str__(self) -> str:
+        return self.text()
 
 
 class GeoStatus(enum.Enum):

@@ -214,7 +214,16 @@ class Episode:
     def report(self, p: Progress, reached: bool, wall0: float) -> EpisodeReport:
         """The EpisodeReport of tally ``p``: ``reached`` the goal (ground truth), the scored
         contacts, and the ground-truth reads by grant; ``wall0``: the start on perf_counter."""
-        report = p.report(self.problem.name, self.config.sim, reached, self.sim.time, wall0)
+        planner = "motion-aware" if self.config.planner.lambda_motion > 0 else "soft"
+        report = p.report(
+            self.problem.name,
+            self.config.sim,
+            reached,
+            self.sim.time,
+            wall0,
+            planner,
+            self.config.observe,
+        )
         reads = Counter()
         for (grant, _), n in self.sim.truth.reads.items():
             reads[grant] += n

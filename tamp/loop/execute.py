@@ -97,6 +97,21 @@ class ExecutionResult:
     planner_runs: int = 0  # motion-planner runs over every grasp and slot tried
     planner_failures: int = 0  # ... of which found no collision-free detour
 
+    def to_json(self) -> dict:
+        """The move's record as plain JSON values (`tamp.episode_report.EpisodeReport`)."""
+        return {
+            "move": str(self.move),
+            "ok": self.ok,
+            "failure": self.failure.value if self.failure else None,
+            "evidence": self.evidence,
+            "sim_time_s": round(self.sim_time_s, 3),
+            "wall_time_s": round(self.wall_time_s, 3),
+            "ik_time_s": round(self.ik_time_s, 4),
+            "rerouted": list(self.rerouted),
+            "planner_runs": self.planner_runs,
+            "planner_failures": self.planner_failures,
+        }
+
 
 Observe = Callable[[], dict[str, Pose]]  # every block's pose; PerceptionError: one is unseen
 

@@ -1,73 +1,18 @@
-"""What an episode reports: its `tamp.outcome.EpisodeStatus`, why it stopped (the geometric
-episode's vocabulary too), and `EpisodeReport`, what happened;
-`Progress` is the tally an episode keeps while it runs, which becomes its report."""
+"""What an episode reports: `Progress` is the tally a loop episode keeps while it runs, which
+becomes its `EpisodeReport` (`tamp.episode_report`: the one report type of both stacks,
+re-exported here), with its `tamp.outcome.EpisodeStatus`."""
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from dataclasses import dataclass, field
 
+from tamp.episode_report import EpisodeReport
 from tamp.loop.execute import ExecutionResult
 from tamp.outcome import EpisodeStatus
 from task.problem import Move
 
-
-@dataclass(frozen=True)
-class EpisodeReport:
-    """What happened in one episode; ``reached_goal`` is scored on simulator ground truth."""
-
-    problem: str
-    sim: str
-    status: EpisodeStatus
-    reached_goal: bool
-    moves: tuple[ExecutionResult, ...]
-    plans: tuple[tuple[str, ...], ...]  # every plan made, as move strings
-    replans: int
-    faults: tuple[str, ...]  # injected faults, e.g. "drop@3" (move index)
-    # moves not scored clean on ground truth (`tamp.loop.score.MoveScore`): another block
-    # changed support, or the true state before or after was unreadable (``unreadable`` of them)
-    disturbed: int
-    sim_time_s: float
-    wall_time_s: float
-    plan_time_s: float
-    initial_plan_solved: bool = False  # the first task plan reached the goal symbolically
-    reason: str = ""
-    first_plan: tuple[Move, ...] = ()  # the first task plan's moves (camera: its first window)
-    steps: tuple = ()  # a given plan: one `tamp.loop.given.StepReport` per step
-    # scoring: what the arm, the hand or the block held in it touched in the simulator that
-    # the move was not meant to touch (`tamp.sim.base.Expected`): block, obstacle or "table",
-    # "held:" + name for the held block's contacts -> physics steps in contact; `collided` is
-    # True when anything was touched
-    touched: dict = field(default_factory=dict)
-    unreadable: int = 0  # moves after which (or before which) the true state formed no state
-    # ground-truth reads answered, by grant (`tamp.sim.truth.GRANTS`), e.g. {"scoring": 12}
-    truth_reads: dict = field(default_factory=dict)
-
-    @property
-    def collided(self) -> bool:
-        return bool(self.touched)
-
-    def to_json(self) -> dict:
-        out = dataclasses.asdict(self)
-        out["status"] = self.status.value
-        out["first_plan"] = [str(m) for m in self.first_plan]
-        out["moves"] = [
-            {
-                "move": str(r.move),
-                "ok": r.ok,
-                "failure": r.failure.value if r.failure else None,
-                "evidence": r.evidence,
-                "sim_time_s": round(r.sim_time_s, 3),
-                "wall_time_s": round(r.wall_time_s, 3),
-                "ik_time_s": round(r.ik_time_s, 4),
-                "rerouted": list(r.rerouted),
-                "planner_runs": r.planner_runs,
-                "planner_failures": r.planner_failures,
-            }
-            for r in self.moves
-        ]
-        return out
+__all__ = ["EpisodeReport", "Progress"]
 
 
 @dataclass
@@ -96,9 +41,17 @@ class Progress:
         self.status, self.reason, self.stopped = status, reason, True
 
     def report(
-        self, problem: str, sim: str, reached: bool, sim_time: float, wall0: float
+        self,
+        problem: str,
+        sim: str,
+        reached: bool,
+        sim_time: float,
+        wall0: float,
+        planner: str = "",
+        observation: str = "state",
     ) -> EpisodeReport:
-        """The EpisodeReport; ``wall0`` is the episode's start on ``time.perf_counter``."""
+        """The EpisodeReport; ``wall0`` is the episode's start on ``time.perf_counter``;
+        ``planner``: the planner that ran, ``observation``: the pose sensor."""
         return EpisodeReport(
             problem,
             sim,
@@ -116,4 +69,6 @@ class Progress:
             self.reason,
             self.first_plan,
             unreadable=self.unreadable,
+            planner=planner,
+            observation=observation,
         )

@@ -50,12 +50,14 @@ class SceneTask:
     config: SceneConfig
 
 
-def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConfig()) -> SceneTask:
-    """The Blocksworld episode of the scene file at ``path`` and the goal ``goal`` (inline PDDL
-    or a file, `load_goal`), on ``base``'s block size; SceneFileError, one line, when the loop
-    cannot run it (see the module docstring)."""
+def scene_task(
+    path: str | Path | Scene, goal: str | Path, base: SceneConfig = SceneConfig()
+) -> SceneTask:
+    """The Blocksworld episode of the scene file at ``path`` (or a loaded `Scene`) and the goal
+    ``goal`` (inline PDDL or a file, `load_goal`), on ``base``'s block size; SceneFileError,
+    one line, when the loop cannot run it (see the module docstring)."""
     scene, facts = explained_scene(path)
-    label = str(path)
+    label = scene.name if isinstance(path, Scene) else str(path)
     _check_blocks(scene, base.block_size, label)
     if not scene.parking:
         raise BeyondLoop(
@@ -95,10 +97,13 @@ def scene_task(path: str | Path, goal: str | Path, base: SceneConfig = SceneConf
     return SceneTask(scene, wanted, facts, problem, poses, config)
 
 
-def explained_scene(path: str | Path) -> tuple[Scene, Facts]:
-    """The scene file at ``path`` and the facts read from its geometry; SceneFileError when it
-    has no movable object or the geometry cannot explain one (any episode needs both)."""
-    scene = load_scene(path)
+def explained_scene(path: str | Path | Scene) -> tuple[Scene, Facts]:
+    """The scene file at ``path`` (or a loaded `Scene`, as it is) and the facts read from its
+    geometry; SceneFileError when it has no movable object or the geometry cannot explain one
+    (any episode needs both)."""
+    scene = path if isinstance(path, Scene) else load_scene(path)
+    if isinstance(path, Scene):
+        path = scene.name  # what the messages name
     if not scene.objects:
         raise SceneFileError(f"{path}: objects: the scene has no movable object to plan for")
     facts = read_facts(scene)

@@ -122,7 +122,7 @@ def test_a_shipped_scene_loads_by_name():
         (lambda: api.validate(SMALL, "(fly a)"), "fly"),
         (lambda: api.plan_images("a.png", "b.png", scene="lego"), "valid: cubes, latplan"),
         (
-            lambda: api.run_episode(next(get_domain("logistics").samples(0))),
+            lambda: api.run(next(get_domain("logistics").samples(0))),
             "executes blocksworld problems only",
         ),
         (lambda: api.execute_plan(next(get_domain("sokoban").samples(0)), ""), "blocksworld"),
@@ -190,14 +190,15 @@ TASK = api.load_problem(SMALL_PDDL)
         ),
         (lambda: api.validate(TASK, 5), "api.validate: plan must be plan text (str), a plan file"),
         (
-            lambda: api.run_episode(TASK, config=api.PlannerConfig()),
-            "api.run_episode: config must be a tamp.loop.LoopConfig or None, got PlannerConfig(",
+            lambda: api.run(TASK, config=api.PlannerConfig()),
+            "api.run: config must be a tamp.loop.LoopConfig or a tamp.geo.config.GeoEpisodeConfig "
+            "or None, got PlannerConfig(",
         ),
         (lambda: api.load_scene({"schema": 1}), "scene: name: missing (required: name, schema"),
         (lambda: api.load_scene(3.0), "api.load_scene: scene must be a scene file"),
         (
-            lambda: api.run_scene("tower", 5),
-            "api.run_scene: goal must be a PDDL goal (str) or a goal file (pathlib.Path), got 5",
+            lambda: api.run("tower", 5),
+            "api.run: goal must be a PDDL goal (str) or a goal file (pathlib.Path) or None, got 5",
         ),
         (
             lambda: api.benchmark(api.random_suite((3,), 1), seeds=()),
@@ -259,3 +260,47 @@ def _tower_dict() -> dict:
     from tamp.world.load import SCENES_DIR
 
     return json.loads((SCENES_DIR / "tower.json").read_text())
+
+
+def test_one_entry_runs_every_kind_of_episode_and_the_old_entries_are_gone():
+    assert "run" in api.__all__
+    for old in ("run_episode", "run_scene", "run_geometric"):
+        assert not hasattr(api, old) and old not in api.__all__
+
+
+@pytest.mark.parametrize(
+    ("call", "words"),
+    [
+        (lambda: api.run(api.EXAMPLE, "(on a b)"), "goal is for a scene file"),
+        (lambda: api.run("shelf", "(on a b)"), "a workcell has its own goal"),
+        (
+            lambda: api.run(SMALL, config=_geo_config()),
+            "a PDDL problem runs in the Blocksworld loop: config must be a tamp.loop.LoopConfig",
+        ),
+        (
+            lambda: api.run("tray", "(in a tray)", config=_loop_config()),
+            "runs as a geometric episode",
+        ),
+        (  # a loaded Scene is a scene: the same routing, before any work
+            lambda: api.run(api.load_scene("tray"), "(in a tray)", config=_loop_config()),
+            "tray runs as a geometric episode",
+        ),
+        (lambda: api.run("tray", "(in a tray)", domain=Path("d.pddl")), "go together"),
+    ],
+)
+def test_run_refuses_what_does_not_fit_the_episode_in_one_line(call, words):
+    with pytest.raises(TampError) as caught:
+        call()
+    assert words in str(caught.value) and "\n" not in str(caught.value), caught.value
+
+
+def _geo_config():
+    from tamp.geo.config import GeoEpisodeConfig
+
+    return GeoEpisodeConfig()
+
+
+def _loop_config():
+    from tamp.loop import LoopConfig
+
+    return LoopConfig()

@@ -10,8 +10,9 @@ from pathlib import Path
 import pytest
 
 import tamp.loop.geo_fallback
+from tamp.episode_report import EpisodeReport
 from tamp.geo.check import FAILURES
-from tamp.geo.episode import AGAIN_FROM_HOME, GeoReport, MoveRecord
+from tamp.geo.episode import AGAIN_FROM_HOME, MoveRecord
 from tamp.geo.ours.planner import BEFORE_GRASPS, FIXED_FAILURES
 from tamp.loop import EpisodeStatus as LoopStatus
 from tamp.loop.execute import GEO_RETRIED
@@ -57,7 +58,7 @@ def test_the_rooms_sets_of_failures_are_members_of_the_one_enum():
 
 def test_both_episodes_report_in_one_status_enum():
     assert LoopStatus is EpisodeStatus
-    assert GeoReport.__dataclass_fields__["status"].type == "EpisodeStatus"
+    assert EpisodeReport.__dataclass_fields__["status"].type == "EpisodeStatus"
     assert MoveRecord.__dataclass_fields__["failure"].type == "Failure | None"
     assert EpisodeStatus.GOAL_REACHED.value == "goal_reached"
     assert len({s.value for s in EpisodeStatus}) == len(EpisodeStatus)

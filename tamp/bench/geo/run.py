@@ -44,7 +44,7 @@ ROW_COLUMNS = (
     "sim",
     "observe",
     "status",
-    "reached",
+    "reached_goal",
     "clean",
     "plan_length",
     "moves",
@@ -54,10 +54,10 @@ ROW_COLUMNS = (
     "touched",
     "failures",
     "run_notes",
-    "planning_time_s",
-    "execution_time_s",
+    "plan_time_s",
+    "sim_time_s",
     "arm_path_rad",
-    "wall_s",
+    "wall_time_s",
     "pose_mm_mean",
     "pose_mm_max",
     "yaw_deg_max",
@@ -114,29 +114,26 @@ def items(
 
 def play(item: Item) -> dict:
     """One episode's row (`ROW_COLUMNS`), in the process that runs it."""
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
-    from tamp.geo.search import SearchConfig
     from tamp.world.canonical import generate
 
     made = generate(item.problem, item.variant)
     t0 = time.perf_counter()
     # ours plans a problem defined by a PDDL domain (Tower of Hanoi) through that domain
     domain = made.domain if item.planner is GeoPlanner.MOTION_AWARE else None
+    config = GeoEpisodeConfig(
+        planner=item.planner,
+        sim=item.sim,
+        seed=item.seed,
+        limits=LIMITS,
+        observation=item.observe,
+        video=item.video,
+        domain=domain,
+    )
     try:
         with torch_threads(1):  # one small problem: thread hand-offs cost more than they give
-            report = run_geo_episode(
-                made.scene,
-                made.goal,
-                item.planner,
-                item.sim,
-                seed=item.seed,
-                planner_config=SearchConfig(seed=item.seed, max_time_s=LIMITS.planning_s),
-                video=item.video,
-                max_moves=LIMITS.max_moves,
-                max_replans=LIMITS.max_replans,
-                domain=domain,
-                observation=item.observe,
-            )
+            report = run_geo_episode(made.scene, made.goal, config)
     except TampError as exc:  # the episode's error is its row; the other episodes go on
         return _error_row(item, made.note, str(exc), time.perf_counter() - t0)
     errors = report.pose_errors
@@ -147,8 +144,8 @@ def play(item: Item) -> dict:
         "sim": item.sim,
         "observe": item.observe.value,
         "status": report.status.value,
-        "reached": report.reached,
-        "clean": report.reached and report.motion_failures == 0,
+        "reached_goal": report.reached_goal,
+        "clean": report.reached_goal and report.motion_failures == 0,
         "plan_length": report.plan_length,
         "moves": len(report.moves),
         "motion_failures": report.motion_failures,
@@ -160,10 +157,10 @@ def play(item: Item) -> dict:
         # what the run of each move that succeeded had to do beyond the plan (`run_move`'s
         # evidence: regrasped on release, corrected above the place), in order
         "run_notes": ";".join(n for n in (_notes(m) for m in report.moves if m.ok) if n),
-        "planning_time_s": report.planning_time_s,
-        "execution_time_s": report.execution_time_s,
+        "plan_time_s": report.plan_time_s,
+        "sim_time_s": report.sim_time_s,
         "arm_path_rad": report.arm_path_rad,
-        "wall_s": time.perf_counter() - t0,
+        "wall_time_s": time.perf_counter() - t0,
         # the camera's estimates against ground truth, over every look (empty: motion capture)
         "pose_mm_mean": errors.get("position_mm_mean"),
         "pose_mm_max": errors.get("position_mm_max"),
@@ -190,9 +187,9 @@ def _error_row(item: Item, note: str, why: str, wall: float) -> dict:
     row = dict.fromkeys(ROW_COLUMNS)
     row |= {"problem": item.problem, "variant": item.variant, "planner": item.planner.value}
     row |= {"sim": item.sim, "observe": item.observe.value, "status": "error", "reason": why}
-    row |= {"reached": False, "clean": False, "note": note, "wall_s": wall}
+    row |= {"reached_goal": False, "clean": False, "note": note, "wall_time_s": wall}
     row |= dict.fromkeys(("plan_length", "moves", "motion_failures", "replans", "collisions"), 0)
-    row |= dict.fromkeys(("planning_time_s", "execution_time_s", "arm_path_rad"), 0.0)
+    row |= dict.fromkeys(("plan_time_s", "sim_time_s", "arm_path_rad"), 0.0)
     row |= {"touched": "", "failures": "", "run_notes": "", "unseen": ""}
     return row
 
@@ -235,8 +232,8 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
         groups.setdefault((row["problem"], row["planner"], row["sim"]), []).append(row)
     out = []
     for (problem, planner, sim), mine in groups.items():
-        solved = [r for r in mine if r["reached"]]
-        times = [r["planning_time_s"] for r in mine if r["status"] != "error"]
+        solved = [r for r in mine if r["reached_goal"]]
+        times = [r["plan_time_s"] for r in mine if r["status"] != "error"]
         out.append(
             {
                 "problem": problem,
@@ -249,7 +246,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
                 "moves": _median([r["moves"] for r in solved]),
                 "planning_p50_s": _quantile(times, 0.5),
                 "planning_p90_s": _quantile(times, 0.9),
-                "execution_s": _median([r["execution_time_s"] for r in solved]),
+                "execution_s": _median([r["sim_time_s"] for r in solved]),
                 "arm_path_rad": _median([r["arm_path_rad"] for r in solved]),
                 "collided": sum(r["collisions"] > 0 for r in mine),
                 "collisions": sum(r["collisions"] for r in mine),

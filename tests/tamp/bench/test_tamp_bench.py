@@ -58,17 +58,17 @@ def _row(problem, planner, sim, reached, failures=0, collisions=0, t=1.0):
         "planner": planner,
         "sim": sim,
         "status": "goal_reached" if reached else "no_plan",
-        "reached": reached,
+        "reached_goal": reached,
         "clean": reached and failures == 0,
         "plan_length": 3 if reached else 0,
         "moves": 3,
         "motion_failures": failures,
         "replans": 0,
         "collisions": collisions,
-        "planning_time_s": t,
-        "execution_time_s": 20.0,
+        "plan_time_s": t,
+        "sim_time_s": 20.0,
         "arm_path_rad": 9.0,
-        "wall_s": 30.0,
+        "wall_time_s": 30.0,
         "reason": "",
         "note": "",
     }
@@ -145,7 +145,7 @@ def test_an_episode_that_errs_is_its_own_row_and_the_others_go_on(monkeypatch):
 
     monkeypatch.setattr(episode, "run_geo_episode", fail)
     row = bench.play(bench.Item("blocked", 0, "soft", "pybullet", 0))
-    assert row["status"] == "error" and "ontable d5" in row["reason"] and not row["reached"]
+    assert row["status"] == "error" and "ontable d5" in row["reason"] and not row["reached_goal"]
     assert set(row) == set(bench.ROW_COLUMNS)
     (summary,) = bench.summarise([row, _row("blocked", "soft", "pybullet", True, t=2.0)])
     assert summary["episodes"] == 2 and summary["solved"] == 1

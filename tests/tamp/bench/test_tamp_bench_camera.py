@@ -46,12 +46,13 @@ def test_items_carry_the_pose_sensor():
 
 
 def test_an_unknown_observation_is_refused_naming_the_valid_ones():
+    from tamp.geo.config import GeoEpisodeConfig
     from tamp.geo.episode import run_geo_episode
     from tamp.world.canonical import generate
 
     made = generate("blocked", 0)
     with pytest.raises(TampError, match="state, camera"):
-        run_geo_episode(made.scene, made.goal, "soft", observation="lidar")
+        run_geo_episode(made.scene, made.goal, GeoEpisodeConfig("soft", observation="lidar"))
 
 
 @pytest.mark.sim
@@ -65,6 +66,6 @@ def test_a_camera_episode_reaches_the_goal_and_records_its_pose_errors(tmp_path)
     body = json.loads((out / "results.json").read_text())
     assert body["config"]["observe"] == "camera"
     (row,) = list(csv.DictReader((out / "episodes.csv").open()))
-    assert row["observe"] == "camera" and row["reached"] == "True"
+    assert row["observe"] == "camera" and row["reached_goal"] == "True"
     assert float(row["pose_mm_mean"]) < 3.0 and float(row["pose_mm_max"]) < 10.0
     assert body["camera"]["pose_mm_max"] == pytest.approx(float(row["pose_mm_max"]), abs=1e-3)

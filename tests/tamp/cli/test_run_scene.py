@@ -173,9 +173,9 @@ def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
     argv = ["run", "--scene", str(path), "--goal", "(in a tray)", "--out", str(out), "--no-video"]
     assert main(argv) == 0
     report = json.loads((out / "report.json").read_text())
-    assert report["report"]["reached"] and report["report"]["collisions"] == 0
-    assert report["report"]["status"] == "goal_reached"  # as the Blocksworld loop spells it
-    assert [m["move"].split(" at ")[0] for m in report["report"]["moves"]] == ["move a -> tray"]
+    assert report["reached_goal"] and report["collisions"] == 0
+    assert report["status"] == "goal_reached"  # as the Blocksworld loop spells it
+    assert [m["move"].split(" at ")[0] for m in report["moves"]] == ["move a -> tray"]
     assert report["config"]["executor"] == "geometric"
     printed = capsys.readouterr()
     assert "goal reached (ground truth): yes" in printed.out and "wrote report.json" in printed.out
@@ -209,10 +209,17 @@ def test_the_episode_starts_where_the_scene_file_puts_the_objects(tmp_path):
 @pytest.mark.sim
 def test_the_python_api_runs_the_same_geometric_episode(tmp_path):
     from tamp import api
+    from tamp.geo.config import GeoEpisodeConfig
 
     path = tmp_path / "s.json"
     path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
-    report = api.run_geometric(path, "(in a tray)", sim="mujoco")
-    assert report.reached and report.backend == "mujoco" and report.planner == "motion-aware"
+    report = api.run(path, "(in a tray)", sim="mujoco")
+    assert report.reached_goal and report.sim == "mujoco" and report.planner == "motion-aware"
+    # a loaded Scene, with the geometric episode's config: its simulator and its planner
+    loaded = api.load_scene(path)
+    report = api.run(loaded, "(in a tray)", GeoEpisodeConfig(sim="pybullet"))
+    assert report.reached_goal and report.sim == "pybullet" and report.problem == "test"
+    report = api.run(loaded, "(in a tray)", GeoEpisodeConfig(planner="search-then-check"))
+    assert report.planner == "search-then-check"
     with pytest.raises(api.TampError, match="needs --goal"):
-        api.run_geometric(path)
+        api.run(path)

@@ -26,8 +26,8 @@ def test_the_example_domain_reaches_its_goal_in_the_tray_scene(tmp_path):
     out = tmp_path / "out"
     assert main([*_argv("--goal", GOAL), "--out", str(out), "--no-video"]) == 0
     body = json.loads((out / "report.json").read_text())
-    report, config = body["report"], body["config"]
-    assert report["reached"] and report["collisions"] == 0
+    report, config = body, body["config"]
+    assert report["reached_goal"] and report["collisions"] == 0
     assert [m["move"].split(" at ")[0] for m in report["moves"]][1:] == [
         "move a -> tray",
         "move b -> a",
@@ -92,8 +92,8 @@ def test_a_goal_the_binding_cannot_write_is_refused(tmp_path, capsys):
 def test_the_python_api_runs_the_example_domain_in_mujoco():
     from tamp import api
 
-    report = api.run_geometric("tray", GOAL, sim="mujoco", domain=DOMAIN, binding=BINDING)
-    assert report.reached and report.collisions == 0
+    report = api.run("tray", GOAL, sim="mujoco", domain=DOMAIN, binding=BINDING)
+    assert report.reached_goal and report.collisions == 0
 
 
 def test_the_api_refuses_a_domain_without_its_binding():
@@ -101,4 +101,4 @@ def test_the_api_refuses_a_domain_without_its_binding():
     from task.errors import TampError
 
     with pytest.raises(TampError, match="domain and binding go together"):
-        api.run_geometric("tray", GOAL, domain=DOMAIN)
+        api.run("tray", GOAL, domain=DOMAIN)

@@ -16,10 +16,11 @@ from functools import partial
 import pytest
 
 from tamp.geo.check import candidate_grasps, check_move
+from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.episode import plan_soft, run_geo_episode
 from tamp.geo.ours import plan_motion_aware
 from tamp.geo.search import SearchConfig
-from tamp.geo.types import GeoStatus, moved
+from tamp.geo.types import GeoLimits, GeoStatus, moved
 from tamp.world.canonical import generate
 from tamp.world.relations import read_facts
 from tests.tamp.geo.geo_scenes import tools
@@ -90,17 +91,15 @@ def test_ours_solves_it_every_move_bound_by_the_full_check(problem):
 @pytest.mark.parametrize("problem", tuple(SMALL))
 def test_ours_reaches_the_goal_in_pybullet_without_a_collision(problem):
     made = _made(problem)
-    report = run_geo_episode(
-        made.scene,
-        made.goal,
+    config = GeoEpisodeConfig(
         "motion-aware",
         "pybullet",
-        planner_config=BUDGET,
-        max_moves=40,
-        tools=tools(),
+        limits=GeoLimits(max_moves=40),
+        search=BUDGET,
         domain=made.domain,
     )
-    assert report.reached, (report.status, report.reason)
+    report = run_geo_episode(made.scene, made.goal, config, tools=tools())
+    assert report.reached_goal, (report.status, report.reason)
     assert report.collisions == 0 and report.touched == {}
 
 

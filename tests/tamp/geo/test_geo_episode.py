@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.episode import planner_by_name, run_geo_episode
 from tamp.geo.modes import GeoPlanner
 from tamp.geo.search import SearchConfig
@@ -22,36 +23,23 @@ SMALL = SearchConfig(choices=("top",), places=4, max_time_s=60.0)
 @pytest.mark.sim
 def test_search_then_check_reaches_the_goal_in_pybullet_without_a_collision():
     s = hemmed()
-    report = run_geo_episode(
-        s,
-        parse_goal("(in t goal)", s),
-        "search-then-check",
-        "pybullet",
-        planner_config=SMALL,
-        tools=tools(),
-    )
-    assert report.reached and report.status is EpisodeStatus.GOAL_REACHED, report
+    config = GeoEpisodeConfig("search-then-check", "pybullet", search=SMALL)
+    report = run_geo_episode(s, parse_goal("(in t goal)", s), config, tools=tools())
+    assert report.reached_goal and report.status is EpisodeStatus.GOAL_REACHED, report
     assert report.collisions == 0 and report.touched == {}
     assert report.motion_failures == 0
     assert [m.move.split()[1] for m in report.moves][-1] == "t"
     assert report.moves[0].move.split()[1] in {"w", "n"}
     assert report.plan_length == 2 and report.arm_path_rad > 0
-    assert report.execution_time_s > 0 and len(report.plan_times_s) == 1
+    assert report.sim_time_s > 0 and len(report.plan_times_s) == 1
 
 
 @pytest.mark.sim
 def test_task_only_planning_fails_on_it_and_says_why():
     s = hemmed()
-    report = run_geo_episode(
-        s,
-        parse_goal("(in t goal)", s),
-        "soft",
-        "pybullet",
-        planner_config=SMALL,
-        tools=tools(),
-        max_replans=1,
-    )
-    assert not report.reached and report.status is EpisodeStatus.REPLAN_BUDGET
+    config = GeoEpisodeConfig("soft", "pybullet", limits=GeoLimits(max_replans=1), search=SMALL)
+    report = run_geo_episode(s, parse_goal("(in t goal)", s), config, tools=tools())
+    assert not report.reached_goal and report.status is EpisodeStatus.REPLAN_BUDGET
     assert {m.failure for m in report.moves} == {Failure.COLLISION}
     assert all(m.move.startswith("move t -> goal") for m in report.moves)
     assert report.collisions == 0 and report.arm_path_rad == 0  # refused before moving
@@ -115,25 +103,24 @@ def test_a_corrected_place_runs_only_where_the_guard_finds_it_free():
 
 
 def test_the_episode_limits_default_to_geo_limits():
-    """One home for the limits ``tamp run``, ``tamp bench tamp`` and `tamp.api.run_geometric`
-    run with: the episode's own defaults are `GeoLimits`'."""
+    """One home for the limits ``tamp run``, ``tamp bench tamp`` and `tamp.api.run`
+    run with: the episode config's defaults are `GeoLimits`', and its planner's time too."""
     import inspect
 
-    params = inspect.signature(run_geo_episode).parameters
-    limits = GeoLimits()
-    assert params["max_moves"].default == limits.max_moves
-    assert params["max_replans"].default == limits.max_replans
+    config = inspect.signature(run_geo_episode).parameters["config"].default
+    assert config == GeoEpisodeConfig() and config.limits == GeoLimits()
+    assert config.search_config().max_time_s == GeoLimits().planning_s
+    assert GeoEpisodeConfig(seed=7).search_config().seed == 7
 
 
 @pytest.mark.sim
 def test_a_plan_stopped_by_the_time_limit_says_so_in_the_no_plan_reason():
     s = hemmed()
+    search = SearchConfig(choices=("top",), places=4, max_time_s=1e-9)
     report = run_geo_episode(
         s,
         parse_goal("(in t goal)", s),
-        "search-then-check",
-        "pybullet",
-        planner_config=SearchConfig(choices=("top",), places=4, max_time_s=1e-9),
+        GeoEpisodeConfig(planner="search-then-check", search=search),
         tools=tools(),
     )
     assert report.status is EpisodeStatus.NO_PLAN, report
