@@ -56,7 +56,7 @@ class EpisodeReport:
     # ground-truth reads answered, by grant (`tamp.sim.truth.GRANTS`), e.g. {"scoring": 12}
     truth_reads: dict = field(default_factory=dict)
     # the planner that ran: the loop's "soft" (the soft-T_P planner) or "motion-aware" (with
-    # the arm's move costs); geometric: a `tamp.geo.modes.GeoPlanner` value
+    # the arm's move costs); geometric: a `tamp.modes.GeoPlanner` value
     planner: str = ""
     observation: str = "state"  # the pose sensor: "state" (motion capture) or "camera"
     plan_times_s: tuple[float, ...] = ()  # geometric: per planner call

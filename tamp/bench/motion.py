@@ -27,8 +27,8 @@ from motion.ik import IKSolver, pose_yaw, top_down_pose
 from motion.pick_place import PickPlaceRequest, waypoint_targets
 from tamp.bench.planning import replay
 from tamp.bench.suites import Suite
-from tamp.geo.modes import Observation
 from tamp.loop import EpisodeReport, LoopConfig, run_episode
+from tamp.modes import Observation
 from tamp.rerun_log import recorder_for
 from tamp.sweep import run_items, torch_threads
 from task.instances import Instance

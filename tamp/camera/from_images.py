@@ -38,9 +38,9 @@ import torch
 from torch import Tensor
 
 from perception.perceive import Perceiver, blur, kl_rows
-from tamp.camera.modes import Adapt, Crisp, Perception
 from tamp.camera.render import block_colours
 from tamp.camera.states import most_likely_state
+from tamp.modes import Adapt, Crisp, Perception
 from task.domains.base import State
 from task.errors import TampError, member
 from task.problem import Problem

@@ -24,7 +24,7 @@ import torch
 from perception.perceive import Perceiver
 from perception.segment import present
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
-from tamp.camera.modes import Crisp, ImageScene
+from tamp.modes import Crisp, ImageScene
 from tamp.scene import CAMERA_COLOURS, PALETTE
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain

@@ -19,11 +19,11 @@ from perception import CHECKPOINT
 from perception.perceive import Perceiver
 from perception.train import load_checkpoint
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
-from tamp.camera.modes import ImageScene
 from tamp.cli import report
 from tamp.cli.options import planner_config
 from tamp.cli.recorded import checkpoint as check_checkpoint
 from tamp.cli.recorded import images_config, out_file
+from tamp.modes import ImageScene
 from task import data
 from task.domains import blocksworld, blocksworld_pddl
 from task.errors import TampError

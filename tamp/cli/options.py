@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 
 from tamp.bench.official import OFFICIAL, default_data
-from tamp.camera.modes import Crisp, ImageScene, Perception
 from tamp.cli.types import (
     MAX_ITERS,
     MAX_RESTARTS,
@@ -26,7 +25,7 @@ from tamp.cli.types import (
     window,
     window_list,
 )
-from tamp.geo.modes import GeoPlanner, Observation
+from tamp.modes import Crisp, GeoPlanner, ImageScene, Observation, Perception
 from tamp.sim.base import SIMULATORS
 from task.config import PlannerConfig
 from task.domains import names

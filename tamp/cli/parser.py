@@ -10,7 +10,6 @@ import argparse
 
 from perception import CHECKPOINT
 from tamp.bench.official import DEFAULT_DATA
-from tamp.camera.modes import Perception
 from tamp.cli.bench.options import (
     executability_options,
     perception_bench_options,
@@ -46,6 +45,7 @@ from tamp.cli.types import (
     seed,
     threads,
 )
+from tamp.modes import Perception
 from tamp.sim.base import SIMULATORS
 
 EPOCHS = 20  # perception.train.TrainConfig.epochs; the parser does not import torch

@@ -13,8 +13,8 @@ from pathlib import Path
 from tqdm import tqdm
 
 from perception import CHECKPOINT
-from tamp.camera.modes import ImageScene
 from tamp.cli.recorded import checkpoint, dataset_config, eval_config, out_file, train_config
+from tamp.modes import ImageScene
 from task.errors import TampError
 
 

@@ -20,10 +20,9 @@ from pathlib import Path
 
 from perception import CHECKPOINT
 from tamp.bench.official import default_data
-from tamp.camera.modes import ImageScene
 from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
-from tamp.geo.modes import Observation
+from tamp.modes import ImageScene, Observation
 from tamp.rerun_log import check_record_path
 from task.errors import TampError
 

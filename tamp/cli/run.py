@@ -36,9 +36,9 @@ from tamp.cli.recorded import (
     scene_run,
 )
 from tamp.episode_report import EpisodeReport
-from tamp.geo.modes import Observation
 from tamp.loop import Episode
 from tamp.loop.given import GivenPlanEpisode, read_given
+from tamp.modes import Observation
 from tamp.outcome import EpisodeInterrupted
 from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads

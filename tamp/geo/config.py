@@ -12,9 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoLimits
+from tamp.modes import GeoPlanner, Observation
 from task.errors import member
 
 
@@ -22,12 +22,12 @@ from task.errors import member
 class GeoEpisodeConfig:
     """Settings of a geometric episode.
 
-    ``planner``: a `tamp.geo.modes.GeoPlanner` or its name (ours by default); ``sim``: ``pybullet``
+    ``planner``: a `tamp.modes.GeoPlanner` or its name (ours by default); ``sim``: ``pybullet``
     or ``mujoco``; ``seed``: the places sampled and each move's check; ``limits``: moves run,
     replans and each planner call's wall clock (`GeoLimits`' documented defaults, those of
     ``tamp run`` and ``tamp bench tamp``); ``search``: the planner's budgets and choices (None:
     `SearchConfig` with ``seed`` and ``limits.planning_s``, see `search_config`);
-    ``observation``: the pose sensor, an `tamp.geo.modes.Observation` or its name; ``grasp``:
+    ``observation``: the pose sensor, an `tamp.modes.Observation` or its name; ``grasp``:
     ``friction`` (physical) or ``weld`` (attach); ``drops``: fault injection, the move indices
     (0-based) on which the gripper opens mid-transit; ``video``: a file to record the episode
     to (.mp4 or .gif; None: no video); ``domain``: ``(pddl_domain_text, binding_text)`` the

@@ -1,7 +1,7 @@
 """A geometric TAMP episode: observe -> plan -> check -> run -> observe -> replan, in one
 simulator, with one of three planners side by side.
 
-Planners (`tamp.geo.modes.GeoPlanner`):
+Planners (`tamp.modes.GeoPlanner`):
 
 - ``"search-then-check"``: `tamp.geo.baseline.plan_search_then_check`;
 - ``"search"``: `tamp.geo.search.plan_search`, the complete best-first search alone;
@@ -47,10 +47,10 @@ from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.execute import RunConfig, rests_of, run_move
-from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
+from tamp.modes import GeoPlanner, Observation
 from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator

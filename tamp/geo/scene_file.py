@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tamp.geo.modes import GeoPlanner
+from tamp.modes import GeoPlanner
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
 
@@ -25,7 +25,7 @@ DEFAULT_PLANNER = GeoPlanner.MOTION_AWARE  # ours, where the loop cannot run the
 @dataclass(frozen=True)
 class GeoRun:
     """A scene file for the geometric TAMP episode with ``planner`` (one of
-    `tamp.geo.modes.GeoPlanner`). ``why``: why not the loop (the loop's `BeyondLoop` line, a
+    `tamp.modes.GeoPlanner`). ``why``: why not the loop (the loop's `BeyondLoop` line, a
     canonical problem, or the planner named); ``domain``: the PDDL domain and binding the
     motion-aware planner plans through (the shipped Tower of Hanoi's, as ``tamp bench tamp``
     does), else None."""

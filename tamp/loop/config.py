@@ -6,10 +6,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from tamp.camera.from_images import PerceptionMode
-from tamp.camera.modes import Crisp, Perception
-from tamp.geo.modes import Observation
 from tamp.loop.execute import CollisionMode, ExecConfig
 from tamp.loop.faults import Injection
+from tamp.modes import Crisp, Observation, Perception
 from tamp.scene import SceneConfig
 from tamp.sim.base import Camera
 from task.config import PlannerConfig

@@ -37,8 +37,6 @@ from motion.guard import guard_free_move
 from motion.ik import IKSolver
 from tamp.arm_costs import ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
-from tamp.camera.modes import Crisp
-from tamp.geo.modes import Observation
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import (
     CollisionMode,
@@ -54,6 +52,7 @@ from tamp.loop.observe import Observer, camera_goal
 from tamp.loop.recover import describe, nudge, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
+from tamp.modes import Crisp, Observation
 from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator

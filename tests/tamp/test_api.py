@@ -221,7 +221,7 @@ TASK = api.load_problem(SMALL_PDDL)
     ],
 )
 def test_arguments_of_the_wrong_kind_are_one_line_naming_them(call, words, monkeypatch):
-    """Every public function checks its arguments' kinds at the edge (`tamp.api_args`): one
+    """Every public function checks its arguments' kinds at the edge (`tamp.api.args`): one
     line naming the function, the argument, what was given and what is expected, never a
     Python error from inside (manual_seed, 'dict' has no attribute, not iterable)."""
     import tamp.bench.planning

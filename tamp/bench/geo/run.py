@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tamp.geo.modes import GeoPlanner, Observation
 from tamp.geo.types import GeoLimits
+from tamp.modes import GeoPlanner, Observation
 from tamp.sweep import run_items, torch_threads
 from task.errors import TampError, member
 

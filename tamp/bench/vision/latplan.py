@@ -33,7 +33,7 @@ from tamp.bench.suites import DEFAULT_DATA, spread
 from tamp.bench.summary import is_optimal
 from tamp.bench.tables import LATPLAN_CITED as CITED
 from tamp.camera.image_pair import blocks_in, check_sizes, plan_from_images, read_image
-from tamp.camera.modes import Perception
+from tamp.modes import Perception
 from task.config import PlannerConfig
 from task.errors import DataError, PDDLError, ProblemError, TampError
 from task.instances import Instance, from_text

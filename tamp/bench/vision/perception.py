@@ -36,9 +36,9 @@ from perception.segment import find_boxes
 from tamp.bench.planning import STATUSES, check
 from tamp.bench.summary import is_optimal
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal
-from tamp.camera.modes import Crisp, Perception
 from tamp.camera.render import StateRenderer, block_colours
 from tamp.camera.states import complete_goal
+from tamp.modes import Crisp, Perception
 from task.config import PlannerConfig
 from task.errors import TampError
 from task.planner import plan_batch

@@ -24,7 +24,7 @@ from tamp.cli.recorded import (
 )
 from tamp.cli.recorded import out_folder as output_folder
 from tamp.cli.types import sim_list
-from tamp.geo.modes import Observation
+from tamp.modes import Observation
 from tamp.rerun_log import require_rerun
 from task.errors import TampError
 

@@ -14,7 +14,7 @@ from tamp.bench import results, tables
 from tamp.cli.bench import interrupted
 from tamp.cli.recorded import out_folder, tamp_bench_config
 from tamp.cli.types import sim_list
-from tamp.geo.modes import Observation
+from tamp.modes import Observation
 
 
 def tamp_command(args: argparse.Namespace) -> int:

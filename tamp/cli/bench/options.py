@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 
-from tamp.camera.modes import Adapt
 from tamp.cli.options import (
     data_option,
     output_options,
@@ -26,7 +25,7 @@ from tamp.cli.types import (
     seed,
     threads,
 )
-from tamp.geo.modes import GeoPlanner, Observation
+from tamp.modes import Adapt, GeoPlanner, Observation
 from tamp.sim.base import SIMULATORS
 
 

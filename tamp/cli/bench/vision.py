@@ -12,7 +12,6 @@ import time
 from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
-from tamp.camera.modes import Crisp, Perception
 from tamp.cli.bench import bar, interrupted
 from tamp.cli.options import planner_config
 from tamp.cli.recorded import (
@@ -24,6 +23,7 @@ from tamp.cli.recorded import (
 )
 from tamp.cli.recorded import out_folder as output_folder
 from tamp.cli.types import sim_list
+from tamp.modes import Crisp, Perception
 
 
 def perception_command(args: argparse.Namespace) -> int:

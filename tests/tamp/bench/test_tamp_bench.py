@@ -11,7 +11,7 @@ from tamp.bench.geo import run as bench
 from tamp.bench.tables import tamp_table
 from tamp.cli import main
 from tamp.cli.bench.options import TAMP_PROBLEMS
-from tamp.geo.modes import GeoPlanner, Observation
+from tamp.modes import GeoPlanner, Observation
 from task.errors import TampError
 
 

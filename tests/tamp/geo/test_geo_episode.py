@@ -9,9 +9,9 @@ import pytest
 
 from tamp.geo.config import GeoEpisodeConfig
 from tamp.geo.episode import planner_by_name, run_geo_episode
-from tamp.geo.modes import GeoPlanner
 from tamp.geo.search import SearchConfig
 from tamp.geo.types import GeoLimits
+from tamp.modes import GeoPlanner
 from tamp.outcome import EpisodeStatus, Failure
 from tamp.world.goal import parse_goal
 from task.errors import TampError

@@ -130,9 +130,8 @@ def test_loop_config_rejects_what_it_cannot_observe(fields, message):
 
 def test_configs_hold_their_modes_as_enums_given_by_name():
     from tamp.camera.from_images import PerceptionMode
-    from tamp.camera.modes import Adapt, Crisp, Perception
-    from tamp.geo.modes import Observation
     from tamp.loop.execute import CollisionMode, ExecConfig
+    from tamp.modes import Adapt, Crisp, Observation, Perception
 
     config = LoopConfig(observe="camera", crisp="true", execution=ExecConfig(collision="off"))
     assert config.observe is Observation.CAMERA and config.crisp is Crisp.TRUE

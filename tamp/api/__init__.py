@@ -41,7 +41,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tamp.api_args import (
+from tamp.api.args import (
     BOOL,
     CALLBACK,
     COSTS,
@@ -62,7 +62,7 @@ from tamp.api_args import (
     Kind,
     checked,
 )
-from tamp.camera.modes import ImageScene
+from tamp.modes import ImageScene
 from task import data
 from task.config import PlannerConfig
 from task.costs import IMPOSSIBLE, CostSource, WindowCosts
