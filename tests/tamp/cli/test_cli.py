@@ -110,7 +110,7 @@ def test_plan_motion_aware_prices_the_arm_and_refuses_other_domains(
 
 
 def test_plan_without_a_plan_exits_1(capsys, files, monkeypatch):
-    def no_plan(problem, config, seed, costs=None):
+    def no_plan(problem, config, seed, costs=None, deadline=None):
         return PlanResult(PlanStatus.NO_PLAN, Plan(), problem, None, {"windows": 12, "time_s": 1})
 
     monkeypatch.setattr(commands, "plan", no_plan)
