@@ -22,6 +22,7 @@ from pathlib import Path
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
+from tamp.arm_costs import Arm
 from tamp.bench.suites import Suite
 from tamp.loop import LoopConfig
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
@@ -112,7 +113,13 @@ def our_plans(
             poses = layout(problem.entities, problem.init, scene, seed * 100_003 + k)
             results.append(
                 plan_on_places(
-                    problem, poses, scene, solver, PANDA.q_home, config, seed, reach=base.placements
+                    problem,
+                    poses,
+                    scene,
+                    Arm(solver, PANDA.q_home),
+                    config,
+                    seed,
+                    reach=base.placements,
                 )
             )
     else:
