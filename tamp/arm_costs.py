@@ -36,7 +36,16 @@ import torch
 from motion.cost import Blocks, MoveCostConfig, block_depths, move_costs_batch, site_solutions
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceConfig
-from tamp.scene import XY, Pose, SceneConfig, free_slot, plain_move, read_state, towers
+from tamp.scene import (
+    XY,
+    PlacedMove,
+    Pose,
+    SceneConfig,
+    free_slot,
+    plain_move,
+    read_state,
+    towers,
+)
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem
@@ -552,10 +561,9 @@ def failed_key(move) -> tuple[str, object]:
     """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
     ("at", place, x, y) for a move onto a planned table place (`tamp.scene.PlacedMove`: the
     place's name and the position the block was to go to, to the mm)."""
-    at = getattr(move, "at", None)
-    if at is not None:
-        place = getattr(move, "place", None)
-        return move.entity, ("at", place, round(at[0], 3), round(at[1], 3))
+    if isinstance(move, PlacedMove) and move.at is not None:
+        at = move.at
+        return move.entity, ("at", move.place, round(at[0], 3), round(at[1], 3))
     return move.entity, move.target
 
 

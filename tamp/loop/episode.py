@@ -453,7 +453,7 @@ class Episode:
         if not done.ok or "placed_at" not in done.evidence:
             return None
         at = move.at
-        return getattr(move, "place", None) or f"({at[0]:.2f}, {at[1]:.2f})"
+        return move.place or f"({at[0]:.2f}, {at[1]:.2f})"
 
     # --- acting and sensing ----------------------------------------------------------------
     def _act(self, move: Move, label: str, drop_at: float | None = None) -> ExecutionResult:

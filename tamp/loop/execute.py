@@ -33,7 +33,7 @@ from motion.trajectory import JointTrajectory
 from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
 from tamp.outcome import Failure
-from tamp.scene import Pose, SceneConfig, place_pose, top_z
+from tamp.scene import PlacedMove, Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Expected, Simulator, holding
 from tamp.sim.harness import Harness
 from task.errors import member
@@ -325,7 +325,7 @@ def placed_elsewhere(move: Move, target: Pose) -> dict:
     and the executor put the block on another one, ``target`` (the next free slot: the
     top-down hand could not reach the named one, or it was taken), else ``{}``: evidence of a
     move that went through but not where its plan had it (`tamp.loop.episode`)."""
-    at = getattr(move, "at", None)
+    at = move.at if isinstance(move, PlacedMove) else None
     if at is None or float(np.hypot(*np.subtract(target.xy, at))) <= 1e-6:
         return {}
     return {"placed_at": (round(float(target.xyz[0]), 4), round(float(target.xyz[1]), 4))}
