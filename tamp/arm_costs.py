@@ -36,7 +36,16 @@ import torch
 from motion.cost import Blocks, MoveCostConfig, block_depths, move_costs_batch, site_solutions
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceConfig
-from tamp.scene import XY, Pose, SceneConfig, free_slot, plain_move, read_state, towers
+from tamp.scene import (
+    XY,
+    PlacedMove,
+    Pose,
+    SceneConfig,
+    free_slot,
+    plain_move,
+    read_state,
+    towers,
+)
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem
@@ -172,36 +181,52 @@ class _Placed:
             self.owner._record(i, done, None if row is None else shift[p * self.restarts + row])
 
 
+@dataclass(frozen=True)
+class Arm:
+    """The arm a plan is priced for, as its planner knows it now: the IK ``solver``, where it
+    stands (``q_now``, (J,)), what its executor can do besides the top-down grasp over the
+    highest stack (``grasps``: the grasp families of its geometric fallback, with which a pick
+    or place only those reach is not ruled out, `ArmCosts`; ``check``: the executor's own check
+    of a move among poses, `ArmCosts.verify`; None: none), and what it failed so far
+    (``avoid``: plain state -> `failed_key`s of the moves that failed there; ``failed``: the
+    moves it failed by where, ruled out wherever they would be the same, `FailedMove`)."""
+
+    solver: IKSolver
+    q_now: object
+    grasps: tuple[str, ...] = ()
+    check: Callable[[Mapping[str, Pose], Move], bool] | None = None
+    avoid: Mapping[State, set] | None = None
+    failed: Sequence[FailedMove] = ()
+
+
 class ArmCosts:
     """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
-    ``poses[k]`` (block -> `Pose`), priced for the arm now at ``q_now`` (J,)."""
+    ``poses[k]`` (block -> `Pose`), priced for ``arm`` (`Arm`: the arm now at ``arm.q_now``,
+    (J,)). ``places``: per problem, table place -> (x, y), for slotted problems (`tamp.slots`);
+    ``reach``: how far a block may go from its place's centre (m; 0: the places are fixed)."""
 
     def __init__(
         self,
         problems: Sequence[Problem],
         poses: Sequence[Mapping[str, Pose]],
         scene: SceneConfig,
-        solver: IKSolver,
-        q_now,
+        arm: Arm,
         config: MoveCostConfig = ARM,
         places: Sequence[Mapping[str, XY]] | None = None,
-        avoid: Mapping[State, set] | None = None,
         reach: float = 0.0,
-        grasps: tuple[str, ...] = (),
-        failed: Sequence[FailedMove] = (),
-        check: Callable[[Mapping[str, Pose], Move], bool] | None = None,
     ) -> None:
         self.problems, self.poses, self.scene = list(problems), list(poses), scene
-        self.check = check  # the executor's own check of a move among poses (`verify`)
+        self.check = arm.check  # the executor's own check of a move among poses (`verify`)
         self._verified: dict[tuple[int, State, object], bool] = {}  # `verify`'s answers
         self._refused: dict[tuple[int, State], set] = {}  # moves `verify` ruled out there
-        self.failed = tuple(failed)  # moves the arm failed, by where (`FailedMove`)
-        self.grasps = tuple(grasps)  # grasp families the executor also has (`_hover`)
+        self.failed = tuple(arm.failed)  # moves the arm failed, by where (`FailedMove`)
+        self.grasps = tuple(arm.grasps)  # grasp families the executor also has (`_hover`)
         self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
         self._sites: dict[tuple, tuple[np.ndarray, bool]] = {}  # point -> `_site_solutions`
         self.places = places  # per problem: table place -> (x, y), for slotted problems
-        self.avoid = avoid or {}  # plain state -> `failed_key`s of moves that failed there
-        self.solver, self.q_now, self.config = solver, np.asarray(q_now, float), config
+        self.avoid = arm.avoid or {}  # plain state -> `failed_key`s of moves that failed there
+        self.solver, self.q_now = arm.solver, np.asarray(arm.q_now, float)
+        self.config = config
         self.reach = reach  # m: how far a block may go from its place's centre (0: fixed)
         self.boxes = obstacle_tensors(scene)  # the collision proxy's obstacles, made once
         self._cache: dict[tuple[int, State], torch.Tensor] = {}
@@ -536,10 +561,9 @@ def failed_key(move) -> tuple[str, object]:
     """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
     ("at", place, x, y) for a move onto a planned table place (`tamp.scene.PlacedMove`: the
     place's name and the position the block was to go to, to the mm)."""
-    at = getattr(move, "at", None)
-    if at is not None:
-        place = getattr(move, "place", None)
-        return move.entity, ("at", place, round(at[0], 3), round(at[1], 3))
+    if isinstance(move, PlacedMove) and move.at is not None:
+        at = move.at
+        return move.entity, ("at", move.place, round(at[0], 3), round(at[1], 3))
     return move.entity, move.target
 
 

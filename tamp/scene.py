@@ -364,7 +364,7 @@ def place_pose(
     if move.target == TABLE:
         others = {k: v for k, v in poses.items() if k != move.entity}
         slots = free_slots(others, poses[move.entity].xyz, config)
-        at = getattr(move, "at", None)
+        at = move.at if isinstance(move, PlacedMove) else None
         if at is not None and all(
             math.dist(at, p.xy) > config.slot_radius for p in others.values()
         ):

@@ -17,11 +17,10 @@ where the executor puts the block (`tamp.scene.place_pose`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
-from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts, FailedMove
+from tamp.arm_costs import Arm, ArmCosts
 from tamp.scene import XY, Pose, SceneConfig, SceneError, layout, plain_move
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots
@@ -84,27 +83,20 @@ def plan_on_places(
     problem: Problem,
     poses: Mapping[str, Pose],
     scene: SceneConfig,
-    solver: IKSolver,
-    q_now,
+    arm: Arm,
     config: PlannerConfig,
     seed: int = 0,
-    avoid: Mapping | None = None,
     reach: float = 0.0,
-    grasps: tuple[str, ...] = (),
-    failed: Sequence[FailedMove] = (),
-    check: Callable[[Mapping[str, Pose], Move], bool] | None = None,
 ) -> PlanResult:
     """Motion-aware planning of ``problem`` (its ``init``: the observed state) on the scene's
-    table places, the arm's cost of each move in the objective (`ArmCosts`, ``avoid``: moves
-    the arm failed, priced out); the plan's moves are plain (`plain_move`). ``reach`` > 0:
-    continuous placements, each place's position optimised within ``reach`` m of its centre
-    with the logits, per window and restart row: every move onto a place carries the position
-    that the restart row it was decoded from decided in its window (`ArmCosts.decided`).
-    ``grasps``: the grasp families the executor has besides top-down over the highest stack
-    (`ArmCosts`' ``grasps``: a pick or place only those reach is not ruled out);
-    ``failed``: moves the arm failed, ruled out wherever they would be the same
-    (`FailedMove`); ``check``: the executor's check of a move among poses, with which the
-    windows vet each move they keep where it starts (`ArmCosts.verify`). A goal tower taller
+    table places, the cost of each move for ``arm`` in the objective (`ArmCosts`; `Arm`: the
+    moves it failed priced out, ``arm.grasps``: the grasp families the executor has besides
+    top-down over the highest stack, ``arm.check``: the executor's check of a move among
+    poses, with which the windows vet each move they keep where it starts, `ArmCosts.verify`);
+    the plan's moves are plain (`plain_move`). ``reach`` > 0: continuous placements, each
+    place's position optimised within ``reach`` m of its centre with the logits, per window
+    and restart row: every move onto a place carries the position that the restart row it was
+    decoded from decided in its window (`ArmCosts.decided`). A goal tower taller
     than the scene's ``max_height`` is UNSOLVABLE at once, its reason in ``stats["reason"]``
     (the prices rule out every such tower)."""
     tall = goal_height(problem)
@@ -119,19 +111,7 @@ def plan_on_places(
     moved = room_goals(current, at, scene)
     if moved:  # a goal tower's base stands where the tower has no room: it moves first
         current = with_room(current, moved)
-    costs = ArmCosts(
-        [current],
-        [poses],
-        scene,
-        solver,
-        q_now,
-        places=[at],
-        avoid=avoid,
-        reach=reach,
-        grasps=grasps,
-        failed=failed,
-        check=check,
-    )
+    costs = ArmCosts([current], [poses], scene, arm, places=[at], reach=reach)
     result = plan(current, config, seed=seed, costs=costs)
     decided = costs.decided(0)
     if [m for m, _ in decided] != list(result.plan.moves):  # the planner commits every move

@@ -478,3 +478,237 @@ def test_no_mode_is_defined_twice():
     )
     stale = SAME_STRINGS_ALLOWED - {v for v, w in where.items() if len(w) > 1}
     assert not stale, f"allowed repeats that no longer repeat: {sorted(stale)}"
+
+
+# --- signatures: concepts, not wide parameter lists ----------------------------------------------
+
+MAX_PARAMETERS = 7  # per function, self / cls not counted, *args and **kwargs one each
+MAX_POSITIONAL = 7  # per call, starred arguments not counted
+
+# The functions still over `MAX_PARAMETERS` ("path:qualname": parameters) and the calls still over
+# `MAX_POSITIONAL` ("path:callee": the most positional arguments of its calls in that file).
+# These lists only shrink: a new entry or a grown count fails, and so does an entry that shrank or
+# went (lower or drop it). Regenerate both literals with `python tests/test_layout.py`.
+WIDE_FUNCTIONS = {
+    "motion/cost.py:move_costs_batch": 8,
+    "motion/pick_place/lines.py:vertical_path": 8,
+    "tamp/api/__init__.py:_run_scene": 8,
+    "tamp/api/__init__.py:execute_plan": 8,
+    "tamp/api/__init__.py:run": 8,
+    "tamp/bench/executability.py:run_given": 10,
+    "tamp/bench/motion.py:run": 8,
+    "tamp/bench/planning.py:run": 8,
+    "tamp/bench/vision/perception.py:run": 10,
+    "tamp/bench/vision/perception.py:run_row": 8,
+    "tamp/camera/dataset.py:generate": 8,
+    "tamp/camera/image_pair.py:plan_from_images": 8,
+    "tamp/camera/latplan.py:generate": 10,
+    "tamp/camera/render.py:StateRenderer.place": 8,
+    "tamp/camera/render.py:StateRenderer.render": 8,
+    "tamp/geo/check.py:Tools.__init__": 9,
+    "tamp/geo/check.py:_plan_grasp": 9,
+    "tamp/geo/check.py:check_move": 8,
+    "tamp/geo/episode.py:_act": 8,
+    "tamp/geo/ours/pack.py:_free": 9,
+    "tamp/geo/ours/pack.py:overlap_loss": 9,
+    "tamp/geo/ours/pack.py:pack": 8,
+    "tamp/geo/ours/pack.py:pack_sampled": 9,
+    "tamp/geo/ours/planner.py:_complete": 8,
+    "tamp/geo/search.py:_expand": 9,
+    "tamp/geo/search.py:_search": 9,
+    "tamp/loop/episode.py:Episode.__init__": 8,
+    "tamp/world/canonical.py:_finish": 8,
+    "task/decode.py:_best_prefix": 9,
+    "task/decode.py:decode_best": 12,
+    "task/decode.py:decode_row": 11,
+    "task/domains/match/rename.py:_action": 8,
+    "task/domains/match/rename.py:_domain_text": 8,
+    "task/domains/match/rename.py:_problem_text": 8,
+    "task/optimize.py:_decoded": 8,
+    "task/optimize.py:optimise_window": 9,
+    "task/planner/fallback.py:fall_back": 8,
+    "task/planner/loop.py:_run": 9,
+    "task/planner/loop.py:plan_batch": 8,
+    "task/planner/windows.py:_part_windows": 8,
+    "task/planner/windows.py:_retry_frozen": 10,
+    "task/planner/windows.py:next_window": 11,
+    "task/planner/windows.py:run_window": 10,
+    "task/planner/windows.py:take_safe": 9,
+    "task/rollout.py:rollout": 8,
+    "task/symbolic/lazy_search.py:lazy_best_first": 8,
+}
+WIDE_CALLS = {
+    "motion/guard.py:Guarded": 8,
+    "motion/pick_place/plan.py:vertical_path": 8,
+    "robots/pybullet_loader.py:p.createConstraint": 8,
+    "tamp/api/__init__.py:_run_scene": 8,
+    "tamp/api/__init__.py:plan_from_images": 8,
+    "tamp/arm_costs.py:move_costs_batch": 8,
+    "tamp/bench/peers/side_by_side.py:Line": 8,
+    "tamp/bench/planning.py:Bench": 9,
+    "tamp/bench/planning.py:Row": 10,
+    "tamp/bench/planning.py:Speed": 8,
+    "tamp/bench/vision/perception.py:run_row": 8,
+    "tamp/bench/vision/poses.py:BlockRow": 12,
+    "tamp/camera/latplan.py:renderers[sims[i % len(sims)]].place": 8,
+    "tamp/camera/render.py:self.place": 8,
+    "tamp/cli/bench/arm.py:bench.run_given": 10,
+    "tamp/cli/bench/arm.py:motion.run": 8,
+    "tamp/cli/bench/planning.py:planning.run": 8,
+    "tamp/cli/images.py:plan_from_images": 8,
+    "tamp/geo/check.py:_plan_grasp": 9,
+    "tamp/geo/episode.py:_act": 8,
+    "tamp/geo/ours/cells.py:_Term": 8,
+    "tamp/geo/ours/pack.py:PackResult": 8,
+    "tamp/geo/ours/pack.py:_Try": 9,
+    "tamp/geo/ours/pack.py:_free": 9,
+    "tamp/geo/ours/pack.py:overlap_loss": 9,
+    "tamp/geo/ours/planner.py:_complete": 8,
+    "tamp/geo/search.py:_expand": 9,
+    "tamp/geo/search.py:_search": 9,
+    "tamp/loop/given.py:StepReport": 10,
+    "tamp/loop/report.py:EpisodeReport": 15,
+    "tamp/video.py:cv2.putText": 8,
+    "tamp/world/canonical.py:_finish": 8,
+    "tamp/world/load.py:Region": 9,
+    "tamp/world/load.py:Scene": 8,
+    "task/decode.py:DecodedWindow": 11,
+    "task/decode.py:_best_prefix": 9,
+    "task/decode.py:decode_row": 11,
+    "task/domains/match/rename.py:_action": 8,
+    "task/domains/match/rename.py:_domain_text": 8,
+    "task/domains/match/rename.py:_problem_text": 8,
+    "task/optimize.py:_decoded": 8,
+    "task/optimize.py:rollout": 8,
+    "task/planner/loop.py:_run": 9,
+    "task/planner/loop.py:fall_back": 8,
+    "task/planner/loop.py:next_window": 11,
+    "task/planner/loop.py:take_safe": 9,
+    "task/planner/windows.py:_retry_frozen": 10,
+    "task/planner/windows.py:decode_best": 12,
+    "task/planner/windows.py:optimise_window": 9,
+    "task/planner/windows.py:run_window": 8,
+    "task/symbolic/strips_task.py:cls": 14,
+}
+
+
+def _parameters(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    a = node.args
+    names = [x.arg for x in (*a.posonlyargs, *a.args, *a.kwonlyargs)]
+    if names and names[0] in ("self", "cls"):
+        names = names[1:]
+    return len(names) + (a.vararg is not None) + (a.kwarg is not None)
+
+
+def _wide(path: Path, root: Path = ROOT) -> tuple[dict[str, int], dict[str, int]]:
+    """``path``'s functions over `MAX_PARAMETERS` and its calls over `MAX_POSITIONAL`, keyed as
+    `WIDE_FUNCTIONS` and `WIDE_CALLS` are (the path relative to ``root``)."""
+    rel = path.relative_to(root).as_posix()
+    functions: dict[str, int] = {}
+    calls: dict[str, int] = {}
+
+    def visit(node: ast.AST, scope: tuple[str, ...]) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = scope
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+                inner = (*scope, child.name)
+            if isinstance(child, ast.FunctionDef | ast.AsyncFunctionDef):
+                n = _parameters(child)
+                if n > MAX_PARAMETERS:
+                    key = f"{rel}:{'.'.join(inner)}"
+                    functions[key] = max(n, functions.get(key, 0))
+            if isinstance(child, ast.Call):
+                n = sum(not isinstance(x, ast.Starred) for x in child.args)
+                if n > MAX_POSITIONAL:
+                    key = f"{rel}:{ast.unparse(child.func)}"
+                    calls[key] = max(n, calls.get(key, 0))
+            visit(child, inner)
+
+    visit(ast.parse(path.read_text(), filename=str(path)), ())
+    return functions, calls
+
+
+def _all_wide() -> tuple[dict[str, int], dict[str, int]]:
+    functions: dict[str, int] = {}
+    calls: dict[str, int] = {}
+    for package in PACKAGES:
+        for path in sorted((ROOT / package).rglob("*.py")):
+            f, c = _wide(path)
+            functions |= f
+            calls |= c
+    return functions, calls
+
+
+def _shrinks_only(found: dict[str, int], allowed: dict[str, int], what: str) -> list[str]:
+    bad = [
+        f"{key}: {n} {what} (a new one: take a config or a concept instead)"
+        for key, n in found.items()
+        if key not in allowed
+    ]
+    bad += [
+        f"{key}: {found[key]} {what}, {allowed[key]} allowed"
+        for key in found.keys() & allowed.keys()
+        if found[key] > allowed[key]
+    ]
+    bad += [
+        f"{key}: {found.get(key, 0)} {what} now; lower or drop its entry (the list only shrinks)"
+        for key, n in allowed.items()
+        if found.get(key, 0) < n
+    ]
+    return sorted(bad)
+
+
+def test_no_function_takes_more_than_seven_parameters():
+    """Parameters that travel together form a concept (a frozen config, a request, the tools a
+    caller holds): no function of the five packages takes more than `MAX_PARAMETERS`, except
+    those of `WIDE_FUNCTIONS`, a list that only shrinks."""
+    found, _ = _all_wide()
+    assert not _shrinks_only(found, WIDE_FUNCTIONS, "parameters"), _shrinks_only(
+        found, WIDE_FUNCTIONS, "parameters"
+    )
+
+
+def test_no_call_passes_more_than_seven_positional_arguments():
+    """Callers name what they pass: no call in the five packages passes more than
+    `MAX_POSITIONAL` positional arguments (a run of Nones reads as nothing), except those of
+    `WIDE_CALLS`, a list that only shrinks."""
+    _, found = _all_wide()
+    bad = _shrinks_only(found, WIDE_CALLS, "positional arguments")
+    assert not bad, bad
+
+
+def test_the_signature_check_finds_wide_functions_and_calls(tmp_path):
+    """The check itself: eight parameters (self not counted) and eight positional arguments
+    are found, seven are not."""
+    code = (
+        "class K:\n"
+        "    def wide(self, a, b, c, d, e, f, g, h): pass\n"
+        "    def fits(self, a, b, c, d, e, f, g): pass\n"
+        "def outer(*args, **kwargs):\n"
+        "    def inner(a, b, c, d, e, f, *rest, **more): pass\n"
+        "    K().fits(1, 2, 3, 4, 5, 6, 7)\n"
+        "    K().wide(1, 2, 3, 4, 5, 6, 7, 8)\n"
+    )
+    (tmp_path / "pkg").mkdir()
+    path = tmp_path / "pkg" / "m.py"
+    path.write_text(code)
+    functions, calls = _wide(path, tmp_path)
+    assert functions == {"pkg/m.py:K.wide": 8, "pkg/m.py:outer.inner": 8}
+    assert calls == {"pkg/m.py:K().wide": 8}
+    assert _shrinks_only({"a": 9}, {"a": 8}, "p") and _shrinks_only({"a": 8}, {}, "p")
+    assert _shrinks_only({}, {"a": 8}, "p") and not _shrinks_only({"a": 8}, {"a": 8}, "p")
+
+
+def _literal(found: dict[str, int]) -> str:
+    return "".join(f'    "{key}": {n},\n' for key, n in sorted(found.items()))
+
+
+if __name__ == "__main__":  # regenerate `WIDE_FUNCTIONS` and `WIDE_CALLS` in this file
+    functions, calls = _all_wide()
+    me = Path(__file__)
+    text = me.read_text()
+    for name, found in (("WIDE_FUNCTIONS", functions), ("WIDE_CALLS", calls)):
+        start = text.index(f"{name} = {{\n") + len(f"{name} = {{\n")
+        end = text.index("}\n", start)
+        text = text[:start] + _literal(found) + text[end:]
+    me.write_text(text)

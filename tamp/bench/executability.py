@@ -22,11 +22,12 @@ from pathlib import Path
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
+from tamp.arm_costs import Arm
 from tamp.bench.suites import Suite
 from tamp.loop import LoopConfig
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given
 from tamp.rerun_log import recorder_for
-from tamp.scene import layout
+from tamp.scene import PlacedMove, layout
 from tamp.slots import plan_on_places
 from tamp.sweep import run_items, torch_threads
 from task.config import PlannerConfig
@@ -112,7 +113,13 @@ def our_plans(
             poses = layout(problem.entities, problem.init, scene, seed * 100_003 + k)
             results.append(
                 plan_on_places(
-                    problem, poses, scene, solver, PANDA.q_home, config, seed, reach=base.placements
+                    problem,
+                    poses,
+                    scene,
+                    Arm(solver, PANDA.q_home),
+                    config,
+                    seed,
+                    reach=base.placements,
                 )
             )
     else:
@@ -202,7 +209,7 @@ def run_given(
                 if steps is None:  # nothing to execute: its row is written at once
                     unrun.append(len(specs))
                 else:
-                    key = (sim, k, tuple((s.label, getattr(s.move, "at", None)) for s in steps))
+                    key = (sim, k, tuple((s.label, _at(s.move)) for s in steps))
                     named = (record, f"{inst.name}-{src}")
                     runs.setdefault(key, (inst.problem, steps, config, seed * 100_003 + k, named))
                     waiting.setdefault(key, []).append(len(specs))
@@ -275,3 +282,8 @@ def given_summary(rows: Sequence[PlanRow], sims: Sequence[str]) -> list[dict]:
             }
         )
     return out
+
+
+def _at(move) -> tuple[float, float] | None:
+    """The table position a move names (`PlacedMove.at`), None for a plain move."""
+    return move.at if isinstance(move, PlacedMove) else None

@@ -320,8 +320,7 @@ class ScenePoses:
 
 def _box_local(points: np.ndarray, box) -> np.ndarray:
     """Points (M, 3) in the frame of an obstacle box (its centre, turned by its yaw)."""
-    yaw = getattr(box, "yaw", 0.0)
-    c, s = math.cos(yaw), math.sin(yaw)
+    c, s = math.cos(box.yaw), math.sin(box.yaw)
     d = points - np.asarray(box.centre)
     return np.stack([d[:, 0] * c + d[:, 1] * s, -d[:, 0] * s + d[:, 1] * c, d[:, 2]], 1)
 

@@ -86,15 +86,15 @@ def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> 
         )
     from motion.ik import IKSolver
     from robots.panda import PANDA
+    from tamp.arm_costs import Arm
     from tamp.obstacles import with_scene
     from tamp.scene import SceneConfig, layout
     from tamp.slots import plan_on_places
 
     scene = with_scene(SceneConfig(), args.scene)
     poses = layout(problem.entities, problem.init, scene, args.seed)
-    found = plan_on_places(
-        problem, poses, scene, IKSolver(), PANDA.q_home, config, args.seed, reach=args.placements
-    )
+    arm = Arm(IKSolver(), PANDA.q_home)
+    found = plan_on_places(problem, poses, scene, arm, config, args.seed, reach=args.placements)
     return replace(found, problem=problem)
 
 

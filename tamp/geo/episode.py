@@ -46,7 +46,7 @@ from tamp.episode_report import EpisodeReport
 from tamp.geo.baseline import plan_search_then_check, symbolic_plan
 from tamp.geo.check import Tools, candidate_grasps, check_move, grasp_order
 from tamp.geo.config import GeoEpisodeConfig
-from tamp.geo.execute import RunConfig, rests_of, run_move
+from tamp.geo.execute import Correction, RunConfig, rests_of, run_move
 from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
@@ -54,6 +54,7 @@ from tamp.modes import GeoPlanner, Observation
 from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
+from tamp.sim.harness import Harness
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
@@ -372,11 +373,12 @@ def _act(
         verdict,
         rests,
         RunConfig(),
-        on_frame,
-        0.5 if drop else None,
-        sense=lambda: np.asarray(_sensed(sim, expected, camera)[move.obj].xyz),
-        solver=runner.solver,
-        screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
+        Harness(drop_at=0.5 if drop else None, on_frame=on_frame),
+        Correction(
+            sense=lambda: np.asarray(_sensed(sim, expected, camera)[move.obj].xyz),
+            solver=runner.solver,
+            screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
+        ),
     )
     _settle(sim, on_frame)
     seen = observe(sim, expected, camera)

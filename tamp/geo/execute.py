@@ -41,6 +41,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -51,6 +52,10 @@ from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
 from tamp.outcome import Failure
 from tamp.sim.base import Expected, Simulator, holding
+from tamp.sim.harness import Harness
+
+if TYPE_CHECKING:
+    from motion.ik import IKSolver
 
 
 @dataclass(frozen=True)
@@ -95,25 +100,34 @@ def expected_contacts(phase: str, obj: str, rests: tuple[str, str]) -> Expected:
     return Expected(obj, obj, frozenset({during[phase]} - {None}))
 
 
+@dataclass(frozen=True)
+class Correction:
+    """How a run corrects the place for the held object's slip in the hand (module
+    docstring): ``sense``, the held object's centre (3,) as a sensor reads it now; ``solver``
+    (`motion.ik.IKSolver`), the corrected phases' IK; ``screen``, whether corrected phases are
+    free of collisions (the guard's check; None: not checked): corrected phases it refuses
+    are not run, the planned ones are."""
+
+    sense: Callable[[], np.ndarray]
+    solver: IKSolver
+    screen: Callable[[tuple[Phase, ...]], bool] | None = None
+
+
 def run_move(
     sim: Simulator,
     move: GeoMove,
     check: MoveCheck,
     rests: tuple[str, str],
     config: RunConfig = RunConfig(),
-    on_frame: Callable[[Simulator], None] | None = None,
-    drop_at: float | None = None,
-    sense: Callable[[], np.ndarray] | None = None,
-    solver=None,
-    screen: Callable[[tuple[Phase, ...]], bool] | None = None,
+    harness: Harness = Harness(),
+    correction: Correction | None = None,
 ) -> MoveRun:
     """Run ``check``'s phases (a feasible `MoveCheck` of ``move``) in ``sim``; ``rests``: what
-    the object leaves and goes onto (`support_box` names). ``drop_at`` in [0, 1] opens the
-    gripper at that fraction of the transit (fault injection). ``sense``: the held object's
-    centre (3,) as a sensor reads it now, and ``solver`` (`motion.ik.IKSolver`): correct the
-    place for the object's slip in the hand (module docstring); None: run as planned.
-    ``screen``: whether corrected phases are free of collisions (the guard's check; None: not
-    checked); corrected phases it refuses are not run, the planned ones are."""
+    the object leaves and goes onto (`support_box` names). ``harness.drop_at`` in [0, 1] opens
+    the gripper at that fraction of the transit (fault injection), ``harness.on_frame`` is
+    called at every frame (`tamp.sim.harness.Harness`). ``correction``: correct the place for
+    the object's slip in the hand (`Correction`); None: run as planned."""
+    on_frame, drop_at = harness.on_frame, harness.drop_at
     wall0, sim0, path = time.perf_counter(), sim.time, 0.0
     width = check.grasp.width
     evidence: dict = {}
@@ -123,20 +137,21 @@ def run_move(
             failure is None,
             failure,
             {**evidence, **found},
-            sim.time - sim0,
-            path,
-            time.perf_counter() - wall0,
+            sim_time_s=sim.time - sim0,
+            path_rad=path,
+            wall_s=time.perf_counter() - wall0,
         )
 
     def corrected(phase: Phase, rest: list, low: bool) -> tuple[Phase, list]:
         """Look at the held object before ``phase`` (a lower) and correct the place side."""
-        fixed = _look_and_correct(sim, move, phase, rest, sense, solver, config, on_frame)
+        fixed = _look_and_correct(sim, move, phase, rest, correction, config, on_frame)
         if fixed is not None and low:  # the shift is a step of the lowering, beside the place
             fixed = (
                 tuple(replace(p, name="lower") if p.name == "shift" else p for p in fixed[0]),
                 fixed[1],
             )
         key = "low" if low else ""
+        screen = correction.screen
         if fixed is not None and screen is not None and not screen(fixed[0]):
             evidence[f"uncorrected{key and '_' + key}_mm"] = fixed[1]  # it would collide
             fixed = None
@@ -147,7 +162,7 @@ def run_move(
 
     handling = Expected(move.obj)
     phases, looks, low = list(check.motion), 0, None
-    looking = sense is not None and solver is not None
+    looking = correction is not None
     while phases:
         phase = phases.pop(0)
         if looking and phase.name == "lower" and looks == 0:  # above the place
@@ -155,7 +170,7 @@ def run_move(
             phase, phases = corrected(phase, phases, low=False)
         if looking and phase.name == "lower" and looks == 1:  # stop short of the release
             looks = 2
-            split = split_lower(solver, phase, config.low_look)
+            split = split_lower(correction.solver, phase, config.low_look)
             if split is not None:
                 phase, low = split
                 phases.insert(0, low)
@@ -200,7 +215,13 @@ def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:
 
 
 def _look_and_correct(
-    sim, move: GeoMove, lower: Phase, rest: list, sense, solver, config: RunConfig, on_frame
+    sim,
+    move: GeoMove,
+    lower: Phase,
+    rest: list,
+    correction: Correction,
+    config: RunConfig,
+    on_frame,
 ):
     """Hold above the place, read where the held object is and, when it is off the plan by
     more than ``correct_min`` (at most ``correct_max``), the corrected place side: (phases
@@ -208,7 +229,8 @@ def _look_and_correct(
     q = sim.arm_q()
     hold = JointTrajectory.hold(q, config.look_s, sim.dt)
     sim.run(hold, "closed", on_frame=on_frame, expected=Expected(move.obj, move.obj))
-    seen = np.asarray(sense(), dtype=np.float64)
+    seen = np.asarray(correction.sense(), dtype=np.float64)
+    solver = correction.solver
     # the object's offset from the TCP in the plane, as planned at the place and as seen now
     # (a top grasp plans it at 0; a tilted one beside the TCP); the hand moves by the difference
     place_tcp, tcp_now = solver.fk(np.stack([lower.trajectory.positions[-1], sim.arm_q()]))

@@ -35,11 +35,12 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
-from tamp.arm_costs import ArmCosts, FailedMove, failed_key
+from tamp.arm_costs import Arm, ArmCosts, FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import (
     CollisionMode,
+    ExecTools,
     ExecutionResult,
     Fallback,
     execute_move,
@@ -57,6 +58,7 @@ from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
+from tamp.sim.harness import Harness
 from tamp.slots import plan_on_places
 from task.domains import get_domain
 from task.planner import plan
@@ -319,6 +321,11 @@ class Episode:
 
         return geo_fallback(self.solver, self.collision, execution.guard)
 
+    def _tools(self) -> ExecTools:
+        """What the executor works with: the episode's IK solver, scene, collision model and
+        geometric fallback (`_fallback`)."""
+        return ExecTools(self.solver, self.config.scene, self.collision, self._fallback())
+
     def _check_ahead(self, q) -> Callable | None:
         """``check(poses, move)`` for the planner's windows (`LoopConfig.check_ahead`): whether
         `tamp.loop.execute.motion_check` finds the move's motion among ``poses`` (the poses
@@ -330,17 +337,7 @@ class Episode:
         seed = self.seed * 1000 + 999_983  # the motion planner's seed for checks ahead
 
         def check(poses, move: Move) -> bool:
-            found = motion_check(
-                self.solver,
-                move,
-                dict(poses),
-                q,
-                cfg.execution,
-                cfg.scene,
-                self.collision,
-                seed,
-                self._fallback(),
-            )
+            found = motion_check(self._tools(), move, dict(poses), q, cfg.execution, seed)
             return found is None
 
         return check
@@ -365,29 +362,18 @@ class Episode:
         if self.config.planner.lambda_motion > 0:
             poses, scene, q = self._poses(), self.config.scene, self.sim.arm_q()
             if self.config.observe is Observation.STATE:
-                return plan_on_places(
-                    current,
-                    poses,
-                    scene,
+                arm = Arm(
                     self.solver,
                     q,
-                    self.config.planner,
-                    seed,
-                    self._avoid,
-                    self.config.placements,
-                    self._grasps(),
-                    self._failed,
-                    self._check_ahead(q),
+                    grasps=self._grasps(),
+                    check=self._check_ahead(q),
+                    avoid=self._avoid,
+                    failed=self._failed,
                 )
-            costs = ArmCosts(
-                [current],
-                [poses],
-                scene,
-                self.solver,
-                q,
-                avoid=self._avoid,
-                failed=self._failed,
-            )
+                planner, reach = self.config.planner, self.config.placements
+                return plan_on_places(current, poses, scene, arm, planner, seed, reach=reach)
+            arm = Arm(self.solver, q, avoid=self._avoid, failed=self._failed)
+            costs = ArmCosts([current], [poses], scene, arm)
         if self.config.observe is Observation.STATE:
             return plan(current, self.config.planner, seed=seed, costs=costs)
         image = self.eyes.image
@@ -467,7 +453,7 @@ class Episode:
         if not done.ok or "placed_at" not in done.evidence:
             return None
         at = move.at
-        return getattr(move, "place", None) or f"({at[0]:.2f}, {at[1]:.2f})"
+        return move.place or f"({at[0]:.2f}, {at[1]:.2f})"
 
     # --- acting and sensing ----------------------------------------------------------------
     def _act(self, move: Move, label: str, drop_at: float | None = None) -> ExecutionResult:
@@ -475,19 +461,19 @@ class Episode:
         self.status_text = label
         cfg = self.config
         self._acts += 1
+        harness = Harness(
+            drop_at=drop_at,
+            on_frame=self._frames(),
+            on_phase=None if self.recorder is None else self.recorder.phase,
+        )
         done = execute_move(
             self.sim,
-            self.solver,
             move,
             self._poses,
+            self._tools(),
             cfg.execution,
-            cfg.scene,
-            drop_at,
-            self._frames(),
-            self.collision,
-            self.seed * 1000 + self._acts,
-            on_phase=None if self.recorder is None else self.recorder.phase,
-            fallback=self._fallback(),
+            seed=self.seed * 1000 + self._acts,
+            harness=harness,
         )
         if self.recorder is not None:
             self.recorder.moved(self.sim, label, done)

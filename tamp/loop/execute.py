@@ -33,8 +33,9 @@ from motion.trajectory import JointTrajectory
 from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
 from tamp.outcome import Failure
-from tamp.scene import Pose, SceneConfig, place_pose, top_z
+from tamp.scene import PlacedMove, Pose, SceneConfig, place_pose, top_z
 from tamp.sim.base import Expected, Simulator, holding
+from tamp.sim.harness import Harness
 from task.errors import member
 from task.problem import TABLE, Move
 
@@ -121,34 +122,50 @@ class Fallback(Protocol):
     to the executor by whoever builds it (the episode: `tamp.loop.geo_fallback.GeoFallback`, every
     grasp family of the geometric room), so this module imports no room of its own."""
 
-    def check(
-        self,
-        move: Move,
-        target: Pose,
-        poses: Mapping[str, Pose],
-        scene: SceneConfig,
-        q_now,
-        seed: int = 0,
-    ) -> bool:
-        """Whether it finds ``move``'s motion to ``target`` among the blocks at ``poses`` from
-        the arm at ``q_now``, nothing run."""
+    def check(self, placing: Placing, q_now, seed: int = 0) -> bool:
+        """Whether it finds the motion of ``placing`` from the arm at ``q_now``, nothing
+        run."""
         ...
 
     def run(
         self,
         sim: Simulator,
-        move: Move,
-        target: Pose,
-        poses: Mapping[str, Pose],
-        scene: SceneConfig,
+        placing: Placing,
         config: ExecConfig,
         seed: int = 0,
         drop_at: float | None = None,
         observe: Observe | None = None,
     ) -> ExecutionResult:
-        """Check ``move`` to ``target`` from the arm's configuration now and run it when it
-        passes; the place checked on the poses ``observe`` gives after it."""
+        """Check ``placing`` from the arm's configuration now and run it when it passes
+        (``drop_at``: the fault, `tamp.sim.harness.Harness`); the place checked on the poses
+        ``observe`` gives after it."""
         ...
+
+
+@dataclass(frozen=True)
+class Placing:
+    """One move as the executor makes it: ``move`` with ``target``, the pose its block is put
+    at, among the blocks at ``poses`` on ``scene``'s table."""
+
+    move: Move
+    target: Pose
+    poses: Mapping[str, Pose]
+    scene: SceneConfig
+
+
+@dataclass(frozen=True)
+class ExecTools:
+    """What the executor works with, built once by its caller (the episode): the IK
+    ``solver``, the ``scene`` the moves are made in, the arm's ``collision`` model
+    (`robots.collision.PandaCollision`, which checks the planned phases unless
+    `ExecConfig.collision` is "off"; None: unchecked) and the ``fallback`` for the moves the
+    top-down grasps cannot make (`Fallback`: the geometric room's,
+    `tamp.loop.geo_fallback.GeoFallback`; None: top-down only)."""
+
+    solver: IKSolver
+    scene: SceneConfig = SceneConfig()
+    collision: CollisionModel | None = None
+    fallback: Fallback | None = None
 
 
 def obstacle_boxes(scene: SceneConfig):
@@ -210,12 +227,13 @@ def _back_off(sim: Simulator, phases: tuple[Phase, ...], on_frame, expected: Exp
         sim.run(back, "open", on_frame=on_frame, expected=expected)
 
 
-def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
+def _plan(tools: ExecTools, move, poses, q_now, config, seed, times):
     """(target pose, phases, IK time, rerouted phases) of the move, or (Failure, IK time,
     evidence); adds to ``times`` (check s, planner s, path rad, planner runs, failures). A move
     whose motion fails tries the quarter-turned grasp (a neighbour touching the block on one
     side leaves the other pair of faces free), and a table placement the next free slots (up
     to ``config.slot_tries``)."""
+    scene, collision = tools.scene, tools.collision
     ik, last = 0.0, None
     tries = range(config.slot_tries if move.target == TABLE else 1)
     pick = poses[move.entity]
@@ -230,11 +248,11 @@ def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
             target.xyz,
             target.yaw,
             clear_z,
-            ceiling(pick.xyz, scene.obstacles),
-            ceiling(target.xyz, scene.obstacles),
-            turn,
+            pick_ceiling=ceiling(pick.xyz, scene.obstacles),
+            place_ceiling=ceiling(target.xyz, scene.obstacles),
+            turn=turn,
         )
-        planned = plan_pick_place(solver, q_now, request, config.motion)
+        planned = plan_pick_place(tools.solver, q_now, request, config.motion)
         ik += planned.ik_time_s
         if not planned.ok:
             last = (Failure(planned.failure), ik, planned.evidence)
@@ -254,13 +272,13 @@ def _plan(q_now, solver, move, poses, config, scene, collision, seed, times):
     return last
 
 
-def _geo(sim, fallback: Fallback, move, target, poses, config, scene, seed, drop_at, observe):
-    """``move`` checked and run by ``fallback`` to ``target``; the place checked on the poses
-    ``observe`` gives after it (a block the camera cannot see then: ``unobservable``)."""
+def _geo(sim, fallback: Fallback, placing: Placing, config, seed, drop_at, observe):
+    """``placing`` checked and run by ``fallback``; the place checked on the poses ``observe``
+    gives after it (a block the camera cannot see then: ``unobservable``)."""
     try:
-        return fallback.run(sim, move, target, poses, scene, config, seed, drop_at, observe)
+        return fallback.run(sim, placing, config, seed, drop_at, observe)
     except PerceptionError as err:
-        return ExecutionResult(move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
+        return ExecutionResult(placing.move, False, Failure.UNOBSERVABLE, {"seen": str(err)})
 
 
 def _geo_retries(failure: Failure, config: ExecConfig, fallback: Fallback | None) -> bool:
@@ -275,28 +293,29 @@ def _geo_retries(failure: Failure, config: ExecConfig, fallback: Fallback | None
 
 
 def motion_check(
-    solver: IKSolver,
+    tools: ExecTools,
     move: Move,
     poses: dict[str, Pose],
     q_now,
-    config: ExecConfig,
-    scene: SceneConfig,
-    collision: CollisionModel | None,
+    config: ExecConfig = ExecConfig(),
     seed: int = 0,
-    fallback: Fallback | None = None,
 ) -> Failure | None:
     """What `execute_move` would find before the arm moves, with the blocks at ``poses`` and
     the arm at ``q_now``, nothing run: None when it finds the move's motion (top-down, each
-    phase guarded, or with its ``fallback`` every other grasp), else the failure it would
+    phase guarded, or with ``tools.fallback`` every other grasp), else the failure it would
     report. A planned move checked ahead, on the poses its plan predicts
     (`tamp.arm_costs.ArmCosts.verify`)."""
     times = [0.0, 0.0, 0.0, 0, 0]
-    planned = _plan(q_now, solver, move, poses, config, scene, collision, seed, times)
+    planned = _plan(tools, move, poses, q_now, config, seed, times)
     if not (isinstance(planned, tuple) and isinstance(planned[0], Failure)):
         return None
+    fallback = tools.fallback
     if _geo_retries(planned[0], config, fallback):
-        target = place_pose(move, poses, scene)
-        if target is not None and fallback.check(move, target, poses, scene, q_now, seed):
+        target = place_pose(move, poses, tools.scene)
+        found = target is not None and fallback.check(
+            Placing(move, target, poses, tools.scene), q_now, seed
+        )
+        if found:
             return None
     return planned[0]
 
@@ -306,7 +325,7 @@ def placed_elsewhere(move: Move, target: Pose) -> dict:
     and the executor put the block on another one, ``target`` (the next free slot: the
     top-down hand could not reach the named one, or it was taken), else ``{}``: evidence of a
     move that went through but not where its plan had it (`tamp.loop.episode`)."""
-    at = getattr(move, "at", None)
+    at = move.at if isinstance(move, PlacedMove) else None
     if at is None or float(np.hypot(*np.subtract(target.xy, at))) <= 1e-6:
         return {}
     return {"placed_at": (round(float(target.xyz[0]), 4), round(float(target.xyz[1]), 4))}
@@ -327,28 +346,23 @@ def failed_pick(done: ExecutionResult) -> bool:
 
 def execute_move(
     sim: Simulator,
-    solver: IKSolver,
     move: Move,
     observe: Observe,
+    tools: ExecTools,
     config: ExecConfig = ExecConfig(),
-    scene: SceneConfig = SceneConfig(),
-    drop_at: float | None = None,
-    on_frame: Callable[[Simulator], None] | None = None,
-    collision: CollisionModel | None = None,
     seed: int = 0,
-    on_phase: Callable[[Simulator, Phase], None] | None = None,
-    fallback: Fallback | None = None,
+    harness: Harness = Harness(),
 ) -> ExecutionResult:
     """Pick ``move.entity`` where it is observed and place it on ``move.target``.
 
-    ``drop_at`` in [0, 1] opens the gripper at that fraction of the transit (fault injection).
-    ``collision``: the arm's collision model (`robots.collision.PandaCollision`), which checks
-    the planned phases unless ``config.collision`` is "off"; ``seed`` seeds the motion planner.
-    ``on_phase(sim, phase)`` is called as each planned phase starts (a recording, `tamp.rerun_log`).
-    ``fallback``: another way to make a move the top-down grasps could not (`Fallback`: the
-    geometric room's, `tamp.loop.geo_fallback.GeoFallback`); None: top-down only.
+    ``tools``: the IK solver, the scene, the arm's collision model and the fallback for the
+    moves the top-down grasps cannot make (`ExecTools`); ``seed`` seeds the motion planner.
+    ``harness``: the fault injected (``drop_at`` in [0, 1] opens the gripper at that fraction
+    of the transit) and the recorders called as frames and phases pass (`Harness`).
     """
     wall0, sim0 = time.perf_counter(), sim.time
+    scene, fallback = tools.scene, tools.fallback
+    drop_at, on_frame, on_phase = harness.drop_at, harness.on_frame, harness.on_phase
 
     # collision checks (s), motion planner (s), path run (rad), planner runs, planner failures
     times = [0.0, 0.0, 0.0, 0, 0]
@@ -360,10 +374,12 @@ def execute_move(
             failure is None,
             failure,
             evidence,
-            sim.time - sim0,
-            time.perf_counter() - wall0,
-            ik_time,
-            *times[:3],
+            sim_time_s=sim.time - sim0,
+            wall_time_s=time.perf_counter() - wall0,
+            ik_time_s=ik_time,
+            check_time_s=times[0],
+            path_time_s=times[1],
+            path_rad=times[2],
             rerouted=tuple(started),
             planner_runs=times[3],
             planner_failures=times[4],
@@ -373,14 +389,13 @@ def execute_move(
         poses = observe()
     except PerceptionError as err:
         return result(Failure.UNOBSERVABLE, when="before the pick", seen=str(err))
-    planned = _plan(sim.arm_q(), solver, move, poses, config, scene, collision, seed, times)
+    planned = _plan(tools, move, poses, sim.arm_q(), config, seed, times)
     if isinstance(planned, tuple) and isinstance(planned[0], Failure):
         if _geo_retries(planned[0], config, fallback):
             target = place_pose(move, poses, scene)
             if target is not None:
-                again = _geo(
-                    sim, fallback, move, target, poses, config, scene, seed, drop_at, observe
-                )
+                placing = Placing(move, target, poses, scene)
+                again = _geo(sim, fallback, placing, config, seed, drop_at, observe)
                 if again.ok or again.path_rad > 0:  # it made the move, or it ran and failed
                     first = result(planned[0], planned[1])  # the top-down tries' times
                     moved = placed_elsewhere(move, target) if again.ok else {}

@@ -38,11 +38,12 @@ import numpy as np
 from motion.grasps import FAMILIES
 from tamp.outcome import Failure
 from tamp.scene import PALETTE, Pose, SceneConfig, read_state, towers
-from task.problem import TABLE, Move, Problem
+from tamp.sim.harness import Harness
+from task.problem import TABLE, Problem
 
 if TYPE_CHECKING:
     from tamp.geo.check import Tools
-    from tamp.loop.execute import ExecConfig, ExecutionResult
+    from tamp.loop.execute import ExecConfig, ExecutionResult, Placing
     from tamp.world.goal import Goal
     from tamp.world.schema import Scene
 
@@ -122,20 +123,14 @@ def geo_tools(
     )
 
 
-def geo_check(
-    move: Move,
-    target: Pose,
-    poses: Mapping[str, Pose],
-    scene: SceneConfig,
-    tools: Tools,
-    q_now,
-    seed: int = 0,
-):
-    """``move`` to ``target`` among the blocks at ``poses`` checked over every grasp family
-    of ``tools`` from the arm at ``q_now``, nothing run: ``(world, geo move, verdict)`` (a
-    `tamp.geo.check.MoveCheck`), what `run_geo` runs when the verdict passes."""
+def geo_check(placing: Placing, tools: Tools, q_now, seed: int = 0):
+    """``placing`` (a move to its target pose among the observed blocks) checked over every
+    grasp family of ``tools`` from the arm at ``q_now``, nothing run: ``(world, geo move,
+    verdict)`` (a `tamp.geo.check.MoveCheck`), what `run_geo` runs when the verdict passes."""
     from tamp.geo.check import candidate_grasps, check_move, grasp_order
     from tamp.geo.types import GeoMove, Place
+
+    move, target, poses, scene = placing.move, placing.target, placing.poses, placing.scene
 
     world = world_scene(tuple(poses), poses, scene)
     name = "table" if move.target == TABLE else f"on.{move.target}"
@@ -150,28 +145,26 @@ def geo_check(
 
 def run_geo(
     sim,
-    move: Move,
-    target: Pose,
-    poses: Mapping[str, Pose],
-    scene: SceneConfig,
+    placing: Placing,
     tools: Tools,
-    config,
+    config: ExecConfig,
     seed: int = 0,
-    drop_at: float | None = None,
-    on_frame: Callable | None = None,
+    harness: Harness = Harness(),
     observe: Callable[[], Mapping[str, Pose]] | None = None,
 ):
-    """Check ``move`` to ``target`` (the pose the loop places the block at) over every grasp
-    family of ``tools`` from the arm's configuration now, and run
-    it when a grasp passes: the loop's `tamp.loop.execute.ExecutionResult` (``evidence`` names
-    the grasp, or the geometric failure). ``config``: the loop's `ExecConfig` (the place check's
-    tolerances); ``observe``: the block poses after the run (default: the simulator's sensor is
-    not read here, so the place is not checked)."""
+    """Check ``placing`` (a move to ``placing.target``, the pose the loop places the block at)
+    over every grasp family of ``tools`` from the arm's configuration now, and run it when a
+    grasp passes: the loop's `tamp.loop.execute.ExecutionResult` (``evidence`` names the
+    grasp, or the geometric failure). ``config``: the loop's `ExecConfig` (the place check's
+    tolerances); ``harness``: the fault injected and the recorders (`tamp.sim.harness.Harness`);
+    ``observe``: the block poses after the run (default: the simulator's sensor
+    is not read here, so the place is not checked)."""
     from tamp.geo.execute import RunConfig, rests_of, run_move
     from tamp.loop.execute import ExecutionResult
 
     wall0, sim0 = time.perf_counter(), sim.time
-    world, geo, verdict = geo_check(move, target, poses, scene, tools, sim.arm_q(), seed)
+    move, poses, scene = placing.move, placing.poses, placing.scene
+    world, geo, verdict = geo_check(placing, tools, sim.arm_q(), seed)
 
     def result(failure: Failure | None, run=None, **evidence) -> ExecutionResult:
         return ExecutionResult(
@@ -179,8 +172,8 @@ def run_geo(
             failure is None,
             failure,
             {"geo": "ok" if failure is None else failure.value, **evidence},
-            sim.time - sim0,
-            time.perf_counter() - wall0,
+            sim_time_s=sim.time - sim0,
+            wall_time_s=time.perf_counter() - wall0,
             check_time_s=verdict.time_s,
             path_rad=0.0 if run is None else run.path_rad,
         )
@@ -191,7 +184,7 @@ def run_geo(
         return result(verdict.failure, tried=tried, sides=sides)
     below = next((x for x, p in poses.items() if _on(p, poses[move.entity], scene)), TABLE)
     rests = rests_of(world, geo, below)
-    run = run_move(sim, geo, verdict, rests, RunConfig(), on_frame, drop_at)
+    run = run_move(sim, geo, verdict, rests, RunConfig(), harness)
     # the grasp, and whether it passed in another posture of the arm (`tamp.geo.postures`)
     held = {
         "grasp": verdict.grasp.name,
@@ -217,34 +210,22 @@ class GeoFallback:
 
     tools: Tools
 
-    def check(
-        self,
-        move: Move,
-        target: Pose,
-        poses: Mapping[str, Pose],
-        scene: SceneConfig,
-        q_now,
-        seed: int = 0,
-    ) -> bool:
-        """Whether `geo_check` passes ``move`` to ``target`` from the arm at ``q_now``."""
-        return geo_check(move, target, poses, scene, self.tools, q_now, seed)[2].ok
+    def check(self, placing: Placing, q_now, seed: int = 0) -> bool:
+        """Whether `geo_check` passes ``placing`` from the arm at ``q_now``."""
+        return geo_check(placing, self.tools, q_now, seed)[2].ok
 
     def run(
         self,
         sim,
-        move: Move,
-        target: Pose,
-        poses: Mapping[str, Pose],
-        scene: SceneConfig,
+        placing: Placing,
         config: ExecConfig,
         seed: int = 0,
         drop_at: float | None = None,
         observe: Callable[[], Mapping[str, Pose]] | None = None,
     ) -> ExecutionResult:
-        """`run_geo` of ``move`` to ``target`` in ``sim``."""
-        return run_geo(
-            sim, move, target, poses, scene, self.tools, config, seed, drop_at, None, observe
-        )
+        """`run_geo` of ``placing`` in ``sim``, ``drop_at`` its fault (`Harness`)."""
+        harness = Harness(drop_at=drop_at)
+        return run_geo(sim, placing, self.tools, config, seed, harness, observe)
 
 
 def geo_fallback(solver, collision, guard) -> GeoFallback:

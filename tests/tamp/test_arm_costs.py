@@ -12,7 +12,7 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import ARM, BLOCKED, ArmCosts, predict_poses
+from tamp.arm_costs import ARM, BLOCKED, Arm, ArmCosts, predict_poses
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
 from tamp.scene import SceneConfig, layout
@@ -43,7 +43,7 @@ def test_predicted_poses_keep_towers_in_place_and_put_new_ones_on_free_slots():
 
 def test_costs_are_one_matrix_per_problem_and_a_far_place_costs_more(solver):
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])  # a-b, c, d
-    source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)
+    source = ArmCosts([FOUR], [poses], SCENE, Arm(solver, PANDA.q_home))
     window = source([0], [FOUR.init])
     c = window.compute()
     assert c.shape == (1, 4, 5) and torch.isfinite(c).all() and window.parameters() == []
@@ -58,7 +58,7 @@ def test_a_tower_at_its_slots_clearance_blocks_one_more_block(solver):
         "five", "blocksworld", tuple("abcdef"), (TABLE, "a", "b", "c", "d", TABLE), (("f", "e"),)
     )
     poses = layout(five.entities, five.init, SCENE, seed=0, slots=[8, 0])  # the tower under it
-    c = ArmCosts([five], [poses], shelf, solver, PANDA.q_home)([0], [five.init]).compute()
+    c = ArmCosts([five], [poses], shelf, Arm(solver, PANDA.q_home))([0], [five.init]).compute()
     assert shelf.capacity(poses["a"].xy) == 5
     assert c[0, 5, 4] >= BLOCKED and c[0, 5, 6] < BLOCKED  # f onto e (6th), f onto the table
 
@@ -77,7 +77,7 @@ def test_a_motion_aware_episode_takes_the_move_the_arm_prefers(solver):
     assert isinstance(first, PlacedMove) and first.entity == "a" and first.target == TABLE
     poses = layout(FOUR.entities, FOUR.init, config.scene, 0)  # the episode's layout
     problem, at = slotted(FOUR, FOUR.init, poses, config.scene)
-    source = ArmCosts([problem], [poses], config.scene, solver, PANDA.q_home, places=[at])
+    source = ArmCosts([problem], [poses], config.scene, Arm(solver, PANDA.q_home), places=[at])
     c = source([0], [problem.init]).compute()[0]
     assert first.at == at[first.place]
     assert c[0, problem.n + problem.fixed.index(first.place)] < c[0, 3]  # below a onto d
@@ -124,7 +124,7 @@ def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver
     for name in ("tabletop", "clutter"):
         scene = with_scene(SCENE, name)
         for cfg in (ARM, replace(ARM, collision_weight=0.0)):
-            source = ArmCosts([FOUR], [poses], scene, solver, PANDA.q_home, config=cfg)
+            source = ArmCosts([FOUR], [poses], scene, Arm(solver, PANDA.q_home), config=cfg)
             costs[name, cfg.collision_weight] = source([0], [FOUR.init]).compute()[0]
     assert obstacle_tensors(with_scene(SCENE, "tabletop"))[0].shape == (0, 3)
     assert torch.equal(costs["tabletop", 5.0], costs["tabletop", 0.0])
@@ -150,7 +150,7 @@ def test_a_place_the_hand_cannot_reach_at_hover_height_is_ruled_out(solver):
         slots = [0] if problem is tall else [0, 1]
         poses = layout(problem.entities, problem.init, cramped, seed=0, slots=slots)
         current, at = slotted(problem, problem.init, poses, cramped)
-        source = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at])
+        source = ArmCosts([current], [poses], cramped, Arm(solver, PANDA.q_home), places=[at])
         matrix = source([0], [current.init]).compute()[0]
         far = [problem.n + j for j, k in enumerate(current.fixed) if at[k][0] > 0.7]
         assert len(far) == 2
@@ -183,8 +183,7 @@ def test_a_release_behind_a_tall_near_tower_is_ruled_out(solver, near, blocked):
             [current],
             [poses],
             cramped,
-            solver,
-            PANDA.q_home,
+            Arm(solver, PANDA.q_home),
             config=replace(ARM, block_weight=weight),
             places=[at],
         )
@@ -197,8 +196,10 @@ def test_a_release_behind_a_tall_near_tower_is_ruled_out(solver, near, blocked):
 
 def test_a_placed_window_at_zero_offsets_prices_like_a_fixed_one_blocks_included(solver):
     cramped, current, at, poses, mover, far = _behind(6)
-    fixed = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at])
-    placed = ArmCosts([current], [poses], cramped, solver, PANDA.q_home, places=[at], reach=0.03)
+    fixed = ArmCosts([current], [poses], cramped, Arm(solver, PANDA.q_home), places=[at])
+    placed = ArmCosts(
+        [current], [poses], cramped, Arm(solver, PANDA.q_home), places=[at], reach=0.03
+    )
     window = placed([0], [current.init])
     c = window.compute()
     torch.testing.assert_close(c, fixed([0], [current.init]).compute(), atol=1e-9, rtol=0)
@@ -215,7 +216,7 @@ def test_each_point_is_solved_once_per_source_with_the_batched_reach(solver, mon
     from motion.cost import site_solutions
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
-    source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)
+    source = ArmCosts([FOUR], [poses], SCENE, Arm(solver, PANDA.q_home))
     picks = torch.tensor([[poses[x].xyz for x in FOUR.entities]], dtype=torch.float64)
     places = torch.tensor([[(0.5, 0.0, 0.025), (2.0, 0.0, 0.025)]], dtype=torch.float64)
     q, ok = source._site_solutions(picks, places)
@@ -250,11 +251,13 @@ def test_a_failed_move_is_ruled_out_wherever_it_would_be_the_same(solver):
     assert site.matches(poses["c"].xyz, crowded, "c")  # another block near: no easier
 
     onto_d = np.add(poses["d"].xyz, (0.0, 0.0, SCENE.block_size))
-    plain = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home)([0], [FOUR.init]).compute()[0]
+    plain = ArmCosts([FOUR], [poses], SCENE, Arm(solver, PANDA.q_home))([0], [FOUR.init]).compute()[
+        0
+    ]
     assert (plain[2] < BLOCKED).all()
     for pick_only, ruled in ((False, [3]), (True, [0, 1, 2, 3, 4])):
         failed = FailedMove.of("c", poses, onto_d, pick_only)
-        source = ArmCosts([FOUR], [poses], SCENE, solver, PANDA.q_home, failed=[failed])
+        source = ArmCosts([FOUR], [poses], SCENE, Arm(solver, PANDA.q_home, failed=[failed]))
         c = source([0], [FOUR.init]).compute()[0]
         assert [j for j in range(5) if c[2, j] >= BLOCKED] == ruled  # columns a, b, c, d, table
         torch.testing.assert_close(c[[0, 1, 3]], plain[[0, 1, 3]], atol=0, rtol=0)

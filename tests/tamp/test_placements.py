@@ -10,7 +10,7 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, ArmCosts, failed_key
+from tamp.arm_costs import BLOCKED, Arm, ArmCosts, failed_key
 from tamp.scene import PlacedMove, layout
 from tamp.slots import slotted
 from task.problem import TABLE, Move
@@ -34,7 +34,9 @@ def four():
 
 def test_each_restart_row_optimises_its_own_placements_fresh_every_window(solver, four):
     problem, at, poses = four
-    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=REACH)
+    source = ArmCosts(
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at], reach=REACH
+    )
     window = source([0], [problem.init], 3)
     (u,) = window.parameters()
     c = window.compute()
@@ -55,7 +57,9 @@ def test_each_restart_row_optimises_its_own_placements_fresh_every_window(solver
 
 def test_a_committed_move_keeps_the_position_of_the_row_it_came_from(solver, four):
     problem, at, poses = four
-    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=REACH)
+    source = ArmCosts(
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at], reach=REACH
+    )
     window = source([0], [problem.init], 3)
     (u,) = window.parameters()
     with torch.no_grad():
@@ -82,9 +86,9 @@ def test_a_failed_move_at_an_offset_position_is_priced_out_at_its_place(solver, 
     failed = PlacedMove("a", TABLE, where, **place)
     far = PlacedMove("c", TABLE, (cx + 0.08, cy), **place)  # beyond the place's reach
     avoid = {FOUR.init: {failed_key(failed), failed_key(far)}}
-    plain = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=REACH)
+    plain = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at], reach=REACH)
     priced = ArmCosts(
-        [problem], [poses], SCENE, solver, PANDA.q_home, places=[at], avoid=avoid, reach=REACH
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home, avoid=avoid), places=[at], reach=REACH
     )
     with torch.no_grad():
         diff = priced([0], [problem.init]).compute() - plain([0], [problem.init]).compute()

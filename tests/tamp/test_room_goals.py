@@ -11,6 +11,7 @@ import pytest
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
+from tamp.arm_costs import Arm
 from tamp.obstacles import with_scene
 from tamp.scene import SceneConfig, layout
 from tamp.slots import plan_on_places, room_goals, slotted
@@ -81,7 +82,7 @@ def test_the_planner_moves_the_base_out_from_under_the_board_before_building():
     solver = IKSolver()
     poses = layout(SIX.entities, SIX.init, SHELF, seed=0, slots=[2, 4, 7, 8, 9, 3])
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
-    result = plan_on_places(SIX, poses, SHELF, solver, PANDA.q_home, config, seed=0)
+    result = plan_on_places(SIX, poses, SHELF, Arm(solver, PANDA.q_home), config, seed=0)
     assert result.solved and result.stats["room_goals"] == {"f": SHELF.slots[1]}
     state = SIX.init
     for move in result.plan:

@@ -13,7 +13,7 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, ArmCosts, failed_key
+from tamp.arm_costs import BLOCKED, Arm, ArmCosts, failed_key
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout, place_pose, plain_move
@@ -69,7 +69,9 @@ def test_a_place_goes_to_the_executor_as_a_table_move_at_its_position():
 def test_slot_columns_are_priced_at_their_own_places(solver):
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
     problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
-    c = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])([0], [problem.init])
+    c = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at])(
+        [0], [problem.init]
+    )
     c = c.compute()[0]
     assert c.shape == (4, 4 + len(at))
     col = {k: 4 + j for j, k in enumerate(problem.fixed)}
@@ -82,8 +84,10 @@ def test_a_move_the_arm_failed_is_priced_out_in_that_state_only(solver):
     problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
     failed = PlacedMove("a", TABLE, at["slot7"])
     avoid = {FOUR.init: {failed_key(failed), failed_key(Move("a", "d"))}}
-    plain = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
-    priced = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], avoid=avoid)
+    plain = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at])
+    priced = ArmCosts(
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home, avoid=avoid), places=[at]
+    )
     before, after = plain([0], [problem.init]).compute()[0], priced([0], [problem.init]).compute()
     diff = (after[0] - before).numpy()
     j = 4 + problem.fixed.index("slot7")
@@ -106,7 +110,9 @@ def test_a_move_its_check_ahead_fails_is_priced_out_where_it_was_checked(solver)
         calls.append((dict(seen), move))
         return move.entity != "c"  # c cannot be moved, say
 
-    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], check=check)
+    source = ArmCosts(
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home, check=check), places=[at]
+    )
     moved = bw.apply_move(problem, problem.init, Move("a", "slot2"))
     before = source([0], [moved]).compute()[0].clone()
     assert source.verify(0, moved, Move("b", "slot4"))
@@ -121,18 +127,16 @@ def test_a_move_its_check_ahead_fails_is_priced_out_where_it_was_checked(solver)
     start = source([0], [problem.init]).compute()[0]
     assert start[2, 1] < BLOCKED  # the same move in another state: not ruled out
     never = ArmCosts(
-        [problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=0.01, check=None
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home, check=None), places=[at], reach=0.01
     )
     assert never.verify(0, moved, Move("c", "b"))  # no check: every move passes
     moving = ArmCosts(
         [problem],
         [poses],
         SCENE,
-        solver,
-        PANDA.q_home,
+        Arm(solver, PANDA.q_home, check=lambda seen, move: False),
         places=[at],
         reach=0.01,
-        check=lambda seen, move: False,
     )
     assert moving.verify(0, moved, Move("c", "b"))  # places that move are not known yet
 
@@ -149,7 +153,7 @@ def test_planning_on_places_names_them_and_never_needs_more_than_the_table_has(s
     scene = with_scene(SCENE, "cramped")
     poses = layout(five.entities, five.init, scene, seed=1)
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05)
-    result = plan_on_places(five, poses, scene, solver, PANDA.q_home, config, seed=0)
+    result = plan_on_places(five, poses, scene, Arm(solver, PANDA.q_home), config, seed=0)
     assert result.solved and [str(m) for m in result.plan] == [
         "move(d -> e)",
         "move(c -> d)",
@@ -205,9 +209,9 @@ def test_the_check_ahead_vets_every_planned_move_and_the_cramped_table_is_still_
     checked = []
     real = episode.motion_check
 
-    def counted(solver, move, poses, *rest):
+    def counted(tools, move, poses, *rest):
         checked.append(move)
-        return real(solver, move, poses, *rest)
+        return real(tools, move, poses, *rest)
 
     monkeypatch.setattr(episode, "motion_check", counted)
     report = run_episode(problem, aware, seed=0)
@@ -252,11 +256,11 @@ def test_random_suites_keep_the_problems_that_fit_the_scene():
 def test_continuous_placements_are_differentiable_offsets_the_planner_optimises(solver):
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
     problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
-    source = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], reach=0.02)
+    source = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at], reach=0.02)
     window = source([0], [problem.init])  # one restart row
     (u,) = window.parameters()
     assert u.shape == (1, len(at), 2) and torch.count_nonzero(u) == 0
-    fixed = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
+    fixed = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at])
     start = window.compute()
     assert torch.allclose(start, fixed([0], [problem.init]).compute(), atol=1e-6)
 
@@ -302,9 +306,9 @@ def test_every_move_keeps_the_placement_its_window_decided(solver):
     )
     poses = layout(five.entities, five.init, SCENE, seed=1)
     config = dataclasses.replace(PlannerConfig(), lambda_motion=0.05, restarts=2, iters=40)
-    whole = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, config, reach=0.02)
+    whole = plan_on_places(five, poses, SCENE, Arm(solver, PANDA.q_home), config, reach=0.02)
     first = dataclasses.replace(config, max_windows=1, fallback=False)  # the first window only
-    cut = plan_on_places(five, poses, SCENE, solver, PANDA.q_home, first, reach=0.02)
+    cut = plan_on_places(five, poses, SCENE, Arm(solver, PANDA.q_home), first, reach=0.02)
     assert whole.solved and whole.stats["windows"] >= 2 and cut.stats["windows"] == 1
     table = [m for m in whole.plan if m.target == TABLE]
     early = [m for m in cut.plan if m.target == TABLE]
@@ -335,7 +339,7 @@ def test_a_goal_tower_taller_than_the_scene_takes_is_unsolvable_at_once(solver, 
     poses = layout(names, eight.init, SCENE, seed=0)
     searched = []
     monkeypatch.setattr(tamp.slots, "plan", lambda *a, **kw: searched.append(a))
-    result = plan_on_places(eight, poses, SCENE, solver, PANDA.q_home, PlannerConfig())
+    result = plan_on_places(eight, poses, SCENE, Arm(solver, PANDA.q_home), PlannerConfig())
     assert result.status is PlanStatus.UNSOLVABLE and searched == []
     assert (
         "stacks 8 blocks in one tower" in result.stats["reason"]
@@ -354,10 +358,12 @@ def test_a_block_parked_twice_in_a_row_moves_once_where_the_arm_may(solver):
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])
     problem, at = slotted(FOUR, FOUR.init, poses, SCENE)
     run = [Move("a", "slot2"), Move("a", "d"), Move("b", "c")]
-    costs = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at])
+    costs = ArmCosts([problem], [poses], SCENE, Arm(solver, PANDA.q_home), places=[at])
     assert _merge_runs(problem, run, costs) == (Move("a", "d"), Move("b", "c"))
     back = [Move("a", "slot2"), Move("a", "b"), Move("a", "d"), Move("b", "c")]
     assert _merge_runs(problem, back, costs) == (Move("a", "d"), Move("b", "c"))
     avoid = {FOUR.init: {failed_key(Move("a", "d"))}}  # a onto d failed in the initial state
-    priced = ArmCosts([problem], [poses], SCENE, solver, PANDA.q_home, places=[at], avoid=avoid)
+    priced = ArmCosts(
+        [problem], [poses], SCENE, Arm(solver, PANDA.q_home, avoid=avoid), places=[at]
+    )
     assert _merge_runs(problem, run, priced) == tuple(run)

@@ -144,26 +144,27 @@ def _check():
 def as_ours(config) -> OursConfig:
     """``config`` as an `OursConfig`: itself, or from the budgets every geometric planner is
     called with (`tamp.geo.search.SearchConfig`: its seed, grasp families and wall-clock limit,
-    which bounds the differentiable planner's windows and fallback)."""
+    which bounds the differentiable planner's windows and fallback). Anything else: a
+    `TampError` naming the two."""
     if isinstance(config, OursConfig):
         return config
-    if isinstance(config, SearchConfig):
-        search = config
-    else:
-        search = SearchConfig(seed=getattr(config, "seed", 0))
+    if not isinstance(config, SearchConfig):
+        raise TampError(
+            f"the motion-aware planner's config is a {type(config).__name__}; "
+            "valid: OursConfig or SearchConfig"
+        )
     # the complete search is bounded by the wall clock: at the shared 500 expansions it gave up
     # on nonmonotonic variants with half its time left (`SEARCH_NODES`)
-    search = replace(search, max_nodes=max(search.max_nodes, SEARCH_NODES))
-    limit = getattr(config, "max_time_s", None)
+    search = replace(config, max_nodes=max(config.max_nodes, SEARCH_NODES))
+    limit = config.max_time_s
     # the differentiable planner gets a third of the wall clock (`SOFT_SHARE`); the complete
     # search what is left
     soft = limit / SOFT_SHARE if limit else None
     planner = replace(PLANNER, time_limit_s=soft) if limit else PLANNER
-    choices = getattr(config, "choices", GeoCostConfig().choices)
     return OursConfig(
         planner=planner,
-        costs=GeoCostConfig(choices=tuple(choices)),
-        seed=getattr(config, "seed", 0),
+        costs=GeoCostConfig(choices=tuple(config.choices)),
+        seed=config.seed,
         search=search,
         soft_time_s=soft,
     )
@@ -260,7 +261,7 @@ def _plan_soft(scene: Scene, goal: Goal, tools, config: OursConfig, check, t0: f
         stats["time_s"] = time.perf_counter() - t0
         why = f"no free arrangement of the goal objects in region(s) {', '.join(unpacked)}"
         return GeoPlan(GeoStatus.BUDGET, reason=why, stats=stats)
-    solver, q = getattr(tools, "solver", None), getattr(tools, "q", None)
+    solver, q = (None, None) if tools is None else (tools.solver, tools.q)
     costs = GeoCosts(bridged, solver, q, config.costs, pack=config.pack)
     failures, plans, cuts = [], 0, 0
     state, world, bound = bridged.problem.init, bridged.scene, []
@@ -395,7 +396,7 @@ def _bind(bridged: Bridged, state, world, moves, tools, costs: GeoCosts, check):
         order = tuple(by_name[n] for n in first) + tuple(g for g in grasps if g.name not in first)
         verdict = _check_in_turn(check, world, geo, tools, order)
         if not verdict.ok:
-            tried = getattr(verdict, "tried", ())
+            tried = verdict.tried
             movable = {x.name for x in world.objects}
             for t in tried:
                 fixed = t.failure in FIXED_FAILURES or (
@@ -427,7 +428,7 @@ def _check_in_turn(check, world, geo: GeoMove, tools, order, chunk: int = CHECK_
         verdict = check(world, geo, tools, grasps=grasps, quick=None if len(grasps) > 1 else False)
         if verdict.ok or verdict.failure in BEFORE_GRASPS:
             return verdict
-        if not getattr(verdict, "tried", ()):
+        if not verdict.tried:
             if verdict.failure is Failure.NO_GRASP:
                 continue  # every grasp of this chunk too wide for the hand
             break  # refused before any grasp: the others would be too

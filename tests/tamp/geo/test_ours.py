@@ -262,3 +262,18 @@ def test_a_hanoi_scene_that_is_no_state_of_its_domain_ends_planning_in_one_line(
     assert result.status is GeoStatus.FAILED and not result.moves
     assert "no state of the PDDL domain" in result.reason and "d1" in result.reason
     assert "\n" not in result.reason
+
+
+def test_as_ours_takes_the_shared_search_config_and_refuses_anything_else():
+    """`as_ours` reads a `SearchConfig`'s seed, grasp families and wall clock directly, and
+    a config of neither kind is one line naming the two valid kinds, not silent defaults."""
+    import pytest
+
+    from tamp.geo.ours.planner import SOFT_SHARE
+    from task.errors import TampError
+
+    config = as_ours(SearchConfig(seed=3, choices=("top",), max_time_s=30.0))
+    assert config.seed == 3 and config.costs.choices == ("top",)
+    assert config.soft_time_s == pytest.approx(30.0 / SOFT_SHARE)
+    with pytest.raises(TampError, match="valid: OursConfig or SearchConfig"):
+        as_ours({"seed": 3})

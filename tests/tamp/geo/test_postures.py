@@ -10,6 +10,7 @@ from motion.guard import GuardConfig
 from motion.ik import IKSolver
 from robots.panda import PANDA
 from tamp.geo.postures import posture_seeds
+from tamp.loop.execute import Placing
 from tamp.loop.geo_fallback import geo_check, geo_tools
 from tamp.obstacles import with_scene
 from tamp.outcome import Failure
@@ -55,13 +56,14 @@ def test_another_posture_puts_a_block_down_behind_a_tower_the_nearest_one_hits(s
         for k, x in enumerate(tower)
     }
     move, target, q = Move("h", TABLE), Pose((0.56, -0.12, S / 2)), np.asarray(PANDA.q_home)
+    placing = Placing(move, target, poses, CRAMPED)
     with PandaCollision(0.01) as model:
         plain = geo_tools(solver, model, GuardConfig(), postures=0)
-        _, _, nearest = geo_check(move, target, poses, CRAMPED, plain, q)
+        _, _, nearest = geo_check(placing, plain, q)
         assert not nearest.ok and nearest.failure is Failure.COLLISION
         assert all(t.failure is not None for t in nearest.tried)
         tools = geo_tools(solver, model, GuardConfig(), postures=16)
-        _, _, other = geo_check(move, target, poses, CRAMPED, tools, q)
+        _, _, other = geo_check(placing, tools, q)
     assert other.ok and other.evidence == {"posture": True}
     assert other.grasp.name.startswith("top")
     assert other.tried[-1].where == "posture" and other.tried[-1].failure is None

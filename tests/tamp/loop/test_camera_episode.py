@@ -15,7 +15,7 @@ from motion.trajectory import straight_segment
 from perception.errors import PerceptionError
 from robots.panda import PANDA
 from tamp.loop import Episode, EpisodeStatus, LoopConfig
-from tamp.loop.execute import execute_move
+from tamp.loop.execute import ExecTools, execute_move
 from tamp.loop.observe import HOME_TOL
 from tamp.loop.sensors import CameraPoses
 from tamp.outcome import Failure
@@ -66,7 +66,7 @@ def test_a_hidden_block_sends_the_arm_home_and_one_still_hidden_is_unobservable(
             raise PerceptionError("block(s) b not found in the image")
 
         eyes.sensor = hidden
-        done = execute_move(sim, episode.solver, Move("b", TABLE), eyes.poses)
+        done = execute_move(sim, Move("b", TABLE), eyes.poses, ExecTools(episode.solver))
         assert done.failure is Failure.UNOBSERVABLE and "b not found" in done.evidence["seen"]
     finally:
         sim.close()

@@ -12,7 +12,7 @@ import pytest
 from motion.ik import IKSolver
 from robots.collision import PandaCollision
 from tamp.loop import LoopConfig, run_episode
-from tamp.loop.execute import ExecConfig, execute_move
+from tamp.loop.execute import ExecConfig, ExecTools, execute_move
 from tamp.obstacles import Obstacle, with_scene
 from tamp.outcome import Failure
 from tamp.scene import SceneConfig, layout, read_state
@@ -34,7 +34,8 @@ def _move(sim_name: str, solver: IKSolver, mode: str):
     with make_simulator(sim_name, ENTITIES, poses, WALL) as sim, PandaCollision() as model:
         observe = sim.truth._read_poses  # the test is the pose sensor
         config = replace(ExecConfig(), collision=mode)
-        result = execute_move(sim, solver, Move("a", "b"), observe, config, WALL, collision=model)
+        tools = ExecTools(solver, WALL, model)
+        result = execute_move(sim, Move("a", "b"), observe, tools, config)
         after = read_state(ENTITIES, observe(), WALL).state
         return result, after, dict(sim.touched)
 
@@ -74,12 +75,11 @@ def test_the_planner_finds_a_way_under_the_shelf_and_runs_it_untouched(sim_name,
     with make_simulator(sim_name, entities, poses, shelf) as sim, PandaCollision() as model:
         observe = sim.truth._read_poses
         check = replace(ExecConfig(), collision="check")
-        refused = execute_move(sim, solver, Move("a", "e"), observe, check, shelf, collision=model)
+        tools = ExecTools(solver, shelf, model)
+        refused = execute_move(sim, Move("a", "e"), observe, tools, check)
         assert refused.failure is Failure.COLLISION
         assert (refused.evidence["phase"], refused.evidence["other"]) == ("approach", "shelf_board")
-        result = execute_move(
-            sim, solver, Move("a", "e"), observe, ExecConfig(), shelf, collision=model
-        )
+        result = execute_move(sim, Move("a", "e"), observe, tools, ExecConfig())
         assert result.ok and result.path_time_s > 0, result.evidence
         assert read_state(entities, observe(), shelf).state == ("e", *state[1:])
         assert sim.touched == {}

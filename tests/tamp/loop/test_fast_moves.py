@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from motion.ik import IKSolver
-from tamp.loop.execute import execute_move
+from tamp.loop.execute import ExecTools, execute_move
 from tamp.scene import SceneConfig, layout
 from tamp.sim import SIMULATORS, make_simulator
 from task.problem import TABLE, Move
@@ -28,7 +28,7 @@ def test_a_block_carried_at_the_default_speeds_stays_in_the_friction_grasp(sim_n
     entities, supports = ("a", "b", "c"), (TABLE, TABLE, "b")
     poses = layout(entities, supports, scene, seed=0)
     with make_simulator(sim_name, entities, poses, scene, "friction") as sim:
-        done = execute_move(sim, solver, Move("a", "c"), sim.truth.block_poses)
+        done = execute_move(sim, Move("a", "c"), sim.truth.block_poses, ExecTools(solver))
         assert done.ok, (done.failure, done.evidence)
         assert done.sim_time_s < 4.0
         assert done.evidence["tracking_rad"] < 0.1

@@ -12,7 +12,7 @@ import pytest
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, DETOUR, ArmCosts
+from tamp.arm_costs import BLOCKED, DETOUR, Arm, ArmCosts
 from tamp.loop.geo_fallback import CHOICES, blocks_goal, geo_fallback, world_scene
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout, read_state
@@ -64,7 +64,7 @@ def test_a_place_only_other_grasps_reach_stays_open_with_them(solver):
     top, cols = TALL.entities.index("g"), [TALL.n + current.fixed.index(k) for k in far]
     for grasps, blocked in (((), True), (CHOICES, False)):
         source = ArmCosts(
-            [current], [poses], CRAMPED, solver, PANDA.q_home, places=[at], grasps=grasps
+            [current], [poses], CRAMPED, Arm(solver, PANDA.q_home, grasps=grasps), places=[at]
         )
         matrix = source([0], [current.init]).compute()[0]
         assert bool((matrix[top, cols] >= BLOCKED).all()) == blocked
@@ -79,7 +79,7 @@ def test_the_top_of_a_far_tower_only_other_grasps_reach_is_priced_a_detour(solve
     rows = {}
     for grasps in ((), CHOICES):
         source = ArmCosts(
-            [current], [poses], CRAMPED, solver, PANDA.q_home, places=[at], grasps=grasps
+            [current], [poses], CRAMPED, Arm(solver, PANDA.q_home, grasps=grasps), places=[at]
         )
         rows[grasps] = source([0], [current.init]).compute()[0][top]
     near = TALL.n + current.fixed.index("slot0")
@@ -93,7 +93,7 @@ def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
     reach the top from above (no IK at the pre-grasp); the geometric fallback makes the move
     (a tilted grasp), touching nothing."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, execute_move
+    from tamp.loop.execute import ExecConfig, ExecTools, execute_move
     from tamp.outcome import Failure
     from tamp.sim import make_simulator
 
@@ -105,9 +105,8 @@ def test_the_executor_makes_a_move_top_down_grasps_cannot(solver):
             observe = sim.truth._read_poses  # the test is the pose sensor
             config = replace(ExecConfig(), geo_fallback=fallback)
             geo = geo_fallback(solver, model, config.guard)
-            done = execute_move(
-                sim, solver, move, observe, config, CRAMPED, collision=model, fallback=geo
-            )
+            tools = ExecTools(solver, CRAMPED, model, geo)
+            done = execute_move(sim, move, observe, tools, config)
             state = read_state(TALL.entities, observe(), CRAMPED).state
             if not fallback:
                 assert done.failure is Failure.IK_INFEASIBLE
@@ -130,7 +129,7 @@ def test_with_other_grasps_a_top_down_release_into_a_neighbour_is_priced_not_rul
     costs = {}
     for grasps in ((), CHOICES):
         source = ArmCosts(
-            [current], [poses], cramped, solver, PANDA.q_home, places=[at], grasps=grasps
+            [current], [poses], cramped, Arm(solver, PANDA.q_home, grasps=grasps), places=[at]
         )
         costs[grasps] = source([0], [current.init]).compute()[0]
     assert costs[()][mover, far] >= BLOCKED
@@ -143,7 +142,13 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     the loop then rules out every move of the block while it stands there). A move that
     failed on the place side, or without the fallback's verdict, is not."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, ExecutionResult, execute_move, failed_pick
+    from tamp.loop.execute import (
+        ExecConfig,
+        ExecTools,
+        ExecutionResult,
+        execute_move,
+        failed_pick,
+    )
     from tamp.outcome import Failure
     from tamp.sim import make_simulator
 
@@ -153,9 +158,8 @@ def test_a_block_no_grasp_reaches_fails_on_the_pick_side_whatever_the_place(solv
     with sim, PandaCollision() as model:
         observe = sim.truth._read_poses
         geo = geo_fallback(solver, model, ExecConfig().guard)
-        done = execute_move(
-            sim, solver, move, observe, ExecConfig(), CRAMPED, collision=model, fallback=geo
-        )
+        tools = ExecTools(solver, CRAMPED, model, geo)
+        done = execute_move(sim, move, observe, tools, ExecConfig())
     assert done.failure is Failure.IK_INFEASIBLE and done.evidence["waypoint"] == "pre_grasp"
     assert done.evidence["geo"]["sides"] == ["pick"] and failed_pick(done)
     place_side = {**done.evidence, "geo": {**done.evidence["geo"], "sides": ["pick", "place"]}}
@@ -170,7 +174,7 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
     a near slot passes through the geometric fallback's tilted grasp (and fails top-down
     alone, as `execute_move` does), a block beyond the arm's reach fails on its IK."""
     from robots.collision import PandaCollision
-    from tamp.loop.execute import ExecConfig, motion_check
+    from tamp.loop.execute import ExecConfig, ExecTools, motion_check
     from tamp.outcome import Failure
 
     poses, _, at, _ = _tall(slot=4)
@@ -180,12 +184,13 @@ def test_the_check_ahead_finds_what_the_executor_finds_without_running(solver):
     alone = replace(ExecConfig(), geo_fallback=False)
     with PandaCollision() as model:
         q, geo = PANDA.q_home, geo_fallback(solver, model, ExecConfig().guard)
-        assert motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model, 0, geo) is None
-        found = motion_check(solver, move, poses, q, alone, CRAMPED, model, 0, geo)
+        tools, top_down = ExecTools(solver, CRAMPED, model, geo), ExecTools(solver, CRAMPED, model)
+        assert motion_check(tools, move, poses, q, ExecConfig()) is None
+        found = motion_check(tools, move, poses, q, alone)
         assert found is Failure.IK_INFEASIBLE
-        found = motion_check(solver, move, poses, q, ExecConfig(), CRAMPED, model)
+        found = motion_check(top_down, move, poses, q, ExecConfig())
         assert found is Failure.IK_INFEASIBLE  # no fallback given: top-down alone
-        found = motion_check(solver, away, far, q, ExecConfig(), CRAMPED, model, 0, geo)
+        found = motion_check(tools, away, far, q, ExecConfig())
         assert found is Failure.IK_INFEASIBLE
 
 
@@ -201,7 +206,7 @@ def test_the_episode_gives_its_executor_the_geometric_fallback(solver, monkeypat
     given, real = [], episode.execute_move
 
     def spy(*args, **kwargs):
-        given.append(kwargs.get("fallback"))
+        given.append(args[3].fallback)
         return real(*args, **kwargs)
 
     monkeypatch.setattr(episode, "execute_move", spy)

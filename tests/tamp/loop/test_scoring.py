@@ -19,7 +19,7 @@ from robots.collision import PandaCollision
 from robots.panda import PANDA
 from tamp.bench.motion import episode_rows
 from tamp.loop import LoopConfig
-from tamp.loop.execute import ExecConfig, execute_move
+from tamp.loop.execute import ExecConfig, ExecTools, execute_move
 from tamp.loop.geo_fallback import geo_fallback
 from tamp.loop.given import GivenPlanEpisode, parse_given
 from tamp.loop.score import MoveScore, Scorer
@@ -49,7 +49,7 @@ def test_the_arm_pushing_over_the_tower_it_just_built_is_a_collision_and_a_distu
     poses = layout(entities, init, seed=0, slots=[2, 7, 9])  # the tower b-c at (0.56, 0.0)
     with make_simulator(sim_name, entities, poses) as sim:
         score = Scorer(sim.truth, problem, SceneConfig())
-        assert execute_move(sim, solver, Move("a", "c"), sim.truth.block_poses).ok
+        assert execute_move(sim, Move("a", "c"), sim.truth.block_poses, ExecTools(solver)).ok
         assert sim.touched == {}  # the move itself touched nothing it was not meant to
         before = score.state()
         x, y = sim.truth.block_poses()["b"].xy
@@ -72,7 +72,8 @@ def test_the_carried_block_hitting_a_wall_is_its_own_collision(sim_name, solver)
     poses = layout(("a", "b"), (TABLE, TABLE), scene, seed=0, slots=[0, 4])
     unchecked = replace(ExecConfig(), collision="off")
     with make_simulator(sim_name, ("a", "b"), poses, scene) as sim:
-        done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses, unchecked, scene)
+        tools = ExecTools(solver, scene)
+        done = execute_move(sim, Move("a", "b"), sim.truth.block_poses, tools, unchecked)
         assert not done.ok
         assert sim.touched.get("held:wall", 0) > 0 and "wall" not in sim.touched, sim.touched
 
@@ -172,13 +173,12 @@ def test_a_planner_run_that_finds_no_way_is_not_a_reroute(solver):
             outcomes.append(
                 execute_move(
                     sim,
-                    solver,
                     Move("a", "b"),
                     sim.truth.block_poses,
+                    ExecTools(
+                        solver, scene, model, geo_fallback(solver, model, ExecConfig().guard)
+                    ),
                     ExecConfig(geo_fallback=fallback),
-                    scene=scene,
-                    collision=model,
-                    fallback=geo_fallback(solver, model, ExecConfig().guard),
                 )
             )
     done, geo = outcomes
