@@ -144,8 +144,8 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     one line: the loop's
     planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
     ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
-    rerouted), ``--crisp``, the perception network's options, faults other than drops, and
-    ``--record``; ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
+    rerouted), ``--crisp``, the perception network's options and faults other than drops;
+    ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
     default). The limits not given are the episode's defaults (`tamp.geo.types.GeoLimits`),
     which ``tamp bench tamp`` runs with too."""
     from tamp.geo.types import GeoLimits
@@ -165,7 +165,6 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         ("--perception", args.perception, "frozen"),
         ("--blur", args.blur, 0),
         ("--checkpoint", args.checkpoint, None),
-        ("--record", args.record, None),
     ):
         if value != default:
             given.append(flag)
@@ -200,6 +199,7 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         "time_limit_s": limit,
         "seed": args.seed,
         "video": None if args.no_video or args.out is None else args.video_format,
+        "record": None if args.record is None else str(check_record_path(args.record)),
     }
 
 

@@ -256,9 +256,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             f"seed {args.seed}",
             file=sys.stderr,
         )
+    recorder = None if args.record is None else RerunRecorder(args.record, task.scene.name)
     with torch_threads(EPISODE_THREADS):
         report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if args.json else _say
+            task.scene, task.goal, config, on_event=None if args.json else _say, recorder=recorder
         )
     body = report_json(report, recorded)
     written = []
@@ -273,6 +274,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         print("\n".join(geo_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
+        if recorder is not None:
+            print(
+                f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
+            )
     return 0 if report.reached_goal else 1
 
 

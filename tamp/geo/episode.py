@@ -39,6 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -59,6 +60,9 @@ from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
 from tamp.world.schema import Scene
 from task.errors import TampError, member
+
+if TYPE_CHECKING:
+    from tamp.rerun_log import RerunRecorder
 
 # settled poses as the motion-capture sensor reads them: `SceneConfig.tol_z`'s 12 mm; an
 # object counts as in a region when its footprint crosses the edge by at most 2 mm (a tight
@@ -191,6 +195,7 @@ def run_geo_episode(
     *,
     tools: Tools | None = None,
     on_event: Callable[[str], None] | None = None,
+    recorder: RerunRecorder | None = None,
 ) -> EpisodeReport:
     """Run ``config.planner`` (a `GeoPlanner`) on ``scene`` toward ``goal`` in simulator
     ``config.sim`` (see the module docstring) with the settings of ``config`` (a
@@ -198,7 +203,10 @@ def run_geo_episode(
     video, a PDDL domain for the motion-aware planner). ``tools``: reuse an IK solver and
     collision model (else built and closed here). ``on_event``: called with a line after each
     plan and each move (progress, e.g. for ``tamp run``); what it is told is also in the
-    report. Returns the `tamp.episode_report.EpisodeReport` both stacks report in: ``status``
+    report. ``recorder`` (a `tamp.rerun_log.RerunRecorder`, an observer as the loop's): told of
+    every frame (the arm's joints and fingers, the objects' true poses), each observation (the
+    facts read), plan, move outcome and message, and closed with the report. Returns the
+    `tamp.episode_report.EpisodeReport` both stacks report in: ``status``
     ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
     saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET`` or
     ``MOVE_BUDGET``; ``reached_goal`` scored on ground truth; one `MoveRecord` per move.
@@ -240,7 +248,11 @@ def run_geo_episode(
         from tamp.camera.scene_poses import ScenePoses
 
         camera = ScenePoses(sim, scene)
-    recorder, on_frame = _recorder(video)
+    writer, on_frame = _recorder(video)
+    if recorder is not None:
+        recorder.begin(tuple(o.name for o in scene.objects), sim, tools.solver)
+        on_frame = _recorded(sim, recorder, on_frame)
+        say = _recorded_say(sim, recorder, say)
     records: list[MoveRecord] = []
     plan_times, plan_stats = [], []
     plans: list[tuple[str, ...]] = []  # every plan made, as move strings
@@ -250,6 +262,7 @@ def run_geo_episode(
     try:
         _settle(sim, on_frame)
         world = observe(sim, scene, camera)
+        _believed(sim, recorder, world)
         while True:
             if goal.holds(read_facts(world, OBSERVED)):
                 status = EpisodeStatus.GOAL_REACHED
@@ -258,10 +271,11 @@ def run_geo_episode(
             plan = plan_fn(world, goal, tools, search)
             plan_times.append(time.perf_counter() - t0)
             plan_stats.append(dict(plan.stats))
-            say(
-                f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
-                f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
-            )
+            head = f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves"
+            why = f" ({plan.reason})" if plan.reason else ""
+            say(f"{head} in {plan_times[-1]:.2f} s{why}")
+            if recorder is not None:
+                recorder.plan_made(sim, head, [m.text() for m in plan.moves], plan_times[-1])
             if not plan.solved:
                 status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
                 limit = _time_limit_s(search)
@@ -276,11 +290,16 @@ def run_geo_episode(
                 if len(records) >= max_moves:
                     status, reason = EpisodeStatus.MOVE_BUDGET, f"{max_moves} moves used"
                     break
-                k = len(records)
+                k, sim0 = len(records), sim.time
                 record, world, ran = _act(
                     sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
                 )
                 records.append(record)
+                if recorder is not None:
+                    grasp = f"grasp {record.grasp}" if record.grasp else ""
+                    args = (record.failure, record.evidence, grasp, ran, sim.time - sim0)
+                    recorder.outcome(sim, record.move, *args)
+                _believed(sim, recorder, world)
                 say(
                     f"move {k + 1}: {record.move}: "
                     f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
@@ -301,16 +320,20 @@ def run_geo_episode(
         with sim.truth.scoring():
             truth = _with_poses(scene, sim.truth.block_poses())
         reached = goal.holds(read_facts(truth, OBSERVED))
-    finally:
-        sim.close()
+    except BaseException:
         if recorder is not None:
             recorder.close()
+        raise
+    finally:
+        sim.close()
+        if writer is not None:
+            writer.close()
         if own:
             tools.close()
     if status is EpisodeStatus.GOAL_REACHED and not reached:
         status = EpisodeStatus.NOT_REACHED
         reason = "the robot saw the goal; the ground truth does not hold it"
-    return EpisodeReport(
+    report = EpisodeReport(
         problem=scene.name,
         sim=backend,
         status=status,
@@ -334,6 +357,9 @@ def run_geo_episode(
         arm_path_rad=path,
         pose_errors=_scored(camera),
     )
+    if recorder is not None:
+        recorder.close(report)
+    return report
 
 
 def _time_limit_s(config) -> float | None:
@@ -431,6 +457,41 @@ def _settle(sim: Simulator, on_frame) -> None:
 
     hold = JointTrajectory.hold(sim.arm_q(), SETTLE_S, sim.dt)
     sim.run(hold, "open", on_frame=on_frame)
+
+
+def _believed(sim: Simulator, recorder, world: Scene) -> None:
+    """Tell ``recorder`` (None: no recording) the facts read from the observed ``world``."""
+    if recorder is None:
+        return
+    facts = read_facts(world, OBSERVED)
+    lines = facts.text().splitlines() + [f"unexplained: {issue}" for issue in facts.issues]
+    recorder.facts(sim, lines)
+
+
+def _recorded(sim: Simulator, recorder, on_frame):
+    """What ``sim`` calls back each frame while ``recorder`` records: the recorder's frame at
+    its period, and ``on_frame`` (a video's, or None) on its own clock, every
+    ``sim.frame_period`` simulated seconds as it stood (the loop's `_recorded_frame`)."""
+    period, due = sim.frame_period, [0.0]
+    sim.frame_period = recorder.period
+
+    def frame(s: Simulator) -> None:
+        recorder.frame(s)
+        if on_frame is not None and s.time >= due[0]:
+            on_frame(s)
+            due[0] = max(due[0] + period, s.time)
+
+    return frame
+
+
+def _recorded_say(sim: Simulator, recorder, say: Callable[[str], None]):
+    """``say``, and the message on the recording's time line."""
+
+    def both(text: str) -> None:
+        recorder.event(sim.time, text)
+        say(text)
+
+    return both
 
 
 def _recorder(video: str | Path | None):

@@ -135,7 +135,7 @@ class Episode:
             self.eyes.home_guard = self._home_guard
         self._shown = (self.sim.frame_period, 0.0)  # on_frame's (period, next time) when recording
         if recorder is not None:
-            recorder.begin(problem, self.sim, self.solver)
+            recorder.begin(problem.entities, self.sim, self.solver)
 
     def belief_lines(self) -> list[str]:
         """The last perceived soft state, one line per block (see `Observer.belief_lines`)."""

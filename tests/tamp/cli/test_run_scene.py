@@ -48,7 +48,6 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
         (["--goal", "(in a tray)", "--horizon", "2"], "--horizon: the Blocksworld loop's"),
         (["--goal", "(in a tray)", "--collision", "off"], "--collision: the Blocksworld loop's"),
         (["--goal", "(in a tray)", "--inject", "nudge:0.1"], "injects drops only"),
-        (["--goal", "(in a tray)", "--record", "x.rrd"], "--record: the Blocksworld loop's"),
         (["--goal", "(in a tray)", "--plan", "x"], "--plan with a scene file"),
         (
             ["--goal", "(on a b)", "--geo-planner", "soft", "--motion-aware"],
