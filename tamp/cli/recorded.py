@@ -144,12 +144,13 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     one line: the loop's
     planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
     ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
-    rerouted), ``--crisp``, the perception network's options and faults other than drops;
-    ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
-    default). The limits not given are the episode's defaults (`tamp.geo.types.GeoLimits`),
-    which ``tamp bench tamp`` runs with too."""
+    rerouted), ``--crisp`` and the perception network's options; ``--motion-aware`` too
+    (``--geo-planner`` names the planner, motion-aware by default). Every fault of
+    ``--inject`` (drop, nudge, noise) is injected as the loop does. The limits not given are
+    the episode's defaults (`tamp.geo.types.GeoLimits`), which ``tamp bench tamp`` runs with
+    too."""
     from tamp.geo.types import GeoLimits
-    from tamp.loop.faults import KINDS, Injection
+    from tamp.loop.faults import Injection
 
     given = [
         _flag(n)
@@ -174,11 +175,6 @@ def geo_config(args: argparse.Namespace, task) -> dict:
             f"{task.path} ({task.why}) has no such setting"
         )
     inject = Injection.parse(args.inject)
-    other = [k for k in KINDS if k != "drop" and getattr(inject, k) > 0]
-    if other:
-        raise TampError(
-            f"--inject {','.join(other)}: the geometric episode injects drops only (drop:P)"
-        )
     limits = GeoLimits()
     limit = args.time_limit_s if args.time_limit_s is not None else limits.planning_s
     return {

@@ -55,6 +55,7 @@ from tamp.modes import GeoPlanner, Observation
 from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
+from tamp.sim.faults import nudge
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
@@ -143,27 +144,52 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
     return GeoPlan(GeoStatus.SOLVED, tuple(moves), f"a plan of {len(moves)} moves", stats)
 
 
-def observe(sim: Simulator, scene: Scene, camera=None) -> Scene:
+@dataclass(frozen=True)
+class PoseNoise:
+    """Injected observation noise (the loop's ``noise`` fault, `tamp.loop.faults`): with
+    probability ``p`` per pose reading, Gaussian noise of ``sigma`` m on every object's
+    position, drawn from ``rng`` (one draw per reading whatever ``p``, so that episodes stay
+    aligned across settings)."""
+
+    p: float
+    sigma: float
+    rng: np.random.Generator
+
+    def __call__(self, poses: dict[str, Pose]) -> dict[str, Pose]:
+        """``poses`` as the noisy sensor reads them."""
+        if not self.rng.random() < self.p:
+            return poses
+        noise = self.rng.normal(0.0, self.sigma, size=(len(poses), 3))  # (N, 3)
+        return {
+            k: Pose(tuple(float(v) for v in np.add(pose.xyz, n)), pose.yaw)
+            for (k, pose), n in zip(poses.items(), noise, strict=True)
+        }
+
+
+def observe(sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None) -> Scene:
     """``scene`` with every object at the pose the robot's sensor reads now (`_sensed`)."""
-    return _with_poses(scene, _sensed(sim, scene, camera))
+    return _with_poses(scene, _sensed(sim, scene, camera, noise))
 
 
-def _sensed(sim: Simulator, scene: Scene, camera=None) -> dict[str, Pose]:
+def _sensed(
+    sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None
+) -> dict[str, Pose]:
     """Every object's pose as the robot's sensor reads it now: the motion-capture sensor, or
     with ``camera`` (a `tamp.camera.scene_poses.ScenePoses`) the poses estimated from its
     images, ``scene``'s poses the previous estimates (an object no camera sees keeps its own).
     The camera's estimates are then scored against the ground truth (``scoring()``) for the
-    record only (``camera.errors``)."""
+    record only (``camera.errors``). ``noise``: injected noise on what is read (None: none)."""
+    noisy = noise or (lambda poses: poses)
     if camera is None:
         with sim.truth.oracle():
-            return sim.truth.block_poses()
+            return noisy(sim.truth.block_poses())
     from tamp.camera.scene_poses import pose_errors
 
     poses = camera(scene)
     with sim.truth.scoring():
         truth = sim.truth.block_poses()
     camera.errors.append(pose_errors(poses, truth, scene))
-    return poses
+    return noisy(poses)
 
 
 def _scored(camera) -> dict:
@@ -225,7 +251,10 @@ def run_geo_episode(
             )
         plan_fn = partial(plan_fn, domain=domain)
     search = config.search_config()
-    drops = set(config.drops)
+    drops, nudges = set(config.drops), set(config.nudges)
+    rng = np.random.default_rng(seed)  # the injected faults' draws: nudges' directions, noise
+    noise = PoseNoise(config.noise, config.noise_sigma, rng) if config.noise > 0 else None
+    nudged: list[int] = []  # the moves after which the object placed was pushed
     wall0 = time.perf_counter()
     own = tools is None
     tools = tools or Tools()
@@ -261,7 +290,7 @@ def run_geo_episode(
     status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
         _settle(sim, on_frame)
-        world = observe(sim, scene, camera)
+        world = observe(sim, scene, camera, noise)
         _believed(sim, recorder, world)
         while True:
             if goal.holds(read_facts(world, OBSERVED)):
@@ -292,7 +321,7 @@ def run_geo_episode(
                     break
                 k, sim0 = len(records), sim.time
                 record, world, ran = _act(
-                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
+                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera, noise
                 )
                 records.append(record)
                 if recorder is not None:
@@ -308,6 +337,17 @@ def run_geo_episode(
                 if not record.ok:
                     replan = True
                     break
+                if k in nudges:  # the experimenter pushes the object just placed
+                    nudge(sim, move.obj, config.nudge_m, rng)
+                    nudged.append(k)
+                    _settle(sim, on_frame)
+                    before = read_facts(world, OBSERVED).atoms
+                    world = observe(sim, world, camera, noise)
+                    _believed(sim, recorder, world)
+                    if read_facts(world, OBSERVED).atoms != before:
+                        say(f"move {k + 1}: {move.obj} was nudged; the facts changed: replan")
+                        replan = True
+                        break
             if status is EpisodeStatus.MOVE_BUDGET:
                 break
             if replan or not goal.holds(read_facts(world, OBSERVED)):
@@ -341,7 +381,7 @@ def run_geo_episode(
         moves=tuple(records),
         plans=tuple(plans),
         replans=replans,
-        faults=tuple(f"drop@{k}" for k in sorted(drops) if k < len(records)),
+        faults=_faults(drops, nudged, len(records)),
         disturbed=0,
         sim_time_s=sim.time,
         wall_time_s=time.perf_counter() - wall0,
@@ -362,6 +402,13 @@ def run_geo_episode(
     return report
 
 
+def _faults(drops: set[int], nudged: list[int], moves: int) -> tuple[str, ...]:
+    """The injected faults as the loop reports them, in move order: ``drop@K`` for each move
+    ``K`` run with a drop, ``nudge@K`` for each object pushed after move ``K``."""
+    hit = [(k, "drop") for k in drops if k < moves] + [(k, "nudge") for k in nudged]
+    return tuple(f"{kind}@{k}" for k, kind in sorted(hit))
+
+
 def _time_limit_s(config) -> float | None:
     """The planner's wall-clock limit in seconds (a `SearchConfig`'s, or the search config a
     planner's own config holds); None without one."""
@@ -369,11 +416,19 @@ def _time_limit_s(config) -> float | None:
 
 
 def _act(
-    sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, drop: bool, camera=None
+    sim,
+    world: Scene,
+    move: GeoMove,
+    runner: Tools,
+    seed: int,
+    on_frame,
+    drop: bool,
+    camera=None,
+    noise: PoseNoise | None = None,
 ):
     """Check ``move`` on the observed ``world`` from the arm's configuration now, run it,
-    settle and observe (``camera``: the camera sensor, None for motion capture): (record,
-    observed scene, joint path run in rad)."""
+    settle and observe (``camera``: the camera sensor, None for motion capture; ``noise``:
+    injected on every reading): (record, observed scene, joint path run in rad)."""
     o = world.object(move.obj)
     grasps = None
     if move.grasp is None:
@@ -400,12 +455,12 @@ def _act(
         RunConfig(),
         on_frame,
         0.5 if drop else None,
-        sense=lambda: np.asarray(_sensed(sim, expected, camera)[move.obj].xyz),
+        sense=lambda: np.asarray(_sensed(sim, expected, camera, noise)[move.obj].xyz),
         solver=runner.solver,
         screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
     )
     _settle(sim, on_frame)
-    seen = observe(sim, expected, camera)
+    seen = observe(sim, expected, camera, noise)
     name = verdict.grasp.name
     path = home + ran.path_rad
     if not ran.ok:

@@ -49,7 +49,7 @@ from tamp.loop.execute import (
 )
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
-from tamp.loop.recover import describe, nudge, out_of_reach, tidy
+from tamp.loop.recover import describe, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
 from tamp.modes import Crisp, Observation
@@ -57,6 +57,7 @@ from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
+from tamp.sim.faults import nudge
 from tamp.slots import plan_on_places
 from task.domains import get_domain
 from task.planner import plan
