@@ -125,7 +125,10 @@ def scene_run(args: argparse.Namespace):
     rules = None if binding is None else (args.domain, binding)
     task = scene_episode(name, goal, geo, rules)
     if getattr(args, "plan", None) is not None:
-        raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
+        raise TampError(
+            "--plan with a scene file: the plan reader reads PDDL actions and moves between "
+            "blocks, not a scene's moves to checked places and grasps (yet); use PROBLEM.pddl"
+        )
     if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == Observation.CAMERA:
         raise TampError(
             "--observe camera with a Blocksworld scene file: the camera's goal image is "
@@ -152,27 +155,60 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     from tamp.geo.types import GeoLimits
     from tamp.loop.faults import Injection
 
-    given = [
+    planner = task.planner
+    soft = [
         _flag(n)
         for n in _PLANNER_FLAGS
         if n not in GEO_PLANNER_FLAGS and getattr(args, n, None) is not None
     ]
+    why = []  # (flags, the reason the episode that runs this scene has no use for them)
+    if soft:
+        why.append(
+            (
+                soft,
+                f"the Blocksworld loop's soft planner's settings; planner {planner} plans "
+                "this scene (--geo-planner names it, --time-limit bounds it)",
+            )
+        )
     if args.device not in (None, "cpu"):
-        given.append("--device")
-    for flag, value, default in (
-        ("--placements", args.placements, 0.0),
-        ("--collision", args.collision, "plan"),
-        ("--crisp", args.crisp, "perceived"),
-        ("--perception", args.perception, "frozen"),
-        ("--blur", args.blur, 0),
-        ("--checkpoint", args.checkpoint, None),
-    ):
-        if value != default:
-            given.append(flag)
-    if given:
+        why.append((["--device"], f"the soft planner's device; planner {planner} runs on the CPU"))
+    if args.placements != 0.0:
+        why.append(
+            (
+                ["--placements"],
+                "a cost on the loop's table places; planner "
+                f"{planner} picks each place by checking its grasp, IK and collisions",
+            )
+        )
+    if args.collision != "plan":
+        why.append(
+            (
+                ["--collision"],
+                f"planner {planner} decides each move by its collision checks and the executor "
+                "reroutes blocked phases; without them the moves it plans are unchecked",
+            )
+        )
+    seen = [
+        flag
+        for flag, value, default in (
+            ("--crisp", args.crisp, "perceived"),
+            ("--perception", args.perception, "frozen"),
+            ("--blur", args.blur, 0),
+            ("--checkpoint", args.checkpoint, None),
+        )
+        if value != default
+    ]
+    if seen:
+        why.append(
+            (
+                seen,
+                "the perception network's, which reads cubes' supports from one image; these "
+                "objects are observed as poses (motion capture, or --observe camera's estimates)",
+            )
+        )
+    if why:
         raise TampError(
-            f"{', '.join(given)}: the Blocksworld loop's; the geometric episode that runs "
-            f"{task.path} ({task.why}) has no such setting"
+            "; ".join(f"{', '.join(flags)}: {reason}" for flags, reason in why) + f" ({task.why})"
         )
     inject = Injection.parse(args.inject)
     limits = GeoLimits()

@@ -46,13 +46,18 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
         (["--goal", "(on a zz)"], "unknown object 'zz'"),
         (["--goal", "(in a zz)"], "unknown region 'zz'"),
         (["--goal", "(in a tray)", "--horizon", "2"], "--horizon: the Blocksworld loop's"),
-        (["--goal", "(in a tray)", "--collision", "off"], "--collision: the Blocksworld loop's"),
+        (["--goal", "(in a tray)", "--collision", "off"], "without them the moves it plans"),
         (["--goal", "(in a tray)", "--plan", "x"], "--plan with a scene file"),
         (
             ["--goal", "(on a b)", "--geo-planner", "soft", "--motion-aware"],
             "--motion-aware: the Blocksworld loop's",
         ),
         (["--goal", "(in a tray)", "--motion-aware"], "--motion-aware: the Blocksworld loop's"),
+        (
+            ["--goal", "(in a tray)", "--motion-aware", "--placements", "0.02"],
+            "picks each place by",
+        ),
+        (["--goal", "(in a tray)", "--crisp", "true"], "these objects are observed as poses"),
         (["p.pddl"], "PROBLEM.pddl with --scene"),
         (
             ["--goal", "(on a b)", "--observe", "camera"],
