@@ -1,8 +1,9 @@
 """Episodes you can scrub through: an episode written as a Rerun recording (``.rrd``).
 
-`RerunRecorder` is an observer that a `tamp.loop.Episode` is given (``recorder=``): the episode
-calls it at its steps, and it logs what happened on one time line, ``sim``, the simulated time
-in seconds. Open a recording with ``rerun FILE.rrd`` (the viewer ships with the extra). Entities:
+`RerunRecorder` is an observer that a `tamp.loop.Episode` or a geometric episode
+(`tamp.geo.episode.run_geo_episode`) is given (``recorder=``): the episode calls it at its
+steps, and it logs what happened on one time line, ``sim``, the simulated time in seconds.
+Open a recording with ``rerun FILE.rrd`` (the viewer ships with the extra). Entities:
 
 - ``/world/objects``: the blocks as boxes at their true poses (read under the ground truth's
   ``recording()`` grant, as the video is; the robot never sees this), every frame;
@@ -11,7 +12,8 @@ in seconds. Open a recording with ``rerun FILE.rrd`` (the viewer ships with the 
 - ``/belief/support``: the support matrix of each observation, (N, Y) with rows the blocks and
   columns the support targets: the perceived soft supports F with the camera (columns: the
   blocks by colour, then the table), the observed crisp state one-hot otherwise;
-  ``/belief/state``: the same as text, one line per block;
+  ``/belief/state``: the same as text, one line per block (a geometric episode: the facts
+  read from the observed scene, one per line, `RerunRecorder.facts`);
 - ``/plan/moves``: each plan (or camera window) as it is made, a Markdown table of its moves
   (a given plan's steps, `tamp.loop.given`);
   ``/plan/length`` and ``/plan/time_s``: its number of moves (the planner's task cost) and its
@@ -125,15 +127,17 @@ class RerunRecorder:
         self._failures = 0
 
     # --- what the episode calls ------------------------------------------------------------
-    def begin(self, problem, sim, solver) -> None:
-        """The static scene: ``problem``'s blocks (sizes, colours, names), ``sim``'s obstacles
-        and table places, the joint names; ``solver`` (`motion.ik.IKSolver`) gives the TCP."""
+    def begin(self, entities: Sequence[str], sim, solver) -> None:
+        """The static scene: the movable ``entities`` (a problem's blocks, a scene file's
+        objects: their sizes, colours and names), ``sim``'s obstacles and table places, the
+        joint names; ``solver`` (`motion.ik.IKSolver`) gives the TCP."""
         rr, rec = self._rr, self.rec
         self._solver = solver
-        self._entities = tuple(problem.entities)
+        self._entities = tuple(entities)
         scene = sim.scene
         half = [scene.body(x).half for x in self._entities]
-        colours = [_rgba(scene.palette[i % len(scene.palette)][1]) for i in range(problem.n)]
+        n = len(self._entities)
+        colours = [_rgba(scene.palette[i % len(scene.palette)][1]) for i in range(n)]
         rec.log(
             "world/objects",
             rr.Boxes3D(half_sizes=half, colors=colours, labels=list(self._entities)),
@@ -206,8 +210,13 @@ class RerunRecorder:
     def planned(self, sim, index: int, result) -> None:
         """Plan ``index`` (1-based) made at ``sim.time``: a `task.problem.PlanResult`."""
         head = f"plan {index}: {result.status.value}, {len(result.plan)} moves"
-        self._plan(sim, head, [str(m) for m in result.plan])
-        self.rec.log("plan/time_s", self._rr.Scalars(float(result.stats.get("time_s", 0.0))))
+        self.plan_made(sim, head, [str(m) for m in result.plan], result.stats.get("time_s", 0.0))
+
+    def plan_made(self, sim, head: str, moves: Sequence[str], time_s: float) -> None:
+        """A plan made at ``sim.time`` in ``time_s`` seconds: its ``moves`` as text under
+        ``head`` (a geometric plan's, `tamp.geo.types.GeoMove.text`, or the loop's)."""
+        self._plan(sim, head, moves)
+        self.rec.log("plan/time_s", self._rr.Scalars(float(time_s)))
 
     def given(self, sim, labels: Sequence[str]) -> None:
         """A given plan (`tamp.loop.given`): its steps' ``labels``, at ``sim.time``."""
@@ -245,25 +254,43 @@ class RerunRecorder:
 
     def moved(self, sim, label: str, result) -> None:
         """A move ``label`` ended at ``sim.time`` with ``result`` (`ExecutionResult`)."""
-        rr, rec = self._rr, self.rec
-        path = self.flush()
-        self._at(sim.time)
-        if len(path) > 1:
-            rec.log("arm/tcp_path", rr.LineStrips3D([path], labels=[label], radii=0.002))
         checks = f"collision checks {result.check_time_s:.2f} s"
         if result.rerouted:
             checks += f", rerouted {', '.join(result.rerouted)}"
         if result.planner_runs:
             checks += f", {result.planner_runs} planner runs ({result.planner_failures} failed)"
-        if result.ok:
-            text, level = f"{label}: ok; {checks}", "INFO"
+        self.outcome(
+            sim, label, result.failure, result.evidence, checks, result.path_rad, result.sim_time_s
+        )
+
+    def outcome(
+        self, sim, label: str, failure, evidence: dict, note: str, path_rad: float, sim_s: float
+    ) -> None:
+        """A move ``label`` ended at ``sim.time``: ok (``failure`` None) or ``failure`` (a
+        `tamp.outcome.Failure`) with ``evidence``; ``note``: what its checks did, after the
+        outcome; its arm cost: joint path ``path_rad`` (rad) in ``sim_s`` simulated seconds."""
+        rr, rec = self._rr, self.rec
+        path = self.flush()
+        self._at(sim.time)
+        if len(path) > 1:
+            rec.log("arm/tcp_path", rr.LineStrips3D([path], labels=[label], radii=0.002))
+        tail = f"; {note}" if note else ""
+        if failure is None:
+            text, level = f"{label}: ok{tail}", "INFO"
         else:
             self._failures += 1
-            evidence = ", ".join(f"{k} {v}" for k, v in result.evidence.items())
-            text, level = f"{label}: {result.failure.value} ({evidence}); {checks}", "WARN"
+            found = ", ".join(f"{k} {v}" for k, v in evidence.items())
+            text, level = f"{label}: {failure.value} ({found}){tail}", "WARN"
         rec.log("checks/moves", rr.TextLog(text, level=level))
         rec.log("checks/failures", rr.Scalars(float(self._failures)))
-        rec.log("plan/cost", rr.Scalars([result.path_rad, result.sim_time_s]))
+        rec.log("plan/cost", rr.Scalars([float(path_rad), float(sim_s)]))
+
+    def facts(self, sim, lines: Sequence[str]) -> None:
+        """An observation at ``sim.time`` read as facts (a geometric episode's observed scene,
+        `tamp.world.relations.read_facts`): ``/belief/state``, one line per fact."""
+        self.flush()
+        self._at(sim.time)
+        self.rec.log("belief/state", self._rr.TextDocument("\n".join(lines)))
 
     def event(self, sim_time: float, text: str) -> None:
         """A message of the episode at ``sim_time``."""

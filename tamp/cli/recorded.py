@@ -125,7 +125,10 @@ def scene_run(args: argparse.Namespace):
     rules = None if binding is None else (args.domain, binding)
     task = scene_episode(name, goal, geo, rules)
     if getattr(args, "plan", None) is not None:
-        raise TampError("--plan with a scene file: a given plan runs on a PDDL problem (yet)")
+        raise TampError(
+            "--plan with a scene file: the plan reader reads PDDL actions and moves between "
+            "blocks, not a scene's moves to checked places and grasps (yet); use PROBLEM.pddl"
+        )
     if not isinstance(task, GeoRun) and getattr(args, "observe", "state") == Observation.CAMERA:
         raise TampError(
             "--observe camera with a Blocksworld scene file: the camera's goal image is "
@@ -144,42 +147,70 @@ def geo_config(args: argparse.Namespace, task) -> dict:
     one line: the loop's
     planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
     ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
-    rerouted), ``--crisp``, the perception network's options, faults other than drops, and
-    ``--record``; ``--motion-aware`` too (``--geo-planner`` names the planner, motion-aware by
-    default). The limits not given are the episode's defaults (`tamp.geo.types.GeoLimits`),
-    which ``tamp bench tamp`` runs with too."""
+    rerouted), ``--crisp`` and the perception network's options; ``--motion-aware`` too
+    (``--geo-planner`` names the planner, motion-aware by default). Every fault of
+    ``--inject`` (drop, nudge, noise) is injected as the loop does. The limits not given are
+    the episode's defaults (`tamp.geo.types.GeoLimits`), which ``tamp bench tamp`` runs with
+    too."""
     from tamp.geo.types import GeoLimits
-    from tamp.loop.faults import KINDS, Injection
+    from tamp.loop.faults import Injection
 
-    given = [
+    planner = task.planner
+    soft = [
         _flag(n)
         for n in _PLANNER_FLAGS
         if n not in GEO_PLANNER_FLAGS and getattr(args, n, None) is not None
     ]
+    why = []  # (flags, the reason the episode that runs this scene has no use for them)
+    if soft:
+        why.append(
+            (
+                soft,
+                f"the Blocksworld loop's soft planner's settings; planner {planner} plans "
+                "this scene (--geo-planner names it, --time-limit bounds it)",
+            )
+        )
     if args.device not in (None, "cpu"):
-        given.append("--device")
-    for flag, value, default in (
-        ("--placements", args.placements, 0.0),
-        ("--collision", args.collision, "plan"),
-        ("--crisp", args.crisp, "perceived"),
-        ("--perception", args.perception, "frozen"),
-        ("--blur", args.blur, 0),
-        ("--checkpoint", args.checkpoint, None),
-        ("--record", args.record, None),
-    ):
-        if value != default:
-            given.append(flag)
-    if given:
+        why.append((["--device"], f"the soft planner's device; planner {planner} runs on the CPU"))
+    if args.placements != 0.0:
+        why.append(
+            (
+                ["--placements"],
+                "a cost on the loop's table places; planner "
+                f"{planner} picks each place by checking its grasp, IK and collisions",
+            )
+        )
+    if args.collision != "plan":
+        why.append(
+            (
+                ["--collision"],
+                f"planner {planner} decides each move by its collision checks and the executor "
+                "reroutes blocked phases; without them the moves it plans are unchecked",
+            )
+        )
+    seen = [
+        flag
+        for flag, value, default in (
+            ("--crisp", args.crisp, "perceived"),
+            ("--perception", args.perception, "frozen"),
+            ("--blur", args.blur, 0),
+            ("--checkpoint", args.checkpoint, None),
+        )
+        if value != default
+    ]
+    if seen:
+        why.append(
+            (
+                seen,
+                "the perception network's, which reads cubes' supports from one image; these "
+                "objects are observed as poses (motion capture, or --observe camera's estimates)",
+            )
+        )
+    if why:
         raise TampError(
-            f"{', '.join(given)}: the Blocksworld loop's; the geometric episode that runs "
-            f"{task.path} ({task.why}) has no such setting"
+            "; ".join(f"{', '.join(flags)}: {reason}" for flags, reason in why) + f" ({task.why})"
         )
     inject = Injection.parse(args.inject)
-    other = [k for k in KINDS if k != "drop" and getattr(inject, k) > 0]
-    if other:
-        raise TampError(
-            f"--inject {','.join(other)}: the geometric episode injects drops only (drop:P)"
-        )
     limits = GeoLimits()
     limit = args.time_limit_s if args.time_limit_s is not None else limits.planning_s
     return {
@@ -200,6 +231,7 @@ def geo_config(args: argparse.Namespace, task) -> dict:
         "time_limit_s": limit,
         "seed": args.seed,
         "video": None if args.no_video or args.out is None else args.video_format,
+        "record": None if args.record is None else str(check_record_path(args.record)),
     }
 
 

@@ -228,11 +228,14 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     video = None
     if recorded["video"] is not None:
         video = out / f"episode.{recorded['video']}"
-    # drop:P: the gripper opens mid-transit on each move with probability P, drawn per move
-    # index from the seed before the episode (the episode's `inject` takes the indices)
-    p = Injection.parse(args.inject).drop
-    draws = np.random.default_rng(args.seed).random(recorded["max_moves"])
-    drops = tuple(k for k, u in enumerate(draws) if u < p)
+    # drop:P: the gripper opens mid-transit on each move with probability P; nudge:P: the
+    # object placed is pushed after each move with probability P; both drawn per move index
+    # from the seed before the episode (the episode takes the indices); noise:P is drawn by
+    # the episode per pose reading
+    inject = Injection.parse(args.inject)
+    rng = np.random.default_rng(args.seed)
+    drops = tuple(k for k, u in enumerate(rng.random(recorded["max_moves"])) if u < inject.drop)
+    nudges = tuple(k for k, u in enumerate(rng.random(recorded["max_moves"])) if u < inject.nudge)
     limit_s = recorded["time_limit_s"]
     config = GeoEpisodeConfig(
         planner=task.planner,
@@ -243,6 +246,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         observation=args.observe,
         grasp=args.grasp,
         drops=drops,
+        nudges=nudges,
+        nudge_m=inject.nudge_m,
+        noise=inject.noise,
+        noise_sigma=inject.noise_sigma,
         video=video,
         domain=task.domain,
     )
@@ -256,9 +263,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             f"seed {args.seed}",
             file=sys.stderr,
         )
+    recorder = None if args.record is None else RerunRecorder(args.record, task.scene.name)
     with torch_threads(EPISODE_THREADS):
         report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if args.json else _say
+            task.scene, task.goal, config, on_event=None if args.json else _say, recorder=recorder
         )
     body = report_json(report, recorded)
     written = []
@@ -273,6 +281,10 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         print("\n".join(geo_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
+        if recorder is not None:
+            print(
+                f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
+            )
     return 0 if report.reached_goal else 1
 
 

@@ -28,8 +28,12 @@ class GeoEpisodeConfig:
     ``tamp run`` and ``tamp bench tamp``); ``search``: the planner's budgets and choices (None:
     `SearchConfig` with ``seed`` and ``limits.planning_s``, see `search_config`);
     ``observation``: the pose sensor, an `tamp.modes.Observation` or its name; ``grasp``:
-    ``friction`` (physical) or ``weld`` (attach); ``drops``: fault injection, the move indices
-    (0-based) on which the gripper opens mid-transit; ``video``: a file to record the episode
+    ``friction`` (physical) or ``weld`` (attach); fault injection (the loop's, `--inject`):
+    ``drops``, the move indices (0-based) on which the gripper opens mid-transit, ``nudges``,
+    the move indices after which the object just placed (when the move succeeded) is pushed
+    ``nudge_m`` m in a random direction, and ``noise``, the probability per pose reading that
+    Gaussian noise of ``noise_sigma`` m is added to every observed position (the directions and
+    the noise drawn from ``seed``); ``video``: a file to record the episode
     to (.mp4 or .gif; None: no video); ``domain``: ``(pddl_domain_text, binding_text)`` the
     motion-aware planner plans through (`tamp.geo.ours.plan_pddl`: Tower of Hanoi by its rules;
     refused for the other planners, which plan over the moves the geometry allows)."""
@@ -42,6 +46,10 @@ class GeoEpisodeConfig:
     observation: Observation = Observation.STATE
     grasp: str = "friction"
     drops: tuple[int, ...] = ()
+    nudges: tuple[int, ...] = ()
+    nudge_m: float = 0.06
+    noise: float = 0.0
+    noise_sigma: float = 0.01
     video: str | Path | None = None
     domain: tuple[str, str] | None = None
 

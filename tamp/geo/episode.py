@@ -39,6 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -54,12 +55,16 @@ from tamp.modes import GeoPlanner, Observation
 from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
+from tamp.sim.faults import nudge
 from tamp.sim.harness import Harness
 from tamp.world.geometry import Tolerances
 from tamp.world.goal import Goal
 from tamp.world.relations import read_facts
 from tamp.world.schema import Scene
 from task.errors import TampError, member
+
+if TYPE_CHECKING:
+    from tamp.rerun_log import RerunRecorder
 
 # settled poses as the motion-capture sensor reads them: `SceneConfig.tol_z`'s 12 mm; an
 # object counts as in a region when its footprint crosses the edge by at most 2 mm (a tight
@@ -140,27 +145,52 @@ def plan_soft(scene: Scene, goal: Goal, tools: Tools, config: SearchConfig) -> G
     return GeoPlan(GeoStatus.SOLVED, tuple(moves), f"a plan of {len(moves)} moves", stats)
 
 
-def observe(sim: Simulator, scene: Scene, camera=None) -> Scene:
+@dataclass(frozen=True)
+class PoseNoise:
+    """Injected observation noise (the loop's ``noise`` fault, `tamp.loop.faults`): with
+    probability ``p`` per pose reading, Gaussian noise of ``sigma`` m on every object's
+    position, drawn from ``rng`` (one draw per reading whatever ``p``, so that episodes stay
+    aligned across settings)."""
+
+    p: float
+    sigma: float
+    rng: np.random.Generator
+
+    def __call__(self, poses: dict[str, Pose]) -> dict[str, Pose]:
+        """``poses`` as the noisy sensor reads them."""
+        if not self.rng.random() < self.p:
+            return poses
+        noise = self.rng.normal(0.0, self.sigma, size=(len(poses), 3))  # (N, 3)
+        return {
+            k: Pose(tuple(float(v) for v in np.add(pose.xyz, n)), pose.yaw)
+            for (k, pose), n in zip(poses.items(), noise, strict=True)
+        }
+
+
+def observe(sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None) -> Scene:
     """``scene`` with every object at the pose the robot's sensor reads now (`_sensed`)."""
-    return _with_poses(scene, _sensed(sim, scene, camera))
+    return _with_poses(scene, _sensed(sim, scene, camera, noise))
 
 
-def _sensed(sim: Simulator, scene: Scene, camera=None) -> dict[str, Pose]:
+def _sensed(
+    sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None
+) -> dict[str, Pose]:
     """Every object's pose as the robot's sensor reads it now: the motion-capture sensor, or
     with ``camera`` (a `tamp.camera.scene_poses.ScenePoses`) the poses estimated from its
     images, ``scene``'s poses the previous estimates (an object no camera sees keeps its own).
     The camera's estimates are then scored against the ground truth (``scoring()``) for the
-    record only (``camera.errors``)."""
+    record only (``camera.errors``). ``noise``: injected noise on what is read (None: none)."""
+    noisy = noise or (lambda poses: poses)
     if camera is None:
         with sim.truth.oracle():
-            return sim.truth.block_poses()
+            return noisy(sim.truth.block_poses())
     from tamp.camera.scene_poses import pose_errors
 
     poses = camera(scene)
     with sim.truth.scoring():
         truth = sim.truth.block_poses()
     camera.errors.append(pose_errors(poses, truth, scene))
-    return poses
+    return noisy(poses)
 
 
 def _scored(camera) -> dict:
@@ -192,6 +222,7 @@ def run_geo_episode(
     *,
     tools: Tools | None = None,
     on_event: Callable[[str], None] | None = None,
+    recorder: RerunRecorder | None = None,
 ) -> EpisodeReport:
     """Run ``config.planner`` (a `GeoPlanner`) on ``scene`` toward ``goal`` in simulator
     ``config.sim`` (see the module docstring) with the settings of ``config`` (a
@@ -199,7 +230,10 @@ def run_geo_episode(
     video, a PDDL domain for the motion-aware planner). ``tools``: reuse an IK solver and
     collision model (else built and closed here). ``on_event``: called with a line after each
     plan and each move (progress, e.g. for ``tamp run``); what it is told is also in the
-    report. Returns the `tamp.episode_report.EpisodeReport` both stacks report in: ``status``
+    report. ``recorder`` (a `tamp.rerun_log.RerunRecorder`, an observer as the loop's): told of
+    every frame (the arm's joints and fingers, the objects' true poses), each observation (the
+    facts read), plan, move outcome and message, and closed with the report. Returns the
+    `tamp.episode_report.EpisodeReport` both stacks report in: ``status``
     ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
     saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET`` or
     ``MOVE_BUDGET``; ``reached_goal`` scored on ground truth; one `MoveRecord` per move.
@@ -218,7 +252,10 @@ def run_geo_episode(
             )
         plan_fn = partial(plan_fn, domain=domain)
     search = config.search_config()
-    drops = set(config.drops)
+    drops, nudges = set(config.drops), set(config.nudges)
+    rng = np.random.default_rng(seed)  # the injected faults' draws: nudges' directions, noise
+    noise = PoseNoise(config.noise, config.noise_sigma, rng) if config.noise > 0 else None
+    nudged: list[int] = []  # the moves after which the object placed was pushed
     wall0 = time.perf_counter()
     own = tools is None
     tools = tools or Tools()
@@ -241,7 +278,11 @@ def run_geo_episode(
         from tamp.camera.scene_poses import ScenePoses
 
         camera = ScenePoses(sim, scene)
-    recorder, on_frame = _recorder(video)
+    writer, on_frame = _recorder(video)
+    if recorder is not None:
+        recorder.begin(tuple(o.name for o in scene.objects), sim, tools.solver)
+        on_frame = _recorded(sim, recorder, on_frame)
+        say = _recorded_say(sim, recorder, say)
     records: list[MoveRecord] = []
     plan_times, plan_stats = [], []
     plans: list[tuple[str, ...]] = []  # every plan made, as move strings
@@ -250,7 +291,8 @@ def run_geo_episode(
     status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
         _settle(sim, on_frame)
-        world = observe(sim, scene, camera)
+        world = observe(sim, scene, camera, noise)
+        _believed(sim, recorder, world)
         while True:
             if goal.holds(read_facts(world, OBSERVED)):
                 status = EpisodeStatus.GOAL_REACHED
@@ -259,10 +301,11 @@ def run_geo_episode(
             plan = plan_fn(world, goal, tools, search)
             plan_times.append(time.perf_counter() - t0)
             plan_stats.append(dict(plan.stats))
-            say(
-                f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves in "
-                f"{plan_times[-1]:.2f} s{' (' + plan.reason + ')' if plan.reason else ''}"
-            )
+            head = f"plan {len(plan_times)}: {plan.status.value}, {len(plan.moves)} moves"
+            why = f" ({plan.reason})" if plan.reason else ""
+            say(f"{head} in {plan_times[-1]:.2f} s{why}")
+            if recorder is not None:
+                recorder.plan_made(sim, head, [m.text() for m in plan.moves], plan_times[-1])
             if not plan.solved:
                 status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
                 limit = _time_limit_s(search)
@@ -277,11 +320,16 @@ def run_geo_episode(
                 if len(records) >= max_moves:
                     status, reason = EpisodeStatus.MOVE_BUDGET, f"{max_moves} moves used"
                     break
-                k = len(records)
+                k, sim0 = len(records), sim.time
                 record, world, ran = _act(
-                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera
+                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera, noise
                 )
                 records.append(record)
+                if recorder is not None:
+                    grasp = f"grasp {record.grasp}" if record.grasp else ""
+                    args = (record.failure, record.evidence, grasp, ran, sim.time - sim0)
+                    recorder.outcome(sim, record.move, *args)
+                _believed(sim, recorder, world)
                 say(
                     f"move {k + 1}: {record.move}: "
                     f"{'ok' if record.ok else 'failed: ' + record.failure.value}"
@@ -290,6 +338,17 @@ def run_geo_episode(
                 if not record.ok:
                     replan = True
                     break
+                if k in nudges:  # the experimenter pushes the object just placed
+                    nudge(sim, move.obj, config.nudge_m, rng)
+                    nudged.append(k)
+                    _settle(sim, on_frame)
+                    before = read_facts(world, OBSERVED).atoms
+                    world = observe(sim, world, camera, noise)
+                    _believed(sim, recorder, world)
+                    if read_facts(world, OBSERVED).atoms != before:
+                        say(f"move {k + 1}: {move.obj} was nudged; the facts changed: replan")
+                        replan = True
+                        break
             if status is EpisodeStatus.MOVE_BUDGET:
                 break
             if replan or not goal.holds(read_facts(world, OBSERVED)):
@@ -302,16 +361,20 @@ def run_geo_episode(
         with sim.truth.scoring():
             truth = _with_poses(scene, sim.truth.block_poses())
         reached = goal.holds(read_facts(truth, OBSERVED))
-    finally:
-        sim.close()
+    except BaseException:
         if recorder is not None:
             recorder.close()
+        raise
+    finally:
+        sim.close()
+        if writer is not None:
+            writer.close()
         if own:
             tools.close()
     if status is EpisodeStatus.GOAL_REACHED and not reached:
         status = EpisodeStatus.NOT_REACHED
         reason = "the robot saw the goal; the ground truth does not hold it"
-    return EpisodeReport(
+    report = EpisodeReport(
         problem=scene.name,
         sim=backend,
         status=status,
@@ -319,7 +382,7 @@ def run_geo_episode(
         moves=tuple(records),
         plans=tuple(plans),
         replans=replans,
-        faults=tuple(f"drop@{k}" for k in sorted(drops) if k < len(records)),
+        faults=_faults(drops, nudged, len(records)),
         disturbed=0,
         sim_time_s=sim.time,
         wall_time_s=time.perf_counter() - wall0,
@@ -335,6 +398,16 @@ def run_geo_episode(
         arm_path_rad=path,
         pose_errors=_scored(camera),
     )
+    if recorder is not None:
+        recorder.close(report)
+    return report
+
+
+def _faults(drops: set[int], nudged: list[int], moves: int) -> tuple[str, ...]:
+    """The injected faults as the loop reports them, in move order: ``drop@K`` for each move
+    ``K`` run with a drop, ``nudge@K`` for each object pushed after move ``K``."""
+    hit = [(k, "drop") for k in drops if k < moves] + [(k, "nudge") for k in nudged]
+    return tuple(f"{kind}@{k}" for k, kind in sorted(hit))
 
 
 def _time_limit_s(config) -> float | None:
@@ -344,11 +417,19 @@ def _time_limit_s(config) -> float | None:
 
 
 def _act(
-    sim, world: Scene, move: GeoMove, runner: Tools, seed: int, on_frame, drop: bool, camera=None
+    sim,
+    world: Scene,
+    move: GeoMove,
+    runner: Tools,
+    seed: int,
+    on_frame,
+    drop: bool,
+    camera=None,
+    noise: PoseNoise | None = None,
 ):
     """Check ``move`` on the observed ``world`` from the arm's configuration now, run it,
-    settle and observe (``camera``: the camera sensor, None for motion capture): (record,
-    observed scene, joint path run in rad)."""
+    settle and observe (``camera``: the camera sensor, None for motion capture; ``noise``:
+    injected on every reading): (record, observed scene, joint path run in rad)."""
     o = world.object(move.obj)
     grasps = None
     if move.grasp is None:
@@ -375,13 +456,13 @@ def _act(
         RunConfig(),
         Harness(drop_at=0.5 if drop else None, on_frame=on_frame),
         Correction(
-            sense=lambda: np.asarray(_sensed(sim, expected, camera)[move.obj].xyz),
+            sense=lambda: np.asarray(_sensed(sim, expected, camera, noise)[move.obj].xyz),
             solver=runner.solver,
             screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
         ),
     )
     _settle(sim, on_frame)
-    seen = observe(sim, expected, camera)
+    seen = observe(sim, expected, camera, noise)
     name = verdict.grasp.name
     path = home + ran.path_rad
     if not ran.ok:
@@ -433,6 +514,41 @@ def _settle(sim: Simulator, on_frame) -> None:
 
     hold = JointTrajectory.hold(sim.arm_q(), SETTLE_S, sim.dt)
     sim.run(hold, "open", on_frame=on_frame)
+
+
+def _believed(sim: Simulator, recorder, world: Scene) -> None:
+    """Tell ``recorder`` (None: no recording) the facts read from the observed ``world``."""
+    if recorder is None:
+        return
+    facts = read_facts(world, OBSERVED)
+    lines = facts.text().splitlines() + [f"unexplained: {issue}" for issue in facts.issues]
+    recorder.facts(sim, lines)
+
+
+def _recorded(sim: Simulator, recorder, on_frame):
+    """What ``sim`` calls back each frame while ``recorder`` records: the recorder's frame at
+    its period, and ``on_frame`` (a video's, or None) on its own clock, every
+    ``sim.frame_period`` simulated seconds as it stood (the loop's `_recorded_frame`)."""
+    period, due = sim.frame_period, [0.0]
+    sim.frame_period = recorder.period
+
+    def frame(s: Simulator) -> None:
+        recorder.frame(s)
+        if on_frame is not None and s.time >= due[0]:
+            on_frame(s)
+            due[0] = max(due[0] + period, s.time)
+
+    return frame
+
+
+def _recorded_say(sim: Simulator, recorder, say: Callable[[str], None]):
+    """``say``, and the message on the recording's time line."""
+
+    def both(text: str) -> None:
+        recorder.event(sim.time, text)
+        say(text)
+
+    return both
 
 
 def _recorder(video: str | Path | None):

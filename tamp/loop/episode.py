@@ -50,7 +50,7 @@ from tamp.loop.execute import (
 )
 from tamp.loop.faults import draw
 from tamp.loop.observe import Observer, camera_goal
-from tamp.loop.recover import describe, nudge, out_of_reach, tidy
+from tamp.loop.recover import describe, out_of_reach, tidy
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
 from tamp.modes import Crisp, Observation
@@ -58,6 +58,7 @@ from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_
 from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
+from tamp.sim.faults import nudge
 from tamp.sim.harness import Harness
 from tamp.slots import plan_on_places
 from task.domains import get_domain
@@ -137,7 +138,7 @@ class Episode:
             self.eyes.home_guard = self._home_guard
         self._shown = (self.sim.frame_period, 0.0)  # on_frame's (period, next time) when recording
         if recorder is not None:
-            recorder.begin(problem, self.sim, self.solver)
+            recorder.begin(problem.entities, self.sim, self.solver)
 
     def belief_lines(self) -> list[str]:
         """The last perceived soft state, one line per block (see `Observer.belief_lines`)."""

@@ -1,20 +1,15 @@
-"""Recovery and its vocabulary: tidying loose blocks, the injected nudge, and one line on why a
-move failed (`describe`), including the give-up test `out_of_reach`.
-
-The nudge is the experimenter's fault, not the robot's act: it reads the pose it perturbs from
-simulator ground truth inside ``GroundTruth.experimenter()`` and teleports the block.
+"""Recovery and its vocabulary: tidying loose blocks and one line on why a move failed
+(`describe`), including the give-up test `out_of_reach`. (The injected nudge, the
+experimenter's fault, is `tamp.sim.faults.nudge`.)
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-import numpy as np
-
 from tamp.loop.execute import ExecutionResult
 from tamp.outcome import Failure
-from tamp.scene import Pose, Reading
-from tamp.sim.base import Simulator
+from tamp.scene import Reading
 from task.problem import TABLE, Move
 
 
@@ -34,19 +29,6 @@ def tidy(
         say(f"tidy {block} onto the table: " + describe(done))
         settle()
     return attempts
-
-
-def nudge(sim: Simulator, block: str, distance: float, rng: np.random.Generator) -> None:
-    """Injected fault: push ``block`` ``distance`` m in a random direction (one draw from
-    ``rng``), off whatever it rests on: it falls to the table next to its support. The
-    experimenter reads the block's true pose to do so (``GroundTruth.experimenter()``)."""
-    with sim.truth.experimenter():
-        pose = sim.truth.block_poses()[block]
-    angle = rng.uniform(0, 2 * np.pi)
-    x, y, z = pose.xyz
-    sim.set_block_pose(
-        block, Pose((x + distance * np.cos(angle), y + distance * np.sin(angle), z), pose.yaw)
-    )
 
 
 def describe(result: ExecutionResult) -> str:

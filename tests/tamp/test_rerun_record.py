@@ -204,3 +204,46 @@ def test_bench_executability_record_writes_a_given_plans_recording(tmp_path):
     rows, timelines = _entities(out / "recordings" / written[0])
     assert rows["/plan/moves"] == 1 and rows["/checks/moves"] == 1  # the given plan, one move
     assert TIMELINE in timelines["/gripper/force"]
+
+
+# what a recording of a geometric episode (a scene file's) holds on the simulated time line:
+# the loop's streams where the geometric episode has them (no planned phases: its executor
+# runs a move's phases as one)
+GEO_TIMED = (
+    "/world/objects",
+    "/belief/state",
+    "/plan/moves",
+    "/plan/length",
+    "/plan/time_s",
+    "/plan/cost",
+    "/arm/joints",
+    "/arm/tcp",
+    "/arm/tcp_path",
+    "/gripper/width",
+    "/gripper/force",
+    "/checks/moves",
+    "/checks/contacts",
+    "/events",
+    "/episode",
+)
+
+
+@pytest.mark.sim
+def test_a_geometric_episode_records_the_loop_s_streams(tmp_path, capsys):
+    pytest.importorskip("rerun")
+    from tests.tamp.world.test_load import TRAY, cube, scene
+
+    path, rrd = tmp_path / "s.json", tmp_path / "tray.rrd"
+    path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
+    argv = ["run", "--scene", str(path), "--goal", "(in a tray)", "--record", str(rrd)]
+    assert main([*argv, "--json"]) == 0
+    body = json.loads(capsys.readouterr().out)
+    assert body["config"]["executor"] == "geometric" and body["config"]["record"] == str(rrd)
+    rows, timelines = _entities(rrd)
+    missing = [e for e in GEO_TIMED if TIMELINE not in timelines.get(e, ())]
+    assert not missing, f"not on the {TIMELINE} time line: {missing}; got {sorted(rows)}"
+    frames = body["sim_time_s"] / 0.05
+    assert rows["/arm/joints"] >= 0.8 * frames and rows["/world/objects"] >= 0.8 * frames
+    assert rows["/checks/moves"] == len(body["moves"]) == 1
+    assert rows["/plan/moves"] == len(body["plans"]) == 1
+    assert rows["/belief/state"] == 2  # the first observation and one after the move

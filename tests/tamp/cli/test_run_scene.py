@@ -46,15 +46,18 @@ def test_a_scene_file_s_tower_is_read_from_its_geometry_and_the_goal_reached(tmp
         (["--goal", "(on a zz)"], "unknown object 'zz'"),
         (["--goal", "(in a zz)"], "unknown region 'zz'"),
         (["--goal", "(in a tray)", "--horizon", "2"], "--horizon: the Blocksworld loop's"),
-        (["--goal", "(in a tray)", "--collision", "off"], "--collision: the Blocksworld loop's"),
-        (["--goal", "(in a tray)", "--inject", "nudge:0.1"], "injects drops only"),
-        (["--goal", "(in a tray)", "--record", "x.rrd"], "--record: the Blocksworld loop's"),
+        (["--goal", "(in a tray)", "--collision", "off"], "without them the moves it plans"),
         (["--goal", "(in a tray)", "--plan", "x"], "--plan with a scene file"),
         (
             ["--goal", "(on a b)", "--geo-planner", "soft", "--motion-aware"],
             "--motion-aware: the Blocksworld loop's",
         ),
         (["--goal", "(in a tray)", "--motion-aware"], "--motion-aware: the Blocksworld loop's"),
+        (
+            ["--goal", "(in a tray)", "--motion-aware", "--placements", "0.02"],
+            "picks each place by",
+        ),
+        (["--goal", "(in a tray)", "--crisp", "true"], "these objects are observed as poses"),
         (["p.pddl"], "PROBLEM.pddl with --scene"),
         (
             ["--goal", "(on a b)", "--observe", "camera"],
@@ -223,3 +226,18 @@ def test_the_python_api_runs_the_same_geometric_episode(tmp_path):
     assert report.planner == "search-then-check"
     with pytest.raises(api.TampError, match="needs --goal"):
         api.run(path)
+
+
+@pytest.mark.sim
+def test_the_geometric_episode_injects_the_loop_s_nudge_and_noise(tmp_path, capsys):
+    """``--inject nudge:1,noise:1``: the cube placed in the tray is pushed after the move and
+    every pose reading is noisy; the report lists the nudge as the loop's does."""
+    path = tmp_path / "s.json"
+    path.write_text(json.dumps(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY])))
+    argv = ["run", "--scene", str(path), "--goal", "(in a tray)", "--inject", "nudge:1,noise:1"]
+    main([*argv, "--json"])
+    report = json.loads(capsys.readouterr().out)
+    assert report["config"]["executor"] == "geometric"
+    assert report["config"]["inject"] == "nudge:1,noise:1"
+    assert report["faults"][0] == "nudge@0" and report["moves"][0]["ok"]
+    assert all(f.startswith("nudge@") for f in report["faults"])

@@ -125,3 +125,39 @@ def test_a_plan_stopped_by_the_time_limit_says_so_in_the_no_plan_reason():
     )
     assert report.status is EpisodeStatus.NO_PLAN, report
     assert report.reason.startswith("time limit (1e-09 s) reached; budget:"), report.reason
+
+
+def _tray_scene():
+    """One cube on the table beside the 20 cm tray (the scene file of ``tamp run``'s tests)."""
+    from tamp.world.load import load_scene
+    from tests.tamp.world.test_load import TRAY, cube, scene
+
+    return load_scene(scene(cube("a", 0.45, -0.2, 0.025), regions=[TRAY]))
+
+
+@pytest.mark.sim
+def test_an_object_nudged_out_of_its_region_is_seen_and_planned_again():
+    """The loop's nudge fault: after the move, the experimenter pushes the placed cube 20 cm
+    (out of the 20 cm tray whichever way); the sensor sees it, the robot plans again and puts
+    it back; the report lists the fault as the loop does."""
+    s = _tray_scene()
+    config = GeoEpisodeConfig(nudges=(0,), nudge_m=0.2)  # ours, its default budgets
+    report = run_geo_episode(s, parse_goal("(in a tray)", s), config, tools=tools())
+    assert report.faults == ("nudge@0",)
+    assert report.replans == 1 and len(report.plans) == 2, report.plans
+    assert [m.ok for m in report.moves] == [True, True]  # the nudge is no failure of the move
+    assert report.reached_goal and report.status is EpisodeStatus.GOAL_REACHED
+
+
+def test_pose_noise_moves_every_observed_position_when_drawn():
+    from tamp.geo.episode import PoseNoise
+    from tamp.scene import Pose
+
+    poses = {"a": Pose((0.4, 0.1, 0.025), 0.3), "b": Pose((0.5, -0.1, 0.075), 0.0)}
+    noisy = PoseNoise(1.0, 0.01, np.random.default_rng(0))(poses)
+    for name, pose in poses.items():
+        shift = np.subtract(noisy[name].xyz, pose.xyz)
+        assert 0 < np.abs(shift).max() < 0.05 and noisy[name].yaw == pose.yaw
+    rng = np.random.default_rng(0)
+    assert PoseNoise(0.0, 0.01, rng)(poses) == poses
+    assert rng.random() == np.random.default_rng(0).random(2)[1]  # the draw was consumed
