@@ -1,5 +1,6 @@
-"""A Blocksworld problem laid out as a scene (`tamp.world.from_problem`): the facts read from
-its geometry are the problem's initial state, on every named workcell, as the loop lays it out."""
+"""A Blocksworld problem laid out as a scene (`tamp.world.convert.from_problem`): the facts
+read from its geometry are the problem's initial state, on every named workcell, as the loop
+lays it out."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ import pytest
 from tamp.obstacles import SCENES
 from tamp.scene import SceneConfig, layout
 from tamp.world import load_named, read_facts, scene_config
-from tamp.world.from_problem import problem_scene
+from tamp.world.convert.from_problem import problem_scene
 from task.errors import TampError
 from task.problem import TABLE, Problem
 from task.symbolic.generate import random_problem
