@@ -94,8 +94,9 @@ def scene_run(args: argparse.Namespace):
     """``run`` and ``demo`` with ``--scene FILE.json [--goal GOAL]``: the scene file's episode
     (`tamp.geo.scene_file.scene_episode`: a `tamp.world.blocks.SceneTask` for the Blocksworld
     loop or a `tamp.geo.scene_file.GeoRun` for the geometric episode), None with a named
-    workcell. Refused in one line before any work: ``--goal`` without a scene file or with a
-    PDDL problem, ``--geo-planner`` with a workcell, a scene file with ``--plan``, the loop's
+    workcell; with a workcell and ``--geo-planner``, the GeoRun of the PDDL problem laid out
+    on it (`_problem_run`). Refused in one line before any work: ``--goal`` without a scene
+    file or with a PDDL problem, a scene file or ``--geo-planner`` with ``--plan``, the loop's
     scene file with the camera, and what `scene_episode` refuses."""
     goal = getattr(args, "goal", None)
     name = getattr(args, "scene", "tabletop")

@@ -14,7 +14,9 @@ targets, ``(in c tray)``, other shapes, no parking on the table), a canonical pr
 name (``--scene packed``, its shipped goal the default) or any scene file with ``--geo-planner``
 runs as a geometric TAMP episode (`geo_run`, `tamp.geo.episode.run_geo_episode`): the
 motion-aware planner by default, grasps, placements and approaches chosen, each move checked
-on the observed scene before it runs.
+on the observed scene before it runs. A PDDL problem with ``--geo-planner`` runs there too, laid
+out on the workcell ``--scene`` names as the loop would lay it out
+(`tamp.world.convert.from_problem`).
 """
 
 from __future__ import annotations
