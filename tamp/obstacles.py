@@ -8,6 +8,11 @@ Both simulators build the boxes, the camera sees them, and the arm's collision m
 every trajectory against them (`motion.guard`, `robots.collision`). Obstacles are fixed and
 known, like a map of the workcell; the blocks still come from observation.
 
+The same four workcells ship as scene files, ``tamp/world/scenes/<name>.json`` (`tamp.world`,
+schema 1, the obstacles as fixed boxes). This module is their source: the files are written from
+`SCENES` and `GRIDS` by ``scripts/workcell_scenes.py`` (`tamp.world.convert.workcells`), and a
+test fails when a file and its definition here differ.
+
 The scene model knows what an overhead obstacle leaves free: `ceiling` is the highest the tool
 (``panda_grasptarget``) may go above a point of the table with the arm still under every board
 there, and `slot_capacity` the number of blocks a tower on a slot may have so the arm can still

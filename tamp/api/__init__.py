@@ -516,10 +516,14 @@ def run(
       ``domain``; None: the embedded 4-op domain). It runs in the closed Blocksworld loop
       (`tamp.loop`): the blocks (5 cm cubes) laid out on table slots with ``seed``, then
       observe, plan a window, execute each move as a pick-and-place, check, and replan on a
-      failure, until the goal or a stop;
+      failure, until the goal or a stop. With a `GeoEpisodeConfig` the same layout is a scene
+      on the ``tabletop`` workcell (`tamp.world.convert.from_problem`) and runs as a
+      geometric episode with the config's planner (``tamp run PROBLEM.pddl --geo-planner
+      P``);
     - a named workcell (`tamp.obstacles.SCENES`: ``tabletop``, ``shelf``, ``clutter``,
       ``cramped``): the embedded example (`EXAMPLE`) in the loop among its obstacles (``tamp
-      run --scene shelf``);
+      run --scene shelf``), or laid out there for the geometric episode with a
+      `GeoEpisodeConfig`;
     - a scene: a scene file (str or Path), a shipped scene's name (``tower``, ``tray``), a
       canonical problem's (``packed``, its goal file the default ``goal``) or a loaded
       `tamp.world.Scene`, toward ``goal`` (a PDDL goal over its objects, inline or a file:
@@ -540,7 +544,7 @@ def run(
     kind = _kind(problem)
     if kind == "scene":
         return _run_scene(problem, goal, config, domain, binding, sim, seed, on_event)
-    from tamp.loop import Episode, LoopConfig
+    from tamp.loop import Episode
 
     what = "a workcell" if kind == "workcell" else "a PDDL problem"
     if goal is not None or binding is not None:
@@ -548,11 +552,8 @@ def run(
         raise TampError(
             f"api.run: {given} is for a scene file (the objects it names); {what} has its own goal"
         )
-    if config is not None and not isinstance(config, LoopConfig):
-        raise TampError(
-            f"api.run: {what} runs in the Blocksworld loop: config must be a "
-            f"tamp.loop.LoopConfig, got {type(config).__name__}"
-        )
+    if _is_geo(config):  # laid out on the workcell as a scene: the geometric episode
+        return _run_laid_out(problem, kind, domain, config, sim, seed, on_event)
     chosen = _loop_config(config, sim)
     if kind == "workcell":
         from tamp.world import load_named, scene_config
@@ -562,6 +563,28 @@ def run(
     else:
         target = _blocksworld(problem, domain)
     return Episode(target, chosen, seed or 0, on_event=on_event).run()
+
+
+def _is_geo(config: object) -> bool:
+    from tamp.geo.config import GeoEpisodeConfig
+
+    return isinstance(config, GeoEpisodeConfig)
+
+
+def _run_laid_out(problem, kind, domain, config, sim, seed, on_event) -> EpisodeReport:
+    """`run` of a Blocksworld problem (a workcell: the embedded example on it) with a
+    `GeoEpisodeConfig`: the problem laid out on the workcell (``tabletop`` for a problem) with
+    ``seed`` (None: the config's) as the loop lays it out, run by the config's planner."""
+    from tamp.geo.episode import run_geo_episode
+    from tamp.geo.scene_file import problem_episode
+
+    workcell, source = (problem, EXAMPLE) if kind == "workcell" else ("tabletop", problem)
+    chosen = config if seed is None else replace(config, seed=seed)
+    if sim is not None:
+        chosen = replace(chosen, sim=sim)
+    target = _blocksworld(source, domain)
+    task = problem_episode(target, workcell, chosen.planner, chosen.seed)
+    return run_geo_episode(task.scene, task.goal, chosen, on_event=on_event)
 
 
 def _run_scene(scene, goal, config, domain, binding, sim, seed, on_event) -> EpisodeReport:

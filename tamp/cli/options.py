@@ -415,7 +415,9 @@ def run_options(p: argparse.ArgumentParser) -> None:
         choices=[m.value for m in GeoPlanner],
         help="--scene FILE.json or a canonical problem: run the geometric TAMP episode with "
         "this planner (motion-aware where the Blocksworld loop cannot run the scene: regions, "
-        "shapes, parking rules; else the loop)",
+        "shapes, parking rules; else the loop); PROBLEM.pddl (or the example) on a named "
+        "workcell: the problem laid out on its slots as the loop lays it out, run by this "
+        "planner (without it: the Blocksworld loop)",
     )
     p.add_argument(
         "--binding",

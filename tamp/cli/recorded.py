@@ -24,7 +24,11 @@ from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
 from tamp.modes import ImageScene, Observation
 from tamp.rerun_log import check_record_path
+from task import data
 from task.errors import TampError
+from task.instances import example, from_files, from_text
+from task.problem import Problem
+from task.symbolic import pddl_io
 
 # options that change where or how the output is shown, never what is computed: checked by
 # their own tests (tests/tamp/cli/test_every_option.py names them)
@@ -90,8 +94,9 @@ def scene_run(args: argparse.Namespace):
     """``run`` and ``demo`` with ``--scene FILE.json [--goal GOAL]``: the scene file's episode
     (`tamp.geo.scene_file.scene_episode`: a `tamp.world.blocks.SceneTask` for the Blocksworld
     loop or a `tamp.geo.scene_file.GeoRun` for the geometric episode), None with a named
-    workcell. Refused in one line before any work: ``--goal`` without a scene file or with a
-    PDDL problem, ``--geo-planner`` with a workcell, a scene file with ``--plan``, the loop's
+    workcell; with a workcell and ``--geo-planner``, the GeoRun of the PDDL problem laid out
+    on it (`_problem_run`). Refused in one line before any work: ``--goal`` without a scene
+    file or with a PDDL problem, a scene file or ``--geo-planner`` with ``--plan``, the loop's
     scene file with the camera, and what `scene_episode` refuses."""
     goal = getattr(args, "goal", None)
     name = getattr(args, "scene", "tabletop")
@@ -104,16 +109,13 @@ def scene_run(args: argparse.Namespace):
                 f"--goal needs --scene FILE.json (the objects it names); --scene {name} is a "
                 "named workcell, whose problem is PROBLEM.pddl"
             )
-        if geo is not None:
-            raise TampError(
-                f"--geo-planner needs --scene FILE.json or a canonical problem's name; --scene "
-                f"{name} is a named workcell"
-            )
         if getattr(args, "binding", None) is not None:
             raise TampError(
                 f"--binding needs --scene FILE.json (the objects its domain moves); --scene "
                 f"{name} is a named workcell"
             )
+        if geo is not None:  # the PDDL problem laid out on the workcell, any planner
+            return _problem_run(args, name, geo)
         return None
     if getattr(args, "problem", None) is not None:
         raise TampError(
@@ -136,6 +138,37 @@ def scene_run(args: argparse.Namespace):
             "(the geometric episode's cameras estimate the objects' poses)"
         )
     return task
+
+
+def load_problem(problem: str | None, domain: str | None) -> Problem:
+    """The problem file (with ``domain`` or the embedded 4-op domain), or the embedded example."""
+    if problem is None:
+        return example()[1].problem
+    if domain is None:
+        loaded = from_text(data.domain(), pddl_io.read_text(problem), str(problem)).problem
+    else:
+        loaded = from_files(domain, problem)[1].problem
+    if loaded.domain != "blocksworld":
+        raise TampError(
+            f"{problem}: the arm executes blocksworld problems only; this is a "
+            f"{loaded.domain} problem (plan it with 'tamp plan')"
+        )
+    return loaded
+
+
+def _problem_run(args: argparse.Namespace, workcell: str, planner: str):
+    """``run PROBLEM.pddl --geo-planner P`` (the embedded example without PROBLEM.pddl): a
+    `tamp.geo.scene_file.GeoRun` of the problem laid out on ``workcell`` with ``--seed``."""
+    from tamp.geo.scene_file import problem_episode
+
+    if getattr(args, "plan", None) is not None:
+        raise TampError(
+            f"--plan with --geo-planner {planner}: a given plan runs in the Blocksworld loop "
+            "(leave out --geo-planner)"
+        )
+    problem = load_problem(getattr(args, "problem", None), getattr(args, "domain", None))
+    source = getattr(args, "problem", None) or f"the example {problem.name}"
+    return problem_episode(problem, workcell, planner, args.seed, source)
 
 
 GEO_PLANNER_FLAGS = ("time_limit_s",)  # the planner flags a GeoRun reads
@@ -282,6 +315,9 @@ def run_config(args: argparse.Namespace) -> dict:
 
         if isinstance(task, GeoRun):  # the geometric episode
             check_workcell(args, executes=True)
+            if task.workcell is not None:  # a PDDL problem laid out on a workcell
+                laid = {"scene_file": None, "problem": args.problem, "scene": task.workcell}
+                return {**geo_config(args, task), **laid}
             return geo_config(args, task)
     config = loop_config(args)
     return {

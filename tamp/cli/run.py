@@ -14,7 +14,9 @@ targets, ``(in c tray)``, other shapes, no parking on the table), a canonical pr
 name (``--scene packed``, its shipped goal the default) or any scene file with ``--geo-planner``
 runs as a geometric TAMP episode (`geo_run`, `tamp.geo.episode.run_geo_episode`): the
 motion-aware planner by default, grasps, placements and approaches chosen, each move checked
-on the observed scene before it runs.
+on the observed scene before it runs. A PDDL problem with ``--geo-planner`` runs there too, laid
+out on the workcell ``--scene`` names as the loop would lay it out
+(`tamp.world.convert.from_problem`).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from pathlib import Path
 
 from tamp.cli.recorded import (
     checkpoint,
+    load_problem,
     loop_config,
     out_file,
     out_folder,
@@ -44,32 +47,13 @@ from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads
 from tamp.video import EpisodeVideo
 from tamp.world.goal_check import UnsolvableGoal
-from task import data
 from task.errors import TampError
-from task.instances import example, from_files, from_text
 from task.problem import Problem
-from task.symbolic import pddl_io
 
 VIDEO_FPS = 10.0  # frames per second of playback, each rendered at VIDEO_SIZE (640x480)
 SPEEDUP = 4.0  # playback is 4x real time
 FRAME_PERIOD = SPEEDUP / VIDEO_FPS  # simulated seconds between video frames
 EPISODE_THREADS = 1  # torch threads: one small problem, thread hand-offs cost more than they give
-
-
-def load_problem(problem: str | None, domain: str | None) -> Problem:
-    """The problem file (with ``domain`` or the embedded 4-op domain), or the embedded example."""
-    if problem is None:
-        return example()[1].problem
-    if domain is None:
-        loaded = from_text(data.domain(), pddl_io.read_text(problem), str(problem)).problem
-    else:
-        loaded = from_files(domain, problem)[1].problem
-    if loaded.domain != "blocksworld":
-        raise TampError(
-            f"{problem}: the arm executes blocksworld problems only; this is a "
-            f"{loaded.domain} problem (plan it with 'tamp plan')"
-        )
-    return loaded
 
 
 def summary_lines(report: EpisodeReport) -> list[str]:

@@ -6,8 +6,9 @@ goals is a `tamp.world.blocks.SceneTask` for the closed Blocksworld loop (`tamp.
 loop cannot run (`tamp.world.blocks.BeyondLoop`: regions as targets, other shapes, no parking on
 the bare table), a canonical problem by its name (`tamp.world.canonical.PROBLEMS`: its shipped
 scene, its goal file the default goal) and any scene with a planner named is a `GeoRun` for the
-geometric episode (`tamp.geo.episode.run_geo_episode`). Parsing-level: nothing here plans,
-simulates or imports a simulator.
+geometric episode (`tamp.geo.episode.run_geo_episode`); so is a Blocksworld PDDL problem
+with a planner named (`problem_episode`: laid out on a named workcell). Parsing-level: nothing
+here plans, simulates or imports a simulator.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pathlib import Path
 from tamp.modes import GeoPlanner
 from tamp.world.goal import Goal
 from tamp.world.schema import Scene, SceneFileError
+from task.problem import Problem
 
 DEFAULT_PLANNER = GeoPlanner.MOTION_AWARE  # ours, where the loop cannot run the scene
 
@@ -37,6 +39,7 @@ class GeoRun:
     why: str
     domain: tuple[str, str] | None = None
     domain_name: str | None = None  # the PDDL domain ``domain`` plans through
+    workcell: str | None = None  # a PDDL problem's: the named workcell it is laid out on
 
 
 def scene_path(name: str) -> tuple[Path, bool]:
@@ -116,6 +119,29 @@ def geo_run(path: Path | Scene, goal: str | Path, planner: str, why: str, hanoi:
     where = scene.name if isinstance(path, Scene) else str(path)
     return GeoRun(
         where, scene, check_goal(scene, load_goal(goal, scene)), planner, why, domain, name
+    )
+
+
+def problem_episode(
+    problem: Problem, workcell: str, planner: str, seed: int, source: str | None = None
+) -> GeoRun:
+    """The `GeoRun` of a Blocksworld PDDL ``problem`` with ``planner``: the problem laid out on
+    the named ``workcell`` with ``seed`` as the loop lays it out
+    (`tamp.world.convert.from_problem.problem_scene`), its goal as the scene's (checked by
+    `tamp.world.goal_check`: an unreachable goal is `UnsolvableGoal` before any planning).
+    ``source``: what messages name (the problem's file; None: the problem's name)."""
+    from tamp.world.convert.from_problem import problem_scene
+    from tamp.world.goal_check import check_goal
+
+    laid = problem_scene(problem, workcell, seed)
+    why = f"--geo-planner {planner}: {problem.name} laid out on workcell {workcell}, seed {seed}"
+    return GeoRun(
+        source or problem.name,
+        laid.scene,
+        check_goal(laid.scene, laid.goal),
+        planner,
+        why,
+        workcell=workcell,
     )
 
 

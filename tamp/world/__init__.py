@@ -20,7 +20,12 @@ and movable objects; the symbolic state is read from that geometry, never given.
   user's pick-and-place domain, its state read from the geometry through the binding's scene
   section (``tamp run --scene FILE --domain D.pddl --binding B.json``);
 - ``tamp.world.blocks``: `scene_task`, a scene file and a goal as the closed loop's Blocksworld
-  episode (``tamp run --scene FILE.json --goal GOAL``), or one line saying what it cannot run.
+  episode (``tamp run --scene FILE.json --goal GOAL``), or one line saying what it cannot run;
+- ``tamp.world.convert``: scenes made from the other world models: `problem_scene`
+  (``convert.from_problem``), the other way from `scene_task`: a Blocksworld PDDL problem laid
+  out as a scene on a named workcell (the loop's slots and seed), with its goal, so any
+  geometric planner runs it (``tamp run PROBLEM.pddl --geo-planner P``); and
+  ``convert.workcells``, the named workcells of `tamp.obstacles` written as scene files.
 
 World frame = the robot base frame (``panda_link0``), the table surface at z = 0, metres and
 radians, as in `tamp.scene`.

@@ -22,6 +22,7 @@ SMALL = api.Problem(
 )
 FAST = PlannerConfig(restarts=4, iters=30)
 SMALL_PDDL = get_domain("blocksworld").to_pddl(SMALL)
+WIDE = api.Problem("wide", "blocksworld", tuple("abcdefghij"), ("table",) * 10, (("a", "b"),))
 LIGHTS = """(define (domain lights) (:requirements :strips)
   (:predicates (on ?x) (off ?x))
   (:action switch :parameters (?x) :precondition (off ?x) :effect (and (on ?x) (not (off ?x)))))"""
@@ -273,9 +274,9 @@ def test_one_entry_runs_every_kind_of_episode_and_the_old_entries_are_gone():
     [
         (lambda: api.run(api.EXAMPLE, "(on a b)"), "goal is for a scene file"),
         (lambda: api.run("shelf", "(on a b)"), "a workcell has its own goal"),
-        (
-            lambda: api.run(SMALL, config=_geo_config()),
-            "a PDDL problem runs in the Blocksworld loop: config must be a tamp.loop.LoopConfig",
+        (  # with the geometric episode's config: laid out, but no room for its towers
+            lambda: api.run(WIDE, config=_geo_config()),
+            "10 towers leave no free table slot",
         ),
         (
             lambda: api.run("tray", "(in a tray)", config=_loop_config()),

@@ -162,12 +162,6 @@ def test_a_problem_file_with_a_canonical_problem_is_refused(capsys):
     assert "\n" not in err and "PROBLEM.pddl with --scene packed" in err, err
 
 
-def test_geo_planner_with_a_workcell_is_refused(capsys):
-    assert main(["run", "--geo-planner", "search"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "--geo-planner needs --scene FILE.json" in err, err
-
-
 @pytest.mark.sim
 def test_a_cube_goes_into_the_tray_by_the_geometric_episode(tmp_path, capsys):
     """The smallest region goal end to end: one move, checked and run in PyBullet."""
