@@ -167,30 +167,36 @@ class PoseNoise:
         }
 
 
-def observe(sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None) -> Scene:
-    """``scene`` with every object at the pose the robot's sensor reads now (`_sensed`)."""
-    return _with_poses(scene, _sensed(sim, scene, camera, noise))
+@dataclass(frozen=True)
+class PoseSensor:
+    """What the robot reads the object poses with: the motion-capture sensor (``camera``
+    None), or a `tamp.camera.scene_poses.ScenePoses` estimating them from its RGB-D images;
+    ``noise``: injected noise on every reading (None: none)."""
+
+    camera: object = None
+    noise: PoseNoise | None = None
+
+    def read(self, sim: Simulator, scene: Scene) -> dict[str, Pose]:
+        """Every object's pose as the sensor reads it now, ``scene``'s poses the camera's
+        previous estimates (an object no camera sees keeps its own). The camera's estimates
+        are then scored against the ground truth (``scoring()``) for the record only
+        (``camera.errors``)."""
+        noisy = self.noise or (lambda poses: poses)
+        if self.camera is None:
+            with sim.truth.oracle():
+                return noisy(sim.truth.block_poses())
+        from tamp.camera.scene_poses import pose_errors
+
+        poses = self.camera(scene)
+        with sim.truth.scoring():
+            truth = sim.truth.block_poses()
+        self.camera.errors.append(pose_errors(poses, truth, scene))
+        return noisy(poses)
 
 
-def _sensed(
-    sim: Simulator, scene: Scene, camera=None, noise: PoseNoise | None = None
-) -> dict[str, Pose]:
-    """Every object's pose as the robot's sensor reads it now: the motion-capture sensor, or
-    with ``camera`` (a `tamp.camera.scene_poses.ScenePoses`) the poses estimated from its
-    images, ``scene``'s poses the previous estimates (an object no camera sees keeps its own).
-    The camera's estimates are then scored against the ground truth (``scoring()``) for the
-    record only (``camera.errors``). ``noise``: injected noise on what is read (None: none)."""
-    noisy = noise or (lambda poses: poses)
-    if camera is None:
-        with sim.truth.oracle():
-            return noisy(sim.truth.block_poses())
-    from tamp.camera.scene_poses import pose_errors
-
-    poses = camera(scene)
-    with sim.truth.scoring():
-        truth = sim.truth.block_poses()
-    camera.errors.append(pose_errors(poses, truth, scene))
-    return noisy(poses)
+def observe(sim: Simulator, scene: Scene, sensor: PoseSensor = PoseSensor()) -> Scene:
+    """``scene`` with every object at the pose ``sensor`` reads now."""
+    return _with_poses(scene, sensor.read(sim, scene))
 
 
 def _scored(camera) -> dict:
@@ -278,6 +284,7 @@ def run_geo_episode(
         from tamp.camera.scene_poses import ScenePoses
 
         camera = ScenePoses(sim, scene)
+    sensor = PoseSensor(camera, noise)
     writer, on_frame = _recorder(video)
     if recorder is not None:
         recorder.begin(tuple(o.name for o in scene.objects), sim, tools.solver)
@@ -291,7 +298,7 @@ def run_geo_episode(
     status, reason = EpisodeStatus.NOT_REACHED, ""
     try:
         _settle(sim, on_frame)
-        world = observe(sim, scene, camera, noise)
+        world = observe(sim, scene, sensor)
         _believed(sim, recorder, world)
         while True:
             if goal.holds(read_facts(world, OBSERVED)):
@@ -322,7 +329,7 @@ def run_geo_episode(
                     break
                 k, sim0 = len(records), sim.time
                 record, world, ran = _act(
-                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, camera, noise
+                    sim, world, move, runner, seed * 1000 + k, on_frame, k in drops, sensor
                 )
                 records.append(record)
                 if recorder is not None:
@@ -343,7 +350,7 @@ def run_geo_episode(
                     nudged.append(k)
                     _settle(sim, on_frame)
                     before = read_facts(world, OBSERVED).atoms
-                    world = observe(sim, world, camera, noise)
+                    world = observe(sim, world, sensor)
                     _believed(sim, recorder, world)
                     if read_facts(world, OBSERVED).atoms != before:
                         say(f"move {k + 1}: {move.obj} was nudged; the facts changed: replan")
@@ -424,12 +431,10 @@ def _act(
     seed: int,
     on_frame,
     drop: bool,
-    camera=None,
-    noise: PoseNoise | None = None,
+    sensor: PoseSensor = PoseSensor(),
 ):
     """Check ``move`` on the observed ``world`` from the arm's configuration now, run it,
-    settle and observe (``camera``: the camera sensor, None for motion capture; ``noise``:
-    injected on every reading): (record, observed scene, joint path run in rad)."""
+    settle and observe with ``sensor``: (record, observed scene, joint path run in rad)."""
     o = world.object(move.obj)
     grasps = None
     if move.grasp is None:
@@ -456,13 +461,13 @@ def _act(
         RunConfig(),
         Harness(drop_at=0.5 if drop else None, on_frame=on_frame),
         Correction(
-            sense=lambda: np.asarray(_sensed(sim, expected, camera, noise)[move.obj].xyz),
+            sense=lambda: np.asarray(sensor.read(sim, expected)[move.obj].xyz),
             solver=runner.solver,
             screen=partial(_free, world, move, verdict.grasp, rests[0], runner),
         ),
     )
     _settle(sim, on_frame)
-    seen = observe(sim, expected, camera, noise)
+    seen = observe(sim, expected, sensor)
     name = verdict.grasp.name
     path = home + ran.path_rad
     if not ran.ok:
