@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Sequence
 from dataclasses import replace
 
 import torch
@@ -69,15 +68,15 @@ def fall_back(
     domain: Domain,
     problem: Problem,
     state: State,
-    costs: CostSource | None,
-    indices: Sequence[int],
-    i: int,
     config: PlannerConfig,
-    deadline: float | None,
+    costs: CostSource | None = None,
+    index: int = 0,
+    deadline: float | None = None,
 ) -> LazyResult:
-    """The complete fallback search for problem ``i`` from its world ``state``, over the moves
-    the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is committed
-    to the cost source move by move (restart row 0 of a one-row window priced in the state
+    """The complete fallback search for ``problem`` (``index``: its position in the list given
+    to `task.planner.plan_batch`, what the cost source is told) from its world ``state``, over
+    the moves the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is
+    committed to the cost source move by move (restart row 0 of a one-row window priced in the state
     the move starts from). ``config.fallback_search`` picks the search: A* on the lower bound,
     or greedy on the domain's ``estimate`` (else its lower bound).
 
@@ -100,9 +99,7 @@ def fall_back(
     within these choices (the windows may have led into a dead end). A plan found has its runs
     of one block's moves merged (`task.symbolic.shorten.merge_runs`, each merged move checked
     feasible) before it is committed."""
-    feasible, windows = (
-        (None, {}) if costs is None else cost_checks(domain, problem, costs, indices[i])
-    )
+    feasible, windows = (None, {}) if costs is None else cost_checks(domain, problem, costs, index)
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
 
     def late() -> bool:
@@ -117,7 +114,7 @@ def fall_back(
         probe = lazy_best_first(domain, problem, start, feasible, nodes, deadline)
         if probe.status is SearchStatus.SOLVED:
             if forget is not None:
-                forget(indices[i])
+                forget(index)
             why = f"from the initial state, A* within {nodes} expansions: {probe.reason}"
             return _commit(
                 domain,
@@ -150,7 +147,7 @@ def fall_back(
         again = lazy_greedy(domain, problem, start, feasible, last, deadline)
         if again.status is SearchStatus.SOLVED:
             if forget is not None:
-                forget(indices[i])
+                forget(index)
             why = f"{found.reason}; from the initial state, greedy: {again.reason}"
             state, found = start, _after(found, again, why, from_start=True)
     if found.status is SearchStatus.UNSOLVABLE and state != start:
