@@ -82,27 +82,55 @@ class DecodedWindow:
         )
 
 
+@dataclass(frozen=True)
+class WindowStart:
+    """Where one problem's window starts, as the decoder reads it: the ``problem``, the crisp
+    ``state`` its moves are checked against, the states its plan already passed through
+    (``seen``: a window that ends in one is a ``revisit``) and whether parking moves rank free
+    (``park``, `PlannerConfig.parks`)."""
+
+    problem: Problem
+    state: State
+    seen: Collection[State] = ()
+    park: bool = False
+
+
+@dataclass(frozen=True)
+class DecodeRule:
+    """How a window is decoded: the confidence ``threshold`` a step's move mass must reach,
+    the ``restarts`` (R) rows of each problem (adjacent in the batch), the crisp ``check``
+    (False keeps the first illegal move and ranks restarts by the soft objective alone) and
+    ``prefix`` (rank each window by its best prefix; see the module docstring)."""
+
+    threshold: float
+    restarts: int = 1
+    check: bool = True
+    prefix: bool = False
+
+    @classmethod
+    def of(cls, config: PlannerConfig) -> DecodeRule:
+        """The rule of a planner's settings (`PlannerConfig.threshold`, ``restarts``,
+        ``crisp_check``, ``rank_prefixes``)."""
+        return cls(config.threshold, config.restarts, config.crisp_check, config.rank_prefixes)
+
+
 def decode_row(
     domain: Domain,
-    problem: Problem,
-    state: State,
+    start: WindowStart,
     gates: Tensor,
-    threshold: float,
     loss: float,
-    check: bool = True,
-    seen: Collection[State] = (),
+    rule: DecodeRule,
     costs: Tensor | None = None,
-    prefix: bool = False,
-    park: bool = False,
 ) -> DecodedWindow:
-    """Decode one rollout row. gates: (T, N, A - 1) applied move mass of that row; costs:
-    (N, A - 1) its move costs (`task.costs`), summed over the decoded moves; a move costing
-    `task.costs.IMPOSSIBLE` or more is refused like an illegal one. ``prefix`` and ``park``:
-    rank its prefixes (see the module docstring).
+    """Decode one rollout row from ``start``. gates: (T, N, A - 1) applied move mass of that
+    row; ``loss``: its soft objective; costs: (N, A - 1) its move costs (`task.costs`), summed
+    over the decoded moves; a move costing `task.costs.IMPOSSIBLE` or more is refused like an
+    illegal one. ``rule.prefix`` and ``start.park``: rank its prefixes (see the module
+    docstring).
 
-    ``check=False`` keeps the first illegal move (last in ``moves``, reason in ``illegal``);
-    ``seen``: states the plan already passed through (the window is a ``revisit`` if it ends
-    in one)."""
+    ``rule.check=False`` keeps the first illegal move (last in ``moves``, reason in
+    ``illegal``)."""
+    problem, state, check = start.problem, start.state, rule.check
     n = gates.shape[1]
     best, flat = gates.flatten(1).max(-1)  # (T,), (T,)
     moves: list = []
@@ -110,9 +138,8 @@ def decode_row(
     if domain.is_goal(problem, state):  # nothing to do (a perceived state may already be it)
         return DecodedWindow((), state, True, True, loss, 0)
     trail: list[tuple[State, float]] = []  # (state, move cost so far) after each move
-    start = state
     for value, index in zip(best.tolist(), flat.tolist(), strict=True):
-        if value < threshold:
+        if value < rule.threshold:
             continue  # a STAY step
         row, col = divmod(index, gates.shape[2])
         move = domain.decode(problem, row, col, n)  # None: padding, never a legal move
@@ -133,8 +160,8 @@ def decode_row(
             break
     reached = domain.is_goal(problem, state)
     estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
-    if prefix and check and estimate is None and moves and not reached:
-        return _best_prefix(domain, problem, start, moves, trail, seen, park, complete, loss)
+    if rule.prefix and check and estimate is None and moves and not reached:
+        return _best_prefix(domain, start, moves, trail, complete, loss)
     remaining = 0 if reached else domain.lower_bound(problem, state)
     estimated = None if reached or estimate is None else estimate(problem, state)
     return DecodedWindow(
@@ -146,25 +173,23 @@ def decode_row(
         remaining,
         illegal,
         estimated,
-        state in seen,
+        state in start.seen,
         motion,
     )
 
 
 def _best_prefix(
     domain: Domain,
-    problem: Problem,
-    start: State,
+    start: WindowStart,
     moves: Sequence,
     trail: Sequence[tuple[State, float]],
-    seen: Collection[State],
-    park: bool,
     complete: bool,
     loss: float,
 ) -> DecodedWindow:
     """The best prefix (see the module docstring) of a window that makes ``moves`` from
     ``start``, passing through ``trail`` (the state and the move cost so far after each)."""
-    before = domain.lower_bound(problem, start)
+    problem, seen, park = start.problem, start.seen, start.park
+    before = domain.lower_bound(problem, start.state)
     best, buried, parked = None, 0, 0
     for k, (move, (state, motion)) in enumerate(zip(moves, trail, strict=True), start=1):
         bound = domain.lower_bound(problem, state)
@@ -192,50 +217,29 @@ def _best_prefix(
 
 def decode_best(
     domain: Domain,
-    problems: Sequence[Problem],
-    states: Sequence[State],
+    starts: Sequence[WindowStart],
     gates: Tensor,
     losses: Tensor,
-    restarts: int,
-    threshold: float,
-    check: bool = True,
-    visited: Sequence[Collection[State]] | None = None,
+    rule: DecodeRule,
     costs: Tensor | None = None,
-    prefix: bool = False,
-    park: bool | Sequence[bool] = False,
 ) -> list[DecodedWindow]:
-    """Best decoded window per problem. gates: (P * R, T, N, A - 1), restarts adjacent.
-    ``park``: for every problem, or one per problem (`PlannerConfig.parks`).
-
-    ``visited``: per problem, the states its plan has passed through (a window that ends in
-    one ranks below every window that does not). ``check=False``: illegal moves are kept and
-    the lowest soft objective wins. ``costs``: (P * R, N, A - 1) move costs (`task.costs`).
-    Each window names the restart row it came from (``row``)."""
+    """Best decoded window per problem, one per ``starts`` (a window that ends in a state
+    its ``seen`` holds ranks below every window that does not). gates: (P * R, T, N, A - 1),
+    restarts adjacent (``rule.restarts``); losses: (P * R,) the rows' soft objectives.
+    ``rule.check=False``: illegal moves are kept and the lowest soft objective wins.
+    ``costs``: (P * R, N, A - 1) move costs (`task.costs`). Each window names the restart
+    row it came from (``row``)."""
     gates, losses = gates.cpu(), losses.cpu().tolist()
     costs = None if costs is None else costs.detach().cpu()
+    restarts = rule.restarts
     out = []
-    for i, (problem, state) in enumerate(zip(problems, states, strict=True)):
-        rows = range(i * restarts, (i + 1) * restarts)
-        seen = () if visited is None else visited[i]
-        parks = park if isinstance(park, bool) else park[i]
+    for i, start in enumerate(starts):
         windows = []
-        for k, r in enumerate(rows):
+        for k, r in enumerate(range(i * restarts, (i + 1) * restarts)):
             c = None if costs is None else costs[r]
-            window = decode_row(
-                domain,
-                problem,
-                state,
-                gates[r],
-                threshold,
-                losses[r],
-                check,
-                seen,
-                c,
-                prefix,
-                parks,
-            )
+            window = decode_row(domain, start, gates[r], losses[r], rule, c)
             windows.append(replace(window, row=k))
-        out.append(min(windows, key=DecodedWindow.key if check else _soft_objective))
+        out.append(min(windows, key=DecodedWindow.key if rule.check else _soft_objective))
     return out
 
 
@@ -251,12 +255,9 @@ NEAR_GOAL = 10.0  # `proof_stop` decodes a restart early only when its soft goal
 
 def proof_stop(
     domain: Domain,
-    problems: Sequence[Problem],
-    states: Sequence[State],
+    starts: Sequence[WindowStart],
     config: PlannerConfig,
-    visited: Sequence[set],
     proven: dict[int, DecodedWindow],
-    parks: Sequence[bool],
 ) -> Callable[[Rollout], bool] | None:
     """The early stop of a window (`PlannerConfig.proof_every`; `task.planner` passes it to
     the window's optimisation): the rollout is read as the decoder reads it, and a problem
@@ -269,14 +270,15 @@ def proof_stop(
     restarts near the goal in the rollout (`NEAR_GOAL`) are decoded, the best of them by the
     decoder's ranking (`DecodedWindow.key`)."""
     longest = max(config.horizons())
-    bounds = [domain.lower_bound(p, s) for p, s in zip(problems, states, strict=True)]
+    bounds = [domain.lower_bound(start.problem, start.state) for start in starts]
     hopeful = [i for i, bound in enumerate(bounds) if bound <= longest]
     if not hopeful or not config.crisp_check or not config.proof_every:
         return None
     r = config.restarts
+    rule = replace(DecodeRule.of(config), check=True)
 
     def stop(roll: Rollout) -> bool:
-        near = (roll.goal < NEAR_GOAL).view(len(problems), r).tolist()  # (P, R)
+        near = (roll.goal < NEAR_GOAL).view(len(starts), r).tolist()  # (P, R)
         todo = [i for i in hopeful if i not in proven and any(near[i])]
         if not todo:
             return False
@@ -286,23 +288,12 @@ def proof_stop(
             windows = []
             for k in (k for k in range(r) if near[i][k]):
                 row = i * r + k
-                window = decode_row(
-                    domain,
-                    problems[i],
-                    states[i],
-                    gates[row],
-                    config.threshold,
-                    losses[row],
-                    True,
-                    visited[i],
-                    None if priced is None else priced[row],
-                    config.rank_prefixes,
-                    parks[i],
-                )
+                c = None if priced is None else priced[row]
+                window = decode_row(domain, starts[i], gates[row], losses[row], rule, c)
                 windows.append(replace(window, row=k))
             best = min(windows, key=DecodedWindow.key)
             if best.reached and len(best.moves) <= bounds[i]:
                 proven[i] = best
-        return len(proven) == len(problems)
+        return len(proven) == len(starts)
 
     return stop

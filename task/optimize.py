@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import torch
 from torch import Tensor
@@ -37,30 +38,41 @@ def initial_logits(
     return logits
 
 
+@dataclass(frozen=True)
+class Window:
+    """One planning window's tensor program: the ``domain``, its encoded ``batch`` (B rows:
+    problems x restarts), the live ``steps`` of each row ((B, T) bool: rows may have shorter
+    windows), the settings, and the soft inputs from outside. ``beliefs`` (see
+    `task.beliefs`) replace the batch's F0 and goal by soft ones, recomputed at every step;
+    their parameters, if any, are optimised too, at their own learning rate. ``costs`` (see
+    `task.costs`) add the expected move cost to the loss, likewise. ``deadline`` (a
+    `time.perf_counter` value): raise `task.rollout.OutOfTime` once it has passed, checked at
+    every Adam step and every rollout step."""
+
+    domain: Domain
+    batch: SoftBatch
+    steps: Tensor  # (B, T) bool
+    config: PlannerConfig
+    beliefs: WindowBeliefs | None = None
+    costs: WindowCosts | None = None
+    deadline: float | None = None
+
+
 def optimise_window(
-    domain: Domain,
-    batch: SoftBatch,
-    steps: Tensor,
-    config: PlannerConfig,
+    window: Window,
     generator: torch.Generator,
-    beliefs: WindowBeliefs | None = None,
-    costs: WindowCosts | None = None,
-    deadline: float | None = None,
     stop: Callable[[Rollout], bool] | None = None,
 ) -> tuple[Tensor, Rollout]:
-    """Optimise the window's logits; returns them and the final rollout (no grad; at
-    ``config.decode_tau`` when set, the temperature the decoder reads the moves at).
+    """Optimise the window's logits, drawn from ``generator``; returns them and the final
+    rollout (no grad; at ``config.decode_tau`` when set, the temperature the decoder reads the
+    moves at).
 
-    steps: (B, T) bool, the live steps of each row (rows may have shorter windows).
-    ``beliefs`` (see `task.beliefs`) replaces the batch's F0 and goal by soft ones, recomputed
-    at every step; their parameters, if any, are optimised too, at their own learning rate.
-    ``costs`` (see `task.costs`) adds the expected move cost to the loss, likewise.
-    ``deadline`` (a `time.perf_counter` value): raise `task.rollout.OutOfTime` once it has
-    passed, checked at every Adam step and every rollout step.
     ``stop``: shown that rollout after every ``config.proof_every`` Adam steps (not after the
     last); the optimisation ends early, returning it, when ``stop`` says so (the planner's
     proof that the window's decode is already an optimal plan, `task.planner`).
     """
+    domain, batch, steps, config = window.domain, window.batch, window.steps, window.config
+    beliefs, costs, deadline = window.beliefs, window.costs, window.deadline
     logits = initial_logits(batch, steps.shape[1], config, generator).requires_grad_(True)
     groups = [{"params": [logits], "lr": config.lr}]
     extra = beliefs.parameters() if beliefs is not None else []
@@ -76,26 +88,29 @@ def optimise_window(
         tau = temperature(config, k)
         live, penalty = with_beliefs(batch, beliefs)
         c = with_costs(batch, costs)
-        roll = rollout(domain, logits, live, steps, config, tau, c, deadline)
+        roll = rollout(domain, logits, live, steps, config, tau, costs=c, deadline=deadline)
         (roll.loss.sum() + penalty).backward()
         opt.step()
         every = config.proof_every
         if stop is not None and every and (k + 1) % every == 0 and k + 1 < config.iters:
-            decoded = _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline)
+            decoded = _decoded(window, logits)
             if stop(decoded):
                 return logits.detach(), decoded
-    return logits.detach(), _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline)
+    return logits.detach(), _decoded(window, logits)
 
 
 @torch.no_grad()
-def _decoded(domain, logits, batch, steps, config, beliefs, costs, deadline) -> Rollout:
+def _decoded(window: Window, logits: Tensor) -> Rollout:
     """The rollout the decoder reads: at ``config.decode_tau`` (None: the last Adam step's
     temperature), without a graph."""
+    config = window.config
     tau = config.decode_tau
     tau = temperature(config, config.iters - 1) if tau is None else tau
-    live, _ = with_beliefs(batch, beliefs)
-    c = with_costs(batch, costs)
-    return rollout(domain, logits, live, steps, config, tau, c, deadline)
+    live, _ = with_beliefs(window.batch, window.beliefs)
+    c = with_costs(window.batch, window.costs)
+    return rollout(
+        window.domain, logits, live, window.steps, config, tau, costs=c, deadline=window.deadline
+    )
 
 
 class Adam:

@@ -8,8 +8,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import torch
 
@@ -20,6 +19,7 @@ from task.domains.base import Domain, State
 from task.errors import TampError
 from task.problem import Move, Problem
 from task.symbolic.lazy_search import (
+    Feasible,
     LazyResult,
     SearchStatus,
     lazy_best_first,
@@ -69,15 +69,15 @@ def fall_back(
     domain: Domain,
     problem: Problem,
     state: State,
-    costs: CostSource | None,
-    indices: Sequence[int],
-    i: int,
     config: PlannerConfig,
-    deadline: float | None,
+    costs: CostSource | None = None,
+    index: int = 0,
+    deadline: float | None = None,
 ) -> LazyResult:
-    """The complete fallback search for problem ``i`` from its world ``state``, over the moves
-    the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is committed
-    to the cost source move by move (restart row 0 of a one-row window priced in the state
+    """The complete fallback search for ``problem`` (``index``: its position in the list given
+    to `task.planner.plan_batch`, what the cost source is told) from its world ``state``, over
+    the moves the cost source does not rule out (`task.symbolic.lazy_search`). A plan found is
+    committed to the cost source move by move (restart row 0 of a one-row window priced in the state
     the move starts from). ``config.fallback_search`` picks the search: A* on the lower bound,
     or greedy on the domain's ``estimate`` (else its lower bound).
 
@@ -100,70 +100,105 @@ def fall_back(
     within these choices (the windows may have led into a dead end). A plan found has its runs
     of one block's moves merged (`task.symbolic.shorten.merge_runs`, each merged move checked
     feasible) before it is committed."""
-    feasible, windows = (
-        (None, {}) if costs is None else cost_checks(domain, problem, costs, indices[i])
-    )
+    feasible, windows = (None, {}) if costs is None else cost_checks(domain, problem, costs, index)
+    run = _Fallback(domain, problem, config, feasible, windows, costs, index, deadline)
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
-
-    def late() -> bool:
-        return deadline is not None and time.perf_counter() >= deadline
-
     start = domain.initial_state(problem)
-    forget = getattr(costs, "forget", None)  # a cost source that can drop committed moves
-    can_forget = costs is None or forget is not None
+    can_forget = costs is None or getattr(costs, "forget", None) is not None
     probing = config.restart_probe > 0 and search is lazy_best_first
     if probing and state != start and can_forget:
-        nodes = config.restart_probe
-        probe = lazy_best_first(domain, problem, start, feasible, nodes, deadline)
-        if probe.status is SearchStatus.SOLVED:
-            if forget is not None:
-                forget(indices[i])
-            why = f"from the initial state, A* within {nodes} expansions: {probe.reason}"
-            return _commit(
-                domain,
-                problem,
-                start,
-                replace(probe, from_start=True, reason=why),
-                feasible,
-                windows,
-                costs,
-            )
+        probed = _probe(run, start)
+        if probed is not None:
+            return probed
     restart = state != start and can_forget  # a last search from the initial state may run
     stages = 1 + (search is lazy_best_first) + restart  # searches that may still run, this one too
+    found = search(domain, problem, state, feasible, config.fallback_nodes, run.share(stages))
+    if search is lazy_best_first and found.status is SearchStatus.BUDGET and not run.late():
+        stages -= 1
+        nodes = config.fallback_nodes
+        greedy = lazy_greedy(domain, problem, state, feasible, nodes, run.share(stages))
+        found = _after(found, greedy, f"A* {found.reason}; then greedy: {greedy.reason}")
+    if found.status is SearchStatus.BUDGET and restart and not run.late():
+        state, found = _start_over(run, state, found)
+    if found.status is SearchStatus.UNSOLVABLE and state != start:
+        found = _dead_end(run, search, found)
+        if found.status is SearchStatus.DEAD_END:
+            return found
+    return _commit(domain, problem, state, found, feasible, windows, costs)
 
-    def share(stages: int) -> float | None:
+
+@dataclass(frozen=True)
+class _Fallback:
+    """One problem's fallback search (`fall_back`): what each of its searches shares."""
+
+    domain: Domain
+    problem: Problem
+    config: PlannerConfig
+    feasible: Feasible | None  # the cost source's verdicts (None: every move is feasible)
+    windows: dict  # the cost source's one-row windows, by the state they price
+    costs: CostSource | None
+    index: int
+    deadline: float | None
+
+    def late(self) -> bool:
+        return self.deadline is not None and time.perf_counter() >= self.deadline
+
+    def share(self, stages: int) -> float | None:
         """The deadline of a search with ``stages`` searches (itself included) still to run:
         an equal share of the time left, so that under load a slow first search does not
         leave the later ones, from elsewhere, no time at all."""
-        if deadline is None or stages <= 1:
-            return deadline
+        if self.deadline is None or stages <= 1:
+            return self.deadline
         now = time.perf_counter()
-        return now + max(0.0, deadline - now) / stages
+        return now + max(0.0, self.deadline - now) / stages
 
-    found = search(domain, problem, state, feasible, config.fallback_nodes, share(stages))
-    if search is lazy_best_first and found.status is SearchStatus.BUDGET and not late():
-        stages -= 1
-        greedy = lazy_greedy(domain, problem, state, feasible, config.fallback_nodes, share(stages))
-        found = _after(found, greedy, f"A* {found.reason}; then greedy: {greedy.reason}")
-    if found.status is SearchStatus.BUDGET and restart and not late():
-        last = config.fallback_nodes if deadline is None else sys.maxsize  # the time left
-        again = lazy_greedy(domain, problem, start, feasible, last, deadline)
-        if again.status is SearchStatus.SOLVED:
-            if forget is not None:
-                forget(indices[i])
-            why = f"{found.reason}; from the initial state, greedy: {again.reason}"
-            state, found = start, _after(found, again, why, from_start=True)
-    if found.status is SearchStatus.UNSOLVABLE and state != start:
-        left = max(1, config.fallback_nodes - found.expanded)
-        again = search(domain, problem, start, feasible, left, deadline)
-        if again.status is not SearchStatus.UNSOLVABLE:
-            why = (
-                "the windows reached a state from which no plan exists within these choices, "
-                f"and from the initial state the search ended {again.status.value}"
-            )
-            return replace(found, status=SearchStatus.DEAD_END, reason=why)
-        found = replace(found, reason=found.reason + ", from the initial state too")
-    return _commit(domain, problem, state, found, feasible, windows, costs)
+    def forget(self) -> None:
+        """Tell the cost source (one that can) to drop the moves committed to it."""
+        forget = getattr(self.costs, "forget", None)  # a cost source that can drop them
+        if forget is not None:
+            forget(self.index)
+
+
+def _probe(run: _Fallback, start: State) -> LazyResult | None:
+    """A* from the initial ``start`` for ``config.restart_probe`` expansions: its plan,
+    committed, when it finds one (the windows' moves dropped), else None."""
+    nodes = run.config.restart_probe
+    probe = lazy_best_first(run.domain, run.problem, start, run.feasible, nodes, run.deadline)
+    if probe.status is not SearchStatus.SOLVED:
+        return None
+    run.forget()
+    why = f"from the initial state, A* within {nodes} expansions: {probe.reason}"
+    found = replace(probe, from_start=True, reason=why)
+    return _commit(run.domain, run.problem, start, found, run.feasible, run.windows, run.costs)
+
+
+def _start_over(run: _Fallback, state: State, found: LazyResult) -> tuple[State, LazyResult]:
+    """After the searches from ``state`` ran out (``found``), a last greedy search from the
+    initial state (until the deadline when there is one): its start and result when it
+    finds a plan, else ``state`` and ``found``."""
+    start = run.domain.initial_state(run.problem)
+    last = run.config.fallback_nodes if run.deadline is None else sys.maxsize  # the time left
+    again = lazy_greedy(run.domain, run.problem, start, run.feasible, last, run.deadline)
+    if again.status is not SearchStatus.SOLVED:
+        return state, found
+    run.forget()
+    why = f"{found.reason}; from the initial state, greedy: {again.reason}"
+    return start, _after(found, again, why, from_start=True)
+
+
+def _dead_end(run: _Fallback, search, found: LazyResult) -> LazyResult:
+    """No plan from the windows' state (``found``): the initial state searched too, with
+    the expansions left; DEAD_END when a plan may exist from there, else still UNSOLVABLE."""
+    start = run.domain.initial_state(run.problem)
+    left = max(1, run.config.fallback_nodes - found.expanded)
+    again = search(run.domain, run.problem, start, run.feasible, left, run.deadline)
+    if again.status is not SearchStatus.UNSOLVABLE:
+        why = (
+            "the windows reached a state from which no plan exists within these choices, "
+            f"and from the initial state the search ended {again.status.value}"
+        )
+        return replace(found, status=SearchStatus.DEAD_END, reason=why)
+    return replace(found, reason=found.reason + ", from the initial state too")
 
 
 def _commit(domain, problem, state, found: LazyResult, feasible, windows, costs) -> LazyResult:

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from functools import partial
 
 import torch
@@ -35,9 +36,11 @@ from task.beliefs import BeliefSource
 from task.config import PlannerConfig, torch_device
 from task.costs import CostSource
 from task.deadline import NO_DEADLINE, Deadline
+from task.decode import DecodedWindow
 from task.domains import get_domain
-from task.domains.base import Domain, resolve_goal_loss
+from task.domains.base import Domain, State, resolve_goal_loss
 from task.errors import ProblemError, TampError, one_of
+from task.planner.context import PlanContext, Progress
 from task.planner.fallback import cost_checks, fall_back, fallback_on
 from task.planner.windows import (
     crisp_states,
@@ -46,174 +49,261 @@ from task.planner.windows import (
     own_state_prefix,
     take_safe,
 )
-from task.problem import Plan, PlanResult, PlanStatus, Problem
+from task.problem import Move, Plan, PlanResult, PlanStatus, Problem
 from task.rollout import OutOfTime
-from task.symbolic.lazy_search import (
-    LazyResult,
-    SearchStatus,
-    improve,
-)
+from task.symbolic.lazy_search import SearchStatus, improve
 from task.symbolic.shorten import shorten
 
 
+@dataclass(frozen=True)
+class _Clock:
+    """When a run started and must end: ``deadline`` (None: never), the earlier of
+    ``config.time_limit_s`` and the caller's; ``windows_end``, where the windows stop (with
+    the fallback on, at ``config.window_share`` of the time); ``limit``, the seconds the
+    messages name."""
+
+    start: float
+    deadline: float | None
+    windows_end: float | None
+    limit: float | None
+
+    @classmethod
+    def of(cls, config: PlannerConfig, until: Deadline, fallback: bool) -> _Clock:
+        start = time.perf_counter()
+        limit = config.time_limit_s
+        ends = [t for t in (None if limit is None else start + limit, until.at) if t is not None]
+        deadline = min(ends) if ends else None
+        if limit is None:
+            limit = until.limit_s  # what the messages name
+        windows_end = deadline
+        if deadline is not None and fallback:
+            windows_end = start + config.window_share * (deadline - start)
+        return cls(start, deadline, windows_end, limit)
+
+
 def _run(
-    domain: Domain,
+    shared: PlanContext,
     problems: Sequence[Problem],
-    config: PlannerConfig,
-    generator: torch.Generator,
+    indices: Sequence[int],
     on_done: Callable[[int], None],
-    source: BeliefSource | None = None,
-    indices: Sequence[int] = (),
-    costs: CostSource | None = None,
     until: Deadline = NO_DEADLINE,
 ) -> list[PlanResult]:
-    """Plan all ``problems`` together; ``on_done(k)`` reports k newly finished problems.
-    ``until``: a caller's deadline (a command's), kept as well as ``config.time_limit_s``.
+    """Plan all ``problems`` together in the ``shared`` context (its domain, settings,
+    generator and sources); ``on_done(k)`` reports k newly finished problems. ``until``: a
+    caller's deadline (a command's), kept as well as ``config.time_limit_s``.
 
-    ``indices``: the problems' positions in the caller's list (what ``source`` and ``costs``
-    are told). ``config.time_limit_s`` holds inside a window too: a window the limit cuts
-    short is abandoned (none of its moves are kept). With the fallback on, the windows stop at
+    ``indices``: the problems' positions in the caller's list (what the sources are told).
+    ``config.time_limit_s`` holds inside a window too: a window the limit cuts short is
+    abandoned (none of its moves are kept). With the fallback on, the windows stop at
     ``config.window_share`` of the limit, the fallback searching in the rest."""
-    start = time.perf_counter()
-    limit = config.time_limit_s
-    ends = [t for t in (None if limit is None else start + limit, until.at) if t is not None]
-    deadline = min(ends) if ends else None
-    if limit is None:
-        limit = until.limit_s  # what the messages name
-    fallback = fallback_on(config, source, costs)
-    windows_end = deadline
-    if deadline is not None and fallback:
-        windows_end = start + config.window_share * (deadline - start)
-    states = [domain.initial_state(p) for p in problems]  # the world
-    visited = [{s} for s in states]  # per problem, every world state its plan passed through
-    moves: list[list] = [[] for _ in problems]
-    windows, misread = [0] * len(problems), [0] * len(problems)
-    solved = [domain.is_goal(p, s) for p, s in zip(problems, states, strict=True)]
-    illegal: list[str | None] = [None] * len(problems)
-    active = [i for i in range(len(problems)) if not solved[i]]
+    domain, config = shared.domain, shared.config
+    fallback = fallback_on(config, shared.source, shared.costs)
+    clock = _Clock.of(config, until, fallback)
+    context = replace(
+        shared,
+        indices=indices,
+        fallback=fallback,
+        windows_end=clock.windows_end,
+        deadline=clock.deadline,
+    )
+    progress = Progress.start(domain, problems)
+    active = [i for i in range(len(problems)) if not progress.solved[i]]
     on_done(len(problems) - len(active))
-    timed_out = False
-    trigger: list[str | None] = [None] * len(problems)  # why the fallback takes over
-    safe = [0] * len(problems)  # moves taken without a window (`PlannerConfig.safe_from`)
-    own_state = costs is not None and source is None and config.own_state_costs
-    check_ahead = getattr(costs, "verify", None)  # the cost source's optional check ahead
-    cut = [0] * len(problems)  # windows cut before a move priced out in its own state
-    for _ in range(config.max_windows):
-        if source is None and costs is None:
-            active = take_safe(
-                domain, problems, active, states, moves, visited, solved, safe, config
-            )
+    active, timed_out = _windows(context, problems, active, progress, on_done)
+    if context.fallback:
+        _fall_back_all(context, problems, progress, timed_out)
+    if config.shorten and context.plain:
+        _shorten_all(domain, problems, progress)
+    if config.improve_s > 0 and context.plain:
+        _improve_all(context, problems, progress)
+    on_done(len(active))
+    elapsed = time.perf_counter() - clock.start
+    late = clock.deadline is not None and clock.start + elapsed >= clock.deadline
+    stopped = timed_out or late  # the windows or the fallback ran out of time
+    return [
+        _result(domain, problems, i, progress, elapsed, stopped, clock.limit)
+        for i in range(len(problems))
+    ]
+
+
+def _windows(
+    context: PlanContext,
+    problems: Sequence[Problem],
+    active: list[int],
+    progress: Progress,
+    on_done: Callable[[int], None],
+) -> tuple[list[int], bool]:
+    """Plan and execute windows of the ``active`` problems until none is left or
+    ``config.max_windows`` ran; returns the problems still active and whether the windows ran
+    out of time (a window the limit cut short is abandoned)."""
+    for _ in range(context.config.max_windows):
+        if context.plain:
+            active = take_safe(context, problems, active, progress)
         if not active:
             break
         try:
             decoded, priced, retried, crisp, perceived = next_window(
-                domain,
-                problems,
-                active,
-                states,
-                indices,
-                visited,
-                config,
-                generator,
-                source,
-                costs,
-                windows_end,
+                context, problems, active, progress
             )
         except OutOfTime:
-            timed_out = True  # stop with the moves so far; each unsolved problem says so
-            break
-        hoped = []  # perceived: windows that predict the goal, for a new image to confirm
-        executed = []
+            return active, True  # stop with the moves so far; each unsolved problem says so
+        executed, hoped = [], []  # hoped: perceived windows that predict the goal
         for i, seen, win in zip(active, crisp, decoded, strict=True):
-            windows[i] += 1
-            misread[i] += seen != states[i]
-            planned = win.moves
-            if own_state:  # each move after the first priced where it starts
-                feasible, _ = cost_checks(domain, problems[i], costs, indices[i])
-                verify = None if check_ahead is None else partial(check_ahead, indices[i])
-                planned = own_state_prefix(
-                    domain, problems[i], states[i], planned, feasible, verify
-                )
-                cut[i] += len(planned) < len(win.moves)
-            tried, states[i], illegal[i], looped = execute(
-                domain, problems[i], states[i], planned, visited[i]
-            )
-            if looped and fallback and trigger[i] is None:
-                trigger[i] = "cycle"  # the windows revisit a state: the fallback takes over
-            moves[i].extend(tried)
+            tried, hopes = _execute_window(context, problems[i], i, progress, seen, win, perceived)
             executed.append(tried)
-            if not perceived:  # decoded on the world: the world reached the goal
-                solved[i] = win.reached and len(planned) == len(win.moves)
-            elif domain.is_goal(problems[i], seen):
-                solved[i] = True  # the image already showed the goal (no move was decoded)
-            elif win.reached and illegal[i] is None:
+            if hopes:
                 hoped.append(i)
         if priced is not None:  # the placements each executed move was decided with
             rows = [None if k in retried else w.row for k, w in enumerate(decoded)]
             priced.commit(rows, executed)
-        if hoped:  # look again: done when the new image shows the goal
-            looked = source([indices[i] for i in hoped], [states[i] for i in hoped])
-            seen_now, _ = crisp_states(looked, [states[i] for i in hoped])
-            for i, seen in zip(hoped, seen_now, strict=True):
-                solved[i] = domain.is_goal(problems[i], seen)
-        still = [i for i in active if illegal[i] is None and not solved[i] and not trigger[i]]
+        if hoped:
+            _confirm(context, problems, hoped, progress)
+        p = progress
+        still = [i for i in active if p.illegal[i] is None and not p.solved[i] and not p.trigger[i]]
         on_done(len(active) - len(still))
         active = still
-    searched: dict[int, LazyResult] = {}
+    return active, False
+
+
+def _execute_window(
+    context: PlanContext,
+    problem: Problem,
+    i: int,
+    progress: Progress,
+    seen: State,
+    win: DecodedWindow,
+    perceived: bool,
+) -> tuple[tuple[Move, ...], bool]:
+    """Execute problem ``i``'s decoded window ``win`` (decoded against ``seen``) in the world,
+    with a cost source only up to the first move it rules out in its own state; returns the
+    moves tried and whether the window predicts the goal that a new image must confirm
+    (``perceived``)."""
+    domain, costs = context.domain, context.costs
+    progress.windows[i] += 1
+    progress.misread[i] += seen != progress.states[i]
+    planned = win.moves
+    if costs is not None and context.source is None and context.config.own_state_costs:
+        feasible, _ = cost_checks(domain, problem, costs, context.indices[i])
+        check_ahead = getattr(costs, "verify", None)  # the cost source's optional check ahead
+        verify = None if check_ahead is None else partial(check_ahead, context.indices[i])
+        planned = own_state_prefix(domain, problem, progress.states[i], planned, feasible, verify)
+        progress.cut[i] += len(planned) < len(win.moves)
+    tried, progress.states[i], progress.illegal[i], looped = execute(
+        domain, problem, progress.states[i], planned, progress.visited[i]
+    )
+    if looped and context.fallback and progress.trigger[i] is None:
+        progress.trigger[i] = "cycle"  # the windows revisit a state: the fallback takes over
+    progress.moves[i].extend(tried)
+    if not perceived:  # decoded on the world: the world reached the goal
+        progress.solved[i] = win.reached and len(planned) == len(win.moves)
+    elif domain.is_goal(problem, seen):
+        progress.solved[i] = True  # the image already showed the goal (no move was decoded)
+    elif win.reached and progress.illegal[i] is None:
+        return tried, True
+    return tried, False
+
+
+def _confirm(
+    context: PlanContext, problems: Sequence[Problem], hoped: list[int], progress: Progress
+) -> None:
+    """Look again at the ``hoped`` problems: each is done when a new image shows its goal."""
+    now = [progress.states[i] for i in hoped]
+    looked = context.source([context.indices[i] for i in hoped], now)
+    seen_now, _ = crisp_states(looked, now)
+    for i, seen in zip(hoped, seen_now, strict=True):
+        progress.solved[i] = context.domain.is_goal(problems[i], seen)
+
+
+def _fall_back_all(
+    context: PlanContext, problems: Sequence[Problem], progress: Progress, timed_out: bool
+) -> None:
+    """The complete fallback search for every problem the windows left unsolved (and
+    executable), from the world state they reached."""
     for i, p in enumerate(problems):
-        if fallback and not solved[i] and illegal[i] is None:
-            trigger[i] = trigger[i] or ("time_limit" if timed_out else "windows")
-            searched[i] = fall_back(domain, p, states[i], costs, indices, i, config, deadline)
-            if searched[i].from_start:  # the windows' moves led nowhere: the plan starts over
-                moves[i] = []
-            moves[i].extend(searched[i].moves)
-            solved[i] = searched[i].status is SearchStatus.SOLVED
-    if config.shorten and source is None and costs is None:
-        for i, p in enumerate(problems):
-            if solved[i] and illegal[i] is None:
-                moves[i] = list(shorten(domain, p, moves[i]))
-    improved: dict[int, dict] = {}
-    if config.improve_s > 0 and source is None and costs is None:
-        small = config.improve_up_to
-        for i, p in enumerate(problems):
-            if solved[i] and illegal[i] is None and (small is None or p.n <= small):
-                better, improved[i] = improve(
-                    domain, p, moves[i], config.improve_nodes, config.improve_s, deadline
-                )
-                moves[i] = list(better)
-    on_done(len(active))
-    elapsed = time.perf_counter() - start
-    late = deadline is not None and start + elapsed >= deadline  # the fallback ran out of time
-    results = []
-    for i, p in enumerate(problems):
-        stats = {
-            "windows": windows[i],
-            "time_s": elapsed / len(problems),
-            "batch_time_s": elapsed,
-            "misread_windows": misread[i],  # windows decoded against a state not the world's
-        }
-        status = PlanStatus.SOLVED if solved[i] else PlanStatus.NO_PLAN
-        exhausted = i in searched and searched[i].status is SearchStatus.UNSOLVABLE
-        if (timed_out or late) and not solved[i] and illegal[i] is None and not exhausted:
-            left = domain.lower_bound(p, states[i])
-            stats["time_limit"] = (
-                f"stopped at the {limit:g} s time limit after {windows[i]} "
-                f"windows and {len(moves[i])} moves; at least {left:g} more moves needed"
+        if not progress.solved[i] and progress.illegal[i] is None:
+            why = progress.trigger[i] or ("time_limit" if timed_out else "windows")
+            progress.trigger[i] = why
+            found = fall_back(
+                context.domain,
+                p,
+                progress.states[i],
+                context.config,
+                costs=context.costs,
+                index=context.indices[i],
+                deadline=context.deadline,
             )
-        if illegal[i] is not None:
-            status, stats["illegal"] = PlanStatus.INVALID, illegal[i]
-        if safe[i]:
-            stats["safe_moves"] = safe[i]
-        if cut[i]:
-            stats["own_state_cuts"] = cut[i]
-        if i in improved:
-            stats["improve"] = improved[i]
-        if i in searched:
-            stats["fallback"] = {"trigger": trigger[i], **searched[i].stats()}
-            if searched[i].status is SearchStatus.UNSOLVABLE:
-                status = PlanStatus.UNSOLVABLE
-        results.append(PlanResult(status, Plan(tuple(moves[i])), p, None, stats))
-    return results
+            progress.searched[i] = found
+            if found.from_start:  # the windows' moves led nowhere: the plan starts over
+                progress.moves[i] = []
+            progress.moves[i].extend(found.moves)
+            progress.solved[i] = found.status is SearchStatus.SOLVED
+
+
+def _shorten_all(domain: Domain, problems: Sequence[Problem], progress: Progress) -> None:
+    """Cut cycles and redundant moves out of every plan that reaches its goal."""
+    for i, p in enumerate(problems):
+        if progress.solved[i] and progress.illegal[i] is None:
+            progress.moves[i] = list(shorten(domain, p, progress.moves[i]))
+
+
+def _improve_all(context: PlanContext, problems: Sequence[Problem], progress: Progress) -> None:
+    """The anytime improvement of every plan found (`PlannerConfig.improve_s`), for the
+    problems of at most ``config.improve_up_to`` entities."""
+    config = context.config
+    small = config.improve_up_to
+    for i, p in enumerate(problems):
+        if progress.solved[i] and progress.illegal[i] is None and (small is None or p.n <= small):
+            better, progress.improved[i] = improve(
+                context.domain,
+                p,
+                progress.moves[i],
+                config.improve_nodes,
+                config.improve_s,
+                context.deadline,
+            )
+            progress.moves[i] = list(better)
+
+
+def _result(
+    domain: Domain,
+    problems: Sequence[Problem],
+    i: int,
+    progress: Progress,
+    elapsed: float,
+    stopped: bool,
+    limit: float | None,
+) -> PlanResult:
+    """Problem ``i``'s result, its stats from ``progress``; ``elapsed``: the run's seconds;
+    ``stopped``: whether the run stopped at its time limit (``limit`` seconds)."""
+    p, searched = problems[i], progress.searched
+    moves, windows, illegal = progress.moves[i], progress.windows[i], progress.illegal[i]
+    stats = {
+        "windows": windows,
+        "time_s": elapsed / len(problems),
+        "batch_time_s": elapsed,
+        "misread_windows": progress.misread[i],  # windows decoded against a state not the world's
+    }
+    status = PlanStatus.SOLVED if progress.solved[i] else PlanStatus.NO_PLAN
+    exhausted = i in searched and searched[i].status is SearchStatus.UNSOLVABLE
+    if stopped and not progress.solved[i] and illegal is None and not exhausted:
+        left = domain.lower_bound(p, progress.states[i])
+        stats["time_limit"] = (
+            f"stopped at the {limit:g} s time limit after {windows} "
+            f"windows and {len(moves)} moves; at least {left:g} more moves needed"
+        )
+    if illegal is not None:
+        status, stats["illegal"] = PlanStatus.INVALID, illegal
+    if progress.safe[i]:
+        stats["safe_moves"] = progress.safe[i]
+    if progress.cut[i]:
+        stats["own_state_cuts"] = progress.cut[i]
+    if i in progress.improved:
+        stats["improve"] = progress.improved[i]
+    if i in searched:
+        stats["fallback"] = {"trigger": progress.trigger[i], **searched[i].stats()}
+        if searched[i].status is SearchStatus.UNSOLVABLE:
+            status = PlanStatus.UNSOLVABLE
+    return PlanResult(status, Plan(tuple(moves)), p, None, stats)
 
 
 def plan_batch(
@@ -249,12 +339,13 @@ def plan_batch(
         )
     torch_device(config.device)  # refused in one line where this machine lacks it
     generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
+    shared = PlanContext(domain, config, generator, source=beliefs, costs=costs)
     report = progress or (lambda k: None)
     final = on_result or (lambda i, result: None)
     if not config.batched:
         alone = []
         for i, p in enumerate(problems):
-            ran = _run(domain, [p], config, generator, report, beliefs, [i], costs, deadline)
+            ran = _run(shared, [p], [i], report, deadline)
             alone.append(ran[0])
             final(i, alone[-1])
         return alone
@@ -264,7 +355,7 @@ def plan_batch(
     for key in sorted(set(keys)):
         group = [i for i, k in enumerate(keys) if k == key]
         subset = [problems[i] for i in group]
-        planned = _run(domain, subset, config, generator, report, beliefs, group, costs, deadline)
+        planned = _run(shared, subset, group, report, deadline)
         for i, result in zip(group, planned, strict=True):
             results[i] = result
             final(i, result)

@@ -9,16 +9,18 @@ state (`own_state_prefix`).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import torch
 
-from task.beliefs import BeliefSource, WindowBeliefs
+from task.beliefs import WindowBeliefs
 from task.config import PlannerConfig
-from task.costs import CostSource, WindowCosts
-from task.decode import DecodedWindow, decode_best, proof_stop
+from task.costs import WindowCosts
+from task.decode import DecodedWindow, DecodeRule, WindowStart, decode_best, proof_stop
 from task.domains.base import Domain, SoftBatch, State, window_part
 from task.errors import TampError
-from task.optimize import optimise_window
+from task.optimize import Window, optimise_window
+from task.planner.context import PlanContext, Progress
 from task.problem import Move, Problem
 from task.rollout import check_deadline
 
@@ -29,23 +31,19 @@ PROOF_PROBLEMS = 1  # windows of at most this many problems are read early (`_pr
 
 
 def run_window(
-    domain: Domain,
-    problems: Sequence[Problem],
-    states: Sequence[State],
-    config: PlannerConfig,
-    generator: torch.Generator,
+    context: PlanContext,
+    starts: Sequence[WindowStart],
     beliefs: WindowBeliefs | None = None,
-    visited: Sequence[set] | None = None,
     costs: WindowCosts | None = None,
-    deadline: float | None = None,
-    parks: Sequence[bool] | None = None,
-):
-    """The decoded window of each problem (`decode_best`); a window of one problem
+) -> list[DecodedWindow]:
+    """The decoded window of each problem from its start (`decode_best`), planned with the
+    context's settings and cut short at its ``windows_end``; a window of one problem
     (`PROOF_PROBLEMS`), without beliefs and move costs, may stop early
-    (`task.decode.proof_stop`).
-    ``parks``: per problem, whether parking moves rank free (default `PlannerConfig.parks`
-    of the problems given; a part of a problem (`_part_windows`) keeps its whole problem's)."""
-    parks = [config.parks(p) for p in problems] if parks is None else list(parks)
+    (`task.decode.proof_stop`). Each start's ``park``: whether parking moves rank free
+    (`PlannerConfig.parks` of its problem; a part of a problem (`_part_windows`) keeps its
+    whole problem's)."""
+    domain, config = context.domain, context.config
+    problems, states = [s.problem for s in starts], [s.state for s in starts]
     device = torch.device(config.device)  # checked by `plan_batch` (`torch_device`)
     batch = on_device(domain.encode(problems, states, torch.float32), device)
     batch = batch.repeat(config.restarts)
@@ -54,27 +52,13 @@ def run_window(
     proven: dict[int, DecodedWindow] = {}
     stop = None
     priced_ok = costs is None or config.proof_costs
-    if len(problems) <= PROOF_PROBLEMS and beliefs is None and priced_ok and visited:
-        stop = proof_stop(domain, problems, states, config, visited, proven, parks)
-    _, roll = optimise_window(
-        domain, batch, steps, config, generator, beliefs, costs, deadline, stop
-    )
+    if len(problems) <= PROOF_PROBLEMS and beliefs is None and priced_ok:
+        stop = proof_stop(domain, starts, config, proven)
+    window = Window(domain, batch, steps, config, beliefs, costs, context.windows_end)
+    _, roll = optimise_window(window, context.generator, stop)
     if len(proven) == len(problems):
         return [proven[i] for i in range(len(problems))]
-    decoded = decode_best(
-        domain,
-        problems,
-        states,
-        roll.gates,
-        roll.loss,
-        config.restarts,
-        config.threshold,
-        config.crisp_check,
-        visited,
-        roll.costs,
-        config.rank_prefixes,
-        parks,
-    )
+    decoded = decode_best(domain, starts, roll.gates, roll.loss, DecodeRule.of(config), roll.costs)
     return [proven.get(i, window) for i, window in enumerate(decoded)]
 
 
@@ -86,25 +70,20 @@ def on_device(batch: SoftBatch, device: torch.device) -> SoftBatch:
 
 
 def _retry_frozen(
-    domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
+    context: PlanContext,
+    starts: Sequence[WindowStart],
+    beliefs: WindowBeliefs | None,
+    decoded: list[DecodedWindow],
 ) -> set[int]:
-    """Windows that decoded no move under adapted beliefs are planned again with the beliefs'
-    frozen ``fallback`` (`task.beliefs`, without move costs); a retry that moves replaces the
-    window in place. Returns the positions of the replaced windows."""
+    """Windows that decoded no move under adapted beliefs are planned again from their
+    ``starts`` with the beliefs' frozen ``fallback`` (`task.beliefs`, without move costs); a
+    retry that moves replaces the window in place. Returns the positions of the replaced
+    windows."""
     fallback = getattr(beliefs, "fallback", None)
     stuck = [k for k, w in enumerate(decoded) if not w.moves and not w.reached]
     if fallback is None or not stuck:
         return set()
-    again = run_window(
-        domain,
-        [problems[active[k]] for k in stuck],
-        [crisp[k] for k in stuck],
-        config,
-        generator,
-        fallback(stuck),
-        [visited[active[k]] for k in stuck],
-        deadline=deadline,
-    )
+    again = run_window(context, [starts[k] for k in stuck], fallback(stuck))
     replaced = set()
     for k, window in zip(stuck, again, strict=True):
         if window.moves or window.reached:
@@ -177,107 +156,89 @@ def own_state_prefix(
 
 
 def take_safe(
-    domain: Domain,
+    context: PlanContext,
     problems: Sequence[Problem],
     active: Sequence[int],
-    states: list[State],
-    moves: list[list],
-    visited: Sequence[set],
-    solved: list[bool],
-    safe: list[int],
-    config: PlannerConfig,
+    progress: Progress,
 ) -> list[int]:
     """The ``active`` problems that `PlannerConfig.takes_safe` take their domain's safe moves
-    (`Domain.safe_moves`) in the world, as executed moves; returns those still active (not
-    at the goal). Only without beliefs and a cost source (the caller's check)."""
+    (`Domain.safe_moves`) in the world, as executed moves (recorded in ``progress``); returns
+    those still active (not at the goal). Only without beliefs and a cost source (the
+    caller's check)."""
+    domain, config = context.domain, context.config
     take = getattr(domain, "safe_moves", None)
     if take is None:
         return list(active)
+    states, solved = progress.states, progress.solved
     still = []
     for i in active:
         if config.takes_safe(problems[i]):
             for move in take(problems[i], states[i]):
                 states[i] = domain.apply_move(problems[i], states[i], move)
-                visited[i].add(states[i])
-                moves[i].append(move)
-                safe[i] += 1
+                progress.visited[i].add(states[i])
+                progress.moves[i].append(move)
+                progress.safe[i] += 1
             solved[i] = domain.is_goal(problems[i], states[i])
         if not solved[i]:
             still.append(i)
     return still
 
 
-def _part_windows(
-    domain: Domain,
-    problems: list[Problem],
-    states: list[State],
-    visited: list[set],
-    config: PlannerConfig,
-    generator: torch.Generator,
-    deadline: float | None,
-    parks: Sequence[bool],
-) -> list[DecodedWindow]:
-    """The decoded windows of ``problems`` without beliefs and move costs: those that
+def _part_windows(context: PlanContext, starts: Sequence[WindowStart]) -> list[DecodedWindow]:
+    """The decoded windows from ``starts`` without beliefs and move costs: the problems that
     `PlannerConfig.takes_safe` plan the part still to be planned, cut to what their windows'
     moves reach (`task.domains.base.window_part`), with the part's settings
-    (`PlannerConfig.for_parts`); the others plan as they are. One `_window` per settings."""
+    (`PlannerConfig.for_parts`), each keeping its whole problem's ``park``; the others plan
+    as they are. One `run_window` per settings."""
+    config = context.config
     part_config = config.for_parts()
     groups: dict[PlannerConfig, list[int]] = {}
-    views = list(problems), list(states), list(visited)
-    for k, problem in enumerate(problems):
-        here = part_config if config.takes_safe(problem) else config
-        if config.takes_safe(problem):
+    views = list(starts)
+    for k, start in enumerate(starts):
+        here = part_config if config.takes_safe(start.problem) else config
+        if config.takes_safe(start.problem):
             depth = max(here.horizons())
-            views[0][k], views[1][k], views[2][k] = window_part(
-                domain, problem, states[k], visited[k], depth
+            problem, state, seen = window_part(
+                context.domain, start.problem, start.state, start.seen, depth
             )
+            views[k] = WindowStart(problem, state, seen, start.park)
         groups.setdefault(here, []).append(k)
-    decoded: list[DecodedWindow | None] = [None] * len(problems)
+    decoded: list[DecodedWindow | None] = [None] * len(starts)
     for here, ks in groups.items():
-        pick = [[view[k] for k in ks] for view in views]
-        parked = [parks[k] for k in ks]
-        windows = run_window(
-            domain, *pick[:2], here, generator, None, pick[2], None, deadline, parked
-        )
+        windows = run_window(replace(context, config=here), [views[k] for k in ks])
         for k, window in zip(ks, windows, strict=True):
             decoded[k] = window
     return decoded
 
 
 def next_window(
-    domain: Domain,
+    context: PlanContext,
     problems: Sequence[Problem],
     active: Sequence[int],
-    states: Sequence[State],
-    indices: Sequence[int],
-    visited: Sequence[set],
-    config: PlannerConfig,
-    generator: torch.Generator,
-    source: BeliefSource | None,
-    costs: CostSource | None,
-    deadline: float | None,
+    progress: Progress,
 ):
-    """One window of the ``active`` problems from their world ``states``: the decoded windows,
-    the window's costs (None without a source), the positions of the windows a frozen-belief
-    retry replaced, the crisp states decoded against and whether they are perceived. Raises
-    `task.rollout.OutOfTime` when ``deadline`` passes before the window is decoded."""
+    """One window of the ``active`` problems from their world states (in ``progress``): the
+    decoded windows, the window's costs (None without a source), the positions of the windows
+    a frozen-belief retry replaced, the crisp states decoded against and whether they are
+    perceived. Raises `task.rollout.OutOfTime` when the context's ``windows_end`` passes
+    before the window is decoded."""
+    config, deadline, indices = context.config, context.windows_end, context.indices
     check_deadline(deadline)
-    now = [states[i] for i in active]
+    now = [progress.states[i] for i in active]
+    source = context.source
     beliefs = None if source is None else source([indices[i] for i in active], now)
     crisp, perceived = crisp_states(beliefs, now)
     priced = None
-    if costs is not None:
-        priced = costs([indices[i] for i in active], crisp, config.restarts)
+    if context.costs is not None:
+        priced = context.costs([indices[i] for i in active], crisp, config.restarts)
     check_deadline(deadline)
-    views = [problems[i] for i in active], list(crisp), [visited[i] for i in active]
-    parks = [config.parks(p) for p in views[0]]
-    if source is None and costs is None:
-        decoded = _part_windows(domain, *views, config, generator, deadline, parks)
+    starts = [
+        WindowStart(problems[i], state, progress.visited[i], config.parks(problems[i]))
+        for i, state in zip(active, crisp, strict=True)
+    ]
+    if context.plain:
+        decoded = _part_windows(context, starts)
     else:
-        decoded = run_window(
-            domain, *views[:2], config, generator, beliefs, views[2], priced, deadline, parks
-        )
-    retried = _retry_frozen(
-        domain, problems, active, crisp, config, generator, beliefs, visited, decoded, deadline
-    )
+        decoded = run_window(context, starts, beliefs, priced)
+    retried = _retry_frozen(context, starts, beliefs, decoded)
     return decoded, priced, retried, crisp, perceived

@@ -1,7 +1,7 @@
 """Best-first search over crisp states with feasibility checked lazily: the planner's complete
 fallback (`task.planner`), PDDLStream's incremental idea in its simplest form.
 
-The search runs A* (``weight`` 1; weighted A* above 1) over the crisp states of any domain that
+The search runs A* over the crisp states of any domain that
 gives ``legal_moves``, ``apply_move``, ``is_goal`` and an admissible ``lower_bound`` (every
 `task.domains.base.Domain` does), with unit move costs. Each move is also a geometric choice
 that may not be executable (the arm cannot reach it, it failed there before): a callback
@@ -15,12 +15,12 @@ The search is complete over these choices (the domain's crisp moves, minus the o
 rules out, states the lower bound calls dead ends cut): it ends ``SOLVED`` with a plan,
 ``UNSOLVABLE`` when the reachable feasible space is exhausted without a goal (no plan exists
 within these choices), or ``BUDGET`` when ``max_nodes`` expansions or the deadline run out.
-With ``weight`` 1 a plan is a shortest one among the feasible moves.
+A plan is a shortest one among the feasible moves.
 
 ``below`` bounds the plans sought (`improve`, the planner's anytime improvement): a
 successor whose moves so far plus lower bound reach ``below`` is cut, so only plans of fewer
 than ``below`` moves are found, and UNSOLVABLE then says that none exists within these choices
-(with ``weight`` 1: a plan of ``below`` moves in hand is a shortest one).
+(a plan of ``below`` moves in hand is then a shortest one).
 
 `lazy_greedy` is the same search made greedy, for problems far beyond A*'s reach (the generic
 STRIPS lift's fallback, `PlannerConfig.fallback_search`): Fast Downward's lazy greedy
@@ -93,6 +93,46 @@ class LazyResult:
         }
 
 
+class _Checks:
+    """The lazy feasibility checks of one search, started now: each (state, move) pair is
+    checked by ``feasible`` (None: every move is allowed) at most once, when the search first
+    needs it."""
+
+    def __init__(self, feasible: Feasible | None) -> None:
+        self.feasible, self.t0 = feasible, time.perf_counter()
+        self.allowed: dict[tuple[Hashable, Move], bool] = {}
+        self.checked = 0  # cache misses
+
+    def ok(self, state: Hashable, move: Move) -> bool:
+        key = (state, move)
+        if key not in self.allowed:
+            self.checked += 1
+            self.allowed[key] = True if self.feasible is None else bool(self.feasible(state, move))
+        return self.allowed[key]
+
+    def ruled_out(self) -> int:
+        """Distinct (state, move) pairs ruled out so far."""
+        return sum(not v for v in self.allowed.values())
+
+    def result(
+        self, status: SearchStatus, moves: tuple[Move, ...], expanded: int, reason: str
+    ) -> LazyResult:
+        """The search's result after ``expanded`` expansions, timed from the start."""
+        elapsed = time.perf_counter() - self.t0
+        return LazyResult(status, moves, expanded, self.checked, self.ruled_out(), elapsed, reason)
+
+
+def _path(parent: dict[Hashable, tuple[Hashable, Move] | None], state: Hashable) -> tuple:
+    """The moves from the search's start to the closed ``state``, traced back through
+    ``parent`` (None at the start)."""
+    path = []
+    while parent[state] is not None:
+        state, move = parent[state]
+        path.append(move)
+    path.reverse()
+    return tuple(path)
+
+
 def lazy_best_first(
     domain: CrispDomain,
     problem: Problem,
@@ -100,29 +140,16 @@ def lazy_best_first(
     feasible: Feasible | None = None,
     max_nodes: int = 20_000,
     deadline: float | None = None,
-    weight: float = 1.0,
     below: float = math.inf,
 ) -> LazyResult:
     """Plan from crisp ``start`` to ``problem``'s goal over ``domain``'s moves that ``feasible``
     allows (None: all), checked lazily (see the module docstring). ``deadline``: a
     ``time.perf_counter()`` value after which the search stops with BUDGET. ``below``: only
     plans of fewer moves (states with moves so far + lower bound >= ``below`` are cut)."""
-    t0 = time.perf_counter()
-    allowed: dict[tuple[Hashable, Move], bool] = {}
-    checked = 0
-
-    def ok(state: Hashable, move: Move) -> bool:
-        nonlocal checked
-        key = (state, move)
-        if key not in allowed:
-            checked += 1
-            allowed[key] = True if feasible is None else bool(feasible(state, move))
-        return allowed[key]
+    checks = _Checks(feasible)
 
     def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
-        ruled = sum(not v for v in allowed.values())
-        elapsed = time.perf_counter() - t0
-        return LazyResult(status, moves, expanded, checked, ruled, elapsed, reason)
+        return checks.result(status, moves, expanded, reason)
 
     # one heap entry per (state, g); the moves reaching the state at that g wait in ``pending``
     # and are checked in order when the entry pops, until one is feasible
@@ -137,7 +164,7 @@ def lazy_best_first(
     if h0 >= below:
         why = f"no plan of fewer than {below:g} moves: the lower bound from the start is {h0:g}"
         return done(SearchStatus.UNSOLVABLE, (), why)
-    heapq.heappush(frontier, (weight * h0, 0, next(tie), start))
+    heapq.heappush(frontier, (h0, 0, next(tie), start))
     pending[start] = {0: []}
     while frontier:
         _, neg_g, _, state = heapq.heappop(frontier)
@@ -148,18 +175,14 @@ def lazy_best_first(
         if state == start and g == 0:
             parent[state] = None
         else:
-            way = next((w for w in ways if ok(*w)), None)
+            way = next((w for w in ways if checks.ok(*w)), None)
             if way is None:
                 continue  # every move reaching it at this depth is ruled out: maybe later
             parent[state] = way
         del pending[state]
         if domain.is_goal(problem, state):
-            path = []
-            while parent[state] is not None:
-                state, move = parent[state]
-                path.append(move)
-            path.reverse()
-            return done(SearchStatus.SOLVED, tuple(path), f"a plan of {len(path)} moves")
+            path = _path(parent, state)
+            return done(SearchStatus.SOLVED, path, f"a plan of {len(path)} moves")
         if expanded >= max_nodes:
             return done(SearchStatus.BUDGET, (), f"stopped after {expanded} expansions (budget)")
         if deadline is not None and time.perf_counter() > deadline:
@@ -175,9 +198,9 @@ def lazy_best_first(
             at = pending.setdefault(nxt, {})
             if g + 1 not in at:
                 at[g + 1] = []
-                heapq.heappush(frontier, (g + 1 + weight * h, -(g + 1), next(tie), nxt))
+                heapq.heappush(frontier, (g + 1 + h, -(g + 1), next(tie), nxt))
             at[g + 1].append((state, move))
-    ruled = sum(not v for v in allowed.values())
+    ruled = checks.ruled_out()
     shorter = "" if math.isinf(below) else f" of fewer than {below:g} moves"
     return done(
         SearchStatus.UNSOLVABLE,
@@ -214,16 +237,12 @@ def lazy_greedy(
     Complete over the same choices as `lazy_best_first` (every reachable state is closed once;
     states the estimate calls dead ends, INF, are cut), but the plan need not be shortest.
     Ends SOLVED, UNSOLVABLE or BUDGET (``max_nodes`` expansions or ``deadline``)."""
-    t0 = time.perf_counter()
-    allowed: dict[tuple[Hashable, Move], bool] = {}
-    checked = 0
+    checks = _Checks(feasible)
     helpful = getattr(domain, "helpful", None)
     guide = getattr(domain, "estimate", None) or domain.lower_bound
 
     def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
-        ruled = sum(not v for v in allowed.values())
-        elapsed = time.perf_counter() - t0
-        return LazyResult(status, moves, expanded, checked, ruled, elapsed, reason)
+        return checks.result(status, moves, expanded, reason)
 
     parent: dict[Hashable, tuple[Hashable, Move] | None] = {start: None}  # closed states
     queues: tuple[list, list] = ([], [])  # every successor; the preferred ones
@@ -233,12 +252,8 @@ def lazy_greedy(
     state, h = start, guide(problem, start)
     while True:
         if domain.is_goal(problem, state):
-            path = []
-            while parent[state] is not None:
-                state, move = parent[state]
-                path.append(move)
-            path.reverse()
-            return done(SearchStatus.SOLVED, tuple(path), f"a plan of {len(path)} moves")
+            path = _path(parent, state)
+            return done(SearchStatus.SOLVED, path, f"a plan of {len(path)} moves")
         if not math.isinf(h):
             if h < best:
                 best = h
@@ -262,14 +277,10 @@ def lazy_greedy(
             nxt = domain.apply_move(problem, before, move)
             if nxt in parent:
                 continue
-            key = (before, move)
-            if key not in allowed:
-                checked += 1
-                allowed[key] = True if feasible is None else bool(feasible(before, move))
-            if allowed[key]:
-                parent[nxt], state = key, nxt
+            if checks.ok(before, move):
+                parent[nxt], state = (before, move), nxt
         if state is None:
-            ruled = sum(not v for v in allowed.values())
+            ruled = checks.ruled_out()
             return done(
                 SearchStatus.UNSOLVABLE,
                 (),

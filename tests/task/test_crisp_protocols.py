@@ -11,7 +11,7 @@ import torch
 from tamp.camera.states import complete_goal
 from task import data
 from task.config import PlannerConfig
-from task.decode import decode_best, decode_row
+from task.decode import DecodeRule, WindowStart, decode_best, decode_row
 from task.domains.blocksworld import DOMAIN as BW
 from task.domains.blocksworld_pddl import to_pddl
 from task.errors import TampError
@@ -152,9 +152,9 @@ def test_decode_row_keeps_the_illegal_move_only_without_the_check():
     gates = torch.zeros(2, 3, 4)  # (T, N, Y)
     gates[0, 0, 2] = 0.9  # a -> c: illegal, a is covered
     gates[1, 1, 3] = 0.9  # b -> table: legal, but after it
-    checked = decode_row(BW, PROBLEM, state, gates, 0.3, 0.0)
+    checked = decode_row(BW, WindowStart(PROBLEM, state), gates, 0.0, DecodeRule(0.3))
     assert checked.moves == () and checked.illegal is None
-    kept = decode_row(BW, PROBLEM, state, gates, 0.3, 0.0, check=False)
+    kept = decode_row(BW, WindowStart(PROBLEM, state), gates, 0.0, DecodeRule(0.3, check=False))
     assert kept.moves == (Move("a", "c"),) and not kept.complete
     assert kept.illegal == "a is not clear (b is on it)"
 
@@ -166,9 +166,11 @@ def test_without_the_check_restarts_are_ranked_by_the_soft_objective_alone():
     gates[0, 1, 0, 2] = 0.9  # a -> c: the goal
     gates[1, 0, 0, 2] = 0.9  # a -> c at once: illegal
     losses = torch.tensor([1.0, 0.5])
-    best = decode_best(BW, [PROBLEM], [state], gates, losses, 2, 0.3)[0]
+    best = decode_best(BW, [WindowStart(PROBLEM, state)], gates, losses, DecodeRule(0.3, 2))[0]
     assert best.reached and len(best.moves) == 2
-    raw = decode_best(BW, [PROBLEM], [state], gates, losses, 2, 0.3, check=False)[0]
+    raw = decode_best(
+        BW, [WindowStart(PROBLEM, state)], gates, losses, DecodeRule(0.3, 2, check=False)
+    )[0]
     assert raw.moves == (Move("a", "c"),) and raw.illegal is not None
 
 

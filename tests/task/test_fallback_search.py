@@ -311,12 +311,12 @@ def test_a_fallback_out_of_budget_where_the_windows_left_it_starts_over_from_ini
     source.committed.append(Move("d", "a"))  # the windows' move
     wandered = BW.apply_move(FLAT, BW.initial_state(FLAT), Move("d", "a"))
     config = PlannerConfig(fallback=True, fallback_nodes=1)
-    found = fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    found = fall_back(BW, FLAT, wandered, config, costs=source)
     assert found.status is SearchStatus.SOLVED and found.from_start
     assert found.moves == (Move("a", "b"),) and "from the initial state, greedy" in found.reason
     assert source.forgot == [0] and source.committed == [Move("a", "b")]
     plain = RuleOut(FLAT, lambda state, move: False)  # cannot forget: no start over
-    kept = fall_back(BW, FLAT, wandered, plain, [0], 0, config, None)
+    kept = fall_back(BW, FLAT, wandered, config, costs=plain)
     assert kept.status is SearchStatus.BUDGET and not kept.from_start
 
 
@@ -330,13 +330,13 @@ def test_a_restart_probe_takes_a_star_from_the_initial_state_first():
     source = Forgetful(FLAT, lambda state, move: False)
     source.committed.append(Move("d", "a"))  # the windows' move
     config = PlannerConfig(fallback=True, restart_probe=5)
-    found = fall_back(BW, FLAT, wandered, source, [0], 0, config, None)
+    found = fall_back(BW, FLAT, wandered, config, costs=source)
     assert found.status is SearchStatus.SOLVED and found.from_start
     assert found.moves == (Move("a", "b"),)
     assert "from the initial state, A* within 5 expansions" in found.reason
     assert source.forgot == [0] and source.committed == [Move("a", "b")]
     source = Forgetful(FLAT, lambda state, move: False)
-    kept = fall_back(BW, FLAT, wandered, source, [0], 0, PlannerConfig(fallback=True), None)
+    kept = fall_back(BW, FLAT, wandered, PlannerConfig(fallback=True), costs=source)
     assert kept.status is SearchStatus.SOLVED and not kept.from_start and len(kept.moves) == 2
     with pytest.raises(TampError, match="restart_probe must be >= 0"):
         PlannerConfig(restart_probe=-1)
@@ -354,7 +354,7 @@ def test_with_a_deadline_the_start_over_runs_until_it_not_for_the_node_budget():
     config = PlannerConfig(fallback=True, fallback_nodes=1)
     for deadline in (None, time.perf_counter() + 60):
         source = Forgetful(problem, lambda state, move: False)
-        found = fall_back(BW, problem, wandered, source, [0], 0, config, deadline)
+        found = fall_back(BW, problem, wandered, config, costs=source, deadline=deadline)
         if deadline is None:
             assert found.status is SearchStatus.BUDGET and not found.from_start
             continue
@@ -388,7 +388,9 @@ def test_with_a_deadline_each_search_gets_an_equal_share_of_the_time_left(monkey
     monkeypatch.setattr(fb, "lazy_greedy", spy(fb.lazy_greedy, "greedy"))
     source = Forgetful(problem, lambda state, move: False)
     config = PlannerConfig(fallback=True, fallback_nodes=50)
-    found = fb.fall_back(BW, problem, wandered, source, [0], 0, config, time.perf_counter() + 60)
+    found = fb.fall_back(
+        BW, problem, wandered, config, costs=source, deadline=time.perf_counter() + 60
+    )
     assert [(name, at_start) for name, at_start, _ in given] == [
         ("A*", False),
         ("greedy", False),

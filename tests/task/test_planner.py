@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from task.config import MAX_HORIZON, PlannerConfig
-from task.decode import decode_row
+from task.decode import DecodeRule, WindowStart, decode_row
 from task.domains import get_domain
 from task.errors import ProblemError, TampError
 from task.planner import plan, plan_batch
@@ -81,11 +81,11 @@ def test_decoding_stops_at_the_first_illegal_move():
     gates = torch.zeros(2, 2, 3)
     gates[0, 0, 1] = 0.9  # a -> b, illegal: a is covered
     gates[1, 1, 2] = 0.9  # b -> table, legal but after an illegal step
-    win = decode_row(BW, problem, state, gates, 0.3, 0.0)
+    win = decode_row(BW, WindowStart(problem, state), gates, 0.0, DecodeRule(0.3))
     assert win.moves == () and not win.complete
     gates[0] = 0.0
     gates[0, 1, 2] = 0.2  # below the threshold: a STAY step
-    win = decode_row(BW, problem, state, gates, 0.3, 0.0)
+    win = decode_row(BW, WindowStart(problem, state), gates, 0.0, DecodeRule(0.3))
     assert [str(m) for m in win.moves] == ["move(b -> table)"]
 
 
@@ -185,11 +185,12 @@ def test_a_window_back_to_a_visited_state_ranks_below_progress_elsewhere():
     gates = torch.zeros(2, 1, n, y)  # restart 0: the optimal first move; restart 1: a STAY
     gates[0, 0, problem.entities.index(ahead.entity), problem.index(ahead.target)] = 1
     losses = torch.tensor([5.0, 0.0])
-    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3)[0]
+    rule = DecodeRule(0.3, 2)
+    best = decode_best(BW, [WindowStart(problem, state)], gates, losses, rule)[0]
     assert best.moves == (ahead,) and not best.revisit
-    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3, visited=[{after}])[0]
+    best = decode_best(BW, [WindowStart(problem, state, {after})], gates, losses, rule)[0]
     assert best.moves == () and not best.revisit  # staying beats going back to ``after``
-    best = decode_best(BW, [problem], [state], gates, losses, 2, 0.3, visited=[{state, after}])[0]
+    best = decode_best(BW, [WindowStart(problem, state, {state, after})], gates, losses, rule)[0]
     assert best.moves == (ahead,) and best.revisit  # both loop: then progress ranks first
 
 

@@ -192,9 +192,10 @@ def test_a_big_problem_plans_its_windows_with_the_part_settings(monkeypatch):
     seen = []
     window = windows.run_window
 
-    def spy(domain, problems, states, config, *args):
-        seen.append((tuple(p.n for p in problems), config.horizon, config.iters))
-        return window(domain, problems, states, config, *args)
+    def spy(context, starts, *args):
+        config = context.config
+        seen.append((tuple(s.problem.n for s in starts), config.horizon, config.iters))
+        return window(context, starts, *args)
 
     monkeypatch.setattr(windows, "run_window", spy)
     small, big = random_problem(5, 2), random_problem(12, 171)

@@ -68,6 +68,24 @@ class _Words:
                 return word
 
 
+@dataclass(frozen=True)
+class _Names:
+    """The new names of one renaming, drawn from ``rng`` (``words``: fresh names, for the
+    variables still to be named): the domain's ``name``, its actions, predicates (each
+    `Renamed`, with its argument order), types, constants and objects (original -> renamed),
+    and whether the domain is ``typed`` (`_typed`)."""
+
+    rng: random.Random
+    words: _Words
+    name: str
+    acts: dict[str, Renamed]
+    preds: dict[str, Renamed]
+    types: dict[str, str]
+    consts: dict[str, str]
+    objects: dict[str, str]
+    typed: bool
+
+
 def _perm(rng: random.Random, k: int) -> tuple[int, ...]:
     order = list(range(k))
     rng.shuffle(order)
@@ -80,10 +98,9 @@ def _atom(pattern: tuple, preds: dict[str, Renamed], names: Sequence[str], const
     return "(" + " ".join((preds[pattern[0]].user, *preds[pattern[0]].to_user(terms))) + ")"
 
 
-def _action(
-    s: Schema, r: Renamed, preds: dict, types: dict, consts: dict, words, rng, typed: bool
-) -> str:
-    old_names = [words() for _ in s.params]  # the variable of original parameter i
+def _action(s: Schema, new: _Names) -> str:
+    r, preds, types, consts, typed = new.acts[s.name], new.preds, new.types, new.consts, new.typed
+    old_names = [new.words() for _ in s.params]  # the variable of original parameter i
     params = " ".join(
         f"?{old_names[i]}" + (f" - {types.get(s.types[i], s.types[i])}" if typed else "")
         for i in r.order
@@ -91,8 +108,8 @@ def _action(
     pre = [_atom(a, preds, old_names, consts) for a in s.pre]
     eff = [_atom(a, preds, old_names, consts) for a in s.add]
     eff += [f"(not {_atom(a, preds, old_names, consts)})" for a in s.delete]
-    rng.shuffle(pre)
-    rng.shuffle(eff)
+    new.rng.shuffle(pre)
+    new.rng.shuffle(eff)
     lines = [f"  (:action {r.user}", f"    :parameters ({params})"]
     if pre:
         lines.append(f"    :precondition (and {' '.join(pre)})")
@@ -107,38 +124,36 @@ def _typed(dom: Shape) -> bool:
     )
 
 
-def _domain_text(
-    dom: Shape, name: str, acts: dict, preds: dict, types: dict, consts: dict, rng, words
-) -> str:
-    typed = _typed(dom)
-    lines = [f"(define (domain {name})", f"  (:requirements :strips{' :typing' if typed else ''})"]
+def _domain_text(dom: Shape, new: _Names) -> str:
+    types, consts, preds, typed = new.types, new.consts, new.preds, new.typed
+    lines = [
+        f"(define (domain {new.name})",
+        f"  (:requirements :strips{' :typing' if typed else ''})",
+    ]
     if typed:
         decl = [
             f"{types[t]}" + (f" - {types.get(p, p)}" if p not in (None, OBJECT) else "")
             for t, p in dom.parents
             if t != OBJECT
         ]
-        rng.shuffle(decl)
+        new.rng.shuffle(decl)
         lines.append(f"  (:types {' '.join(decl)})")
     if dom.constants:
         decl = [f"{consts[c]}" + (f" - {types[k]}" if typed else "") for c, k in dom.constants]
         lines.append(f"  (:constants {' '.join(decl)})")
     declared = []
     for pred, arg_types in dom.predicates:
-        vars_ = [f"?{words()}" + (f" - {types.get(t, t)}" if typed else "") for t in arg_types]
+        vars_ = [f"?{new.words()}" + (f" - {types.get(t, t)}" if typed else "") for t in arg_types]
         declared.append(f"({' '.join((preds[pred].user, *preds[pred].to_user(vars_)))})")
-    rng.shuffle(declared)
+    new.rng.shuffle(declared)
     lines.append(f"  (:predicates {' '.join(declared)})")
-    actions = [
-        _action(s, acts[s.name], preds, types, consts, words, rng, typed) for s in dom.actions
-    ]
-    rng.shuffle(actions)
+    actions = [_action(s, new) for s in dom.actions]
+    new.rng.shuffle(actions)
     return "\n".join([*lines, *actions, ")"]) + "\n"
 
 
-def _problem_text(
-    text: str, domain, name: str, preds: dict, types: dict, objects: dict, rng, typed: bool
-) -> str:
+def _problem_text(text: str, domain, new: _Names) -> str:
+    preds, types, objects, typed = new.preds, new.types, new.objects, new.typed
     parsed = pddl_io.parse_problem(text, "<problem>", domain)
     kinds = {
         str(o.name).lower(): sorted(str(t).lower() for t in o.type_tags) for o in parsed.objects
@@ -153,9 +168,9 @@ def _problem_text(
         return strips.atom_str((r.user, *r.to_user([objects.get(x, x) for x in a[1:]])))
 
     init = [atom(a) for a in sorted(strips.initial_state(parsed))]
-    rng.shuffle(init)
+    new.rng.shuffle(init)
     goal = [atom(a) for a in strips.goal_atoms(parsed)]
-    lines = [f"(define (problem {str(parsed.name).lower()})", f"  (:domain {name})"]
+    lines = [f"(define (problem {str(parsed.name).lower()})", f"  (:domain {new.name})"]
     lines += [f"  (:objects {' '.join(declared)})", "  (:init", *(f"    {a}" for a in init), "  )"]
     lines += ["  (:goal (and", *(f"    {a}" for a in goal), "  ))", ")"]
     return "\n".join(lines) + "\n"
@@ -187,11 +202,9 @@ def rename(
     types = {t: words() for t, _ in dom.parents if t != OBJECT}
     consts = {c: words() for c, _ in dom.constants}
     objects = _object_names(problem_texts, domain, words, monotone)
-    text = _domain_text(dom, name, acts, preds, types, consts, rng, words)
-    typed = _typed(dom)
-    problems = tuple(
-        _problem_text(t, domain, name, preds, types, objects, rng, typed) for t in problem_texts
-    )
+    new = _Names(rng, words, name, acts, preds, types, consts, objects, _typed(dom))
+    text = _domain_text(dom, new)
+    problems = tuple(_problem_text(t, domain, new) for t in problem_texts)
     renaming = Renaming(
         dom.name,
         name,
