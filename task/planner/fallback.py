@@ -101,7 +101,16 @@ def fall_back(
     of one block's moves merged (`task.symbolic.shorten.merge_runs`, each merged move checked
     feasible) before it is committed."""
     feasible, windows = (None, {}) if costs is None else cost_checks(domain, problem, costs, index)
-    run = _Fallback(domain, problem, config, feasible, windows, costs, index, deadline)
+    run = _Fallback(
+        domain=domain,
+        problem=problem,
+        config=config,
+        feasible=feasible,
+        windows=windows,
+        costs=costs,
+        index=index,
+        deadline=deadline,
+    )
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
     start = domain.initial_state(problem)
     can_forget = costs is None or getattr(costs, "forget", None) is not None

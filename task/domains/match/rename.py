@@ -202,7 +202,17 @@ def rename(
     types = {t: words() for t, _ in dom.parents if t != OBJECT}
     consts = {c: words() for c, _ in dom.constants}
     objects = _object_names(problem_texts, domain, words, monotone)
-    new = _Names(rng, words, name, acts, preds, types, consts, objects, _typed(dom))
+    new = _Names(
+        rng=rng,
+        words=words,
+        name=name,
+        acts=acts,
+        preds=preds,
+        types=types,
+        consts=consts,
+        objects=objects,
+        typed=_typed(dom),
+    )
     text = _domain_text(dom, new)
     problems = tuple(_problem_text(t, domain, new) for t in problem_texts)
     renaming = Renaming(
