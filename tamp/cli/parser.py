@@ -188,8 +188,10 @@ def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
         run_options(p)
         output_options(p, "write the episode video and report.json into this folder")
         p.set_defaults(
-            func=_lazy("tamp.cli.run", "run_command"),
-            recorded=_lazy("tamp.cli.recorded", "run_config"),
+            func=_at_edge("tamp.cli.run_settings.run_settings", "tamp.cli.run.run_command"),
+            recorded=_at_edge(
+                "tamp.cli.run_settings.run_settings", "tamp.cli.run_settings.run_record"
+            ),
         )
     sub.choices["demo"].set_defaults(observe="camera", out="out/demo")
 
@@ -581,6 +583,26 @@ def _perception_commands(sub) -> None:
         func=_lazy("tamp.cli.perception", "eval_command"),
         recorded=_lazy("tamp.cli.recorded", "eval_config"),
     )
+
+
+def _at_edge(edge: str, then: str):
+    """``then`` (a dotted function name) of the typed settings that ``edge`` builds from the
+    parsed options: ``edge`` is the one function of its command that reads the namespace; both
+    imported when the command runs."""
+
+    def handler(args: argparse.Namespace):
+        return _imported(then)(_imported(edge)(args))
+
+    handler.__qualname__ = f"{then}({edge})"
+    return handler
+
+
+def _imported(dotted: str):
+    """The function ``package.module.name``, its module imported now."""
+    from importlib import import_module
+
+    module, name = dotted.rsplit(".", 1)
+    return getattr(import_module(module), name)
 
 
 def _lazy(module: str, name: str):

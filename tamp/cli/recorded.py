@@ -23,7 +23,6 @@ from tamp.bench.official import default_data
 from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
 from tamp.modes import ImageScene, Observation
-from tamp.rerun_log import check_record_path
 from task import data
 from task.errors import TampError
 from task.instances import example, from_files, from_text
@@ -62,8 +61,10 @@ def images_config(args: argparse.Namespace) -> dict:
     }
 
 
-def loop_config(args: argparse.Namespace):
-    """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first)."""
+def loop_config(args: argparse.Namespace, task=None):
+    """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first);
+    ``task``: the scene file's `tamp.world.blocks.SceneTask` (`scene_run`), whose table it runs
+    on (None: the named workcell ``--scene``)."""
     from tamp.camera.from_images import PerceptionMode
     from tamp.loop import LoopConfig
     from tamp.loop.execute import ExecConfig
@@ -71,7 +72,6 @@ def loop_config(args: argparse.Namespace):
     from tamp.world import load_named, scene_config
 
     check_workcell(args, executes=True)
-    task = scene_run(args)
     config = LoopConfig(
         sim=args.sim,
         grasp=args.grasp,
@@ -171,104 +171,7 @@ def _problem_run(args: argparse.Namespace, workcell: str, planner: str):
     return problem_episode(problem, workcell, planner, args.seed, source)
 
 
-GEO_PLANNER_FLAGS = ("time_limit_s",)  # the planner flags a GeoRun reads
-
-
-def geo_config(args: argparse.Namespace, task) -> dict:
-    """``run`` and ``demo`` of a `tamp.geo.scene_file.GeoRun`: what the geometric episode
-    runs with. Options of the Blocksworld loop that it has no counterpart for are refused in
-    one line: the loop's
-    planner settings (``--time-limit`` bounds each planner call), ``--device`` other than cpu,
-    ``--placements``, ``--collision`` other than plan (every phase is checked and blocked ones
-    rerouted), ``--crisp`` and the perception network's options; ``--motion-aware`` too
-    (``--geo-planner`` names the planner, motion-aware by default). Every fault of
-    ``--inject`` (drop, nudge, noise) is injected as the loop does. The limits not given are
-    the episode's defaults (`tamp.geo.types.GeoLimits`), which ``tamp bench tamp`` runs with
-    too."""
-    from tamp.geo.types import GeoLimits
-    from tamp.loop.faults import Injection
-
-    planner = task.planner
-    soft = [
-        _flag(n)
-        for n in _PLANNER_FLAGS
-        if n not in GEO_PLANNER_FLAGS and getattr(args, n, None) is not None
-    ]
-    why = []  # (flags, the reason the episode that runs this scene has no use for them)
-    if soft:
-        why.append(
-            (
-                soft,
-                f"the Blocksworld loop's soft planner's settings; planner {planner} plans "
-                "this scene (--geo-planner names it, --time-limit bounds it)",
-            )
-        )
-    if args.device not in (None, "cpu"):
-        why.append((["--device"], f"the soft planner's device; planner {planner} runs on the CPU"))
-    if args.placements != 0.0:
-        why.append(
-            (
-                ["--placements"],
-                "a cost on the loop's table places; planner "
-                f"{planner} picks each place by checking its grasp, IK and collisions",
-            )
-        )
-    if args.collision != "plan":
-        why.append(
-            (
-                ["--collision"],
-                f"planner {planner} decides each move by its collision checks and the executor "
-                "reroutes blocked phases; without them the moves it plans are unchecked",
-            )
-        )
-    seen = [
-        flag
-        for flag, value, default in (
-            ("--crisp", args.crisp, "perceived"),
-            ("--perception", args.perception, "frozen"),
-            ("--blur", args.blur, 0),
-            ("--checkpoint", args.checkpoint, None),
-        )
-        if value != default
-    ]
-    if seen:
-        why.append(
-            (
-                seen,
-                "the perception network's, which reads cubes' supports from one image; these "
-                "objects are observed as poses (motion capture, or --observe camera's estimates)",
-            )
-        )
-    if why:
-        raise TampError(
-            "; ".join(f"{', '.join(flags)}: {reason}" for flags, reason in why) + f" ({task.why})"
-        )
-    inject = Injection.parse(args.inject)
-    limits = GeoLimits()
-    limit = args.time_limit_s if args.time_limit_s is not None else limits.planning_s
-    return {
-        "executor": "geometric",
-        "why": task.why,
-        "scene_file": task.path,
-        "goal": task.goal.text(),
-        "planner": task.planner,
-        "domain": task.domain_name,
-        "domain_file": getattr(args, "domain", None),
-        "binding": getattr(args, "binding", None),
-        "sim": args.sim,
-        "grasp": args.grasp,
-        "observe": args.observe,
-        "inject": str(inject),
-        "max_replans": limits.max_replans if args.max_replans is None else args.max_replans,
-        "max_moves": limits.max_moves,
-        "time_limit_s": limit,
-        "seed": args.seed,
-        "video": None if args.no_video or args.out is None else args.video_format,
-        "record": None if args.record is None else str(check_record_path(args.record)),
-    }
-
-
-def _loop_dict(config) -> dict:
+def loop_dict(config) -> dict:
     """A `LoopConfig` as recorded (flat names kept from earlier reports)."""
     return {
         "sim": config.sim,
@@ -288,53 +191,6 @@ def _loop_dict(config) -> dict:
     }
 
 
-def run_config(args: argparse.Namespace) -> dict:
-    """``run`` and ``demo``."""
-    binding = getattr(args, "binding", None)
-    if binding is not None and args.domain is None:
-        raise TampError("--binding needs --domain DOMAIN.pddl (the domain whose actions it binds)")
-    if binding is not None and args.problem is not None:
-        raise TampError(
-            "--binding with PROBLEM.pddl: a bound domain's problem is read from the scene "
-            "file's geometry (--scene FILE.json --goal GOAL)"
-        )
-    if args.domain is not None and args.problem is None and binding is None:
-        raise TampError(
-            "--domain needs PROBLEM.pddl (the embedded example has its own domain), or "
-            "--scene FILE.json with --binding (a pick-and-place domain bound to the arm)"
-        )
-    if args.plan is None and (args.replan or args.stop_at_invalid):
-        raise TampError("--replan and --stop-at-invalid apply to a given plan (--plan PLAN)")
-    if args.no_video and args.video_format != "mp4":
-        raise TampError("--video-format with --no-video: there is no video to format")
-    if args.out is None and (args.no_video or args.video_format != "mp4"):
-        raise TampError("--no-video and --video-format apply with --out DIR (the video's folder)")
-    task = scene_run(args)
-    if task is not None:
-        from tamp.geo.scene_file import GeoRun
-
-        if isinstance(task, GeoRun):  # the geometric episode
-            check_workcell(args, executes=True)
-            if task.workcell is not None:  # a PDDL problem laid out on a workcell
-                laid = {"scene_file": None, "problem": args.problem, "scene": task.workcell}
-                return {**geo_config(args, task), **laid}
-            return geo_config(args, task)
-    config = loop_config(args)
-    return {
-        **_loop_dict(config),
-        "scene_file": None if task is None else args.scene,
-        "goal": None if task is None else task.goal.text(),
-        "problem": args.problem,
-        "domain": args.domain,
-        "seed": args.seed,
-        "plan": args.plan,
-        "replan": args.replan,
-        "stop_at_invalid": args.stop_at_invalid,
-        "video": None if args.no_video or args.out is None else args.video_format,
-        "record": None if args.record is None else str(check_record_path(args.record)),
-    }
-
-
 def given_config(args: argparse.Namespace):
     """The loop settings of ``bench executability``: grasp, scene, collision mode, and the
     planner and placements of our reference row (refused without it)."""
@@ -345,9 +201,9 @@ def given_config(args: argparse.Namespace):
 
     check_workcell(args, executes=True)
     if not args.ours:
-        given = [name for name in _PLANNER_FLAGS if getattr(args, name, None) is not None]
+        given = [name for name in PLANNER_FLAGS if getattr(args, name, None) is not None]
         if given:
-            flags = ", ".join(_flag(n) for n in given)
+            flags = ", ".join(flag(n) for n in given)
             raise TampError(
                 f"{flags} set(s) our planner, whose row --no-ours leaves out; drop one of them"
             )
@@ -360,8 +216,8 @@ def given_config(args: argparse.Namespace):
     )
 
 
-def _flag(dest: str) -> str:
-    """The option of a `_PLANNER_FLAGS` destination as the user types it."""
+def flag(dest: str) -> str:
+    """The option of a `PLANNER_FLAGS` destination as the user types it."""
     return _FLAG_NAMES.get(dest, "--" + dest.replace("_", "-"))
 
 
@@ -372,7 +228,7 @@ _FLAG_NAMES = {
     "improve_s": "--improve",
 }
 
-_PLANNER_FLAGS = (
+PLANNER_FLAGS = (
     "horizon",
     "restarts",
     "iters",
@@ -441,7 +297,7 @@ def motion_config(args: argparse.Namespace) -> dict:
         raise TampError("--data with --blocks: random problems read no data; drop one")
     _records_under_out(args)
     config = loop_config(args)
-    body = _loop_dict(config)
+    body = loop_dict(config)
     del body["sim"]
     return {
         **body,

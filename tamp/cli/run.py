@@ -21,7 +21,6 @@ out on the workcell ``--scene`` names as the loop would lay it out
 
 from __future__ import annotations
 
-import argparse
 import enum
 import json
 import math
@@ -29,15 +28,8 @@ import sys
 import time
 from pathlib import Path
 
-from tamp.cli.recorded import (
-    checkpoint,
-    load_problem,
-    loop_config,
-    out_file,
-    out_folder,
-    run_config,
-    scene_run,
-)
+from tamp.cli.recorded import checkpoint, load_problem, out_file, out_folder
+from tamp.cli.run_settings import RunSettings, Unsolvable, run_record
 from tamp.episode_report import EpisodeReport
 from tamp.loop import Episode
 from tamp.loop.given import GivenPlanEpisode, read_given
@@ -46,7 +38,6 @@ from tamp.outcome import EpisodeInterrupted
 from tamp.rerun_log import RerunRecorder, require_rerun
 from tamp.sweep import torch_threads
 from tamp.video import EpisodeVideo
-from tamp.world.goal_check import UnsolvableGoal
 from task.errors import TampError
 from task.problem import Problem
 
@@ -89,45 +80,49 @@ def _out_dir(out: str | None) -> Path | None:
     return out_folder(out) if out else None
 
 
-def run_command(args: argparse.Namespace) -> int:
-    try:
-        recorded = run_config(args)  # refused combinations: before any work
-    except UnsolvableGoal as exc:  # a scene file's goal no plan can reach: before planning
-        return unsolvable(args, exc.reason)
-    out_folder(args.out)
-    out_file(args.record, "--record")
-    if args.record is not None:
+def run_command(settings: RunSettings | Unsolvable) -> int:
+    """Run the episode of ``settings`` (`tamp.cli.run_settings.run_settings`, the options read
+    once): its video, report.json and summary; exit 0 when the goal is reached."""
+    if isinstance(settings, Unsolvable):  # a scene file's goal no plan can reach
+        return unsolvable(settings)
+    recorded = run_record(settings)
+    output, source, given = settings.output, settings.source, settings.given
+    out_folder(output.out)
+    out_file(output.record, "--record")
+    if output.record is not None:
         require_rerun()  # the optional extra: a one-line error naming it
-    task = scene_run(args)
-    if recorded.get("executor") == "geometric":
-        return geo_run(args, task, recorded)
-    problem = load_problem(args.problem, args.domain) if task is None else task.problem
-    config = loop_config(args)
+    task = settings.task
+    if settings.geo is not None:
+        return geo_run(settings, recorded)
+    problem = load_problem(source.problem, source.domain) if task is None else task.problem
+    config = settings.loop
     if config.observe == Observation.CAMERA:
         checkpoint(config.checkpoint)
-    steps = _given_steps(args.plan, problem)
-    out = _out_dir(args.out)
+    steps = _given_steps(given.path, problem)
+    out = _out_dir(output.out)
     video = None
-    if out is not None and not args.no_video:  # its renderer process starts now
-        video = EpisodeVideo(out / f"episode.{args.video_format}", VIDEO_FPS)
-    quiet = args.json
+    if output.video is not None:  # its renderer process starts now
+        video = EpisodeVideo(out / f"episode.{output.video}", VIDEO_FPS)
+    quiet = output.json
 
     def say(text: str) -> None:
         if not quiet:
             print(f"  [{time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
 
-    recorder = None if args.record is None else RerunRecorder(args.record, problem.name)
+    recorder = None if output.record is None else RerunRecorder(output.record, problem.name)
     if steps is None:
         poses = None if task is None else dict(task.poses)  # a scene file's: where it puts them
-        episode = Episode(problem, config, args.seed, on_event=say, poses=poses, recorder=recorder)
+        episode = Episode(
+            problem, config, settings.seed, on_event=say, poses=poses, recorder=recorder
+        )
     else:
         episode = GivenPlanEpisode(
             problem,
             steps,
             config,
-            args.seed,
-            args.replan,
-            args.stop_at_invalid,
+            settings.seed,
+            given.replan,
+            given.stop_at_invalid,
             on_event=say,
             recorder=recorder,
         )
@@ -144,11 +139,11 @@ def run_command(args: argparse.Namespace) -> int:
         seen = config.observe
         if seen == Observation.CAMERA:
             seen += f" ({config.perception.mode} perception, blur {config.perception.blur})"
-        given = f", given plan {args.plan} ({len(steps)} steps)" if steps is not None else ""
+        plan = f", given plan {given.path} ({len(steps)} steps)" if steps is not None else ""
         if task is not None:
-            given += f", scene file {args.scene}, goal {task.goal.text()}"
+            plan += f", scene file {source.scene}, goal {task.goal.text()}"
         print(
-            f"{head}, observe {seen}, faults {config.inject}, seed {args.seed}{given}",
+            f"{head}, observe {seen}, faults {config.inject}, seed {settings.seed}{plan}",
             file=sys.stderr,
         )
     interrupted = False
@@ -168,7 +163,7 @@ def run_command(args: argparse.Namespace) -> int:
     if out is not None:
         (out / "report.json").write_text(body)
         written.append("report.json")
-    if args.json:
+    if output.json:
         print(body)
     else:
         print("\n".join(summary_lines(report)))
@@ -184,73 +179,41 @@ def run_command(args: argparse.Namespace) -> int:
     return 0 if report.reached_goal else 1
 
 
-def unsolvable(args: argparse.Namespace, reason: str) -> int:
+def unsolvable(found: Unsolvable) -> int:
     """The ``unsolvable`` outcome of a scene file's goal the static check
     (`tamp.world.goal_check`) proved unreachable, as ``tamp plan`` reports a PDDL problem's:
     ``unsolvable: REASON`` (or its ``--json`` report), exit code 1, nothing planned or run."""
-    if args.json:
-        body = {"status": "unsolvable", "reason": reason, "reached_goal": False}
-        print(json.dumps({**body, "scene_file": args.scene, "goal": args.goal}, indent=2))
+    if found.json:
+        body = {"status": "unsolvable", "reason": found.reason, "reached_goal": False}
+        print(json.dumps({**body, "scene_file": found.scene, "goal": found.goal}, indent=2))
     else:
-        print(f"unsolvable: {reason}")
+        print(f"unsolvable: {found.reason}")
     return 1
 
 
-def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
-    """A `tamp.geo.scene_file.GeoRun`: the geometric episode with ``recorded``'s settings
-    (`tamp.cli.recorded.geo_config`), its video and report.json under ``--out``; exit 0 when
-    the goal is reached (ground truth)."""
-    import numpy as np
-
-    from tamp.geo.config import GeoEpisodeConfig
+def geo_run(settings: RunSettings, recorded: dict) -> int:
+    """A `tamp.geo.scene_file.GeoRun` (``settings.task``): the geometric episode with
+    ``settings.geo``, its video and report.json under ``--out``; exit 0 when the goal is reached
+    (ground truth)."""
     from tamp.geo.episode import run_geo_episode
-    from tamp.geo.search import SearchConfig
-    from tamp.geo.types import GeoLimits
-    from tamp.loop.faults import Injection
 
-    out = _out_dir(args.out)
-    video = None
-    if recorded["video"] is not None:
-        video = out / f"episode.{recorded['video']}"
-    # drop:P: the gripper opens mid-transit on each move with probability P; nudge:P: the
-    # object placed is pushed after each move with probability P; both drawn per move index
-    # from the seed before the episode (the episode takes the indices); noise:P is drawn by
-    # the episode per pose reading
-    inject = Injection.parse(args.inject)
-    rng = np.random.default_rng(args.seed)
-    drops = tuple(k for k, u in enumerate(rng.random(recorded["max_moves"])) if u < inject.drop)
-    nudges = tuple(k for k, u in enumerate(rng.random(recorded["max_moves"])) if u < inject.nudge)
-    limit_s = recorded["time_limit_s"]
-    config = GeoEpisodeConfig(
-        planner=task.planner,
-        sim=args.sim,
-        seed=args.seed,
-        limits=GeoLimits(recorded["max_moves"], recorded["max_replans"], limit_s),
-        search=SearchConfig(seed=args.seed, max_time_s=limit_s),
-        observation=args.observe,
-        grasp=args.grasp,
-        drops=drops,
-        nudges=nudges,
-        nudge_m=inject.nudge_m,
-        noise=inject.noise,
-        noise_sigma=inject.noise_sigma,
-        video=video,
-        domain=task.domain,
-    )
-    if not args.json:
+    task, config, output = settings.task, settings.geo, settings.output
+    out = _out_dir(output.out)
+    video = None if config.video is None else Path(config.video)
+    if not output.json:
         print(
-            f"running {task.scene.name} ({len(task.scene.objects)} objects) in {args.sim} "
+            f"running {task.scene.name} ({len(task.scene.objects)} objects) in {config.sim} "
             f"with the geometric episode ({task.why}): planner {task.planner}"
             f"{f' through the {task.domain_name} domain' if task.domain else ''}, "
             f"goal {task.goal.text()}, "
-            f"observe {args.observe}, grasp {args.grasp}, faults {recorded['inject']}, "
-            f"seed {args.seed}",
+            f"observe {recorded['observe']}, grasp {config.grasp}, faults {recorded['inject']}, "
+            f"seed {settings.seed}",
             file=sys.stderr,
         )
-    recorder = None if args.record is None else RerunRecorder(args.record, task.scene.name)
+    recorder = None if output.record is None else RerunRecorder(output.record, task.scene.name)
     with torch_threads(EPISODE_THREADS):
         report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if args.json else _say, recorder=recorder
+            task.scene, task.goal, config, on_event=None if output.json else _say, recorder=recorder
         )
     body = report_json(report, recorded)
     written = []
@@ -259,7 +222,7 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
     if out is not None:
         (out / "report.json").write_text(body)
         written.append("report.json")
-    if args.json:
+    if output.json:
         print(body)
     else:
         print("\n".join(geo_lines(report)))
