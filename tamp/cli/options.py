@@ -7,6 +7,7 @@ nothing here plans or simulates, and nothing here imports torch, so ``tamp --hel
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 
 from tamp.bench.official import OFFICIAL, default_data
 from tamp.cli.types import (
@@ -57,13 +58,40 @@ _OVERRIDES = (
 )
 
 
+@dataclass(frozen=True)
+class PlannerOverrides:
+    """The planner options the user gave (``given``: ``(PlannerConfig field, value)`` pairs, in
+    `_OVERRIDES` order; an option not given is absent), read once from the command line
+    (`planner_overrides`); `config` lays them over a domain's defaults."""
+
+    given: tuple[tuple[str, object], ...] = ()
+
+    def get(self, name: str, default: object = None) -> object:
+        """The value given for the `PlannerConfig` field ``name`` (``default``: not given)."""
+        return dict(self.given).get(name, default)
+
+    def config(self, domain: str | None = None) -> PlannerConfig:
+        """PlannerConfig defaults (with ``domain``'s own, `PlannerConfig.for_domain`) and the
+        options given."""
+        given = dict(self.given)
+        if "improve_s" in given:  # --improve applies at any size (a domain's cap is its default's)
+            given["improve_up_to"] = None
+        if domain is None:
+            return PlannerConfig(**given)
+        return PlannerConfig.for_domain(domain, **given)
+
+
+def planner_overrides(args: argparse.Namespace) -> PlannerOverrides:
+    """The planner options of ``args`` that were given (None: not given)."""
+    return PlannerOverrides(
+        tuple((k, getattr(args, k)) for k in _OVERRIDES if getattr(args, k, None) is not None)
+    )
+
+
 def planner_config(args: argparse.Namespace, domain: str | None = None) -> PlannerConfig:
     """PlannerConfig defaults (with ``domain``'s own, `PlannerConfig.for_domain`) and the
     options the user gave (None: not given)."""
-    given = {k: getattr(args, k) for k in _OVERRIDES if getattr(args, k, None) is not None}
-    if "improve_s" in given:  # --improve applies at any size (a domain's cap is its default's)
-        given["improve_up_to"] = None
-    return PlannerConfig(**given) if domain is None else PlannerConfig.for_domain(domain, **given)
+    return planner_overrides(args).config(domain)
 
 
 class Parser(argparse.ArgumentParser):

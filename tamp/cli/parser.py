@@ -109,8 +109,8 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     rules_option(p)
     output_options(p, "write the plan file (VAL format) here")
     p.set_defaults(
-        func=_lazy("tamp.cli.plan", "plan_command"),
-        recorded=_lazy("tamp.cli.recorded", "plan_config"),
+        func=_at_edge(_PLAN_EDGE + "plan_settings", "tamp.cli.plan.plan_command"),
+        recorded=_at_edge(_PLAN_EDGE + "plan_settings", _PLAN_EDGE + "plan_record"),
     )
 
     p = sub.add_parser("validate", help="validate a plan file against a domain and a problem")
@@ -119,8 +119,8 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("plan", metavar="PLAN")
     p.add_argument("--json", action="store_true", help="machine-readable output on stdout")
     p.set_defaults(
-        func=_lazy("tamp.cli.plan", "validate_command"),
-        recorded=_lazy("tamp.cli.recorded", "validate_config"),
+        func=_at_edge(_PLAN_EDGE + "validate_settings", "tamp.cli.plan.validate_command"),
+        recorded=_at_edge(_PLAN_EDGE + "validate_settings", _PLAN_EDGE + "validate_record"),
     )
 
     p = sub.add_parser(
@@ -132,8 +132,8 @@ def _plan_commands(sub, plan_opts: argparse.ArgumentParser) -> None:
     p.add_argument("--threads", type=threads, default=1, help=PLAN_THREADS)
     output_options(p, "write the example's domain, problem and plan files into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.plan", "example_command"),
-        recorded=_lazy("tamp.cli.recorded", "plan_config"),
+        func=_at_edge(_PLAN_EDGE + "example_settings", "tamp.cli.plan.example_command"),
+        recorded=_at_edge(_PLAN_EDGE + "example_settings", _PLAN_EDGE + "plan_record"),
     )
 
 
@@ -583,6 +583,9 @@ def _perception_commands(sub) -> None:
         func=_lazy("tamp.cli.perception", "eval_command"),
         recorded=_lazy("tamp.cli.recorded", "eval_config"),
     )
+
+
+_PLAN_EDGE = "tamp.cli.plan_settings."  # the edges of plan, validate and example
 
 
 def _at_edge(edge: str, then: str):

@@ -13,7 +13,6 @@ validates against the PDDL.
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 import time
@@ -23,8 +22,8 @@ from pathlib import Path
 from pddl.core import Domain
 
 from tamp.cli import report
-from tamp.cli.options import check_workcell, planner_config
-from tamp.cli.recorded import out_file, out_folder, plan_config
+from tamp.cli.plan_settings import PlanSettings, ValidateSettings, plan_record
+from tamp.cli.recorded import out_file, out_folder
 from task import data
 from task.config import PlannerConfig
 from task.deadline import NO_DEADLINE, Deadline
@@ -51,20 +50,20 @@ def _write(path: Path, text: str) -> None:
 
 
 def _solve(
-    domain: Domain, instance: Instance, args: argparse.Namespace, deadline: Deadline = NO_DEADLINE
+    domain: Domain, instance: Instance, settings: PlanSettings, deadline: Deadline = NO_DEADLINE
 ):
     """Plan ``instance`` and validate its PDDL plan against its PDDL (None without a plan);
     ``(recorded config, config, result, actions, validation)``. ``deadline``: the command's,
     which the planner stops at too."""
     from tamp.sweep import torch_threads
 
-    recorded = plan_config(args, instance.problem.domain)
-    config = planner_config(args, instance.problem.domain)
-    with torch_threads(args.threads):
-        if getattr(args, "lambda_motion", None):
-            result = _plan_on_table(instance.problem, config, args)
+    recorded = plan_record(settings, instance.problem.domain)
+    config = settings.planner.config(instance.problem.domain)
+    with torch_threads(settings.threads):
+        if settings.planner.get("lambda_motion"):
+            result = _plan_on_table(instance.problem, config, settings)
         else:
-            result = plan(instance.problem, config, args.seed, deadline=deadline)
+            result = plan(instance.problem, config, settings.seed, deadline=deadline)
     actions: tuple = ()
     validation = None
     if result.solved:
@@ -75,7 +74,7 @@ def _solve(
     return recorded, config, result, actions, validation
 
 
-def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> PlanResult:
+def _plan_on_table(problem, config: PlannerConfig, settings: PlanSettings) -> PlanResult:
     """``--motion-aware``: plan with the arm's move costs, the problem laid out on ``--scene``
     (seeded by ``--seed``), the arm at home, on the scene's table slots (`tamp.slots`): a
     move onto the table carries the place it goes to."""
@@ -91,10 +90,11 @@ def _plan_on_table(problem, config: PlannerConfig, args: argparse.Namespace) -> 
     from tamp.scene import SceneConfig, layout
     from tamp.slots import plan_on_places
 
-    scene = with_scene(SceneConfig(), args.scene)
-    poses = layout(problem.entities, problem.init, scene, args.seed)
+    workcell, seed = settings.workcell, settings.seed
+    scene = with_scene(SceneConfig(), workcell.scene)
+    poses = layout(problem.entities, problem.init, scene, seed)
     arm = Arm(IKSolver(), PANDA.q_home)
-    found = plan_on_places(problem, poses, scene, arm, config, args.seed, reach=args.placements)
+    found = plan_on_places(problem, poses, scene, arm, config, seed, reach=workcell.placements)
     return replace(found, problem=problem)
 
 
@@ -192,16 +192,16 @@ def _unmet(result: PlanResult, instance: Instance) -> list[tuple[str, ...]]:
     return [a for a in strips.goal_atoms(instance.pddl) if a not in holds]
 
 
-def _proved_first(args: argparse.Namespace, deadline: Deadline = NO_DEADLINE) -> tuple[str, Proof]:
+def _proved_first(settings: PlanSettings, deadline: Deadline = NO_DEADLINE) -> tuple[str, Proof]:
     """The problem's name and the cheap proofs (`prove_unsolvable` without search) on the
     PDDL files, after they parse and stay within the STRIPS the planners plan (else
     `TampError`, exit code 2)."""
-    domain_text = pddl_io.read_text(args.domain)
-    domain = pddl_io.parse_domain(domain_text, str(args.domain))
-    pddl_io.check_strips(domain_text, str(args.domain))
-    problem_text = pddl_io.read_text(args.problem)
-    problem = pddl_io.parse_problem(problem_text, str(args.problem), domain)
-    pddl_io.check_strips(problem_text, str(args.problem))
+    domain_text = pddl_io.read_text(settings.domain)
+    domain = pddl_io.parse_domain(domain_text, str(settings.domain))
+    pddl_io.check_strips(domain_text, str(settings.domain))
+    problem_text = pddl_io.read_text(settings.problem)
+    problem = pddl_io.parse_problem(problem_text, str(settings.problem), domain)
+    pddl_io.check_strips(problem_text, str(settings.problem))
     proof = prove_unsolvable(domain, problem, time_limit_s=PROOF_FIRST_S, deadline=deadline)
     return str(problem.name), proof
 
@@ -230,24 +230,23 @@ def _proof_json(name: str, proof: Proof, seed: int) -> str:
     )
 
 
-def plan_command(args: argparse.Namespace) -> int:
+def plan_command(settings: PlanSettings) -> int:
     """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line; ``unsolvable:
     REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
-    check_workcell(args, executes=False)
-    out_file(args.out)
+    out_file(settings.out)
     start = time.perf_counter()  # the reported time: the whole command's work, wall clock
-    deadline = Deadline.after(getattr(args, "time_limit_s", None), start)
-    name, proof = _proved_first(args, deadline)
+    deadline = Deadline.after(settings.planner.get("time_limit_s"), start)
+    name, proof = _proved_first(settings, deadline)
     if proof.unsolvable:
-        if args.json:
-            print(_proof_json(name, proof, args.seed))
+        if settings.json:
+            print(_proof_json(name, proof, settings.seed))
         else:
             print(f"unsolvable: {proof.reason}")
         return 1
-    domain, instance = from_files(args.domain, args.problem, args.domain_rules)
-    if instance.note and not args.json:  # a near miss of a hand-written domain: the lift plans
+    domain, instance = from_files(settings.domain, settings.problem, settings.workcell.rules)
+    if instance.note and not settings.json:  # a near miss of a hand-written domain: the lift plans
         print(f"note: {instance.note}", file=sys.stderr)
-    recorded, config, result, actions, validation = _solve(domain, instance, args, deadline)
+    recorded, config, result, actions, validation = _solve(domain, instance, settings, deadline)
     valid = validation is not None and validation.valid
     said = result.stats.get("reason") if result.status is PlanStatus.UNSOLVABLE else None
     searched = validation is not None or said is not None  # no proof needed after either
@@ -255,10 +254,12 @@ def plan_command(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - start
     stats = {**result.stats, "plan_time_s": result.stats.get("time_s"), "time_s": wall}
     result = replace(result, stats=stats)
-    if args.out is not None and valid:
-        _write(Path(args.out), pddl_io.format_plan(actions))
-    if args.json:
-        print(_plan_json(recorded, result, actions, validation, args.seed, after, instance.note))
+    if settings.out is not None and valid:
+        _write(Path(settings.out), pddl_io.format_plan(actions))
+    if settings.json:
+        print(
+            _plan_json(recorded, result, actions, validation, settings.seed, after, instance.note)
+        )
     elif after is not None and after.unsolvable:
         print(f"unsolvable: {after.reason}")
     elif said is not None:  # the planner's own reason (a goal the scene cannot hold)
@@ -273,33 +274,33 @@ def plan_command(args: argparse.Namespace) -> int:
     return 0 if valid else 1
 
 
-def validate_command(args: argparse.Namespace) -> int:
+def validate_command(settings: ValidateSettings) -> int:
     """``tamp validate DOMAIN PROBLEM PLAN``: VALID or the first failing step."""
-    validation = validate_files(args.domain, args.problem, args.plan)
-    if args.json:
+    validation = validate_files(settings.domain, settings.problem, settings.plan)
+    if settings.json:
         print(json.dumps(report.validation_dict(validation), indent=2))
     else:
         print(report.validation_line(validation))
     return 0 if validation.valid else 1
 
 
-def example_command(args: argparse.Namespace) -> int:
+def example_command(settings: PlanSettings) -> int:
     """``tamp example``: plan the embedded 5-block example and show every stage (no robot;
     ``tamp demo`` runs it with the arm)."""
-    out_folder(args.out)
+    out_folder(settings.out)
     domain, instance = example()
-    recorded, config, result, actions, validation = _solve(domain, instance, args)
+    recorded, config, result, actions, validation = _solve(domain, instance, settings)
     written = []
-    if args.out is not None:
-        out = Path(args.out)
+    if settings.out is not None:
+        out = Path(settings.out)
         for name in (data.DOMAIN_FILE, data.EXAMPLE_FILE):
             _write(out / name, data.read_text(name))
             written.append(name)
         if validation is not None and validation.valid:
             _write(out / "example-5.plan", pddl_io.format_plan(actions))
             written.append("example-5.plan")
-    if args.json:
-        print(_plan_json(recorded, result, actions, validation, args.seed))
+    if settings.json:
+        print(_plan_json(recorded, result, actions, validation, settings.seed))
         return 0 if validation is not None and validation.valid else 1
     problem = instance.problem
     best = optimal_moves(problem)
@@ -309,7 +310,7 @@ def example_command(args: argparse.Namespace) -> int:
         "",
         *report.problem_picture(problem),
         "",
-        f"soft-T_P planner (T={config.horizon}, {config.restarts} restarts, seed {args.seed}):",
+        f"soft-T_P planner (T={config.horizon}, {config.restarts} restarts, seed {settings.seed}):",
         *(f"  {k}. {m}" for k, m in enumerate(result.plan.moves, start=1)),
         "",
         f"PDDL plan ({blocksworld.PDDL_DOMAIN}):",
@@ -319,5 +320,5 @@ def example_command(args: argparse.Namespace) -> int:
     ]
     print("\n".join(lines))
     if written:
-        print(f"wrote {', '.join(written)} to {args.out}")
+        print(f"wrote {', '.join(written)} to {settings.out}")
     return 0 if validation is not None and validation.valid else 1

@@ -38,17 +38,6 @@ def _planner(args: argparse.Namespace, domain: str | None = None) -> dict:
     return asdict(planner_config(args, domain))
 
 
-def plan_config(args: argparse.Namespace, domain: str | None = None) -> dict:
-    """``plan`` and ``example``: the planner config, seed, rules, and the table planned on."""
-    if hasattr(args, "scene"):
-        check_workcell(args, executes=False)
-    body = {**_planner(args, domain), "seed": args.seed, "threads": args.threads}
-    if hasattr(args, "scene"):
-        body |= {"scene": args.scene, "placements": args.placements}
-        body["domain_rules"] = args.domain_rules
-    return body
-
-
 def images_config(args: argparse.Namespace) -> dict:
     """``plan-images``."""
     return {
@@ -453,11 +442,6 @@ def eval_config(args: argparse.Namespace) -> dict:
         "blur": args.blur,
         "device": args.device,
     }
-
-
-def validate_config(args: argparse.Namespace) -> dict:
-    """``validate``: its inputs only."""
-    return {"domain": args.domain, "problem": args.problem, "plan": args.plan}
 
 
 # --- checks before the work ------------------------------------------------------------------
