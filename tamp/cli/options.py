@@ -366,7 +366,7 @@ def scene_options(p: argparse.ArgumentParser, files: bool = False) -> None:
 def workcell_options(p: argparse.ArgumentParser, files: bool = False) -> None:
     """The robot's table (``--scene``) and motion-aware planning on it (``--motion-aware``,
     ``--placements``): the one place these options are defined. With ``files``, ``--scene``
-    also takes a scene file (`tamp.world`), checked by `tamp.cli.run_settings.run_settings`."""
+    also takes a scene file (`tamp.world`), checked by `tamp.cli.settings.run.run_settings`."""
     if files:
         p.add_argument(
             "--scene",

@@ -188,9 +188,9 @@ def _run_command(sub, plan_opts: argparse.ArgumentParser) -> None:
         run_options(p)
         output_options(p, "write the episode video and report.json into this folder")
         p.set_defaults(
-            func=_at_edge("tamp.cli.run_settings.run_settings", "tamp.cli.run.run_command"),
+            func=_at_edge("tamp.cli.settings.run.run_settings", "tamp.cli.run.run_command"),
             recorded=_at_edge(
-                "tamp.cli.run_settings.run_settings", "tamp.cli.run_settings.run_record"
+                "tamp.cli.settings.run.run_settings", "tamp.cli.settings.run.run_record"
             ),
         )
     sub.choices["demo"].set_defaults(observe="camera", out="out/demo")
@@ -585,7 +585,7 @@ def _perception_commands(sub) -> None:
     )
 
 
-_PLAN_EDGE = "tamp.cli.plan_settings."  # the edges of plan, validate and example
+_PLAN_EDGE = "tamp.cli.settings.plan."  # the edges of plan, validate and example
 
 
 def _at_edge(edge: str, then: str):

@@ -22,8 +22,8 @@ from pathlib import Path
 from pddl.core import Domain
 
 from tamp.cli import report
-from tamp.cli.plan_settings import PlanSettings, ValidateSettings, plan_record
 from tamp.cli.recorded import out_file, out_folder
+from tamp.cli.settings.plan import PlanSettings, ValidateSettings, plan_record
 from task import data
 from task.config import PlannerConfig
 from task.deadline import NO_DEADLINE, Deadline

@@ -1,9 +1,11 @@
 """What each ``tamp`` command records as its configuration, and the checks run before any work.
 
 Every command's handler builds the settings it runs with through the function named here for it
-(the parser binds it as ``args.recorded``), and writes that dict as the ``config`` of its
-``results.json`` / ``report.json`` / ``--json`` output. So an option either changes the recorded
-config (and the run, which is built from the same objects) or is refused here in one line
+(the parser binds it as ``args.recorded``; ``run``, ``demo``, ``plan``, ``example`` and
+``validate`` build theirs at the edge instead, `tamp.cli.settings`), and writes that dict as
+the ``config`` of its ``results.json`` / ``report.json`` / ``--json`` output. So an option
+either changes the recorded config (and the run, which is built from the same objects) or is
+refused here in one line
 (`TampError`, exit 2) in the combination where it would do nothing; ``tests/tamp/cli/
 test_every_option.py`` walks every option of every command to keep it so.
 

@@ -29,7 +29,7 @@ import time
 from pathlib import Path
 
 from tamp.cli.recorded import checkpoint, load_problem, out_file, out_folder
-from tamp.cli.run_settings import RunSettings, Unsolvable, run_record
+from tamp.cli.settings.run import RunSettings, Unsolvable, run_record
 from tamp.episode_report import EpisodeReport
 from tamp.loop import Episode
 from tamp.loop.given import GivenPlanEpisode, read_given
@@ -81,7 +81,7 @@ def _out_dir(out: str | None) -> Path | None:
 
 
 def run_command(settings: RunSettings | Unsolvable) -> int:
-    """Run the episode of ``settings`` (`tamp.cli.run_settings.run_settings`, the options read
+    """Run the episode of ``settings`` (`tamp.cli.settings.run.run_settings`, the options read
     once): its video, report.json and summary; exit 0 when the goal is reached."""
     if isinstance(settings, Unsolvable):  # a scene file's goal no plan can reach
         return unsolvable(settings)

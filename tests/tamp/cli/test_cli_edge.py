@@ -23,11 +23,11 @@ CLI = "tamp/cli"
 
 # command -> its edge, the one function that reads the namespace ("path:function")
 EDGES = {
-    "run": "tamp/cli/run_settings.py:run_settings",
-    "demo": "tamp/cli/run_settings.py:run_settings",
-    "plan": "tamp/cli/plan_settings.py:plan_settings",
-    "example": "tamp/cli/plan_settings.py:example_settings",
-    "validate": "tamp/cli/plan_settings.py:validate_settings",
+    "run": "tamp/cli/settings/run.py:run_settings",
+    "demo": "tamp/cli/settings/run.py:run_settings",
+    "plan": "tamp/cli/settings/plan.py:plan_settings",
+    "example": "tamp/cli/settings/plan.py:example_settings",
+    "validate": "tamp/cli/settings/plan.py:validate_settings",
 }
 
 # what the edges call to read and refuse options (each called from an edge, or by a command
@@ -39,10 +39,10 @@ EDGE_HELPERS = {
     "tamp/cli/recorded.py:loop_config",
     "tamp/cli/recorded.py:scene_run",
     "tamp/cli/recorded.py:_problem_run",
-    "tamp/cli/run_settings.py:_output",
-    "tamp/cli/run_settings.py:_refuse_inputs",
-    "tamp/cli/run_settings.py:_refuse_for_geo",
-    "tamp/cli/run_settings.py:_with_geo",
+    "tamp/cli/settings/run.py:_output",
+    "tamp/cli/settings/run.py:_refuse_inputs",
+    "tamp/cli/settings/run.py:_refuse_for_geo",
+    "tamp/cli/settings/run.py:_with_geo",
 }
 
 # the parser's handlers: the namespace in, the edge's settings to the command
