@@ -303,8 +303,8 @@ def _motion_benchmark(bench, plan_opts: argparse.ArgumentParser) -> None:
     progress_option(p)
     output_options(p, "write results.json and episodes.csv into this folder")
     p.set_defaults(
-        func=_lazy("tamp.cli.bench.arm", "motion_command"),
-        recorded=_lazy("tamp.cli.recorded", "motion_config"),
+        func=_at_edge(_MOTION_EDGE, "tamp.cli.bench.arm.motion_command"),
+        recorded=_at_edge(_MOTION_EDGE, "tamp.cli.settings.motion.motion_record"),
     )
 
 
@@ -586,6 +586,7 @@ def _perception_commands(sub) -> None:
 
 
 _PLAN_EDGE = "tamp.cli.settings.plan."  # the edges of plan, validate and example
+_MOTION_EDGE = "tamp.cli.settings.motion.motion_settings"
 
 
 def _at_edge(edge: str, then: str):

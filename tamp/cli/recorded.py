@@ -21,7 +21,6 @@ from dataclasses import asdict, replace
 from pathlib import Path
 
 from perception import CHECKPOINT
-from tamp.bench.official import default_data
 from tamp.cli.options import SCENES, check_workcell, planner_config
 from tamp.cli.types import sim_list
 from tamp.modes import ImageScene, Observation
@@ -238,7 +237,7 @@ PLANNER_FLAGS = (
 def executability_config(args: argparse.Namespace) -> dict:
     """``bench executability``."""
     config = given_config(args)
-    _records_under_out(args)
+    records_under_out(args.record, args.out)
     return {
         "plans": str(args.plans),
         "sims": list(sim_list(args.sim)),
@@ -259,9 +258,9 @@ def executability_config(args: argparse.Namespace) -> dict:
     }
 
 
-def _records_under_out(args: argparse.Namespace) -> None:
+def records_under_out(record: bool, out: str | None) -> None:
     """A benchmark's ``--record`` writes OUT/recordings/: refused without ``--out``."""
-    if args.record and not args.out:
+    if record and not out:
         raise TampError("--record writes OUT/recordings/SIM-INSTANCE.rrd; give --out DIR")
 
 
@@ -279,27 +278,6 @@ def tamp_bench_config(args: argparse.Namespace) -> dict:
         "observe": args.observe,
         "workers": args.workers,
         "ray": args.ray,
-    }
-
-
-def motion_config(args: argparse.Namespace) -> dict:
-    """``bench motion``."""
-    if args.blocks and args.data != str(default_data("blocksworld")):
-        raise TampError("--data with --blocks: random problems read no data; drop one")
-    _records_under_out(args)
-    config = loop_config(args)
-    body = loop_dict(config)
-    del body["sim"]
-    return {
-        **body,
-        "sims": list(sim_list(args.sim)),
-        "n": args.n,
-        "seed": args.seed,
-        "data": None if args.blocks else str(args.data),
-        "blocks": list(args.blocks) if args.blocks else None,
-        "workers": args.workers,
-        "ray": args.ray,
-        "record": args.record,
     }
 
 

@@ -15,14 +15,9 @@ from tqdm import tqdm
 
 from tamp.bench import results, suites, tables
 from tamp.cli.bench import interrupted
-from tamp.cli.recorded import (
-    checkpoint,
-    executability_config,
-    given_config,
-    loop_config,
-    motion_config,
-)
+from tamp.cli.recorded import checkpoint, executability_config, given_config
 from tamp.cli.recorded import out_folder as output_folder
+from tamp.cli.settings.motion import MotionSettings, motion_record
 from tamp.cli.types import sim_list
 from tamp.modes import Observation
 from tamp.rerun_log import require_rerun
@@ -31,30 +26,31 @@ from task.errors import TampError
 DEFAULT_N = 20  # bench executability: instances when --n is not given (fewer if fewer named)
 
 
-def motion_command(args: argparse.Namespace) -> int:
+def motion_command(settings: MotionSettings) -> int:
     """Closed-loop episodes on a ``--n`` spread of PlanBench (or random ``--blocks``
-    problems) in each ``--sim``."""
+    problems) in each ``--sim`` (``settings``: `tamp.cli.settings.motion.motion_settings`)."""
     from tamp.bench import motion
     from tamp.slots import fits
 
-    recorded = motion_config(args)  # refused combinations: before any work
-    output_folder(args.out)
-    if args.record:
+    recorded = motion_record(settings)
+    output = settings.output
+    output_folder(output.out)
+    if output.record:
         require_rerun()  # the optional extra: a one-line error naming it
-    if args.observe == Observation.CAMERA:
-        checkpoint(args.checkpoint)
-    sims, base = sim_list(args.sim), loop_config(args)
-    if args.blocks:
+    sims, base = settings.sims, settings.loop
+    if base.observe == Observation.CAMERA:
+        checkpoint(base.checkpoint)
+    if settings.blocks:
         suite = suites.generated(
-            args.blocks, args.n, args.seed, keep=partial(fits, scene=base.scene)
+            settings.blocks, settings.n, settings.seed, keep=partial(fits, scene=base.scene)
         )
     else:
-        suite = suites.planbench(args.data, args.n)
+        suite = suites.planbench(settings.data, settings.n)
     recorded |= {"n": len(suite.instances), "source": suite.source}
     goals, done = dict.fromkeys(sims, 0), []
     total = len(sims) * len(suite.instances)
     with tqdm(
-        total=total, desc="motion", unit="episode", file=sys.stderr, disable=not args.progress
+        total=total, desc="motion", unit="episode", file=sys.stderr, disable=not output.progress
     ) as bar:
 
         def progress(sim: str, report) -> None:
@@ -64,36 +60,36 @@ def motion_command(args: argparse.Namespace) -> int:
             bar.update(1)
 
         try:
-            record = args.out if args.record else None  # OUT/recordings/SIM-INSTANCE.rrd
+            record = output.out if output.record else None  # OUT/recordings/SIM-INSTANCE.rrd
             result = motion.run(
-                suite, base, sims, args.seed, progress, args.workers, args.ray, record
+                suite, base, sims, settings.seed, progress, settings.workers, settings.ray, record
             )
         except KeyboardInterrupt:
-            if args.out:
-                _motion_partial(args.out, recorded, suite, done, sims, base, total)
-            return interrupted(args.out, len(done), total, "episodes")
+            if output.out:
+                _motion_partial(output.out, recorded, suite, done, sims, base, total)
+            return interrupted(output.out, len(done), total, "episodes")
     inject = str(base.inject)
     body = {
         "config": recorded,
-        "machine": results.machine(args.argv, getattr(args, "device", None)),
+        "machine": results.machine(output.argv, output.device),
         "ik_batch": result.ik,
         "summary": result.summary,
     }
-    if args.out:
-        out = results.out_folder(args.out)
+    if output.out:
+        out = results.out_folder(output.out)
         results.write_json(out / "results.json", body)
         rows = motion.episode_rows(result.reports)
         results.write_csv(out / "episodes.csv", rows, motion.EPISODE_COLUMNS)
-    if args.json:
+    if output.json:
         print(json.dumps(body, indent=2))
         return 0
     seen = base.observe + (
         f" ({base.perception.mode} perception)" if base.observe == Observation.CAMERA else ""
     )
-    kind = "PlanBench" if not args.blocks else f"random ({base.scene.name} scene)"
+    kind = "PlanBench" if not settings.blocks else f"random ({base.scene.name} scene)"
     print(
         f"motion benchmark: {len(suite.instances)} {kind} instances, grasp {base.grasp}, "
-        f"observe {seen}, crisp {base.crisp}, faults {inject}, seed {args.seed}"
+        f"observe {seen}, crisp {base.crisp}, faults {inject}, seed {settings.seed}"
     )
     print(tables.motion_table(result.summary, inject))
     ik = result.ik
@@ -110,9 +106,9 @@ def motion_command(args: argparse.Namespace) -> int:
             f"collision checks {s['check_per_move_s']:.3f} s, motion planner "
             f"{s['path_per_move_s']:.3f} s"
         )
-    if args.out:
-        also = ", recordings/" if args.record else ""
-        print(f"wrote results.json, episodes.csv{also} to {args.out}")
+    if output.out:
+        also = ", recordings/" if output.record else ""
+        print(f"wrote results.json, episodes.csv{also} to {output.out}")
     return 0
 
 

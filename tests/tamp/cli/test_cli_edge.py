@@ -28,6 +28,7 @@ EDGES = {
     "plan": "tamp/cli/settings/plan.py:plan_settings",
     "example": "tamp/cli/settings/plan.py:example_settings",
     "validate": "tamp/cli/settings/plan.py:validate_settings",
+    "bench motion": "tamp/cli/settings/motion.py:motion_settings",
 }
 
 # what the edges call to read and refuse options (each called from an edge, or by a command
@@ -50,7 +51,6 @@ PARSER = {"tamp/cli/parser.py:_at_edge.handler", "tamp/cli/parser.py:_lazy.handl
 
 # commands whose namespace still travels below their entry: a list that only shrinks
 NOT_YET = {
-    "tamp/cli/bench/arm.py:motion_command",
     "tamp/cli/bench/arm.py:executability_command",
     "tamp/cli/bench/checker.py:checker_config",
     "tamp/cli/bench/checker.py:checker_command",
@@ -75,9 +75,7 @@ NOT_YET = {
     "tamp/cli/recorded.py:images_config",
     "tamp/cli/recorded.py:given_config",
     "tamp/cli/recorded.py:executability_config",
-    "tamp/cli/recorded.py:_records_under_out",
     "tamp/cli/recorded.py:tamp_bench_config",
-    "tamp/cli/recorded.py:motion_config",
     "tamp/cli/recorded.py:planning_config",
     "tamp/cli/recorded.py:perception_bench_config",
     "tamp/cli/recorded.py:latplan_config",
@@ -192,8 +190,9 @@ def _dotted(entry: str) -> tuple[str, str]:
 def test_a_converted_command_runs_on_its_edges_settings(command):
     """The parser binds each converted command's handler and recorded configuration through
     its named edge (`tamp.cli.parser._at_edge`), so the handler receives typed settings."""
-    sub = next(a for a in build_parser()._actions if a.dest == "command")
-    parser = sub.choices[command]
+    parser = build_parser()
+    for word in command.split():
+        parser = next(a for a in parser._actions if isinstance(a.choices, dict)).choices[word]
     edge = ".".join(_dotted(EDGES[command]))
     for bound in ("func", "recorded"):
         assert parser.get_default(bound).__qualname__.endswith(f"({edge})"), (command, bound)
@@ -228,13 +227,15 @@ def _namespaces(value, seen=()) -> list:
         ["plan", "d.pddl", "p.pddl", "--scene", "shelf", "--motion-aware", "--horizon", "4"],
         ["example", "--restarts", "3"],
         ["validate", "d.pddl", "p.pddl", "p.plan", "--json"],
+        ["bench", "motion", "--blocks", "4,5", "--n", "2", "--observe", "camera"],
     ],
 )
 def test_the_edge_builds_typed_settings_with_no_namespace_inside(argv):
     """What the edge hands the command is frozen and holds no namespace."""
     from importlib import import_module
 
-    module, name = _dotted(EDGES[argv[0]])
+    command = " ".join(argv[:2]) if argv[0] == "bench" else argv[0]
+    module, name = _dotted(EDGES[command])
     settings = getattr(import_module(module), name)(build_parser().parse_args(argv))
     assert dataclasses.is_dataclass(settings)
     assert type(settings).__dataclass_params__.frozen
