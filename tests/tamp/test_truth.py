@@ -124,7 +124,8 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
     sims = {"tamp/sim/base.py", "tamp/sim/pybullet_sim.py", "tamp/sim/mujoco_sim.py"}
     assert _uses("_block_poses", "tamp") <= sims
     assert _uses("_snapshot", "tamp") <= sims
-    assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py"}
+    # in the simulator room: the truth itself, and the experimenter's nudge (an injected fault)
+    assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py", "tamp/sim/faults.py"}
     # a snapshot (the true block poses) is read by the video and the Rerun recording alone,
     # inside their recording grant
     assert _uses("snapshot", "tamp") <= {"tamp/sim/truth.py", "tamp/video.py", "tamp/rerun_log.py"}
