@@ -256,10 +256,14 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             f"seed {args.seed}",
             file=sys.stderr,
         )
+    interrupted = False
     with torch_threads(EPISODE_THREADS):
-        report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if args.json else _say
-        )
+        try:
+            report = run_geo_episode(
+                task.scene, task.goal, config, on_event=None if args.json else _say
+            )
+        except EpisodeInterrupted as stop:  # Ctrl-C: the video and report of what was done
+            report, interrupted = stop.report, True
     body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
@@ -273,6 +277,9 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
         print("\n".join(geo_lines(report)))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
+    if interrupted:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
     return 0 if report.reached_goal else 1
 
 
