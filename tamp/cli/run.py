@@ -118,7 +118,7 @@ def run_command(args: argparse.Namespace) -> int:
     if recorded.get("executor") == "geometric":
         return geo_run(args, task, recorded)
     problem = load_problem(args.problem, args.domain) if task is None else task.problem
-    config = loop_config(args)
+    config = loop_config(args, task)
     if config.observe == Observation.CAMERA:
         checkpoint(config.checkpoint)
     steps = _given_steps(args.plan, problem)
