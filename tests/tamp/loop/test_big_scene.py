@@ -7,11 +7,16 @@ from __future__ import annotations
 
 import json
 import math
+import random
+
+import pytest
 
 from tamp.cli import build_parser
 from tamp.cli.recorded import loop_config, scene_run
 from tamp.loop import LoopConfig
-from tamp.world.load import MAX_REACH, MIN_REACH
+from tamp.world import geometry
+from tamp.world.geometry import Solid, apart, footprint_gap
+from tamp.world.load import MAX_REACH, MIN_REACH, load_scene
 from task.config import PlannerConfig
 from task.planner import plan
 
@@ -58,3 +63,39 @@ def test_a_scene_of_300_cubes_plans_a_3_move_goal_without_a_window(tmp_path):
     result = plan(task.problem, config.planner, seed=0)  # what the episode's first plan runs
     assert result.solved and len(result.plan) == 3
     assert result.stats["windows"] == 0  # Blocksworld's constructive moves, no soft window
+
+
+def test_loading_300_cubes_tests_footprints_only_where_they_may_touch(tmp_path, monkeypatch):
+    """The loader's pairwise checks (overlap, support) skip pairs apart in height or whose
+    footprints' circles do not meet: at 300 cubes 45k pairs, of which few need a footprint
+    test (each scene file was read in seconds, and the loop read it four times)."""
+    path = tmp_path / "towers.json"
+    path.write_text(json.dumps(towers(100)))
+    calls = []
+    real = geometry.footprint_gap
+
+    def counted(a, b):
+        calls.append(1)
+        return real(a, b)
+
+    monkeypatch.setattr(geometry, "footprint_gap", counted)
+    assert len(load_scene(path).objects) == 300
+    assert 0 < len(calls) < 10 * 300
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_footprints_apart_never_touch(seed):
+    """`apart` is conservative: whenever it holds, the footprints' gap is positive."""
+    rng = random.Random(seed)
+
+    def solid() -> Solid:
+        half = (rng.uniform(0.01, 0.1), rng.uniform(0.01, 0.1), 0.05)
+        cylinder = rng.random() < 0.3
+        half = (half[0], half[0], half[2]) if cylinder else half
+        centre = (rng.uniform(0, 0.4), rng.uniform(0, 0.4), 0.05)
+        return Solid("s", cylinder, centre, half, rng.uniform(-math.pi, math.pi))
+
+    pairs = [(solid(), solid()) for _ in range(2000)]
+    held = [(a, b) for a, b in pairs if apart(a, b)]
+    assert held and len(held) < len(pairs)  # both cases occur
+    assert all(footprint_gap(a, b) > 0 for a, b in held)
