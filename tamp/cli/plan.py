@@ -27,7 +27,7 @@ from tamp.cli.options import check_workcell, planner_config
 from tamp.cli.recorded import out_file, out_folder, plan_config
 from task import data
 from task.config import PlannerConfig
-from task.deadline import NO_DEADLINE, Deadline
+from task.deadline import NO_DEADLINE, Deadline, TimeLimitReached
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.instances import Instance, example, from_files
@@ -230,6 +230,31 @@ def _proof_json(name: str, proof: Proof, seed: int) -> str:
     )
 
 
+def _stopped(args: argparse.Namespace, name: str, proof: Proof, why: str, wall: float) -> int:
+    """The report of a ``tamp plan`` whose time limit passed before planning began (``why``:
+    the phase that stopped, `TimeLimitReached`'s message); exit code 1."""
+    said = f"stopped at the {args.time_limit_s:g} s time limit before planning ({why})"
+    if not args.json:
+        print(f"no plan found within the time limit: {said}")
+        return 1
+    body = {
+        "problem": name,
+        "status": PlanStatus.NO_PLAN.value,
+        "valid": False,
+        "proof": {"reason": proof.reason, "method": proof.method},
+        "domain_rules": None,
+        "note": "",
+        "moves": [],
+        "actions": [],
+        "validation": None,
+        "stats": {"time_s": wall, "time_limit": said},
+        "seed": args.seed,
+        "config": plan_config(args),
+    }
+    print(json.dumps(body, indent=2))
+    return 1
+
+
 def plan_command(args: argparse.Namespace) -> int:
     """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line; ``unsolvable:
     REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
@@ -244,7 +269,10 @@ def plan_command(args: argparse.Namespace) -> int:
         else:
             print(f"unsolvable: {proof.reason}")
         return 1
-    domain, instance = from_files(args.domain, args.problem, args.domain_rules)
+    try:
+        domain, instance = from_files(args.domain, args.problem, args.domain_rules, deadline)
+    except TimeLimitReached as exc:  # the lift grounds the problem again, for the planner
+        return _stopped(args, name, proof, str(exc), time.perf_counter() - start)
     if instance.note and not args.json:  # a near miss of a hand-written domain: the lift plans
         print(f"note: {instance.note}", file=sys.stderr)
     recorded, config, result, actions, validation = _solve(domain, instance, args, deadline)

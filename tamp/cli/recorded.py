@@ -62,20 +62,23 @@ def images_config(args: argparse.Namespace) -> dict:
     }
 
 
-def loop_config(args: argparse.Namespace):
-    """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first)."""
+def loop_config(args: argparse.Namespace, task=None):
+    """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first);
+    ``task``: the `scene_run` of ``args`` when the caller has it (a scene file of hundreds of
+    objects takes seconds to load and check), else it is read here."""
     from tamp.camera.from_images import PerceptionMode
     from tamp.loop import LoopConfig
     from tamp.loop.execute import ExecConfig
     from tamp.loop.faults import Injection
     from tamp.world import load_named, scene_config
+    from task.domains.blocksworld import NAME as BLOCKSWORLD
 
     check_workcell(args, executes=True)
-    task = scene_run(args)
+    task = scene_run(args) if task is None else task
     config = LoopConfig(
         sim=args.sim,
         grasp=args.grasp,
-        planner=planner_config(args),
+        planner=planner_config(args, BLOCKSWORLD),  # the loop's problems (`LoopConfig.planner`)
         inject=Injection.parse(args.inject),
         observe=args.observe,
         perception=PerceptionMode(args.perception, blur=args.blur),
@@ -319,7 +322,7 @@ def run_config(args: argparse.Namespace) -> dict:
                 laid = {"scene_file": None, "problem": args.problem, "scene": task.workcell}
                 return {**geo_config(args, task), **laid}
             return geo_config(args, task)
-    config = loop_config(args)
+    config = loop_config(args, task)
     return {
         **_loop_dict(config),
         "scene_file": None if task is None else args.scene,

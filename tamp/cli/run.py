@@ -102,7 +102,7 @@ def run_command(args: argparse.Namespace) -> int:
     if recorded.get("executor") == "geometric":
         return geo_run(args, task, recorded)
     problem = load_problem(args.problem, args.domain) if task is None else task.problem
-    config = loop_config(args)
+    config = loop_config(args, task)
     if config.observe == Observation.CAMERA:
         checkpoint(config.checkpoint)
     steps = _given_steps(args.plan, problem)
@@ -248,10 +248,18 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             file=sys.stderr,
         )
     recorder = None if args.record is None else RerunRecorder(args.record, task.scene.name)
+    interrupted = False
     with torch_threads(EPISODE_THREADS):
-        report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if args.json else _say, recorder=recorder
-        )
+        try:
+            report = run_geo_episode(
+                task.scene,
+                task.goal,
+                config,
+                on_event=None if args.json else _say,
+                recorder=recorder,
+            )
+        except EpisodeInterrupted as stop:  # Ctrl-C: the video and report of what was done
+            report, interrupted = stop.report, True
     body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
@@ -269,6 +277,9 @@ def geo_run(args: argparse.Namespace, task, recorded: dict) -> int:
             print(
                 f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
             )
+    if interrupted:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
     return 0 if report.reached_goal else 1
 
 

@@ -124,10 +124,20 @@ def footprint_gap(a: Solid, b: Solid) -> float:
     return _box_gap(a, b)
 
 
+def apart(a: Solid, b: Solid) -> bool:
+    """True when the circles around two footprints do not meet, so neither do the footprints
+    (`footprint_gap` > 0): the cheap test that spares a scene of hundreds of objects its
+    pairwise footprint tests."""
+    reach = math.hypot(a.half[0], a.half[1]) + math.hypot(b.half[0], b.half[1])
+    return math.dist(a.centre[:2], b.centre[:2]) > reach
+
+
 def penetration(a: Solid, b: Solid) -> float:
     """How deep (m) two solids interpenetrate: the lesser of their overlaps in height and on
     the table (0 when they do not)."""
     dz = min(a.top, b.top) - max(a.bottom, b.bottom)
+    if dz <= 0 or apart(a, b):  # apart in height or on the table
+        return 0.0
     dxy = -footprint_gap(a, b)
     return max(0.0, min(dz, dxy))
 
@@ -152,7 +162,9 @@ def support(scene: Scene, o: Movable, tol: Tolerances) -> Support:
     others = [of_movable(x) for x in scene.objects if x.name != o.name]
     walls = [of_box(w) for r in scene.regions for w in r.walls()]
     for s in [*others, *(of_box(b) for b in scene.obstacles), *walls]:
-        if abs(o.bottom - s.top) <= tol.z and footprint_gap(me, s) < -tol.overlap:
+        if abs(o.bottom - s.top) > tol.z or (tol.overlap >= 0 and apart(me, s)):
+            continue  # not at its bottom's height, or no footprint contact to test
+        if footprint_gap(me, s) < -tol.overlap:
             faces.append(s.name)
             if s.covers(o.pose.xyz):
                 centre.append(s.name)
