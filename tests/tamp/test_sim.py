@@ -19,8 +19,9 @@ from tamp.cli import main
 from tamp.cli.run import FRAME_PERIOD
 from tamp.loop.execute import ExecTools, execute_move
 from tamp.outcome import Failure
-from tamp.scene import Pose, layout, read_state
+from tamp.scene import Pose, layout
 from tamp.sim import SIMULATORS, make_simulator
+from tamp.world.convert.from_poses import read_state
 from task.errors import TampError
 from task.problem import TABLE, Move
 
