@@ -43,9 +43,9 @@ from tamp.scene import (
     SceneConfig,
     free_slot,
     plain_move,
-    read_state,
     towers,
 )
+from tamp.world.convert.from_poses import read_state
 from task.costs import IMPOSSIBLE
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem

@@ -6,8 +6,8 @@ colours from the scene's palette; ``SceneConfig.bodies`` may give any entity its
 on a *table slot*, a fixed grid of positions in front of the robot; a block moved onto the table
 goes to a free slot, or to the place a plan named for it (`PlacedMove`, made by `plain_move`
 from a move onto a planner's table place, `tamp.slots`). ``layout`` turns a state into poses
-(with small seeded jitter); ``read_state`` turns observed poses into a state, with tolerances,
-and says which block it cannot explain.
+(with small seeded jitter). Observed poses are read back into a state by the one scene reader
+(`tamp.world.convert.from_poses.read_state`, the support projection of `tamp.world.read_facts`).
 
 World frame = the robot base frame (``panda_link0``); the table surface is z = 0.
 """
@@ -106,8 +106,10 @@ class SceneConfig:
     jitter_xy: float = 0.004  # uniform +-, m
     jitter_yaw: float = 0.15  # uniform +-, rad
     max_height: int = 7  # blocks per tower the arm can still clear
-    tol_xy: float = 0.02  # read_state: a block rests on another if centres are this close in xy
-    tol_z: float = 0.012  # ... and the heights differ by one block size within this
+    tol_xy: float = 0.02  # the executor's checks: a block stacked on another is centred this close
+    # a bottom this close to a face rests on it (the loop's state reader, `tamp.world.geometry.
+    # loop_tolerances`; the executor's checks: heights differ by one block size within this)
+    tol_z: float = 0.012
     slot_radius: float = 0.05  # a slot is occupied when a block centre lies this close
     isolation: float = 0.3  # free_slot prefers slots with this much room to every block
     shape: str = "cube"  # one of SHAPES; a cylinder stands upright
@@ -241,55 +243,6 @@ def _fit(stacks: list[list[str]], order: np.ndarray, config: SceneConfig) -> lis
             )
         chosen[i] = int(fits[0])
     return [chosen[i] for i in range(len(stacks))]
-
-
-@dataclass(frozen=True)
-class Reading:
-    """The state read from poses: supports in entity order, or None with the reasons."""
-
-    state: tuple[str, ...] | None
-    issues: tuple[str, ...] = ()
-    loose: tuple[str, ...] = ()  # blocks resting on neither the table nor one block
-
-
-def read_state(
-    entities: Sequence[str], poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()
-) -> Reading:
-    """Observed poses -> crisp supports. A block rests on the table when its centre is half a
-    block high, on block b when it sits one block above b's centre within the tolerances (with
-    ``config.bodies``, each entity's own half height: x on b when x's centre is b's half height
-    plus x's above b's)."""
-    missing = [x for x in entities if x not in poses]
-    if missing:
-        raise SceneError(f"no pose for blocks {missing} (poses given: {sorted(poses)})")
-    hz = {x: config.body(x).half[2] for x in entities}  # half heights, m
-    support, issues, loose = {}, [], []
-    for x in entities:
-        px = poses[x]
-        if abs(px.xyz[2] - hz[x]) <= config.tol_z:
-            support[x] = TABLE
-            continue
-        below = [
-            b
-            for b in entities
-            if b != x
-            and np.linalg.norm(px.xy - poses[b].xy) <= config.tol_xy
-            and abs(px.xyz[2] - poses[b].xyz[2] - (hz[b] + hz[x])) <= config.tol_z
-        ]
-        if len(below) == 1:
-            support[x] = below[0]
-        else:
-            where = ", ".join(f"{v:.3f}" for v in px.xyz)
-            issues.append(f"block {x} at ({where}) rests on neither the table nor one block")
-            loose.append(x)
-    onto: dict[str, str] = {}
-    for x, sup in support.items():
-        if sup != TABLE and sup in onto:
-            issues.append(f"blocks {onto[sup]} and {x} both rest on {sup}")
-        onto[sup] = x
-    if issues:
-        return Reading(None, tuple(issues), tuple(loose))
-    return Reading(tuple(support[x] for x in entities))
 
 
 def top_z(poses: Mapping[str, Pose], config: SceneConfig = SceneConfig()) -> float:

@@ -22,6 +22,7 @@ from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
 from task import data
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains import GENERIC, get_domain, names
 from task.domains.match import Match, NearMiss, Renaming, match_domain, to_reference
 from task.errors import PDDLError, ProblemError, one_of
@@ -105,33 +106,41 @@ def from_text(
     name: str | None = None,
     optimal: int | None = None,
     rules: str | None = None,
-    reference: int | None = None,
+    deadline: Deadline = NO_DEADLINE,
 ) -> Instance:
-    """Parse problem text of ``domain``; errors name ``source``. ``rules``: see `choose_rules`."""
+    """Parse problem text of ``domain``; errors name ``source``. ``rules``: see `choose_rules`.
+    (A reference plan's length, `Instance.reference`, is the suite's to add.)
+    ``deadline``: a command's; the generic lift's grounding stops at it (`TimeLimitReached`)."""
     parsed = pddl_io.parse_problem(text, source, domain)
     chosen = choose_rules(domain, rules)
     order = pddl_io.object_order(text)
     try:
         if chosen.renaming is None:
-            problem = get_domain(chosen.name).from_pddl(domain, parsed, order)
+            problem = get_domain(chosen.name).from_pddl(domain, parsed, order, deadline)
         else:
             found = Match(chosen.name, chosen.renaming)
             ref_domain, ref_problem, ref_order = to_reference(found, domain, parsed, order)
-            problem = get_domain(chosen.name).from_pddl(ref_domain, ref_problem, ref_order)
+            problem = get_domain(chosen.name).from_pddl(
+                ref_domain, ref_problem, ref_order, deadline
+            )
             problem = replace(problem, renaming=chosen.renaming)
     except (PDDLError, ProblemError) as exc:
         said = str(exc) if chosen.renaming is None else chosen.renaming.speak(str(exc))
         raise type(exc)(f"{source}: {said}") from None
-    return Instance(name or problem.name, problem, parsed, optimal, reference, chosen.note)
+    return Instance(name or problem.name, problem, parsed, optimal, note=chosen.note)
 
 
 def from_files(
-    domain_path: str | Path, problem_path: str | Path, rules: str | None = None
+    domain_path: str | Path,
+    problem_path: str | Path,
+    rules: str | None = None,
+    deadline: Deadline = NO_DEADLINE,
 ) -> tuple[Domain, Instance]:
-    """Load a domain file and a problem file (``rules``: see `rules_for`)."""
+    """Load a domain file and a problem file (``rules``: see `rules_for`; ``deadline``: see
+    `from_text`)."""
     domain = pddl_io.load_domain(domain_path)
     text = pddl_io.read_text(problem_path)
-    return domain, from_text(domain, text, str(problem_path), rules=rules)
+    return domain, from_text(domain, text, str(problem_path), rules=rules, deadline=deadline)
 
 
 def example() -> tuple[Domain, Instance]:

@@ -34,8 +34,8 @@ SHARED = {"task.errors"}
 TAMP_LAYERS = (
     ("episode_report", "modes", "obstacles", "outcome", "rerun_log", "sweep"),
     ("scene",),
-    ("arm_costs", "sim"),
-    ("slots", "video", "world"),
+    ("sim",),
+    ("arm_costs", "slots", "video", "world"),
     ("camera",),
     ("geo",),
     ("loop",),

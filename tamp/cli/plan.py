@@ -26,7 +26,7 @@ from tamp.cli.recorded import out_file, out_folder
 from tamp.cli.settings.plan import PlanSettings, ValidateSettings, plan_record
 from task import data
 from task.config import PlannerConfig
-from task.deadline import NO_DEADLINE, Deadline
+from task.deadline import NO_DEADLINE, Deadline, TimeLimitReached
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
 from task.instances import Instance, example, from_files
@@ -230,6 +230,32 @@ def _proof_json(name: str, proof: Proof, seed: int) -> str:
     )
 
 
+def _stopped(settings: PlanSettings, name: str, proof: Proof, why: str, wall: float) -> int:
+    """The report of a ``tamp plan`` whose time limit passed before planning began (``why``:
+    the phase that stopped, `TimeLimitReached`'s message); exit code 1."""
+    limit = settings.planner.get("time_limit_s")
+    said = f"stopped at the {limit:g} s time limit before planning ({why})"
+    if not settings.json:
+        print(f"no plan found within the time limit: {said}")
+        return 1
+    body = {
+        "problem": name,
+        "status": PlanStatus.NO_PLAN.value,
+        "valid": False,
+        "proof": {"reason": proof.reason, "method": proof.method},
+        "domain_rules": None,
+        "note": "",
+        "moves": [],
+        "actions": [],
+        "validation": None,
+        "stats": {"time_s": wall, "time_limit": said},
+        "seed": settings.seed,
+        "config": plan_record(settings),
+    }
+    print(json.dumps(body, indent=2))
+    return 1
+
+
 def plan_command(settings: PlanSettings) -> int:
     """``tamp plan DOMAIN PROBLEM``: the PDDL plan and its validation line; ``unsolvable:
     REASON`` when a proof says no plan exists, ``no plan found within BUDGET`` otherwise."""
@@ -243,7 +269,11 @@ def plan_command(settings: PlanSettings) -> int:
         else:
             print(f"unsolvable: {proof.reason}")
         return 1
-    domain, instance = from_files(settings.domain, settings.problem, settings.workcell.rules)
+    rules = settings.workcell.rules
+    try:
+        domain, instance = from_files(settings.domain, settings.problem, rules, deadline)
+    except TimeLimitReached as exc:  # the lift grounds the problem again, for the planner
+        return _stopped(settings, name, proof, str(exc), time.perf_counter() - start)
     if instance.note and not settings.json:  # a near miss of a hand-written domain: the lift plans
         print(f"note: {instance.note}", file=sys.stderr)
     recorded, config, result, actions, validation = _solve(domain, instance, settings, deadline)

@@ -53,19 +53,22 @@ def images_config(args: argparse.Namespace) -> dict:
 
 def loop_config(args: argparse.Namespace, task=None):
     """The `LoopConfig` of ``run``, ``demo`` and ``bench motion`` (refused combinations first);
-    ``task``: the scene file's `tamp.world.blocks.SceneTask` (`scene_run`), whose table it runs
-    on (None: the named workcell ``--scene``)."""
+    ``task``: the scene file's `tamp.world.blocks.SceneTask` (`scene_run`, read once by the
+    caller: a scene file of hundreds of objects takes seconds to load and check), whose table
+    it runs on (None: the named workcell ``--scene``). The loop plans with Blocksworld's
+    planner defaults, as ``tamp plan`` does."""
     from tamp.camera.from_images import PerceptionMode
     from tamp.loop import LoopConfig
     from tamp.loop.execute import ExecConfig
     from tamp.loop.faults import Injection
     from tamp.world import load_named, scene_config
+    from task.domains.blocksworld import NAME as BLOCKSWORLD
 
     check_workcell(args, executes=True)
     config = LoopConfig(
         sim=args.sim,
         grasp=args.grasp,
-        planner=planner_config(args),
+        planner=planner_config(args, BLOCKSWORLD),  # the loop's problems (`LoopConfig.planner`)
         inject=Injection.parse(args.inject),
         observe=args.observe,
         perception=PerceptionMode(args.perception, blur=args.blur),

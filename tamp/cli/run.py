@@ -211,10 +211,18 @@ def geo_run(settings: RunSettings, recorded: dict) -> int:
             file=sys.stderr,
         )
     recorder = None if output.record is None else RerunRecorder(output.record, task.scene.name)
+    interrupted = False
     with torch_threads(EPISODE_THREADS):
-        report = run_geo_episode(
-            task.scene, task.goal, config, on_event=None if output.json else _say, recorder=recorder
-        )
+        try:
+            report = run_geo_episode(
+                task.scene,
+                task.goal,
+                config,
+                on_event=None if output.json else _say,
+                recorder=recorder,
+            )
+        except EpisodeInterrupted as stop:  # Ctrl-C: the video and report of what was done
+            report, interrupted = stop.report, True
     body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
@@ -232,6 +240,9 @@ def geo_run(settings: RunSettings, recorded: dict) -> int:
             print(
                 f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
             )
+    if interrupted:
+        print("tamp: interrupted", file=sys.stderr)
+        return 130
     return 0 if report.reached_goal else 1
 
 

@@ -52,7 +52,7 @@ from tamp.geo.places import candidate_places, fixed_targets
 from tamp.geo.search import SearchConfig, plan_search
 from tamp.geo.types import TABLE, GeoMove, GeoPlan, GeoStatus, moved
 from tamp.modes import GeoPlanner, Observation
-from tamp.outcome import EpisodeStatus, Failure, time_limit_reached
+from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_reached
 from tamp.scene import Pose
 from tamp.sim.base import Simulator
 from tamp.sim.faults import nudge
@@ -243,6 +243,7 @@ def run_geo_episode(
     ``GOAL_REACHED`` / ``NOT_REACHED`` (the plans ran out without the goal, or only the robot
     saw it), ``NO_PLAN`` (the planner's status and reason in ``reason``), ``REPLAN_BUDGET`` or
     ``MOVE_BUDGET``; ``reached_goal`` scored on ground truth; one `MoveRecord` per move.
+    Ctrl-C raises `EpisodeInterrupted` holding the report so far (status ``INTERRUPTED``).
     Torch's thread count is the caller's: ``tamp run`` and ``tamp bench tamp`` run an
     episode on one thread (`tamp.sweep.torch_threads`)."""
     planner, backend, seed = config.planner, config.sim, config.seed
@@ -365,9 +366,10 @@ def run_geo_episode(
                     last = records[-1].failure
                     reason = f"more than {max_replans} replans; last: {last and last.value}"
                     break
-        with sim.truth.scoring():
-            truth = _with_poses(scene, sim.truth.block_poses())
-        reached = goal.holds(read_facts(truth, OBSERVED))
+        reached = _truly_holds(sim, scene, goal)
+    except KeyboardInterrupt:  # Ctrl-C: the report so far, raised as the loop's episode does
+        status, reason = EpisodeStatus.INTERRUPTED, f"Ctrl-C after {len(records)} moves"
+        reached = _truly_holds(sim, scene, goal)
     except BaseException:
         if recorder is not None:
             recorder.close()
@@ -407,6 +409,8 @@ def run_geo_episode(
     )
     if recorder is not None:
         recorder.close(report)
+    if status is EpisodeStatus.INTERRUPTED:
+        raise EpisodeInterrupted(report)
     return report
 
 
@@ -415,6 +419,13 @@ def _faults(drops: set[int], nudged: list[int], moves: int) -> tuple[str, ...]:
     ``K`` run with a drop, ``nudge@K`` for each object pushed after move ``K``."""
     hit = [(k, "drop") for k in drops if k < moves] + [(k, "nudge") for k in nudged]
     return tuple(f"{kind}@{k}" for k, kind in sorted(hit))
+
+
+def _truly_holds(sim: Simulator, scene: Scene, goal: Goal) -> bool:
+    """Whether ``goal`` holds in the simulator's ground truth (scoring only)."""
+    with sim.truth.scoring():
+        truth = _with_poses(scene, sim.truth.block_poses())
+    return goal.holds(read_facts(truth, OBSERVED))
 
 
 def _time_limit_s(config) -> float | None:

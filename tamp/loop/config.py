@@ -12,6 +12,7 @@ from tamp.modes import Crisp, Observation, Perception
 from tamp.scene import SceneConfig
 from tamp.sim.base import Camera
 from task.config import PlannerConfig
+from task.domains.blocksworld import NAME as BLOCKSWORLD
 from task.errors import TampError, member
 
 
@@ -28,7 +29,10 @@ class LoopConfig:
     max_replans: int = 8
     max_tidies: int = 2  # attempts to put loose (leaning) blocks back on the table
     max_moves: int = 60
-    planner: PlannerConfig = PlannerConfig()
+    # the loop executes Blocksworld problems: Blocksworld's planner defaults, as ``tamp plan``
+    # plans them (`PlannerConfig.for_domain`): from 16 blocks its constructive moves without a
+    # window and windows over the part a window reaches, not all the blocks (300: 40 s a window)
+    planner: PlannerConfig = PlannerConfig.for_domain(BLOCKSWORLD)
     execution: ExecConfig = ExecConfig()
     scene: SceneConfig = SceneConfig()
     camera: Camera = Camera()

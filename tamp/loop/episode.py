@@ -55,12 +55,13 @@ from tamp.loop.report import EpisodeReport, Progress
 from tamp.loop.score import MoveScore, Scorer
 from tamp.modes import Crisp, Observation
 from tamp.outcome import EpisodeInterrupted, EpisodeStatus, Failure, time_limit_reached
-from tamp.scene import CAMERA_COLOURS, Pose, Reading, SceneError, layout, place_pose
+from tamp.scene import CAMERA_COLOURS, Pose, SceneError, layout, place_pose
 from tamp.sim.base import Simulator
 from tamp.sim.factory import make_simulator
 from tamp.sim.faults import nudge
 from tamp.sim.harness import Harness
 from tamp.slots import plan_on_places
+from tamp.world.convert.from_poses import Reading, read_state
 from task.domains import get_domain
 from task.planner import plan
 from task.problem import Move, Problem
@@ -351,7 +352,8 @@ class Episode:
         if self.config.crisp is not Crisp.TRUE:
             return observed
         with self.sim.truth.oracle():
-            truth = self.sim.truth.state(self.problem.entities, self.config.scene)
+            poses = self.sim.truth.block_poses()
+        truth = read_state(self.problem.entities, poses, self.config.scene).state
         return observed if truth is None else truth
 
     def _plan_window(self, state, seed: int):

@@ -10,9 +10,10 @@ the loop's: a block goes where the loop would put it (onto a block, or onto its 
 so the scene's few slots stay the constraint they are. This module translates:
 
 - `world_scene`: the observed block poses on a `tamp.scene.SceneConfig` table as a
-  `tamp.world.schema.Scene` (cubes of the block size, the scene's obstacles and slot grid);
-  each block's height is snapped to its level in the observed state, so the geometric reader's
-  tight tolerances read the state the loop's looser reader read;
+  `tamp.world.schema.Scene` (`tamp.world.convert.from_poses.loop_scene`, the scene the loop's
+  state is read from); each block's height is snapped to its level in the observed state, so
+  the geometric checks, which read facts at a scene file's tight tolerances, read the state
+  the loop read at its looser ones;
 - `blocks_goal`: a Blocksworld goal as the scene goal (``on`` / ``ontable`` atoms);
 - `geo_check`: one loop move checked over every grasp family, and a colliding grasp in other
   postures of the arm (`POSTURES`), without running it (the loop's motion check of a planned
@@ -37,8 +38,9 @@ import numpy as np
 
 from motion.grasps import FAMILIES
 from tamp.outcome import Failure
-from tamp.scene import PALETTE, Pose, SceneConfig, read_state, towers
+from tamp.scene import Pose, SceneConfig, towers
 from tamp.sim.harness import Harness
+from tamp.world.convert.from_poses import loop_scene, read_state
 from task.problem import TABLE, Problem
 
 if TYPE_CHECKING:
@@ -47,8 +49,6 @@ if TYPE_CHECKING:
     from tamp.world.goal import Goal
     from tamp.world.schema import Scene
 
-# the named scenes' table top (`tamp/world/scenes/*.json`), m: (x, y) low and high corners
-TABLE_LO, TABLE_HI = (-0.3, -0.7), (1.0, 0.7)
 CHOICES = FAMILIES  # the grasp families the loop's geometric moves try: every one
 # the order they are tried in (each family in `tamp.geo.check.grasp_order`): side grasps last,
 # as the open fingers of a side grasp beside a block on the table reach the table top (a
@@ -63,39 +63,24 @@ POSTURES = 16
 
 
 def world_scene(entities: Sequence[str], poses: Mapping[str, Pose], scene: SceneConfig) -> Scene:
-    """The blocks ``entities`` observed at ``poses`` on ``scene``'s table as a geometric scene:
-    cubes of ``scene.block_size`` in the palette's colours, the scene's fixed boxes as
-    obstacles, its slot grid. When the loop's reader reads a state from the poses, each block's
-    centre height is set to its level in it (the geometric reader is tighter than the loop's)."""
-    from tamp.world.schema import Movable, Scene, Slots, Table
-
-    s = scene.block_size
-    poses = dict(poses)
+    """The blocks ``entities`` observed at ``poses`` on ``scene``'s table as a geometric scene
+    (`tamp.world.convert.from_poses.loop_scene`: each block its solid, the scene's fixed boxes as
+    obstacles, its slot grid). When the loop's reader reads a state from the poses, each block
+    stands exactly on what it was read on (the geometric checks read the scene with a file's
+    tight tolerances, not the loop's)."""
+    world = loop_scene(entities, poses, scene)
     reading = read_state(entities, poses, scene)
-    if reading.state is not None:
-        for tower in towers(entities, reading.state):
-            for level, x in enumerate(tower):
-                xyz = poses[x].xyz
-                poses[x] = Pose((float(xyz[0]), float(xyz[1]), s / 2 + level * s), poses[x].yaw)
-    colours = dict(scene.palette)
-    fallback = [rgb for _, rgb in PALETTE]
-    objects = tuple(
-        Movable(
-            x,
-            "cube",
-            (s,),
-            colours.get(x, fallback[i % len(fallback)]),
-            Pose(tuple(float(v) for v in poses[x].xyz), float(poses[x].yaw)),
-        )
-        for i, x in enumerate(entities)
-    )
-    return Scene(
-        scene.name,
-        Table(TABLE_LO, TABLE_HI),
-        obstacles=tuple(scene.obstacles),
-        objects=objects,
-        slots=Slots(tuple(scene.slot_xs), tuple(scene.slot_ys)),
-    )
+    if reading.state is None:
+        return world
+    objects = {o.name: o for o in world.objects}
+    for tower in towers(entities, reading.state):
+        bottom = 0.0
+        for x in tower:
+            o = objects[x]
+            xyz = (o.pose.xyz[0], o.pose.xyz[1], bottom + o.half[2])
+            objects[x] = replace(o, pose=Pose(xyz, o.pose.yaw))
+            bottom += 2 * o.half[2]
+    return replace(world, objects=tuple(objects[x] for x in entities))
 
 
 def blocks_goal(problem: Problem) -> Goal:

@@ -35,7 +35,8 @@ from tamp.loop.config import LoopConfig
 from tamp.loop.episode import Episode
 from tamp.loop.report import EpisodeReport, Progress
 from tamp.outcome import EpisodeInterrupted, EpisodeStatus
-from tamp.scene import SceneConfig, read_state
+from tamp.scene import SceneConfig
+from tamp.world.convert.from_poses import read_state
 from task import data
 from task.domains.blocksworld import moves_to_actions, to_atoms, to_pddl
 from task.errors import PDDLError, ProblemError, one_of
@@ -309,7 +310,8 @@ class GivenPlanEpisode(Episode):
         if not self.stop_at_invalid or step.move is None:
             return False
         with self.sim.truth.experimenter():
-            truth = self.sim.truth.state(self.problem.entities, self.config.scene)
+            poses = self.sim.truth.block_poses()
+        truth = read_state(self.problem.entities, poses, self.config.scene).state
         return verdict(step, self.problem, truth, self.pddl)[0] is False
 
     def _observe(self, p: Progress) -> bool:

@@ -3,7 +3,7 @@ from, each from the sensor its observation mode has (`tamp.loop.sensors`).
 
 ``observe="state"``: poses from the motion-capture oracle (`MocapPoses`, the one sensor that
 reads simulator ground truth, by design), optionally with injected noise; the state is read
-from them (`tamp.scene.read_state`).
+from them (`tamp.world.convert.from_poses.read_state`).
 ``observe="camera"``: poses estimated from one RGB-D image per observation (`CameraPoses`);
 the state is read from the camera image by the trained perception model
 (`tamp.camera.from_images`). When the camera cannot see a block while the arm is away from
@@ -30,8 +30,9 @@ from tamp.camera.states import complete_goal
 from tamp.loop.config import LoopConfig
 from tamp.loop.faults import draw
 from tamp.loop.sensors import CameraPoses, MocapPoses
-from tamp.scene import PALETTE, Pose, Reading, read_state
+from tamp.scene import PALETTE, Pose
 from tamp.sim.base import Simulator
+from tamp.world.convert.from_poses import Reading, read_state
 from task.problem import TABLE, Problem
 
 SETTLE_S = 0.3  # simulated seconds to let blocks come to rest before an observation

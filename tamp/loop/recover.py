@@ -9,7 +9,7 @@ from collections.abc import Callable, Sequence
 
 from tamp.loop.execute import ExecutionResult
 from tamp.outcome import Failure
-from tamp.scene import Reading
+from tamp.world.convert.from_poses import Reading
 from task.problem import TABLE, Move
 
 

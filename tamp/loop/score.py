@@ -18,6 +18,7 @@ import enum
 
 from tamp.scene import SceneConfig
 from tamp.sim.truth import GroundTruth
+from tamp.world.convert.from_poses import read_state
 from task.domains.base import Domain, State
 from task.problem import Move, Problem
 
@@ -39,7 +40,8 @@ class Scorer:
     def state(self) -> State | None:
         """The true symbolic state (None when the blocks form none, e.g. one leans)."""
         with self.truth.scoring():
-            return self.truth.state(self.problem.entities, self.scene)
+            poses = self.truth.block_poses()
+        return read_state(self.problem.entities, poses, self.scene).state
 
     def reached(self, domain: Domain) -> bool:
         """The true state satisfies the problem's own (PDDL) goal."""

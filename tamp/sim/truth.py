@@ -1,10 +1,11 @@
 """The simulator's ground truth behind one door, `GroundTruth`, which the closed loop locks.
 
 Simulator ground truth only scores episodes: a real robot has joint encoders, finger sensors
-and a camera, not the world's state. Every ground-truth query (block poses, the true symbolic
-state, the snapshot a video frame is drawn from) goes through ``sim.truth``. An episode locks
-it; a locked `GroundTruth` answers only inside one of four named grants, and anything else that
-reads it raises `GroundTruthLeak` naming the caller:
+and a camera, not the world's state. Every ground-truth query (block poses, which the one
+state reader `tamp.world.convert.from_poses.read_state` reads as the true symbolic state; the
+snapshot a video frame is drawn from) goes through ``sim.truth``. An episode locks it; a
+locked `GroundTruth` answers only inside one of four named grants, and anything else that reads
+it raises `GroundTruthLeak` naming the caller:
 
 - ``scoring()``: the experimenter scores the episode (the goal check, disturbed stacks, a given
   plan's per-step verdicts); what it reads never changes what the robot does;
@@ -25,13 +26,13 @@ from __future__ import annotations
 
 import sys
 from collections import Counter
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import NamedTuple
 
 import numpy as np
 
-from tamp.scene import Pose, SceneConfig, read_state
+from tamp.scene import Pose
 from task.errors import TampError
 
 GRANTS = ("scoring", "experimenter", "oracle", "recording")
@@ -131,14 +132,6 @@ class GroundTruth:
         locked."""
         self._check("block_poses")
         return self._read_poses()
-
-    def state(
-        self, entities: Sequence[str], scene: SceneConfig = SceneConfig()
-    ) -> tuple[str, ...] | None:
-        """The true symbolic state the block poses form (`tamp.scene.read_state`), or None when
-        they form none (a block leaning or on an edge)."""
-        self._check("state")
-        return read_state(entities, self._read_poses(), scene).state
 
     def snapshot(self) -> Snapshot:
         """The arm, fingers and true block poses now (`Snapshot`), what a video

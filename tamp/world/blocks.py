@@ -11,9 +11,11 @@ A scene the geometry cannot explain is one `SceneFileError` line, before any wor
 beyond the Blocksworld loop is a `BeyondLoop` (a `SceneFileError`) instead: an object that is not
 a cube of the loop's block size, an object resting in a region, a scene where nothing may be
 parked on the bare table, a goal atom other than ``on`` / ``ontable`` (``in``: regions are not
-the loop's targets), and poses the loop's own state reader (`tamp.scene.read_state`, whose
-tolerances are looser than the scene file's) would read as another state. ``tamp run`` runs such
-a scene through the geometric TAMP episode (`tamp.geo.episode`) instead.
+the loop's targets), and poses from which the loop's state reader reads no Blocksworld state.
+The initial state is what the loop reads at every observation
+(`tamp.world.convert.from_poses.read_state`: the same reader, `read_facts`, at the loop's
+tolerances), so the loop plans from the state it then observes. ``tamp run`` runs a scene
+beyond the loop through the geometric TAMP episode (`tamp.geo.episode`) instead.
 """
 
 from __future__ import annotations
@@ -21,7 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from tamp.scene import Pose, SceneConfig, read_state
+from tamp.scene import Pose, SceneConfig
+from tamp.world.convert.from_poses import read_state
 from tamp.world.goal import Goal, load_goal
 from tamp.world.goal_check import check_goal
 from tamp.world.load import load_scene, scene_config
@@ -83,17 +86,15 @@ def scene_task(
                 f"{' and '.join(GOAL_PREDICATES)} atoms only ({why})"
             )
     entities = tuple(o.name for o in scene.objects)
-    support = dict(facts.supports)
+    config = scene_config(scene, base)  # obstacles, walls, floors, slots, bodies, colours
+    poses = tuple((o.name, o.pose) for o in scene.objects)
     problem = Problem(
         name=scene.name,
         domain="blocksworld",
         entities=entities,
-        init=tuple(support[x] for x in entities),
+        init=_loop_state(entities, dict(poses), config, label),
         goal=tuple((a[1], a[2] if a[0] == "on" else TABLE) for a in wanted.atoms),
     )
-    config = scene_config(scene, base)  # obstacles, walls, floors, slots, bodies, colours
-    poses = tuple((o.name, o.pose) for o in scene.objects)
-    _check_reader(problem, dict(poses), config, label)
     return SceneTask(scene, wanted, facts, problem, poses, config)
 
 
@@ -126,22 +127,14 @@ def _check_blocks(scene: Scene, size: float, label: str) -> None:
             )
 
 
-def _check_reader(problem: Problem, poses: dict, config: SceneConfig, label: str) -> None:
-    """The loop reads each new state with `tamp.scene.read_state`: the file's poses must read
-    as the state the geometry gives, or the loop would replan from the first observation."""
-    reading = read_state(problem.entities, poses, config)
-    if reading.state == problem.init:
-        return
+def _loop_state(entities: tuple[str, ...], poses: dict, config: SceneConfig, label: str):
+    """The initial state as the loop reads it at every observation (`read_state`, the one scene
+    reader at the loop's tolerances, on the loop's table): BeyondLoop when it reads none."""
+    reading = read_state(entities, poses, config)
     if reading.state is None:
-        detail = "; ".join(reading.issues)
-    else:
-        detail = ", ".join(
-            f"{x} on {r} (geometry: on {g})"
-            for x, r, g in zip(problem.entities, reading.state, problem.init, strict=True)
-            if r != g
+        raise BeyondLoop(
+            f"{label}: the loop's state reader (bottoms within {config.tol_z * 1000:.0f} mm of "
+            f"a face, a block on another only with its centre over it) reads no Blocksworld "
+            f"state from the poses: {'; '.join(reading.issues)}"
         )
-    raise BeyondLoop(
-        f"{label}: the loop's state reader (centres within {config.tol_xy * 1000:.0f} mm, "
-        f"heights within {config.tol_z * 1000:.0f} mm of a block) reads the poses otherwise: "
-        f"{detail}"
-    )
+    return reading.state

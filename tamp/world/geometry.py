@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 from tamp.obstacles import Obstacle
+from tamp.scene import SceneConfig
 from tamp.world.schema import Movable, Region, Scene
 
 TABLE_FACE = "table"
@@ -21,14 +22,29 @@ TABLE_FACE = "table"
 @dataclass(frozen=True)
 class Tolerances:
     """How exact a scene must be (m). A file is authored, so the defaults are tight; reading
-    observed poses may want `tamp.scene.SceneConfig`'s looser ``tol_z`` (0.012)."""
+    observed poses wants looser ones (`loop_tolerances`, `LOOP`)."""
 
     z: float = 0.005  # a bottom this close to a face rests on it; farther above floats
     overlap: float = 0.002  # two solids may interpenetrate this much (contact, not overlap)
     edge: float = 0.0  # a footprint "in" a region may cross its edge this much (sensing)
+    # an object rests on another object only when its centre lies over the other's footprint
+    # grown by this (its weight is carried there); None: whenever the footprints overlap
+    centre: float | None = None
 
 
 TIGHT = Tolerances()  # the default: a scene file's
+
+
+def loop_tolerances(config: SceneConfig = SceneConfig()) -> Tolerances:
+    """The closed loop's tolerances for observed block poses
+    (`tamp.world.convert.from_poses.read_state`): a bottom within ``config.tol_z`` of a face
+    rests on it (sensing and settling), and a block rests on another only with its centre over
+    that block's footprint, so a block across two reads as on the one that carries it, as the
+    loop stacks, and a block tipped past its support's edge (which falls) rests on neither."""
+    return Tolerances(z=config.tol_z, centre=0.0)
+
+
+LOOP = loop_tolerances()  # the loop's, on the default table
 
 
 @dataclass(frozen=True)
@@ -124,10 +140,20 @@ def footprint_gap(a: Solid, b: Solid) -> float:
     return _box_gap(a, b)
 
 
+def apart(a: Solid, b: Solid) -> bool:
+    """True when the circles around two footprints do not meet, so neither do the footprints
+    (`footprint_gap` > 0): the cheap test that spares a scene of hundreds of objects its
+    pairwise footprint tests."""
+    reach = math.hypot(a.half[0], a.half[1]) + math.hypot(b.half[0], b.half[1])
+    return math.dist(a.centre[:2], b.centre[:2]) > reach
+
+
 def penetration(a: Solid, b: Solid) -> float:
     """How deep (m) two solids interpenetrate: the lesser of their overlaps in height and on
     the table (0 when they do not)."""
     dz = min(a.top, b.top) - max(a.bottom, b.bottom)
+    if dz <= 0 or apart(a, b):  # apart in height or on the table
+        return 0.0
     dxy = -footprint_gap(a, b)
     return max(0.0, min(dz, dxy))
 
@@ -143,7 +169,8 @@ class Support:
 
 
 def support(scene: Scene, o: Movable, tol: Tolerances) -> Support:
-    """The faces ``o`` rests on (within ``tol.z`` of its bottom and touching its footprint)."""
+    """The faces ``o`` rests on (within ``tol.z`` of its bottom and touching its footprint; an
+    object's only under ``o``'s centre when ``tol.centre`` says so)."""
     me = of_movable(o)
     faces, centre = [], []
     if abs(o.bottom) <= tol.z and scene.table.holds(o.pose.xyz):
@@ -151,8 +178,13 @@ def support(scene: Scene, o: Movable, tol: Tolerances) -> Support:
         centre.append(TABLE_FACE)
     others = [of_movable(x) for x in scene.objects if x.name != o.name]
     walls = [of_box(w) for r in scene.regions for w in r.walls()]
-    for s in [*others, *(of_box(b) for b in scene.obstacles), *walls]:
-        if abs(o.bottom - s.top) <= tol.z and footprint_gap(me, s) < -tol.overlap:
+    fixed = [*(of_box(b) for b in scene.obstacles), *walls]
+    for k, s in enumerate([*others, *fixed]):
+        if abs(o.bottom - s.top) > tol.z or (tol.overlap >= 0 and apart(me, s)):
+            continue  # not at its bottom's height, or no footprint contact to test
+        if footprint_gap(me, s) < -tol.overlap:
+            if k < len(others) and not _carries(s, o, tol):
+                continue
             faces.append(s.name)
             if s.covers(o.pose.xyz):
                 centre.append(s.name)
@@ -161,6 +193,12 @@ def support(scene: Scene, o: Movable, tol: Tolerances) -> Support:
             faces.append(f"region:{r.name}")
             centre.append(f"region:{r.name}")
     return Support(tuple(faces), tuple(centre))
+
+
+def _carries(s: Solid, o: Movable, tol: Tolerances) -> bool:
+    """True when object ``s``, touching ``o``'s footprint, carries it by ``tol.centre``: its
+    footprint (grown by that) lies under ``o``'s centre, or ``tol.centre`` is None."""
+    return tol.centre is None or s.covers(o.pose.xyz, tol.centre)
 
 
 def _over_region(r: Region, xy) -> bool:

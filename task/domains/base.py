@@ -26,6 +26,7 @@ from pddl.core import Domain as PDDLDomain
 from pddl.core import Problem as PDDLProblem
 from torch import Tensor
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.problem import Action, Move, Problem
 from task.soft import transition
 
@@ -201,9 +202,17 @@ class Domain(Protocol):
         """Whether the parsed PDDL domain is this domain (recognition, ``--domain-rules``)."""
         ...
 
-    def from_pddl(self, domain: PDDLDomain, problem: PDDLProblem, order: Sequence[str]) -> Problem:
+    def from_pddl(
+        self,
+        domain: PDDLDomain,
+        problem: PDDLProblem,
+        order: Sequence[str],
+        deadline: Deadline = NO_DEADLINE,
+    ) -> Problem:
         """The relational problem of a parsed PDDL problem; ``order``: objects in file order.
-        Raises PDDLError naming what does not fit the domain."""
+        Raises PDDLError naming what does not fit the domain. ``deadline``: a command's
+        (`task.deadline`); a domain that grounds the problem (the generic lift) stops at it
+        with `TimeLimitReached`, one that reads it in linear time may ignore it."""
         ...
 
     def to_actions(

@@ -17,6 +17,7 @@ from pathlib import Path
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.errors import PDDLError, ProblemError, one_of
 from task.problem import TABLE, Action, Move, Problem
 from task.symbolic import pddl_io, strips
@@ -104,11 +105,17 @@ def _goal(problem: PDDLProblem, objects: Sequence[str]) -> tuple[tuple[str, str]
     return goal
 
 
-def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None = None) -> Problem:
+def from_pddl(
+    domain: Domain,
+    problem: PDDLProblem,
+    order: Sequence[str] | None = None,
+    deadline: Deadline = NO_DEADLINE,
+) -> Problem:
     """The relational `Problem` of a parsed blocksworld problem.
 
     ``order`` gives the entity order (the file order, see `pddl_io.object_order`); without it
     the objects are sorted naturally (a < b < ... , b2 < b10), since `pddl` keeps only a set.
+    ``deadline`` is not looked at: the reading is linear in the problem (`Domain.from_pddl`).
     """
     actions = {str(a.name).lower() for a in domain.actions}
     if actions != set(OPERATORS):

@@ -19,6 +19,7 @@ from collections.abc import Sequence
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains.logistics_map import LogisticsData
 from task.errors import PDDLError, one_of
 from task.problem import Problem
@@ -119,12 +120,18 @@ def _goal(problem: PDDLProblem, kinds, city, airports, support) -> list[tuple[st
     return list(goal.items())
 
 
-def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None = None) -> Problem:
+def from_pddl(
+    domain: Domain,
+    problem: PDDLProblem,
+    order: Sequence[str] | None = None,
+    deadline: Deadline = NO_DEADLINE,
+) -> Problem:
     """The relational `Problem` of a parsed logistics-strips problem.
 
     ``order``: the objects in file order (`pddl_io.object_order`); without it they are sorted
     naturally. PDDLError names what does not fit (an object without one type, a package in two
-    places, an airplane off an airport, a goal that is not an ``at`` atom or cannot hold)."""
+    places, an airplane off an airport, a goal that is not an ``at`` atom or cannot hold).
+    ``deadline`` is not looked at: the reading is linear in the problem."""
     if not matches(domain):
         raise PDDLError(f"domain {domain.name} is not {PDDL_DOMAIN} (needs {', '.join(OPERATORS)})")
     names = {str(o.name).lower() for o in problem.objects}

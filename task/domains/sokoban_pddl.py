@@ -17,6 +17,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains.sokoban_grid import ROBOT, Grid, apply_move, check_move, grid
 from task.errors import PDDLError, ProblemError
 from task.problem import Action, Move, Problem
@@ -63,8 +64,14 @@ def _checked(atoms: Iterable[tuple], kinds: dict[str, list[str]], where: str) ->
     return out
 
 
-def from_pddl(domain: Domain, problem: PDDLProblem, order: Sequence[str] | None = None) -> Problem:
-    """The `Problem` of a parsed typed-sokoban problem (``order``: objects in file order)."""
+def from_pddl(
+    domain: Domain,
+    problem: PDDLProblem,
+    order: Sequence[str] | None = None,
+    deadline: Deadline = NO_DEADLINE,
+) -> Problem:
+    """The `Problem` of a parsed typed-sokoban problem (``order``: objects in file order;
+    ``deadline`` is not looked at: the reading is linear in the problem)."""
     if not matches(domain):
         raise PDDLError(f"domain {domain.name} is not {PDDL_DOMAIN} (needs move/3, push/5)")
     kinds = _kinds(problem, order)

@@ -30,6 +30,7 @@ from types import MappingProxyType
 from pddl.core import Domain as PDDLDomain
 from pddl.core import Problem as PDDLProblem
 
+from task.deadline import NO_DEADLINE, Deadline
 from task.domains import strips_soft
 from task.domains.base import zero_cycle_loss
 from task.errors import PDDLError, ProblemError
@@ -45,13 +46,19 @@ State = frozenset[Atom]
 # ------------------------------------------------------------------------------------- PDDL
 
 
-def from_pddl(domain: PDDLDomain, problem: PDDLProblem, order: Sequence[str] = ()) -> Problem:
+def from_pddl(
+    domain: PDDLDomain,
+    problem: PDDLProblem,
+    order: Sequence[str] = (),
+    deadline: Deadline = NO_DEADLINE,
+) -> Problem:
     """Ground ``problem`` and lift it. PDDLError for what is not STRIPS (negative
     preconditions, conditional or universal effects, numeric fluents, derived predicates),
-    ProblemError for a goal atom that no sequence of actions reaches."""
+    ProblemError for a goal atom that no sequence of actions reaches; `TimeLimitReached` when
+    ``deadline`` (a command's) passes while grounding."""
     from task.symbolic.ground import reachable
 
-    grounding = reachable(domain, problem)
+    grounding = reachable(domain, problem, deadline)
     reached = set(grounding.atoms)
     goal = strips.goal_atoms(problem)
     missing = [a for a in goal if a not in reached]

@@ -20,7 +20,7 @@ from pathlib import Path
 from pddl.core import Domain
 from pddl.core import Problem as PDDLProblem
 
-from task.errors import ProblemError, one_of
+from task.errors import PDDLError, ProblemError, one_of
 from task.problem import TABLE, Action, Move
 from task.symbolic import pddl_io, strips
 from task.symbolic.pddl_io import PlanLine
@@ -85,9 +85,21 @@ def _check(domain: Domain, problem: PDDLProblem, step: Action | Move) -> None:
         strips.ground(domain, problem, Action("stack", (step.entity, step.target)))
 
 
+def _refuse_derived(domain: Domain) -> None:
+    """PDDLError when ``domain`` declares derived predicates: the validator has no axioms, so
+    a goal or precondition over one would be judged as if it never held."""
+    if domain.derived_predicates:
+        first = sorted(str(d.predicate) for d in domain.derived_predicates)[0]
+        raise PDDLError(
+            f"domain {domain.name}: derived predicate {first} is not supported "
+            "(validate checks STRIPS actions without axioms)"
+        )
+
+
 def validate(domain: Domain, problem: PDDLProblem, plan: Iterable[Action | Move]) -> Validation:
     """Simulate ``plan`` (actions, or blocksworld moves) from the initial state and check the
-    goal at the end."""
+    goal at the end; a domain with derived predicates is refused (PDDLError)."""
+    _refuse_derived(domain)
     steps = tuple(plan)
     for step in steps:
         _check(domain, problem, step)
@@ -98,6 +110,7 @@ def validate_lines(
     domain: Domain, problem: PDDLProblem, lines: Iterable[PlanLine], source: str = "<plan>"
 ) -> Validation:
     """`validate` the entries of a plan file; misuse names ``source`` and the line."""
+    _refuse_derived(domain)
     entries = tuple(lines)
     for entry in entries:
         try:

@@ -15,9 +15,9 @@ from tamp.scene import (
     free_slot,
     layout,
     place_pose,
-    read_state,
     towers,
 )
+from tamp.world.convert.from_poses import read_state
 from task.errors import ProblemError, TampError
 from task.problem import TABLE, Move
 

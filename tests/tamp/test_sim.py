@@ -17,10 +17,11 @@ from motion.trajectory import JointTrajectory
 from robots.panda import PANDA
 from tamp.cli import main
 from tamp.cli.run import FRAME_PERIOD
-from tamp.loop.execute import execute_move
+from tamp.loop.execute import ExecTools, execute_move
 from tamp.outcome import Failure
-from tamp.scene import Pose, layout, read_state
+from tamp.scene import Pose, layout
 from tamp.sim import SIMULATORS, make_simulator
+from tamp.world.convert.from_poses import read_state
 from task.errors import TampError
 from task.problem import TABLE, Move
 
@@ -36,7 +37,7 @@ def solver() -> IKSolver:
 def test_one_pick_and_place_stacks_the_block(sim_name, solver):
     entities = ("a", "b")
     with make_simulator(sim_name, entities, layout(entities, (TABLE, TABLE), seed=2)) as sim:
-        done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses)
+        done = execute_move(sim, Move("a", "b"), sim.truth.block_poses, ExecTools(solver))
         assert done.ok, done.evidence
         assert read_state(entities, sim.truth.block_poses()).state == ("b", TABLE)
         assert done.sim_time_s > 1.0 and done.ik_time_s > 0.0
@@ -47,7 +48,7 @@ def test_weld_grasp_mode_also_stacks_the_block(sim_name, solver):
     entities = ("a", "b")
     poses = layout(entities, (TABLE, TABLE), seed=4)
     with make_simulator(sim_name, entities, poses, grasp="weld") as sim:
-        done = execute_move(sim, solver, Move("a", "b"), sim.truth.block_poses)
+        done = execute_move(sim, Move("a", "b"), sim.truth.block_poses, ExecTools(solver))
         assert done.ok, done.evidence
         assert read_state(entities, sim.truth.block_poses()).state == ("b", TABLE)
 
@@ -64,7 +65,7 @@ def test_the_weld_holds_the_block_between_the_fingers_not_the_one_the_move_names
             true = sim.truth.block_poses()
             return {**true, "a": true["b"], "b": true["a"]}
 
-        done = execute_move(sim, solver, Move("a", "c"), misread)
+        done = execute_move(sim, Move("a", "c"), misread, ExecTools(solver))
         after = sim.truth.block_poses()
         assert done.ok, done.evidence
         assert np.linalg.norm(np.subtract(after["a"].xyz, poses["a"].xyz)) < 0.005
@@ -74,7 +75,7 @@ def test_the_weld_holds_the_block_between_the_fingers_not_the_one_the_move_names
 def test_an_unreachable_block_is_an_ik_infeasible_failure(solver):
     entities = ("a",)
     with make_simulator("pybullet", entities, {"a": Pose((1.4, 0.0, 0.025))}) as sim:
-        done = execute_move(sim, solver, Move("a", TABLE), sim.truth.block_poses)
+        done = execute_move(sim, Move("a", TABLE), sim.truth.block_poses, ExecTools(solver))
     assert not done.ok and done.failure is Failure.IK_INFEASIBLE
     assert done.evidence["waypoint"] == "pre_grasp"
 

@@ -17,6 +17,7 @@ from robots.panda import PANDA
 from tamp.scene import Body, Pose, SceneConfig, SceneError
 from tamp.sim import SIMULATORS, make_simulator
 from tamp.sim.base import MAX_MASS, MIN_MASS, body_mass, body_yaw
+from tamp.world.convert.from_poses import read_state
 from task.problem import TABLE
 
 BODIES = (
@@ -79,7 +80,7 @@ def test_bodies_of_every_size_and_kind_settle_where_they_were_put_and_stay_stack
     with make_simulator(sim_name, entities, POSES, config) as sim:
         sim.run(JointTrajectory.hold(PANDA.q_home, 1.0, sim.dt), "open")
         after = sim.truth.block_poses()
-        state = sim.truth.state(entities, config)
+        state = read_state(entities, after, config).state
         snapshot = sim.truth.snapshot()
     for name, pose in POSES.items():
         assert np.abs(np.subtract(after[name].xyz, pose.xyz)).max() < 0.002, name

@@ -16,6 +16,7 @@ import pytest
 from tamp.scene import Pose
 from tamp.sim.base import GripperReading, Simulator
 from tamp.sim.truth import GRANTS, RULE, GroundTruth, GroundTruthLeak, Snapshot
+from tamp.world.convert.from_poses import read_state
 from task.problem import TABLE
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -36,15 +37,15 @@ def test_a_locked_read_raises_naming_the_rule_and_the_caller():
     message = str(err.value)
     assert RULE in message and "only scores episodes" in message
     assert "test_truth.robot_side_read" in message and "(block_poses)" in message
-    with pytest.raises(GroundTruthLeak, match=r"\(state\)"):
-        truth.state(("a", "b"))
+    with pytest.raises(GroundTruthLeak, match=r"\(block_poses\)"):
+        read_state(("a", "b"), truth.block_poses())
 
 
 def test_reads_inside_a_grant_are_answered_and_counted_by_grant_and_caller():
     truth = GroundTruth(lambda: dict(POSES))
     truth.lock()
     with truth.scoring():
-        assert truth.state(("a", "b")) == (TABLE, "a")
+        assert read_state(("a", "b"), truth.block_poses()).state == (TABLE, "a")
     with truth.experimenter():
         assert truth.block_poses()["a"] == POSES["a"]
     with truth.oracle():
@@ -124,7 +125,8 @@ def test_only_the_simulators_reach_the_raw_poses_and_only_named_loop_modules_the
     sims = {"tamp/sim/base.py", "tamp/sim/pybullet_sim.py", "tamp/sim/mujoco_sim.py"}
     assert _uses("_block_poses", "tamp") <= sims
     assert _uses("_snapshot", "tamp") <= sims
-    assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py"}
+    # in the simulator room: the truth itself, and the experimenter's nudge (an injected fault)
+    assert _uses("block_poses", "tamp/sim") <= {"tamp/sim/truth.py", "tamp/sim/faults.py"}
     # a snapshot (the true block poses) is read by the video and the Rerun recording alone,
     # inside their recording grant
     assert _uses("snapshot", "tamp") <= {"tamp/sim/truth.py", "tamp/video.py", "tamp/rerun_log.py"}

@@ -15,8 +15,9 @@ from tamp.loop import LoopConfig, run_episode
 from tamp.loop.execute import ExecConfig, ExecTools, execute_move
 from tamp.obstacles import Obstacle, with_scene
 from tamp.outcome import Failure
-from tamp.scene import SceneConfig, layout, read_state
+from tamp.scene import SceneConfig, layout
 from tamp.sim import SIMULATORS, make_simulator
+from tamp.world.convert.from_poses import read_state
 from task.problem import TABLE, Move, Problem
 
 # a 20 cm wall across the table between the y = -0.32 and y = 0.32 slots

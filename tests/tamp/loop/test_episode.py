@@ -206,7 +206,7 @@ def test_an_out_of_reach_episode_stops_with_a_clear_reason(solver, monkeypatch):
 @pytest.mark.sim
 def test_a_loose_block_is_tidied_onto_the_table_and_the_episode_goes_on(solver, monkeypatch):
     import tamp.loop.observe as observe
-    from tamp.scene import Reading
+    from tamp.world.convert.from_poses import Reading
 
     real, calls = observe.read_state, []
 
@@ -247,7 +247,8 @@ def test_a_block_left_on_another_table_place_than_planned_triggers_a_replan(monk
     executor put on another slot (``placed_at``: the next free one): the state is the planned
     one, yet the plan's later moves assumed the block on its place, so the loop replans and
     says why. A block put on its place, or a move onto a block, goes on."""
-    from tamp.scene import PlacedMove, Reading
+    from tamp.scene import PlacedMove
+    from tamp.world.convert.from_poses import Reading
 
     episode = Episode(THREE, LoopConfig(), seed=0)
     try:

@@ -15,8 +15,9 @@ from robots.panda import PANDA
 from tamp.arm_costs import BLOCKED, DETOUR, Arm, ArmCosts
 from tamp.loop.geo_fallback import CHOICES, blocks_goal, geo_fallback, world_scene
 from tamp.obstacles import with_scene
-from tamp.scene import PlacedMove, Pose, SceneConfig, layout, read_state
+from tamp.scene import PlacedMove, Pose, SceneConfig, layout
 from tamp.slots import slotted
+from tamp.world.convert.from_poses import read_state
 from tamp.world.relations import read_facts
 from task.problem import TABLE, Problem
 

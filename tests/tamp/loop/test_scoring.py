@@ -119,16 +119,28 @@ def _drop(poses: dict[str, Pose]) -> dict[str, Pose]:
 
 
 def _offset(poses: dict[str, Pose]) -> dict[str, Pose]:
-    """Put f on e 2.2 cm off its centre: it stays there, on nothing the state can name."""
+    """Put f on e 2.2 cm off its centre: it stays there, its centre over e, so on e."""
     e = poses["e"]
     along = 0.022 * np.array([np.cos(e.yaw), np.sin(e.yaw)])
     return {"f": Pose((*(e.xy + along), e.xyz[2] + 0.05), e.yaw)}
 
 
+def _bridge(poses: dict[str, Pose]) -> dict[str, Pose]:
+    """Set e beside f, 1 mm apart, and d across the two: it stays there, on nothing the state
+    can name (its centre over neither)."""
+    f = poses["f"]
+    x, y = f.xyz[0], f.xyz[1]
+    return {
+        "f": Pose((x, y, 0.025)),
+        "e": Pose((x, y + 0.051, 0.025)),
+        "d": Pose((x, y + 0.0255, 0.075)),
+    }
+
+
 @pytest.mark.parametrize(
     ("script", "unreadable"),
-    [(_shove, None), (_drop, 0), (_offset, 1)],
-    ids=["shove", "drop", "offset"],
+    [(_shove, None), (_drop, 0), (_offset, 0), (_bridge, 1)],
+    ids=["shove", "drop", "offset", "bridge"],
 )
 def test_a_scripted_disturbance_during_a_move_counts_against_the_plan(script, unreadable, solver):
     """The given plan moves a onto b; during the move the experimenter disturbs other blocks.

@@ -84,3 +84,27 @@ def test_tamp_plan_stops_every_phase_at_its_time_limit_and_reports_the_wall_time
     assert body["stats"]["time_s"] == pytest.approx(42.0)  # the whole command's wall time
     assert body["stats"]["time_limit"].startswith("stopped at the 5 s time limit")
     assert "time limit (5 s) reached while grounding" in body["proof"]["reason"]
+
+
+def test_the_lift_grounds_again_within_the_deadline(files):
+    """The generic lift grounds the problem again for the planner (`from_files` ->
+    `strips.from_pddl`): that grounding stops at the command's deadline too."""
+    from task.instances import from_files
+
+    with pytest.raises(TimeLimitReached, match=r"time limit \(5 s\) reached while grounding"):
+        from_files(*files, "strips", PASSED)
+
+
+def test_tamp_plan_stops_at_the_time_limit_in_the_planners_grounding(files, capsys, monkeypatch):
+    """With the limit passed, the planner's grounding (not only the proofs') stops at once,
+    and the output names the limit and the phase."""
+    import tamp.cli.plan as plan_cli
+    from tamp.cli import main
+
+    real = time.perf_counter()
+    clock = iter([real - 10.0, real + 1.0])  # the command's start (its 5 s long gone), end
+    monkeypatch.setattr(plan_cli, "time", SimpleNamespace(perf_counter=lambda: next(clock)))
+    assert main(["plan", *files, "--time-limit", "5"]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("no plan found within the time limit: stopped at the 5 s time limit")
+    assert "before planning" in out and "reached while grounding" in out

@@ -173,6 +173,25 @@ def test_tamp_plan_refuses_an_unsupported_feature_in_one_line(capsys, tmp_path):
     assert f"{domain}: line 8: conditional effect (when)" in one_line_error(capsys)
 
 
+def test_tamp_validate_refuses_derived_predicates_in_one_line(capsys, tmp_path):
+    """The validator has no axioms: a goal over a derived predicate was judged
+    NON_GOAL_REACHING in silence; it is refused in one line, as tamp plan refuses it."""
+    domain = tmp_path / "d.pddl"
+    domain.write_text(
+        "(define (domain d) (:requirements :strips :derived-predicates)"
+        " (:predicates (p ?x) (q ?x))"
+        " (:derived (q ?x) (p ?x))"
+        " (:action a :parameters (?x) :precondition (and) :effect (p ?x)))"
+    )
+    problem = tmp_path / "x.pddl"
+    problem.write_text("(define (problem x) (:domain d) (:objects o) (:init) (:goal (q o)))")
+    plan = tmp_path / "x.plan"
+    plan.write_text("(a o)\n")
+    assert main(["validate", str(domain), str(problem), str(plan)]) == 2
+    line = one_line_error(capsys)
+    assert "derived predicate (q ?x) is not supported" in line
+
+
 def test_object_annotations_keep_every_name_its_type():
     """``- object`` that ends a typed list is dropped (an untyped name is an object); the
     names before another type keep that type."""
