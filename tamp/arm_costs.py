@@ -46,7 +46,7 @@ from tamp.scene import (
     read_state,
     towers,
 )
-from task.costs import IMPOSSIBLE
+from task.costs import IMPOSSIBLE, CostSourceBase
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem
 
@@ -199,11 +199,13 @@ class Arm:
     failed: Sequence[FailedMove] = ()
 
 
-class ArmCosts:
+class ArmCosts(CostSourceBase):
     """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
     ``poses[k]`` (block -> `Pose`), priced for ``arm`` (`Arm`: the arm now at ``arm.q_now``,
     (J,)). ``places``: per problem, table place -> (x, y), for slotted problems (`tamp.slots`);
     ``reach``: how far a block may go from its place's centre (m; 0: the places are fixed)."""
+
+    can_forget = True  # `forget` drops the moves committed for a problem
 
     def __init__(
         self,
@@ -234,7 +236,7 @@ class ArmCosts:
 
     def verify(self, index: int, state: State, move) -> bool:
         """Whether the executor finds ``move``'s motion in ``state`` of problem ``index``
-        (`task.costs.CostSource`'s optional check ahead, `task.planner.windows.own_state_prefix`):
+        (`task.costs.CostSourceBase`'s check ahead, `task.planner.windows.own_state_prefix`):
         ``check`` on the poses this source predicts there (`predict_poses`; a move onto a table
         place goes to its centre), the arm where it is now. A move it fails is ruled out in that
         state from then on (priced `BLOCKED`): the next window there decodes another. True

@@ -159,11 +159,11 @@ def decode_row(
         if domain.is_goal(problem, state):
             break
     reached = domain.is_goal(problem, state)
-    estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
-    if rule.prefix and check and estimate is None and moves and not reached:
+    estimate = domain.has_estimate  # the domain's own inadmissible ranking estimate
+    if rule.prefix and check and not estimate and moves and not reached:
         return _best_prefix(domain, start, moves, trail, complete, loss)
     remaining = 0 if reached else domain.lower_bound(problem, state)
-    estimated = None if reached or estimate is None else estimate(problem, state)
+    estimated = None if reached or not estimate else domain.estimate(problem, state)
     return DecodedWindow(
         tuple(moves),
         state,

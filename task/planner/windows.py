@@ -166,14 +166,13 @@ def take_safe(
     those still active (not at the goal). Only without beliefs and a cost source (the
     caller's check)."""
     domain, config = context.domain, context.config
-    take = getattr(domain, "safe_moves", None)
-    if take is None:
+    if not domain.has_safe_moves:
         return list(active)
     states, solved = progress.states, progress.solved
     still = []
     for i in active:
         if config.takes_safe(problems[i]):
-            for move in take(problems[i], states[i]):
+            for move in domain.safe_moves(problems[i], states[i]):
                 states[i] = domain.apply_move(problems[i], states[i], move)
                 progress.visited[i].add(states[i])
                 progress.moves[i].append(move)
