@@ -148,18 +148,18 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
         if isinstance(fit, str):
             out.append(
                 BlockRow(
-                    sim,
-                    scene,
-                    x,
-                    len(names),
-                    level[x],
-                    x in free,
-                    fit,
-                    None,
-                    None,
-                    None,
-                    None,
-                    None,
+                    sim=sim,
+                    scene=scene,
+                    block=x,
+                    blocks=len(names),
+                    level=level[x],
+                    top_free=x in free,
+                    reason=fit,
+                    error_mm=None,
+                    dx_mm=None,
+                    dy_mm=None,
+                    dz_mm=None,
+                    yaw_error_deg=None,
                 )
             )
             continue
@@ -168,18 +168,18 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
         yaw = yaw_error(fit.pose.yaw, true.yaw)
         out.append(
             BlockRow(
-                sim,
-                scene,
-                x,
-                len(names),
-                level[x],
-                x in free,
-                "",
-                error,
-                float(d[0]),
-                float(d[1]),
-                float(d[2]),
-                yaw,
+                sim=sim,
+                scene=scene,
+                block=x,
+                blocks=len(names),
+                level=level[x],
+                top_free=x in free,
+                reason="",
+                error_mm=error,
+                dx_mm=float(d[0]),
+                dy_mm=float(d[1]),
+                dz_mm=float(d[2]),
+                yaw_error_deg=yaw,
             )
         )
     return out

@@ -286,7 +286,19 @@ def pack_tries(
         edge = half if walled else body  # what must stay inside: the hand too where walls stand
         room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
         u0.append(torch.randn(r, m, 2, generator=gen, dtype=torch.float64))
-        made.append(_Try(config, lo, edge, room, turn, axis, half, body, slice(start, start + r)))
+        made.append(
+            _Try(
+                config=config,
+                lo=lo,
+                edge=edge,
+                room=room,
+                turn=turn,
+                axis=axis,
+                half=half,
+                body=body,
+                rows=slice(start, start + r),
+            )
+        )
         start += r
     m = len(half_np)
     if m == 0:
@@ -408,7 +420,16 @@ def pack_sampled(
                 break
         if placed == m:
             took = time.perf_counter() - t0
-            return PackResult(xy, yaws, axes, True, -math.inf, took, spent, tuple(range(m)))
+            return PackResult(
+                positions=xy,
+                yaws=yaws,
+                axes=axes,
+                ok=True,
+                overlap=-math.inf,
+                time=took,
+                tries=spent,
+                order=tuple(range(m)),
+            )
         if best is None or placed > len(best.positions):
             best = PackResult(xy[:placed], yaws[:placed], axes[:placed], False, math.inf, 0.0, 0)
     if best is None:
