@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -354,6 +355,7 @@ def check_move(
     quick = quick_check(scene, move, tools, grasps, q) if quick or not full else {}
     tried, last = [], (Failure.COLLISION, {})
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
+    attempt = _Move(scene, o, move, support, heights)
     for g in grasps:
         early = quick.get(g.name)
         if early is not None:
@@ -365,7 +367,7 @@ def check_move(
         if not full:
             tried.append(GraspTry(g.name, None, quick=True))
             return verdict(ok=True, grasp=g, tried=tuple(tried), evidence={"quick": True})
-        result = _plan_grasp(scene, o, move, g, support, heights, tools, q, seed)
+        result = _plan_grasp(attempt, g, tools, q, seed)
         if isinstance(result, tuple):  # the phases that work
             tried.append(GraspTry(g.name, None))
             return verdict(ok=True, grasp=g, motion=result, tried=tuple(tried))
@@ -389,12 +391,24 @@ def check_move(
     return verdict(ok=False, failure=last[0], evidence=last[1], tried=tuple(tried))
 
 
-def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
+@dataclass(frozen=True)
+class _Move:
+    """The move `check_move` tries grasps of: ``move`` of object ``o`` in ``scene``, from the
+    ``support`` box it stands on, its transit at each of ``heights`` (m) in turn."""
+
+    scene: Scene
+    o: Movable
+    move: GeoMove
+    support: object
+    heights: Sequence[float]
+
+
+def _plan_grasp(attempt: _Move, g, tools, q, seed):
     """The guarded phases of the move with grasp ``g`` (a tuple), or a dict with the failure,
     its side and evidence; the transit goes over the near things, then over everything."""
     failure = None
-    for clear_z in heights:
-        request = pick_place_request(o, move, g, clear_z, scene)
+    for clear_z in attempt.heights:
+        request = pick_place_request(attempt.o, attempt.move, g, clear_z, attempt.scene)
         planned = plan_pick_place(tools.solver, q, request, tools.pick_place)
         if not planned.ok:
             bad = planned.evidence.get("waypoint", "")
@@ -402,7 +416,7 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
             why = Failure(planned.failure)  # the motion layer's name of it
             failure = {"failure": why, "side": side, "evidence": planned.evidence}
             continue
-        world = pick_place_world(scene, o, move, g, support)
+        world = pick_place_world(attempt.scene, attempt.o, attempt.move, g, attempt.support)
         guarded = guard_pick_place(planned.phases, tools.collision, world, tools.guard, seed)
         if guarded.ok:
             return guarded.phases
