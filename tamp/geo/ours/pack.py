@@ -147,20 +147,21 @@ def overlap_loss(
     fixed_xy: torch.Tensor,
     fixed_half: torch.Tensor,
     beta: float,
-    eps: float,
-    gap: float,
-    ordered: bool = False,
+    config: PackConfig,
 ) -> torch.Tensor:
-    """(R,) the packing loss of each row (module docstring). ``xy`` (R, M, 2) centres, ``half``
-    (R, M, 2) grown half extents (finger room), ``body`` (R, M, 2) the bodies' own; fixed
-    occupants ``fixed_xy`` / ``fixed_half`` (F, 2). A grown footprint must clear the other
-    bodies: pairs count both ways (i's fingers against j's body and j's against i's), or with
-    ``ordered`` the lesser of the two (whichever is placed second needs the room)."""
+    """(R,) the packing loss of each row (module docstring) at softplus sharpness ``beta``.
+    ``xy`` (R, M, 2) centres, ``half`` (R, M, 2) grown half extents (finger room), ``body``
+    (R, M, 2) the bodies' own; fixed occupants ``fixed_xy`` / ``fixed_half`` (F, 2). Of
+    ``config``: the smoothing ``eps``, the clearance ``gap`` and ``ordered``. A grown footprint
+    must clear the other bodies: pairs count both ways (i's fingers against j's body and j's
+    against i's), or with ``ordered`` the lesser of the two (whichever is placed second needs
+    the room)."""
+    eps, gap = config.eps, config.gap
     m = xy.shape[1]
     d = xy[:, :, None] - xy[:, None]  # (R, M, M, 2)
     reach = half[:, :, None] + body[:, None] + gap  # (R, M, M, 2): i grown, j body
     pair = soft_area(d, reach, beta, eps)  # (R, M, M)
-    if ordered:
+    if config.ordered:
         pair = torch.minimum(pair, pair.transpose(1, 2))  # (R, M, M), symmetric
     off = ~torch.eye(m, dtype=torch.bool)
     loss = torch.where(off, pair, 0.0).sum((-1, -2))  # (R,)
@@ -319,9 +320,7 @@ def pack_tries(
 
     for k in range(steps):
         beta = first.beta * (first.beta_end / first.beta) ** (k / max(steps - 1, 1))
-        loss = overlap_loss(
-            centres(), half, body, fxy, fh, beta, first.eps, first.gap, first.ordered
-        )
+        loss = overlap_loss(centres(), half, body, fxy, fh, beta, first)
         opt.zero_grad()
         loss.sum().backward()
         opt.step()
@@ -410,9 +409,7 @@ def pack_sampled(
                     break
                 spent += 1
                 p = lo + edge + rng.random(2) * (hi - lo - 2 * edge)
-                if _free(
-                    p, grown[i], bodies[i], xy[:i], grown[:i], bodies[:i], fxy_np, fh_np, config
-                ):
+                if _free(p, i, xy, grown, bodies, (fxy_np, fh_np), config):
                     xy[i] = p
                     placed += 1
                     break
@@ -439,8 +436,12 @@ def pack_sampled(
     )
 
 
-def _free(p, grown, body, xy, others_grown, others_body, fxy, fh, config: PackConfig) -> bool:
-    """Whether a footprint at ``p`` clears the placed ones (both ways) and the fixed ones."""
+def _free(p, i: int, xy, grown, bodies, fixed, config: PackConfig) -> bool:
+    """Whether footprint ``i`` (grown and body half extents ``grown[i]``, ``bodies[i]``) at
+    ``p`` clears the ones placed before it (both ways: the first ``i`` of ``xy``, ``grown``,
+    ``bodies``) and the ``fixed`` ones (centres, half extents)."""
+    grown, body, xy, others_grown, others_body = grown[i], bodies[i], xy[:i], grown[:i], bodies[:i]
+    fxy, fh = fixed
     g, tol = config.gap, config.tol
     if len(xy):
         d = np.abs(xy - p)  # (k, 2)

@@ -86,7 +86,8 @@ def test_the_packing_loss_gradient_matches_finite_differences():
     fixed_half = torch.tensor([[0.01, 0.02]], dtype=torch.float64)
 
     def loss(p):
-        return overlap_loss(p, grown, body, fixed_xy, fixed_half, 300.0, 1e-3, 0.002)
+        smooth = PackConfig(eps=1e-3, gap=0.002, ordered=False)
+        return overlap_loss(p, grown, body, fixed_xy, fixed_half, 300.0, smooth)
 
     assert loss(xy).gt(0).all()  # overlapping, so the check sees a gradient
     assert torch.autograd.gradcheck(loss, (xy,), eps=1e-7, atol=1e-6)
