@@ -33,7 +33,14 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from motion.cost import Blocks, MoveCostConfig, block_depths, move_costs_batch, site_solutions
+from motion.cost import (
+    Blocks,
+    Bodies,
+    MoveCostConfig,
+    block_depths,
+    move_costs_batch,
+    site_solutions,
+)
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceConfig
 from tamp.scene import (
@@ -167,9 +174,8 @@ class _Placed:
         o, n = self.owner, self.n
         table = self.places[:, n:] + torch.nn.functional.pad(self.shift(), (0, 1))  # (B, K, 3)
         places = torch.cat([self.places[:, :n], table], dim=1)  # (B, Y, 3)
-        c = move_costs_batch(
-            o.solver, o.q_now, self.picks, places, o.config, o.boxes, self.solved, self.blocks
-        )
+        bodies = Bodies(o.boxes, self.blocks)
+        c = move_costs_batch(o.solver, o.q_now, self.picks, places, o.config, bodies, self.solved)
         return c + self.extra  # (B, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
@@ -308,8 +314,9 @@ class ArmCosts(CostSourceBase):
         picks, places, extra, blocks, other = self._inputs(todo)
         solved = self._site_solutions(picks, places)
         with torch.no_grad():
+            bodies = Bodies(self.boxes, blocks)
             c = move_costs_batch(
-                self.solver, self.q_now, picks, places, self.config, self.boxes, solved, blocks
+                self.solver, self.q_now, picks, places, self.config, bodies, solved
             )
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return list(c + extra)  # (P, N, Y) each
