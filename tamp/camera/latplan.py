@@ -31,7 +31,7 @@ import numpy as np
 
 from perception import data as pdata
 from tamp.camera.dataset import check_settings, label_row
-from tamp.camera.render import StateRenderer, ViewJitter, jitter_camera
+from tamp.camera.render import StateRenderer, View, ViewJitter, jitter_camera
 from tamp.scene import SceneConfig, towers
 from tamp.sim.base import SIMULATORS, Camera, Lighting
 from task.symbolic.generate import block_names, random_towers
@@ -216,16 +216,9 @@ def generate(
                 if layout_of(names, colours, state, slots) not in excluded:
                     break
                 redrawn += 1
-            poses = renderers[sims[i % len(sims)]].place(
-                names,
-                state,
-                int(rng.integers(2**31)),
-                colours,
-                jitter_camera(camera, jitter, rng),
-                random_light(rng, rand),
-                scene,
-                slots,
-            )
+            draw = int(rng.integers(2**31))
+            view = View(jitter_camera(camera, jitter, rng), random_light(rng, rand), scene)
+            poses = renderers[sims[i % len(sims)]].place(names, state, draw, colours, view, slots)
             for part in ("floor", "backdrop"):
                 sim.set_colour(part, [rng.uniform(*rand.grey)] * 3)
             for name, rgb in COLOURS:

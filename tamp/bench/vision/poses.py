@@ -23,6 +23,7 @@ from tamp.camera.dataset import sample_scene
 from tamp.camera.poses import estimate_fits
 from tamp.camera.render import (
     StateRenderer,
+    View,
     ViewJitter,
     block_colours,
     jitter_camera,
@@ -122,9 +123,8 @@ def run(
                 names, colours, state = sample_scene(rng, min_blocks, max_blocks)
                 camera = jitter_camera(renderer.camera, view, rng) if jitter else renderer.camera
                 light = random_lighting(rng) if jitter else Lighting()
-                truth = renderer.place(
-                    names, state, int(rng.integers(2**31)), colours, camera, light, scene
-                )
+                view = View(camera, light, scene)
+                truth = renderer.place(names, state, int(rng.integers(2**31)), colours, view)
                 rgb, depth = renderer.sim.render_rgbd()
                 t0 = time.perf_counter()
                 fits = estimate_fits(
