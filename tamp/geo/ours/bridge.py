@@ -41,7 +41,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tamp.geo.ours.pack import PackConfig, PackError, PackResult, pack_sampled, pack_tries
+from tamp.geo.ours.pack import (
+    Occupants,
+    PackConfig,
+    PackError,
+    PackResult,
+    pack_sampled,
+    pack_tries,
+)
 from tamp.geo.places import PACK_MARGIN, TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose
@@ -235,8 +242,7 @@ def bridge(
         args = (
             r.inner(),
             [own_footprint(scene.object(x)) for x in movers],
-            [o.pose.xyz[:2] for o in fixed],
-            [footprint(o) for o in fixed],
+            Occupants([o.pose.xyz[:2] for o in fixed], [footprint(o) for o in fixed]),
         )
         step = 1 if sampler == "sampled" else PACK_BATCH
         for k in range(0, len(tries), step):

@@ -42,6 +42,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -106,7 +107,19 @@ class PackResult:
     order: tuple[int, ...] = ()
 
 
-def _check(inner: Rect, half, fixed_xy, fixed_half) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class Occupants(NamedTuple):
+    """The fixed occupants of a region that a packing must keep clear of: centres ``xy``
+    (F, 2) and half extents ``half`` (F, 2), m."""
+
+    xy: Sequence = ()
+    half: Sequence = ()
+
+
+NO_OCCUPANTS = Occupants()
+
+
+def _check(inner: Rect, half, fixed: Occupants) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    fixed_xy, fixed_half = fixed
     half = np.asarray(half, dtype=np.float64).reshape(-1, 2)
     fxy = np.asarray(fixed_xy if fixed_xy is not None else (), dtype=np.float64).reshape(-1, 2)
     fh = np.asarray(fixed_half if fixed_half is not None else (), dtype=np.float64).reshape(-1, 2)
@@ -207,21 +220,18 @@ def placing_order(xy, half, body, gap: float, tol: float) -> tuple[int, ...]:
 def pack(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     config: PackConfig = PackConfig(),
     seed: int = 0,
     turnable: Sequence[bool] | None = None,
     walled: bool = True,
 ) -> PackResult:
     """Place the M ``footprints`` (half extents (M, 2), m) inside ``inner`` free of each other
-    and of the fixed occupants (centres (F, 2), half extents (F, 2)); see the module docstring.
+    and of the ``fixed`` occupants (`Occupants`); see the module docstring.
     ``turnable[m]``: whether footprint m may turn a quarter turn (default: when it is not
     square); ``walled``: the hand must stay inside the region too (walls stand on its edges;
     a marked area lets the fingers reach beyond it)."""
-    (result,) = pack_tries(
-        inner, footprints, fixed_xy, fixed_half, ((config, seed),), turnable, walled
-    )
+    (result,) = pack_tries(inner, footprints, fixed, ((config, seed),), turnable, walled)
     return result
 
 
@@ -245,8 +255,7 @@ class _Try:
 def pack_tries(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     tries: Sequence[tuple[PackConfig, int]] = ((PackConfig(), 0),),
     turnable: Sequence[bool] | None = None,
     walled: bool = True,
@@ -269,7 +278,7 @@ def pack_tries(
             (x0 + config.margin, y0 + config.margin),
             (x1 - config.margin, y1 - config.margin),
         )
-        half_np, fxy_np, fh_np = _check(inside, footprints, fixed_xy, fixed_half)
+        half_np, fxy_np, fh_np = _check(inside, footprints, fixed)
         m, r = len(half_np), config.restarts
         gen = torch.Generator().manual_seed(seed)
         square = np.isclose(half_np[:, 0], half_np[:, 1])
@@ -367,8 +376,7 @@ def _best(t: _Try, xy: np.ndarray, fxy_np, fh_np, took: float) -> PackResult:
 def pack_sampled(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     budget: int = 1000,
     seed: int = 0,
     config: PackConfig = PackConfig(),
@@ -382,7 +390,7 @@ def pack_sampled(
     t0 = time.perf_counter()
     (x0, y0), (x1, y1) = inner
     inner = ((x0 + config.margin, y0 + config.margin), (x1 - config.margin, y1 - config.margin))
-    half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
+    half_np, fxy_np, fh_np = _check(inner, footprints, fixed)
     m = len(half_np)
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(inner[0], float), np.asarray(inner[1], float)
