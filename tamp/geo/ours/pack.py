@@ -279,37 +279,10 @@ def pack_tries(
             (x1 - config.margin, y1 - config.margin),
         )
         half_np, fxy_np, fh_np = _check(inside, footprints, fixed)
-        m, r = len(half_np), config.restarts
-        gen = torch.Generator().manual_seed(seed)
-        square = np.isclose(half_np[:, 0], half_np[:, 1])
-        may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
-        turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
-        axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
-        h = torch.where(
-            turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np)
-        )
-        wide = 2 * h.gather(-1, axis[..., None])[..., 0] >= config.stroke - 1e-6  # (R, M)
-        axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
-        body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
-        lo = torch.tensor(inside[0], dtype=torch.float64)
-        span = torch.tensor(inside[1], dtype=torch.float64) - lo
-        edge = half if walled else body  # what must stay inside: the hand too where walls stand
-        room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
-        u0.append(torch.randn(r, m, 2, generator=gen, dtype=torch.float64))
-        made.append(
-            _Try(
-                config=config,
-                lo=lo,
-                edge=edge,
-                room=room,
-                turn=turn,
-                axis=axis,
-                half=half,
-                body=body,
-                rows=slice(start, start + r),
-            )
-        )
-        start += r
+        made_try, start_u = _try(inside, half_np, (config, seed), turnable, walled, start)
+        made.append(made_try)
+        u0.append(start_u)
+        start += config.restarts
     m = len(half_np)
     if m == 0:
         empty = np.zeros((0, 2))
@@ -337,6 +310,41 @@ def pack_tries(
         xy = centres().numpy()  # (sum R, M, 2)
     took = time.perf_counter() - t0
     return [_best(t, xy[t.rows], fxy_np, fh_np, took) for t in made]
+
+
+def _try(inside: Rect, half_np: np.ndarray, at: tuple, turnable, walled: bool, start: int):
+    """One try of `pack_tries`, ``at`` its (config, seed), in the ``inside`` rectangle (its
+    margin taken off), the footprints' half extents ``half_np`` (M, 2): its rows from
+    ``start`` (their turns and closing axes drawn, the grown and body footprints, the room
+    the centres may use) and their unbounded start values u (R, M, 2)."""
+    config, seed = at
+    m, r = len(half_np), config.restarts
+    gen = torch.Generator().manual_seed(seed)
+    square = np.isclose(half_np[:, 0], half_np[:, 1])
+    may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
+    turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
+    axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
+    h = torch.where(turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np))
+    wide = 2 * h.gather(-1, axis[..., None])[..., 0] >= config.stroke - 1e-6  # (R, M)
+    axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
+    body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
+    lo = torch.tensor(inside[0], dtype=torch.float64)
+    span = torch.tensor(inside[1], dtype=torch.float64) - lo
+    edge = half if walled else body  # what must stay inside: the hand too where walls stand
+    room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
+    u0 = torch.randn(r, m, 2, generator=gen, dtype=torch.float64)
+    made = _Try(
+        config=config,
+        lo=lo,
+        edge=edge,
+        room=room,
+        turn=turn,
+        axis=axis,
+        half=half,
+        body=body,
+        rows=slice(start, start + r),
+    )
+    return made, u0
 
 
 def _best(t: _Try, xy: np.ndarray, fxy_np, fh_np, took: float) -> PackResult:
