@@ -379,15 +379,13 @@ def check_move(
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
     if full and tools.postures > 0:  # the colliding grasps again, in other postures
         collided = [t.grasp for t in tried if t.failure is Failure.COLLISION]
-        for g in [g for g in grasps if g.name in collided][:POSTURE_GRASPS]:
-            world = pick_place_world(scene, o, move, g, support)
-            requests = [pick_place_request(o, move, g, z, scene) for z in heights]
-            phases = plan_postures(world, requests, tools, q, seed)
-            if phases is not None:
-                tried.append(GraspTry(g.name, None, where="posture"))
-                return verdict(
-                    ok=True, grasp=g, motion=phases, tried=tuple(tried), evidence={"posture": True}
-                )
+        found = _in_postures(attempt, [g for g in grasps if g.name in collided], tools, q, seed)
+        if found is not None:
+            g, phases = found
+            tried.append(GraspTry(g.name, None, where="posture"))
+            return verdict(
+                ok=True, grasp=g, motion=phases, tried=tuple(tried), evidence={"posture": True}
+            )
     return verdict(ok=False, failure=last[0], evidence=last[1], tried=tuple(tried))
 
 
@@ -425,6 +423,19 @@ def _plan_grasp(attempt: _Move, g, tools, q, seed):
         if side == "pick":
             break  # the transit height changes nothing before the lift
     return failure
+
+
+def _in_postures(attempt: _Move, collided, tools, q, seed):
+    """The first of the ``collided`` grasps (at most `POSTURE_GRASPS`) whose move works in
+    another arm posture (`plan_postures`), with its phases; None when none does."""
+    scene, o, move = attempt.scene, attempt.o, attempt.move
+    for g in collided[:POSTURE_GRASPS]:
+        world = pick_place_world(scene, o, move, g, attempt.support)
+        requests = [pick_place_request(o, move, g, z, scene) for z in attempt.heights]
+        phases = plan_postures(world, requests, tools, q, seed)
+        if phases is not None:
+            return g, phases
+    return None
 
 
 def _supported(scene: Scene, move: GeoMove) -> bool:
