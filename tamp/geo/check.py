@@ -359,9 +359,7 @@ def check_move(
     for g in grasps:
         early = quick.get(g.name)
         if early is not None:
-            where = early[2].get("phase", early[2].get("waypoint", ""))
-            other = early[2].get("other", "")
-            tried.append(GraspTry(g.name, early[0], early[1], where, other, quick=True))
+            tried.append(_failed(g.name, *early, quick=True))
             last = (early[0], {"grasp": g.name, **early[2]})
             continue
         if not full:
@@ -371,11 +369,7 @@ def check_move(
         if isinstance(result, tuple):  # the phases that work
             tried.append(GraspTry(g.name, None))
             return verdict(ok=True, grasp=g, motion=result, tried=tuple(tried))
-        ev = result["evidence"]
-        where = ev.get("phase", ev.get("waypoint", ""))
-        tried.append(
-            GraspTry(g.name, result["failure"], result["side"], where, ev.get("other", ""))
-        )
+        tried.append(_failed(g.name, result["failure"], result["side"], result["evidence"]))
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
     if full and tools.postures > 0:  # the colliding grasps again, in other postures
         collided = [t.grasp for t in tried if t.failure is Failure.COLLISION]
@@ -423,6 +417,13 @@ def _plan_grasp(attempt: _Move, g, tools, q, seed):
         if side == "pick":
             break  # the transit height changes nothing before the lift
     return failure
+
+
+def _failed(grasp: str, failure: Failure, side: str, evidence: dict, quick=False) -> GraspTry:
+    """The record of grasp ``grasp`` failing on ``side`` (pick or place), where its
+    ``evidence`` says (a phase or a waypoint) and against what."""
+    where = evidence.get("phase", evidence.get("waypoint", ""))
+    return GraspTry(grasp, failure, side, where, evidence.get("other", ""), quick=quick)
 
 
 def _in_postures(attempt: _Move, collided, tools, q, seed):
