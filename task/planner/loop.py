@@ -32,7 +32,7 @@ from functools import partial
 
 import torch
 
-from task.beliefs import BeliefSource
+from task.beliefs import BeliefSource, belief_source
 from task.config import PlannerConfig, torch_device
 from task.costs import CostSource, cost_source
 from task.deadline import NO_DEADLINE, Deadline
@@ -338,8 +338,10 @@ def plan_batch(
         )
     torch_device(config.device)  # refused in one line where this machine lacks it
     generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
-    # a cost source that does not inherit `CostSourceBase` is wrapped here, once
-    shared = PlanContext(domain, config, generator, source=beliefs, costs=cost_source(costs))
+    # cost sources and window beliefs that do not inherit `CostSourceBase` and
+    # `WindowBeliefsBase` are wrapped here, once
+    source = belief_source(beliefs)
+    shared = PlanContext(domain, config, generator, source=source, costs=cost_source(costs))
     report = progress or (lambda k: None)
     final = on_result or (lambda i, result: None)
     if not config.batched:
