@@ -274,7 +274,16 @@ def plan_search(
     if dead:
         return end(GeoStatus.UNSOLVABLE, f"no plan: {dead}")
     cache: dict[tuple, MoveCheck] = {}  # (state key, object, place name) -> quick verdict
-    run = _Run(goal, tools, config, memory, cache, stats, t0, hints or {})
+    run = _Run(
+        goal=goal,
+        tools=tools,
+        config=config,
+        memory=memory,
+        cache=cache,
+        stats=stats,
+        t0=t0,
+        hints=hints or {},
+    )
     while True:
         found = _search(run, scene)
         if isinstance(found, tuple):  # (status, reason): no plan this round
