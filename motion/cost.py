@@ -87,6 +87,18 @@ class Blocks(NamedTuple):
     under: torch.Tensor  # (P, N) long: the block x stands on, -1 on the table
 
 
+class Bodies(NamedTuple):
+    """What the arm's configurations are priced against besides reach (`move_costs_batch`):
+    ``obstacles``, (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the base
+    frame, and the problems' ``blocks``; None: not priced."""
+
+    obstacles: tuple | None = None
+    blocks: Blocks | None = None
+
+
+NO_BODIES = Bodies()  # reach and joint distance alone
+
+
 def top_down_targets(xyz: torch.Tensor) -> torch.Tensor:
     """Top-down TCP poses (..., 4, 4) at ``xyz`` (..., 3), yaw 0, differentiable in ``xyz``.
 
@@ -118,21 +130,21 @@ def move_costs_batch(
     picks: torch.Tensor,
     places: torch.Tensor,
     config: MoveCostConfig = MoveCostConfig(),
-    obstacles: tuple | None = None,
+    bodies: Bodies = NO_BODIES,
     solved: tuple[torch.Tensor, torch.Tensor] | None = None,
-    blocks: Blocks | None = None,
 ) -> torch.Tensor:
     """Costs (P, N, Y) float64 of P problems at once: picks (P, N, 3), places (P, Y, 3).
 
     One batched IK call covers all ``P * (N + Y)`` targets, seeded from ``q_ref`` (J,) plus the
     solver's own seeds; see `move_costs` for one problem and the module docstring for c(x, y).
-    ``obstacles`` is (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the base
-    frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing. ``solved``:
-    the detached solutions of targets near these (`site_solutions`), reused instead of solving
-    (an optimiser moving the places a little calls this at every step). ``blocks``: the
-    problems' blocks, priced at the grasp and release configurations when
-    ``config.block_weight > 0`` (`block_term`).
+    ``bodies.obstacles`` is (centres (O, 3), half extents (O, 3)) of axis-aligned boxes in the
+    base frame, priced when ``config.collision_weight > 0``; None or O = 0 adds nothing.
+    ``solved``: the detached solutions of targets near these (`site_solutions`), reused instead
+    of solving (an optimiser moving the places a little calls this at every step).
+    ``bodies.blocks``: the problems' blocks, priced at the grasp and release configurations
+    when ``config.block_weight > 0`` (`block_term`).
     """
+    obstacles, blocks = bodies
     picks = _points(picks, 3, "picks")  # (P, N, 3)
     places = _points(places, 3, "places")  # (P, Y, 3)
     if picks.shape[0] != places.shape[0]:
@@ -288,5 +300,5 @@ def move_costs(
     """
     picks = _points(picks, 2, "picks")  # (N, 3)
     places = _points(places, 2, "places")  # (Y, 3)
-    c = move_costs_batch(solver, q_ref, picks[None], places[None], config, obstacles)
+    c = move_costs_batch(solver, q_ref, picks[None], places[None], config, Bodies(obstacles))
     return c[0]  # (N, Y)

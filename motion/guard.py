@@ -323,7 +323,16 @@ def guard_pick_place(
         t_check, t_plan = t_check + checked, t_plan + planned
         runs += (run is not None and run is not phase) or "planner" in evidence
         if run is None:
-            return Guarded(False, (), "collision", evidence, tuple(rerouted), t_check, t_plan, runs)
+            return Guarded(
+                ok=False,
+                phases=(),
+                failure="collision",
+                evidence=evidence,
+                rerouted=tuple(rerouted),
+                check_time_s=t_check,
+                plan_time_s=t_plan,
+                planner_runs=runs,
+            )
         out.append(run)
         if run is not phase:
             rerouted.append(phase.name)
@@ -332,7 +341,16 @@ def guard_pick_place(
             for n in (k - 1, k + 1):
                 if 0 <= n < len(out) and out[n].name not in ("close", "open"):
                     out[n] = at_rest(out[n])
-    return Guarded(True, tuple(out), None, {}, tuple(rerouted), t_check, t_plan, runs)
+    return Guarded(
+        ok=True,
+        phases=tuple(out),
+        failure=None,
+        evidence={},
+        rerouted=tuple(rerouted),
+        check_time_s=t_check,
+        plan_time_s=t_plan,
+        planner_runs=runs,
+    )
 
 
 def guard_free_move(

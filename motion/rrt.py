@@ -426,21 +426,7 @@ def plan_path(
 
     if valid_batch is not None:
         batch = _Batch(valid_batch, checker.step)
-        path = None
-        ends = batch(np.stack([start, goal]))
-        if not ends.all() and checker(start) and checker(goal):
-            # the stricter check refuses an end that ``valid`` accepts: ask ``valid`` about
-            # every configuration the batch refuses (the search is then as strict as valid)
-            batch.valid_batch = _screened(valid_batch, checker)
-            evidence["screened"] = True
-            ends = batch(np.stack([start, goal]))
-        if ends.all():
-            path = _via_search(start, goal, batch, lo, hi, config)
-            if path is None:
-                deadline = time.perf_counter() + min(config.batch_time_limit, config.time_limit)
-                path = _batched_connect(start, goal, batch, lo, hi, config, deadline)
-                if path is not None:
-                    path = _dedupe(_batched_reduce(path, batch))
+        path = _batched_path(start, goal, batch, checker, (lo, hi), config, evidence)
         evidence |= {"batch_configs": batch.configs, "batch_calls": batch.calls}
         evidence |= {"batch_s": time.perf_counter() - t0}
         if path is not None and (
@@ -458,13 +444,7 @@ def plan_path(
     if raw is None:
         return result(None, "no_path", status=status, time_limit=config.time_limit, plan_s=plan_s)
     raw[0], raw[-1] = start, goal
-    path, deadline = _dedupe(raw), time.perf_counter() + config.simplify_time
-    if config.simplify:
-        rng = np.random.default_rng(config.seed)
-        path = _reduce(path, checker)
-        path = _reduce(_shortcut(path, checker, rng, config.shortcut_attempts, deadline), checker)
-        path = _dedupe(path)
-    capped = config.simplify and time.perf_counter() > deadline  # the path then depends on speed
+    path, capped = _simplified(raw, checker, config)
     info = {"status": status, "plan_s": plan_s, "plan_checks": plan_checks}
     info |= {"raw_waypoints": len(raw), "waypoints": len(path), "simplify_capped": capped}
     info |= {"raw_length": _length(raw), "length": _length(path)}
@@ -472,6 +452,44 @@ def plan_path(
         if all(checker.segment(a, b, ends=True) for a, b in pairwise(candidate)):
             return result(candidate, None, **info, simplified=candidate is path)
     return result(None, "invalid_path", **info)
+
+
+def _batched_path(start, goal, batch: _Batch, checker: _Checker, bounds, config, evidence: dict):
+    """`plan_path`'s batched search with ``batch`` between joint ``bounds`` (lo, hi): the
+    seeded via points, then RRT-Connect for at most ``config.batch_time_limit``; the path
+    found (reduced), or None, also when ``batch`` refuses start or goal. When it refuses an
+    end that ``checker`` accepts, it asks ``checker`` about every configuration it refuses
+    from then on (the search is then as strict as ``valid``), noted in ``evidence``."""
+    lo, hi = bounds
+    ends = batch(np.stack([start, goal]))
+    if not ends.all() and checker(start) and checker(goal):
+        # the stricter check refuses an end that ``valid`` accepts: ask ``valid`` about
+        # every configuration the batch refuses (the search is then as strict as valid)
+        batch.valid_batch = _screened(batch.valid_batch, checker)
+        evidence["screened"] = True
+        ends = batch(np.stack([start, goal]))
+    if not ends.all():
+        return None
+    path = _via_search(start, goal, batch, lo, hi, config)
+    if path is None:
+        deadline = time.perf_counter() + min(config.batch_time_limit, config.time_limit)
+        path = _batched_connect(start, goal, batch, lo, hi, config, deadline)
+        if path is not None:
+            path = _dedupe(_batched_reduce(path, batch))
+    return path
+
+
+def _simplified(raw: np.ndarray, checker: _Checker, config) -> tuple[np.ndarray, bool]:
+    """The search's ``raw`` path without repeats and, with ``config.simplify``, reduced and
+    shortcut within ``config.simplify_time``; and whether that time ran out (the path then
+    depends on the machine's speed)."""
+    path, deadline = _dedupe(raw), time.perf_counter() + config.simplify_time
+    if config.simplify:
+        rng = np.random.default_rng(config.seed)
+        path = _reduce(path, checker)
+        path = _reduce(_shortcut(path, checker, rng, config.shortcut_attempts, deadline), checker)
+        path = _dedupe(path)
+    return path, config.simplify and time.perf_counter() > deadline
 
 
 def _length(path: np.ndarray) -> float:

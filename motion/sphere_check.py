@@ -115,35 +115,14 @@ class SphereCollision:
         self.gap = COVER_GAP
         self.parts = (*PARTS, HELD)  # (P,) = L links + the held box, as PandaCollision.parts
         self._rot, self._off, self._hand, self._tcp = chain(spec)
-        # each joint origin's rotation as (source axis, sign) per axis; the URDF's are all
-        # quarter turns
-        self._swaps = []
-        for origin in self._rot:
-            k = np.abs(origin).argmax(0)  # (3,) the parent axis each new axis is
-            if not np.allclose(np.abs(origin), onehot(k), atol=1e-9):
-                raise MotionError(f"joint origin rotations must be quarter turns, got {origin}")
-            self._swaps.append([(int(k[a]), float(np.sign(origin[k[a], a]))) for a in range(3)])
+        self._quarter_turns()
         spheres = link_spheres()
         # the G spheres, link by link: centres (G, 3) in their link's frame, radii (G,)
         self._local = np.concatenate([spheres[link][0] for link in PARTS])
         self._radii = np.concatenate([spheres[link][1] for link in PARTS])
         self._count = np.array([len(spheres[link][1]) for link in PARTS])  # (L,)
         self._start = np.cumsum(self._count) - self._count  # (L,) first sphere of each link
-        # links by sphere count into BUCKETS; per bucket, every link's spheres padded to the
-        # bucket's largest count by repeating its first (a repeat changes no minimum): centres
-        # (L, S_k, 3) in the link's frame, radii (L, S_k); a link outside the bucket is zeros
-        self._bucket = np.searchsorted(BUCKETS, self._count)  # (L,)
-        self._pad_local, self._pad_radii = [], []
-        for k in range(len(BUCKETS) + 1):
-            width = int(self._count[self._bucket == k].max(initial=1))
-            local, radii = np.zeros((len(PARTS), width, 3)), np.zeros((len(PARTS), width))
-            for link, name in enumerate(PARTS):
-                if self._bucket[link] == k:
-                    rows = np.arange(width)
-                    rows = np.where(rows < self._count[link], rows, 0)
-                    local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
-            self._pad_local.append(local.astype(FLOAT))
-            self._pad_radii.append(radii.astype(FLOAT))
+        self._buckets(spheres)
         self._clusters(spheres)
         bounds = [bound(*spheres[link]) for link in PARTS]
         self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
@@ -154,17 +133,7 @@ class SphereCollision:
             "robot": list(range(len(PARTS))),
             "hand": [index[n] for n in HAND],
         }
-        pairs = [
-            (a, b)
-            for a, b in combinations(range(len(PARTS)), 2)
-            if frozenset((PARTS[a], PARTS[b])) not in DISABLED_PAIRS
-        ]
-        self._pairs = np.array(pairs)  # (K, 2) link pairs checked for self-collision
-        # (K,) the joint whose angle, when at least (K,), keeps the pair apart (see APART)
-        apart = {frozenset((a, b)): (j, lowest) for a, b, j, lowest in APART}
-        rule = [apart.get(frozenset((PARTS[a], PARTS[b])), (0, math.inf)) for a, b in pairs]
-        self._apart_joint = np.array([j for j, _ in rule])
-        self._apart_from = np.array([lowest for _, lowest in rule])
+        self._pair_rules()
         self._directions, self._dop = dops()  # (26, 3), (L, 26)
         self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
         self._cos, self._sin = np.zeros(0, FLOAT), np.zeros(0, FLOAT)  # (O,) of the yaws
@@ -180,7 +149,54 @@ class SphereCollision:
         for name in ("_rot", "_off", "_hand", "_tcp", "_local", "_radii", "_bounds", "_reach"):
             setattr(self, name, getattr(self, name).astype(FLOAT))
         self._directions, self._dop = self._directions.astype(FLOAT), self._dop.astype(FLOAT)
-        # the 26-DOP's first test: its axis-aligned box, centre (L, 3) and half extents (L, 3)
+        self._dop_boxes()
+
+    def _quarter_turns(self) -> None:
+        """Each joint origin's rotation as (source axis, sign) per axis (``_swaps``); the
+        URDF's are all quarter turns (MotionError otherwise)."""
+        self._swaps = []
+        for origin in self._rot:
+            k = np.abs(origin).argmax(0)  # (3,) the parent axis each new axis is
+            if not np.allclose(np.abs(origin), onehot(k), atol=1e-9):
+                raise MotionError(f"joint origin rotations must be quarter turns, got {origin}")
+            self._swaps.append([(int(k[a]), float(np.sign(origin[k[a], a]))) for a in range(3)])
+
+    def _buckets(self, spheres) -> None:
+        """The links by sphere count into BUCKETS; per bucket, every link's spheres padded to
+        the bucket's largest count by repeating its first (a repeat changes no minimum):
+        centres (L, S_k, 3) in the link's frame, radii (L, S_k); a link outside the bucket is
+        zeros."""
+        self._bucket = np.searchsorted(BUCKETS, self._count)  # (L,)
+        self._pad_local, self._pad_radii = [], []
+        for k in range(len(BUCKETS) + 1):
+            width = int(self._count[self._bucket == k].max(initial=1))
+            local, radii = np.zeros((len(PARTS), width, 3)), np.zeros((len(PARTS), width))
+            for link, name in enumerate(PARTS):
+                if self._bucket[link] == k:
+                    rows = np.arange(width)
+                    rows = np.where(rows < self._count[link], rows, 0)
+                    local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
+            self._pad_local.append(local.astype(FLOAT))
+            self._pad_radii.append(radii.astype(FLOAT))
+
+    def _pair_rules(self) -> None:
+        """The link pairs checked for self-collision (K, 2), and per pair the joint whose
+        angle, when at least its bound, keeps the pair apart (see APART)."""
+        pairs = [
+            (a, b)
+            for a, b in combinations(range(len(PARTS)), 2)
+            if frozenset((PARTS[a], PARTS[b])) not in DISABLED_PAIRS
+        ]
+        self._pairs = np.array(pairs)  # (K, 2) link pairs checked for self-collision
+        # (K,) the joint whose angle, when at least (K,), keeps the pair apart (see APART)
+        apart = {frozenset((a, b)): (j, lowest) for a, b, j, lowest in APART}
+        rule = [apart.get(frozenset((PARTS[a], PARTS[b])), (0, math.inf)) for a, b in pairs]
+        self._apart_joint = np.array([j for j, _ in rule])
+        self._apart_from = np.array([lowest for _, lowest in rule])
+
+    def _dop_boxes(self) -> None:
+        """The 26-DOP's first test: its axis-aligned box, centre (L, 3) and half extents
+        (L, 3), and the supports from the box's centre (26, L)."""
         axes = [np.flatnonzero((self._directions == e).all(1))[0] for e in np.eye(3, dtype=FLOAT)]
         minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
         high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each

@@ -33,7 +33,14 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from motion.cost import Blocks, MoveCostConfig, block_depths, move_costs_batch, site_solutions
+from motion.cost import (
+    Blocks,
+    Bodies,
+    MoveCostConfig,
+    block_depths,
+    move_costs_batch,
+    site_solutions,
+)
 from motion.ik import IKSolver
 from motion.pick_place import PickPlaceConfig
 from tamp.scene import (
@@ -46,7 +53,7 @@ from tamp.scene import (
     towers,
 )
 from tamp.world.convert.from_poses import read_state
-from task.costs import IMPOSSIBLE
+from task.costs import IMPOSSIBLE, CostSourceBase
 from task.domains.base import State
 from task.problem import TABLE, Move, Problem
 
@@ -167,9 +174,8 @@ class _Placed:
         o, n = self.owner, self.n
         table = self.places[:, n:] + torch.nn.functional.pad(self.shift(), (0, 1))  # (B, K, 3)
         places = torch.cat([self.places[:, :n], table], dim=1)  # (B, Y, 3)
-        c = move_costs_batch(
-            o.solver, o.q_now, self.picks, places, o.config, o.boxes, self.solved, self.blocks
-        )
+        bodies = Bodies(o.boxes, self.blocks)
+        c = move_costs_batch(o.solver, o.q_now, self.picks, places, o.config, bodies, self.solved)
         return c + self.extra  # (B, N, Y)
 
     def parameters(self) -> list[torch.Tensor]:
@@ -199,11 +205,13 @@ class Arm:
     failed: Sequence[FailedMove] = ()
 
 
-class ArmCosts:
+class ArmCosts(CostSourceBase):
     """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
     ``poses[k]`` (block -> `Pose`), priced for ``arm`` (`Arm`: the arm now at ``arm.q_now``,
     (J,)). ``places``: per problem, table place -> (x, y), for slotted problems (`tamp.slots`);
     ``reach``: how far a block may go from its place's centre (m; 0: the places are fixed)."""
+
+    can_forget = True  # `forget` drops the moves committed for a problem
 
     def __init__(
         self,
@@ -234,7 +242,7 @@ class ArmCosts:
 
     def verify(self, index: int, state: State, move) -> bool:
         """Whether the executor finds ``move``'s motion in ``state`` of problem ``index``
-        (`task.costs.CostSource`'s optional check ahead, `task.planner.windows.own_state_prefix`):
+        (`task.costs.CostSourceBase`'s check ahead, `task.planner.windows.own_state_prefix`):
         ``check`` on the poses this source predicts there (`predict_poses`; a move onto a table
         place goes to its centre), the arm where it is now. A move it fails is ruled out in that
         state from then on (priced `BLOCKED`): the next window there decodes another. True
@@ -306,8 +314,9 @@ class ArmCosts:
         picks, places, extra, blocks, other = self._inputs(todo)
         solved = self._site_solutions(picks, places)
         with torch.no_grad():
+            bodies = Bodies(self.boxes, blocks)
             c = move_costs_batch(
-                self.solver, self.q_now, picks, places, self.config, self.boxes, solved, blocks
+                self.solver, self.q_now, picks, places, self.config, bodies, solved
             )
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return list(c + extra)  # (P, N, Y) each

@@ -12,10 +12,16 @@ expose ``crisp_states`` (the perceived protocol: a robot without an oracle) make
 decode against those states instead, apply the decoded moves to the true state (the world),
 end the plan as inexecutable at the first move that is illegal there (that move kept, last),
 and finish a problem when a crisp state read after its moves satisfies the goal.
+
+The window beliefs of this repository inherit `WindowBeliefsBase`, which gives the optional
+members their defaults (the true states; no frozen beliefs to retry a stuck window with); a
+source's beliefs that do not are wrapped once where the source enters the planner
+(`belief_source`, in `task.planner.plan_batch`), their own members kept.
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -41,10 +47,10 @@ class WindowBeliefs(Protocol):
         """Tensors to optimise with the logits; empty when the beliefs are frozen."""
         ...
 
-    # Optional: ``fallback(rows) -> WindowBeliefs``, frozen beliefs for the problems at
-    # ``rows`` (positions in this window), with which the planner retries a window that decoded
-    # no move under adapted beliefs: adapting perception must never leave a problem stuck
-    # where the frozen reading plans on.
+    # Optional (`WindowBeliefsBase`): ``fallback(rows) -> WindowBeliefs | None``, frozen
+    # beliefs for the problems at ``rows`` (positions in this window), with which the planner
+    # retries a window that decoded no move under adapted beliefs: adapting perception must
+    # never leave a problem stuck where the frozen reading plans on.
 
 
 class BeliefSource(Protocol):
@@ -52,3 +58,66 @@ class BeliefSource(Protocol):
     to `task.planner.plan_batch`) in their current crisp ``states``."""
 
     def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefs: ...
+
+
+class WindowBeliefsBase(ABC):
+    """A `WindowBeliefs` with the defaults of its optional members: ``crisp_states`` None
+    (decode against the true states) and no `fallback`. The planner reads these members
+    directly; window beliefs inherit this class, or are wrapped in it where their source
+    enters the planner (`belief_source`)."""
+
+    lr: float
+    crisp_states: Sequence[State] | None = None
+
+    @abstractmethod
+    def compute(self) -> tuple[Tensor, Tensor, Tensor]: ...
+
+    @abstractmethod
+    def parameters(self) -> list[Tensor]: ...
+
+    def fallback(self, rows: Sequence[int]) -> WindowBeliefsBase | None:
+        """Frozen beliefs for the problems at ``rows`` to retry a stuck window with; by default
+        None: the window is not retried."""
+        return None
+
+
+class _Given(WindowBeliefsBase):
+    """Window beliefs that do not inherit `WindowBeliefsBase`, wrapped: their own
+    ``crisp_states`` and ``fallback`` where they have them, else the defaults."""
+
+    def __init__(self, given: WindowBeliefs) -> None:
+        self.given, self.lr = given, given.lr
+        self.crisp_states = getattr(given, "crisp_states", None)  # the one look at them
+        self._fallback = getattr(given, "fallback", None)
+
+    def compute(self) -> tuple[Tensor, Tensor, Tensor]:
+        return self.given.compute()
+
+    def parameters(self) -> list[Tensor]:
+        return self.given.parameters()
+
+    def fallback(self, rows: Sequence[int]) -> WindowBeliefsBase | None:
+        return None if self._fallback is None else window_beliefs(self._fallback(rows))
+
+
+def window_beliefs(beliefs: WindowBeliefs) -> WindowBeliefsBase:
+    """``beliefs`` as a `WindowBeliefsBase`: themselves when they inherit it, else wrapped."""
+    return beliefs if isinstance(beliefs, WindowBeliefsBase) else _Given(beliefs)
+
+
+class _Source:
+    """A `BeliefSource` whose windows' beliefs are all `WindowBeliefsBase` (`window_beliefs`)."""
+
+    def __init__(self, source: BeliefSource) -> None:
+        self.source = source
+
+    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefsBase:
+        return window_beliefs(self.source(indices, states))
+
+
+def belief_source(source: BeliefSource | None) -> BeliefSource | None:
+    """``source`` (None stays None) made to give `WindowBeliefsBase` beliefs: where a belief
+    source enters the planner, so that the optional members are looked up once, there."""
+    if source is None or isinstance(source, _Source):
+        return source
+    return _Source(source)

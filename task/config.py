@@ -110,7 +110,7 @@ class PlannerConfig:
         of it is left out."""
         from task.domains import get_domain
 
-        tuned = dict(getattr(get_domain(name), "planner_defaults", {}))
+        tuned = dict(get_domain(name).planner_defaults)
         parts = tuned.get("part_window", ())
         tuned["part_window"] = tuple((k, v) for k, v in parts if k not in given)
         return cls(**{**tuned, **given})

@@ -19,14 +19,21 @@ leaves `task`; the costs come in as a tensor. The costs are those of the window'
 for every step of the window (later steps see the same matrix): an approximation the next
 window corrects, as it starts from the state the executed moves reached.
 
-A source may also check moves ahead: an optional ``verify(index, state, move) -> bool`` says
+A source may also check moves ahead: ``verify(index, state, move) -> bool`` says
 whether the move of problem ``index`` can be carried out where it starts (the arm's executor
 check on the poses the source predicts there, `tamp.arm_costs.ArmCosts.verify`). The receding
 windows call it on each move they keep (`task.planner.windows.own_state_prefix`), ending the
 window before the first it fails; the source then rules that move out in that state, so the
 next window decodes another. A cheap matrix for every move, an exact check for the few the
 windows choose: motion feasibility checked lazily, and a failure fed back, before anything
-runs.
+runs. A source that records the moves committed to it may drop them again, ``forget(index)``,
+when the planner's fallback starts a problem's plan over from its initial state; only a source
+that can (``can_forget``) lets the fallback start over.
+
+The cost sources of this repository inherit `CostSourceBase`, which gives these members their
+defaults (every move passes the check ahead; nothing to forget, so no start over); a user's own
+`CostSource` that does not inherit it is wrapped once where it enters the planner
+(`cost_source`, in `task.planner.plan_batch`), its own ``verify`` and ``forget`` kept.
 
 Shapes: P problems in the window (all of one size N, `Y` targets each), R restart rows per
 problem, adjacent in the batch (row ``p * R + r`` is restart r of problem p).
@@ -34,6 +41,7 @@ problem, adjacent in the batch (row ``p * R + r`` is restart r of problem p).
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -82,6 +90,64 @@ class CostSource(Protocol):
     def __call__(
         self, indices: Sequence[int], states: Sequence[State], restarts: int
     ) -> WindowCosts: ...
+
+
+class CostSourceBase(ABC):
+    """A `CostSource` with the defaults of its optional members: every move passes the check
+    ahead (`verify`) and there is nothing to forget (`forget`, ``can_forget`` False). The
+    planner calls these members directly; cost sources inherit this class, or are wrapped in
+    it where they enter the planner (`cost_source`)."""
+
+    # whether `forget` drops the moves committed to the source: only then may the planner's
+    # fallback start a plan over from the initial state (the source's moves would be stale)
+    can_forget: bool = False
+
+    @abstractmethod
+    def __call__(
+        self, indices: Sequence[int], states: Sequence[State], restarts: int
+    ) -> WindowCosts: ...
+
+    def verify(self, index: int, state: State, move) -> bool:
+        """Whether the move of problem ``index`` can be carried out where it starts, in
+        ``state`` (the check ahead of the receding windows,
+        `task.planner.windows.own_state_prefix`); by default every move can."""
+        return True
+
+    def forget(self, index: int) -> None:
+        """Drop the moves committed for problem ``index`` (the fallback started its plan over
+        from the initial state); by default there is nothing to drop."""
+        return None
+
+
+class _Given(CostSourceBase):
+    """A `CostSource` that does not inherit `CostSourceBase`, wrapped: its own ``verify`` and
+    ``forget`` where it has them, else the defaults."""
+
+    def __init__(self, given: CostSource) -> None:
+        self.given = given
+        self._verify = getattr(given, "verify", None)  # the one look at its optional members
+        self._forget = getattr(given, "forget", None)
+        self.can_forget = self._forget is not None
+
+    def __call__(
+        self, indices: Sequence[int], states: Sequence[State], restarts: int
+    ) -> WindowCosts:
+        return self.given(indices, states, restarts)
+
+    def verify(self, index: int, state: State, move) -> bool:
+        return True if self._verify is None else bool(self._verify(index, state, move))
+
+    def forget(self, index: int) -> None:
+        if self._forget is not None:
+            self._forget(index)
+
+
+def cost_source(costs: CostSource | None) -> CostSourceBase | None:
+    """``costs`` as a `CostSourceBase` (None stays None): itself when it inherits the class,
+    else wrapped once, its optional members looked up here and nowhere else."""
+    if costs is None or isinstance(costs, CostSourceBase):
+        return costs
+    return _Given(costs)
 
 
 def finite_costs(costs: Tensor) -> Tensor:

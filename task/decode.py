@@ -159,22 +159,22 @@ def decode_row(
         if domain.is_goal(problem, state):
             break
     reached = domain.is_goal(problem, state)
-    estimate = getattr(domain, "estimate", None)  # optional: an inadmissible ranking estimate
-    if rule.prefix and check and estimate is None and moves and not reached:
+    estimate = domain.has_estimate  # the domain's own inadmissible ranking estimate
+    if rule.prefix and check and not estimate and moves and not reached:
         return _best_prefix(domain, start, moves, trail, complete, loss)
     remaining = 0 if reached else domain.lower_bound(problem, state)
-    estimated = None if reached or estimate is None else estimate(problem, state)
+    estimated = None if reached or not estimate else domain.estimate(problem, state)
     return DecodedWindow(
-        tuple(moves),
-        state,
-        reached,
-        complete,
-        loss,
-        remaining,
-        illegal,
-        estimated,
-        state in start.seen,
-        motion,
+        moves=tuple(moves),
+        state=state,
+        reached=reached,
+        complete=complete,
+        loss=loss,
+        remaining=remaining,
+        illegal=illegal,
+        estimated=estimated,
+        revisit=state in start.seen,
+        motion=motion,
     )
 
 
@@ -197,17 +197,17 @@ def _best_prefix(
         buried += bound >= before and not fixed
         parked += park and bound == before and fixed
         window = DecodedWindow(
-            tuple(moves[:k]),
-            state,
-            False,
-            complete,
-            loss,
-            bound,
-            None,
-            bound - parked,
-            state in seen,
-            motion,
-            buried,
+            moves=tuple(moves[:k]),
+            state=state,
+            reached=False,
+            complete=complete,
+            loss=loss,
+            remaining=bound,
+            illegal=None,
+            estimated=bound - parked,
+            revisit=state in seen,
+            motion=motion,
+            buried=buried,
         )
         if best is None or window.key() < best.key():
             best = window

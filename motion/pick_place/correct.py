@@ -9,7 +9,7 @@ import numpy as np
 
 from motion.errors import MotionError
 from motion.ik import IKSolver
-from motion.pick_place.lines import vertical_path
+from motion.pick_place.lines import LineEnd, vertical_path
 from motion.pick_place.plan import Phase, PickPlaceConfig
 from motion.trajectory import JointTrajectory, polyline_segment, thin
 
@@ -46,11 +46,12 @@ def corrected_place(
     pre, place, up = poses
     q_pre, q_place, q_up = ends.q
     step, tolerance = config.vertical_step, config.straight_tolerance
-    paths = [vertical_path(solver, here, pre, q_now, q_pre, step, tolerance)]
+    paths = [vertical_path(solver, LineEnd(here, q_now), LineEnd(pre, q_pre), step, tolerance)]
     for a, b, q_b in ((pre, place, q_place), (place, up, q_up)):
         if paths[-1] is None:
             return None
-        paths.append(vertical_path(solver, a, b, paths[-1][-1], q_b, step, tolerance))
+        start, end = LineEnd(a, paths[-1][-1]), LineEnd(b, q_b)
+        paths.append(vertical_path(solver, start, end, step, tolerance))
     if paths[-1] is None:
         return None
     spec, dt, limits = solver.spec, config.dt, config.approach

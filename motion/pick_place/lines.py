@@ -10,6 +10,7 @@ limit can part the branches of the two ends). `bow` measures how far a joint pat
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -76,17 +77,24 @@ def bow(solver: IKSolver, path: np.ndarray, samples: int = 30) -> float:
     return float(np.linalg.norm(p - (a + t[:, None] * line), axis=1).max())
 
 
+class LineEnd(NamedTuple):
+    """One end of a straight tool line: the tool's ``pose`` (4, 4) and the joints ``q`` (J,)
+    planned there."""
+
+    pose: np.ndarray
+    q: np.ndarray
+
+
 def vertical_path(
     solver: IKSolver,
-    pose_a: np.ndarray,
-    pose_b: np.ndarray,
-    q_a,
-    q_b,
+    start: LineEnd,
+    end: LineEnd,
     step: float,
     tolerance: float,
     free_start: bool = False,
 ) -> np.ndarray | None:
-    """Joint knots (K, J) along the straight Cartesian line pose_a -> pose_b (same rotation),
+    """Joint knots (K, J) along the straight Cartesian line from ``start`` (pose_a, q_a) to
+    ``end`` (pose_b, q_b), both of the same rotation,
     one IK point every ``step`` m, so the tool moves straight instead of drifting sideways. The
     knots follow one IK branch from ``q_a`` (`_walk`); the last solves pose_b on that branch
     (it may differ from ``q_b``). With ``free_start`` (nothing before pose_a is planned yet)
@@ -95,6 +103,7 @@ def vertical_path(
     most ``tolerance`` m from the line, else None: near the arm's base one branch may not reach
     both ends (the elbow at its limit), and a joint segment there bows centimetres off the
     vertical, into whatever stands beside the pick or the place."""
+    (pose_a, q_a), (pose_b, q_b) = start, end
     ends = np.stack([q_a, q_b])  # (2, J)
     knots = _line_knots(pose_a, pose_b, step)  # (n, 4, 4)
     if not len(knots):

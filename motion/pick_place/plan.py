@@ -46,7 +46,7 @@ import numpy as np
 from motion.errors import MotionError
 from motion.grasps import Grasp, back_out, grasps, world_tcp
 from motion.ik import IKSolver, grasp_yaw, pose_yaw, top_down_pose
-from motion.pick_place.lines import vertical_path
+from motion.pick_place.lines import LineEnd, vertical_path
 from motion.trajectory import (
     APPROACH,
     TRANSIT,
@@ -354,10 +354,8 @@ def _phases(solver: IKSolver, w: dict, pose: dict, config: PickPlaceConfig) -> t
     for src, dst, free_start in lines:
         path = vertical_path(
             solver,
-            pose[src],
-            pose[dst],
-            w[src],
-            w[dst],
+            LineEnd(pose[src], w[src]),
+            LineEnd(pose[dst], w[dst]),
             config.vertical_step,
             config.straight_tolerance,
             free_start,

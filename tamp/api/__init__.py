@@ -65,7 +65,7 @@ from tamp.api.args import (
 from tamp.modes import ImageScene
 from task import data
 from task.config import PlannerConfig
-from task.costs import IMPOSSIBLE, CostSource, WindowCosts
+from task.costs import IMPOSSIBLE, CostSource, CostSourceBase, WindowCosts
 from task.domains import GENERIC, get_domain, names
 from task.domains.match import recognise
 from task.errors import PDDLError, TampError, one_of
@@ -102,6 +102,7 @@ __all__ = [
     "Action",
     "CostFunction",
     "CostSource",
+    "CostSourceBase",
     "FixedCosts",
     "Move",
     "PddlTask",
@@ -342,7 +343,7 @@ class FixedCosts:
 
 
 @dataclass(frozen=True, eq=False)
-class CostFunction:
+class CostFunction(CostSourceBase):
     """A `CostSource` from a function: ``price(problem, state)`` returns the (N, Y) tensor of
     costs of every move from the crisp ``state`` (Blocksworld: a tuple of each entity's support)
     of ``problems[i]``, where ``i`` is the problem's position in the list given to the planner

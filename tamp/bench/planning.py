@@ -162,16 +162,16 @@ def run_once(
     def row(instance: Instance, result: PlanResult, wall: float) -> Row:
         status, length = check(suite.domain, instance, result)
         return Row(
-            instance.name,
-            instance.size,
-            instance.optimal,
-            instance.reference,
-            config.horizon,
-            seed,
-            length,
-            status,
-            float(result.stats.get("time_s", wall / max(len(chosen), 1))),
-            int(result.stats.get("windows", 0)),
+            instance=instance.name,
+            size=instance.size,
+            optimal=instance.optimal,
+            reference=instance.reference,
+            horizon=config.horizon,
+            seed=seed,
+            length=length,
+            status=status,
+            time_s=float(result.stats.get("time_s", wall / max(len(chosen), 1))),
+            windows=int(result.stats.get("windows", 0)),
         )
 
     kept: dict[int, Row] = {}
@@ -224,18 +224,28 @@ def run(
         slow = run_once(suite, replace(cfg, batched=False), seeds[0], progress, subset)
         latency = percentiles([r.time_s for r in slow.rows])
         speed = Speed(
-            len(subset),
-            horizons[0],
-            seeds[0],
-            fast.wall_s,
-            slow.wall_s,
-            fast.valid(),
-            slow.valid(),
-            latency,
+            n=len(subset),
+            horizon=horizons[0],
+            seed=seeds[0],
+            batched_s=fast.wall_s,
+            sequential_s=slow.wall_s,
+            batched_valid=fast.valid(),
+            sequential_valid=slow.valid(),
+            latency_s=latency,
         )
     n = len(suite.instances)
     size_name = get_domain(domain_of(suite)).size_name
-    return Bench(suite.name, suite.source, n, config, seeds, horizons, runs, speed, size_name)
+    return Bench(
+        suite=suite.name,
+        source=suite.source,
+        n=n,
+        config=config,
+        seeds=seeds,
+        horizons=horizons,
+        runs=runs,
+        speed=speed,
+        size_name=size_name,
+    )
 
 
 def with_lama(

@@ -20,6 +20,7 @@ from perception.errors import PerceptionError
 from perception.segment import find_boxes
 from tamp.camera.render import (
     StateRenderer,
+    View,
     ViewJitter,
     block_colours,
     jitter_camera,
@@ -84,15 +85,9 @@ def generate(
             while True:
                 names, colours, state = sample_scene(rng, min_blocks, max_blocks)
                 camera = jitter_camera(renderer.camera, jitter, rng)
-                image = renderer.render(
-                    names,
-                    state,
-                    int(rng.integers(2**31)),
-                    colours,
-                    camera,
-                    random_lighting(rng),
-                    scene,
-                )
+                draw = int(rng.integers(2**31))  # drawn before the light, as always
+                view = View(camera, random_lighting(rng), scene)
+                image = renderer.render(names, state, draw, colours, view)
                 try:
                     find_boxes(image, palette[colours])
                     break

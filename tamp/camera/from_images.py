@@ -41,6 +41,7 @@ from perception.perceive import Perceiver, blur, kl_rows
 from tamp.camera.render import block_colours
 from tamp.camera.states import most_likely_state
 from tamp.modes import Adapt, Crisp, Perception
+from task.beliefs import WindowBeliefsBase
 from task.domains.base import State
 from task.errors import TampError, member
 from task.problem import Problem
@@ -70,7 +71,7 @@ class PerceptionMode:
             raise TampError("PerceptionMode needs lr > 0, kl_weight >= 0 and blur >= 0")
 
 
-class _Frozen:
+class _Frozen(WindowBeliefsBase):
     """Soft inputs computed once, no parameters; ``crisp_states`` see `task.beliefs`."""
 
     lr = 0.0
@@ -85,7 +86,7 @@ class _Frozen:
         return []
 
 
-class _Adapted:
+class _Adapted(WindowBeliefsBase):
     """Soft inputs recomputed from the images by per-problem models at every step.
 
     ``features[i]``: the frozen backbone's features of problem i's two images, or None to run

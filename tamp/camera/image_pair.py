@@ -26,6 +26,7 @@ from perception.segment import present
 from tamp.camera.from_images import ImageBeliefs, PerceptionMode, perceived_goal, perceived_state
 from tamp.modes import Crisp, ImageScene
 from tamp.scene import CAMERA_COLOURS, PALETTE
+from task.beliefs import WindowBeliefsBase
 from task.config import PlannerConfig
 from task.domains import blocksworld, get_domain
 from task.errors import TampError
@@ -157,7 +158,7 @@ def blocks_in(
     return names, [rgb for (name, rgb) in palette if name in names]
 
 
-class Unseen:
+class Unseen(WindowBeliefsBase):
     """Window beliefs for states no camera saw: the rows of problems whose state is not the
     photographed initial state start from that state one-hot (and are decoded against it);
     the goal (read from the goal image, adapted in ``optimised``) and the penalty are kept."""
@@ -169,12 +170,14 @@ class Unseen:
         self.onehot = domain.encode([problem] * len(states), states, torch.float32).F0
         read = zip(states, inner.crisp_states, strict=True)
         self.crisp_states = [s if s != problem.init else r for s, r in read]
-        if hasattr(inner, "fallback"):  # optimised: a stuck window is retried frozen
-            self.fallback = self._fallback
 
-    def _fallback(self, rows):
-        states = [self.states[r] for r in rows]
-        return Unseen(self.inner.fallback(rows), self.problem, states)
+    def fallback(self, rows):
+        """Optimised beliefs: a stuck window is retried with the frozen ones (the inner
+        beliefs' `fallback`, None for frozen beliefs), here for the same states."""
+        frozen = self.inner.fallback(rows)
+        if frozen is None:
+            return None
+        return Unseen(frozen, self.problem, [self.states[r] for r in rows])
 
     def compute(self):
         F0, goal, penalty = self.inner.compute()  # (P, N, Y), (P, N, Y), (P,)

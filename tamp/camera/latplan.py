@@ -31,7 +31,7 @@ import numpy as np
 
 from perception import data as pdata
 from tamp.camera.dataset import check_settings, label_row
-from tamp.camera.render import StateRenderer, ViewJitter, jitter_camera
+from tamp.camera.render import StateRenderer, View, ViewJitter, jitter_camera
 from tamp.scene import SceneConfig, towers
 from tamp.sim.base import SIMULATORS, Camera, Lighting
 from task.symbolic.generate import block_names, random_towers
@@ -206,32 +206,13 @@ def generate(
         for i in range(n):
             rng = np.random.default_rng([seed, i])
             sim = renderers[sims[i % len(sims)]].sim
-            while True:
-                m = int(rng.integers(min_blocks, max_blocks + 1))
-                names = block_names(m)
-                colours = [int(c) for c in rng.permutation(len(COLOURS))[:m]]
-                state = random_towers(names, random.Random(int(rng.integers(2**31))))
-                slots = [int(s) for s in rng.permutation(len(SLOTS_CLEVR))]
-                slots = slots[: len(towers(names, state))]
-                if layout_of(names, colours, state, slots) not in excluded:
-                    break
-                redrawn += 1
-            poses = renderers[sims[i % len(sims)]].place(
-                names,
-                state,
-                int(rng.integers(2**31)),
-                colours,
-                jitter_camera(camera, jitter, rng),
-                random_light(rng, rand),
-                scene,
-                slots,
-            )
-            for part in ("floor", "backdrop"):
-                sim.set_colour(part, [rng.uniform(*rand.grey)] * 3)
-            for name, rgb in COLOURS:
-                gain = rng.uniform(*rand.shade_gain)
-                shade = np.asarray(rgb) * gain + rng.uniform(0.0, rand.shade_offset, 3)
-                sim.set_colour(name, np.clip(shade, 0.0, 1.0))
+            (names, colours, state, slots), again = _layout(rng, (min_blocks, max_blocks), excluded)
+            redrawn += again
+            m = len(names)
+            draw = int(rng.integers(2**31))
+            view = View(jitter_camera(camera, jitter, rng), random_light(rng, rand), scene)
+            poses = renderers[sims[i % len(sims)]].place(names, state, draw, colours, view, slots)
+            _shade(sim, rng, rand)
             images.append(_finish(sim.render(), rng, rand))
             row_c, row_s = label_row(names, colours, state, max_blocks)
             colours_out.append(row_c)
@@ -258,16 +239,43 @@ def generate(
         excluded_from=exclude_source if excluded else None,
         redrawn_as_excluded=redrawn,
     )
+    return _at_sizes(np.stack(images), np.stack(colours_out), np.stack(supports_out), info)
+
+
+def _layout(rng: np.random.Generator, blocks: tuple[int, int], excluded: frozenset):
+    """A drawn scene of ``blocks`` (least, most) blocks whose layout is not ``excluded``:
+    its (names, colours, state, tower slots), and how many excluded ones were drawn first."""
+    redrawn = 0
+    while True:
+        m = int(rng.integers(blocks[0], blocks[1] + 1))
+        names = block_names(m)
+        colours = [int(c) for c in rng.permutation(len(COLOURS))[:m]]
+        state = random_towers(names, random.Random(int(rng.integers(2**31))))
+        slots = [int(s) for s in rng.permutation(len(SLOTS_CLEVR))]
+        slots = slots[: len(towers(names, state))]
+        if layout_of(names, colours, state, slots) not in excluded:
+            return (names, colours, state, slots), redrawn
+        redrawn += 1
+
+
+def _shade(sim, rng: np.random.Generator, rand: Randomisation) -> None:
+    """Random greys of the floor and the backdrop and random shades of the block colours."""
+    for part in ("floor", "backdrop"):
+        sim.set_colour(part, [rng.uniform(*rand.grey)] * 3)
+    for name, rgb in COLOURS:
+        gain = rng.uniform(*rand.shade_gain)
+        shade = np.asarray(rgb) * gain + rng.uniform(0.0, rand.shade_offset, 3)
+        sim.set_colour(name, np.clip(shade, 0.0, 1.0))
+
+
+def _at_sizes(full: np.ndarray, colours, supports, info: dict):
+    """The samples at each of `SIZES`: the ``full`` (M, 100, 150, 3) renders, area-downscaled
+    where the size is smaller, with their labels: {(W, H): SupportData}."""
     palette = np.asarray([rgb for _, rgb in COLOURS], dtype=np.float32)
-    full = np.stack(images)  # (M, 100, 150, 3)
     out = {}
     for size in SIZES:
         pics = full if full.shape[2:0:-1] == size else downscale(full, size)
         out[size] = pdata.SupportData(
-            pics,
-            np.stack(colours_out),
-            np.stack(supports_out),
-            palette,
-            {**info, "size": list(size)},
+            pics, colours, supports, palette, {**info, "size": list(size)}
         )
     return out

@@ -31,6 +31,19 @@ class ViewJitter:
     place_yaw: float = 0.3  # block yaw jitter, replaces SceneConfig.jitter_yaw
 
 
+@dataclass(frozen=True)
+class View:
+    """How one image is taken (`StateRenderer.render`): the ``camera`` and the ``scene``'s
+    settings (None: the renderer's own) and the ``lighting``."""
+
+    camera: Camera | None = None
+    lighting: Lighting = Lighting()
+    scene: SceneConfig | None = None
+
+
+PLAIN = View()  # the renderer's camera and scene, the default light
+
+
 def random_lighting(rng: np.random.Generator) -> Lighting:
     """A light from a random direction above the table, random diffuse and ambient levels."""
     azimuth = rng.uniform(0.0, 2.0 * np.pi)
@@ -81,18 +94,16 @@ class StateRenderer:
         state: Sequence[str],
         seed: int = 0,
         colours: Sequence[int] | None = None,
-        camera: Camera | None = None,
-        lighting: Lighting = Lighting(),
-        scene: SceneConfig | None = None,
+        view: View = PLAIN,
         slots: Sequence[int] | None = None,
     ) -> np.ndarray:
         """RGB image (H, W, 3) uint8 of ``state`` (supports in ``entities`` order).
 
         ``seed`` picks the tower slots (unless ``slots`` gives them) and jitter
         (`tamp.scene.layout`); ``colours`` gives the palette index of each entity (default 0, 1,
-        2, ...).
+        2, ...); ``view``: the camera, light and scene settings of this image.
         """
-        self.place(entities, state, seed, colours, camera, lighting, scene, slots)
+        self.place(entities, state, seed, colours, view, slots)
         return self.sim.render()
 
     def place(
@@ -101,9 +112,7 @@ class StateRenderer:
         state: Sequence[str],
         seed: int = 0,
         colours: Sequence[int] | None = None,
-        camera: Camera | None = None,
-        lighting: Lighting = Lighting(),
-        scene: SceneConfig | None = None,
+        view: View = PLAIN,
         slots: Sequence[int] | None = None,
     ) -> dict[str, Pose]:
         """Set up the view of `render` without rendering; returns each entity's true pose (the
@@ -116,13 +125,13 @@ class StateRenderer:
             raise SceneError(f"colours must give each of the {len(entities)} blocks its own index")
         if any(not 0 <= c < k for c in colours):
             raise SceneError(f"colour indices must lie in 0..{k - 1}, got {colours}")
-        poses = layout(entities, state, scene or self.scene, seed, slots)
+        poses = layout(entities, state, view.scene or self.scene, seed, slots)
         placed = self._parked()
         for x, c in zip(entities, colours, strict=True):
             placed[self.names[c]] = poses[x]
         for name, pose in placed.items():
             self.sim.set_block_pose(name, pose)
-        self.sim.set_view(camera or self.camera, lighting)
+        self.sim.set_view(view.camera or self.camera, view.lighting)
         return poses
 
     def close(self) -> None:

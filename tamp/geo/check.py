@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -354,47 +355,52 @@ def check_move(
     quick = quick_check(scene, move, tools, grasps, q) if quick or not full else {}
     tried, last = [], (Failure.COLLISION, {})
     heights = transit_heights(scene, o.name, o.pose.xyz, move.place.xyz)
+    attempt = _Move(scene, o, move, support, heights)
     for g in grasps:
         early = quick.get(g.name)
         if early is not None:
-            where = early[2].get("phase", early[2].get("waypoint", ""))
-            other = early[2].get("other", "")
-            tried.append(GraspTry(g.name, early[0], early[1], where, other, quick=True))
+            tried.append(_failed(g.name, *early, quick=True))
             last = (early[0], {"grasp": g.name, **early[2]})
             continue
         if not full:
             tried.append(GraspTry(g.name, None, quick=True))
             return verdict(ok=True, grasp=g, tried=tuple(tried), evidence={"quick": True})
-        result = _plan_grasp(scene, o, move, g, support, heights, tools, q, seed)
+        result = _plan_grasp(attempt, g, tools, q, seed)
         if isinstance(result, tuple):  # the phases that work
             tried.append(GraspTry(g.name, None))
             return verdict(ok=True, grasp=g, motion=result, tried=tuple(tried))
-        ev = result["evidence"]
-        where = ev.get("phase", ev.get("waypoint", ""))
-        tried.append(
-            GraspTry(g.name, result["failure"], result["side"], where, ev.get("other", ""))
-        )
+        tried.append(_failed(g.name, result["failure"], result["side"], result["evidence"]))
         last = (result["failure"], {"grasp": g.name, **result["evidence"]})
     if full and tools.postures > 0:  # the colliding grasps again, in other postures
         collided = [t.grasp for t in tried if t.failure is Failure.COLLISION]
-        for g in [g for g in grasps if g.name in collided][:POSTURE_GRASPS]:
-            world = pick_place_world(scene, o, move, g, support)
-            requests = [pick_place_request(o, move, g, z, scene) for z in heights]
-            phases = plan_postures(world, requests, tools, q, seed)
-            if phases is not None:
-                tried.append(GraspTry(g.name, None, where="posture"))
-                return verdict(
-                    ok=True, grasp=g, motion=phases, tried=tuple(tried), evidence={"posture": True}
-                )
+        found = _in_postures(attempt, [g for g in grasps if g.name in collided], tools, q, seed)
+        if found is not None:
+            g, phases = found
+            tried.append(GraspTry(g.name, None, where="posture"))
+            return verdict(
+                ok=True, grasp=g, motion=phases, tried=tuple(tried), evidence={"posture": True}
+            )
     return verdict(ok=False, failure=last[0], evidence=last[1], tried=tuple(tried))
 
 
-def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
+@dataclass(frozen=True)
+class _Move:
+    """The move `check_move` tries grasps of: ``move`` of object ``o`` in ``scene``, from the
+    ``support`` box it stands on, its transit at each of ``heights`` (m) in turn."""
+
+    scene: Scene
+    o: Movable
+    move: GeoMove
+    support: object
+    heights: Sequence[float]
+
+
+def _plan_grasp(attempt: _Move, g, tools, q, seed):
     """The guarded phases of the move with grasp ``g`` (a tuple), or a dict with the failure,
     its side and evidence; the transit goes over the near things, then over everything."""
     failure = None
-    for clear_z in heights:
-        request = pick_place_request(o, move, g, clear_z, scene)
+    for clear_z in attempt.heights:
+        request = pick_place_request(attempt.o, attempt.move, g, clear_z, attempt.scene)
         planned = plan_pick_place(tools.solver, q, request, tools.pick_place)
         if not planned.ok:
             bad = planned.evidence.get("waypoint", "")
@@ -402,7 +408,7 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
             why = Failure(planned.failure)  # the motion layer's name of it
             failure = {"failure": why, "side": side, "evidence": planned.evidence}
             continue
-        world = pick_place_world(scene, o, move, g, support)
+        world = pick_place_world(attempt.scene, attempt.o, attempt.move, g, attempt.support)
         guarded = guard_pick_place(planned.phases, tools.collision, world, tools.guard, seed)
         if guarded.ok:
             return guarded.phases
@@ -411,6 +417,26 @@ def _plan_grasp(scene, o, move, g, support, heights, tools, q, seed):
         if side == "pick":
             break  # the transit height changes nothing before the lift
     return failure
+
+
+def _failed(grasp: str, failure: Failure, side: str, evidence: dict, quick=False) -> GraspTry:
+    """The record of grasp ``grasp`` failing on ``side`` (pick or place), where its
+    ``evidence`` says (a phase or a waypoint) and against what."""
+    where = evidence.get("phase", evidence.get("waypoint", ""))
+    return GraspTry(grasp, failure, side, where, evidence.get("other", ""), quick=quick)
+
+
+def _in_postures(attempt: _Move, collided, tools, q, seed):
+    """The first of the ``collided`` grasps (at most `POSTURE_GRASPS`) whose move works in
+    another arm posture (`plan_postures`), with its phases; None when none does."""
+    scene, o, move = attempt.scene, attempt.o, attempt.move
+    for g in collided[:POSTURE_GRASPS]:
+        world = pick_place_world(scene, o, move, g, attempt.support)
+        requests = [pick_place_request(o, move, g, z, scene) for z in attempt.heights]
+        phases = plan_postures(world, requests, tools, q, seed)
+        if phases is not None:
+            return g, phases
+    return None
 
 
 def _supported(scene: Scene, move: GeoMove) -> bool:

@@ -142,24 +142,7 @@ def run_move(
             wall_s=time.perf_counter() - wall0,
         )
 
-    def corrected(phase: Phase, rest: list, low: bool) -> tuple[Phase, list]:
-        """Look at the held object before ``phase`` (a lower) and correct the place side."""
-        fixed = _look_and_correct(sim, move, phase, rest, correction, config, on_frame)
-        if fixed is not None and low:  # the shift is a step of the lowering, beside the place
-            fixed = (
-                tuple(replace(p, name="lower") if p.name == "shift" else p for p in fixed[0]),
-                fixed[1],
-            )
-        key = "low" if low else ""
-        screen = correction.screen
-        if fixed is not None and screen is not None and not screen(fixed[0]):
-            evidence[f"uncorrected{key and '_' + key}_mm"] = fixed[1]  # it would collide
-            fixed = None
-        if fixed is None:
-            return phase, rest
-        evidence[f"corrected{key and '_' + key}_mm"] = fixed[1]
-        return fixed[0][0], list(fixed[0][1:])
-
+    corrected = _Looks(sim, move, correction, config, on_frame, evidence).corrected
     handling = Expected(move.obj)
     phases, looks, low = list(check.motion), 0, None
     looking = correction is not None
@@ -189,24 +172,68 @@ def run_move(
         if worst > config.max_tracking:
             freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
             return done(Failure.TRACKING, phase=phase.name, error_rad=round(worst, 3), **freed)
-        if phase.name == "close":
-            missed = holding(sim, width, config, fresh=True)
-            if missed is None and sim.grasp == "weld" and not sim.attach():
-                missed = {"weld": "no object between the fingers"}
-            if missed is not None:
-                freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
-                return done(Failure.GRASP_MISSED, **missed, **freed)
-        elif phase.name == "open":
+        if phase.name == "open":
             closing = expected_contacts("lower", move.obj, rests)
             evidence |= _release(sim, config, on_frame, closing, phase.trajectory.duration)
-        elif phase.name in ("lift", "transit"):
-            gone = holding(sim, width, config, fresh=False)
-            if gone is not None:
-                sim.detach()
-                hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
-                sim.run(hold, "open", on_frame=on_frame, expected=handling)
-                return done(Failure.DROPPED, after=phase.name, injected=release is not None, **gone)
+        lost = _lost(sim, phase.name, width, config, on_frame, handling)
+        if lost is not None and lost[0] is Failure.GRASP_MISSED:
+            freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
+            return done(Failure.GRASP_MISSED, **lost[1], **freed)
+        if lost is not None:
+            return done(Failure.DROPPED, after=phase.name, injected=release is not None, **lost[1])
     return done()
+
+
+@dataclass(frozen=True)
+class _Looks:
+    """`run_move`'s looks at the held object on the way down, with what it needs; each
+    look's correction (or its refusal) noted in ``evidence``."""
+
+    sim: Simulator
+    move: GeoMove
+    correction: Correction
+    config: RunConfig
+    on_frame: Callable | None
+    evidence: dict
+
+    def corrected(self, phase: Phase, rest: list, low: bool) -> tuple[Phase, list]:
+        """Look at the held object before ``phase`` (a lower) and correct the place side."""
+        sim, move, correction, config = self.sim, self.move, self.correction, self.config
+        fixed = _look_and_correct(sim, move, phase, rest, correction, config, self.on_frame)
+        if fixed is not None and low:  # the shift is a step of the lowering, beside the place
+            fixed = (
+                tuple(replace(p, name="lower") if p.name == "shift" else p for p in fixed[0]),
+                fixed[1],
+            )
+        key = "low" if low else ""
+        screen = correction.screen
+        if fixed is not None and screen is not None and not screen(fixed[0]):
+            self.evidence[f"uncorrected{key and '_' + key}_mm"] = fixed[1]  # it would collide
+            fixed = None
+        if fixed is None:
+            return phase, rest
+        self.evidence[f"corrected{key and '_' + key}_mm"] = fixed[1]
+        return fixed[0][0], list(fixed[0][1:])
+
+
+def _lost(sim, phase: str, width: float, config, on_frame, handling):
+    """What went wrong with the held object after phase ``phase``, with its evidence:
+    GRASP_MISSED when the closed gripper (``width`` apart) holds nothing (a welded grasp: no
+    object between the fingers), DROPPED when it left the hand in the lift or the transit
+    (the hand then opens and holds still for 0.5 s); else None."""
+    if phase == "close":
+        missed = holding(sim, width, config, fresh=True)
+        if missed is None and sim.grasp == "weld" and not sim.attach():
+            missed = {"weld": "no object between the fingers"}
+        return None if missed is None else (Failure.GRASP_MISSED, missed)
+    if phase in ("lift", "transit"):
+        gone = holding(sim, width, config, fresh=False)
+        if gone is not None:
+            sim.detach()
+            hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
+            sim.run(hold, "open", on_frame=on_frame, expected=handling)
+            return Failure.DROPPED, gone
+    return None
 
 
 def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:

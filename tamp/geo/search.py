@@ -43,7 +43,7 @@ import itertools
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -274,8 +274,18 @@ def plan_search(
     if dead:
         return end(GeoStatus.UNSOLVABLE, f"no plan: {dead}")
     cache: dict[tuple, MoveCheck] = {}  # (state key, object, place name) -> quick verdict
+    run = _Run(
+        goal=goal,
+        tools=tools,
+        config=config,
+        memory=memory,
+        cache=cache,
+        stats=stats,
+        t0=t0,
+        hints=hints or {},
+    )
     while True:
-        found = _search(scene, goal, tools, config, memory, cache, stats, t0, hints or {})
+        found = _search(run, scene)
         if isinstance(found, tuple):  # (status, reason): no plan this round
             return end(*found)
         verified = _verify(scene, found, tools, config, memory, cache, stats)
@@ -313,18 +323,45 @@ def _count(stats: dict, check: MoveCheck, full: bool) -> None:
     stats["check_time_s"] += check.time_s
 
 
-def _search(scene, goal, tools, config, memory, cache, stats, t0, hints):
+@dataclass(frozen=True)
+class _Run:
+    """What every round of one `plan_search` shares: the goal, the tools and budgets, the
+    failure memory, the quick checks' verdicts (``cache``), the counts (``stats``), the start
+    time and the ``hints`` places."""
+
+    goal: Goal
+    tools: Tools
+    config: SearchConfig
+    memory: _Memory
+    cache: dict[tuple, MoveCheck]  # (state key, object, place name) -> quick verdict
+    stats: dict
+    t0: float
+    hints: Mapping
+
+
+@dataclass
+class _Round:
+    """One round's best-first search: its nodes (by id), its open queue and its guide."""
+
+    run: _Run
+    guide: _Guide
+    nodes: list[_Node] = field(default_factory=list)
+    queue: list = field(default_factory=list)
+    tie: itertools.count = field(default_factory=itertools.count)
+
+
+def _search(run: _Run, scene: Scene):
     """One round of the best-first search with quick checks: the moves of a plan, or
     (status, reason) when the round ends without one."""
-    start = _Node(scene, dict(read_facts(scene).supports), 0, None, None)
-    nodes = [start]
+    goal, tools, config, memory = run.goal, run.tools, run.config, run.memory
+    cache, stats = run.cache, run.stats
+    search = _Round(run, _Guide(goal))
+    nodes, queue = search.nodes, search.queue
+    nodes.append(_Node(scene, dict(read_facts(scene).supports), 0, None, None))
     closed = {state_key(scene)}
-    guide = _Guide(goal)
-    tie = itertools.count()
-    queue: list = []
-    _expand(0, nodes, goal, config, queue, tie, guide, stats, hints)
+    _expand(search, 0)
     while queue:
-        if time.perf_counter() - t0 > config.max_time_s:
+        if time.perf_counter() - run.t0 > config.max_time_s:
             return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (time)"
         *_, parent_id, move = heapq.heappop(queue)
         parent = nodes[parent_id]
@@ -358,7 +395,7 @@ def _search(scene, goal, tools, config, memory, cache, stats, t0, hints):
             return _path(nodes, len(nodes) - 1)
         if stats["nodes"] >= config.max_nodes:
             return GeoStatus.BUDGET, f"stopped after {stats['nodes']} expansions (nodes)"
-        _expand(len(nodes) - 1, nodes, goal, config, queue, tie, guide, stats, hints)
+        _expand(search, len(nodes) - 1)
     return (
         GeoStatus.UNSOLVABLE,
         f"no plan within the discretised choices: {config.places} places per target, grasps "
@@ -432,13 +469,19 @@ class _Guide:
         return out
 
 
-def _expand(i, nodes, goal, config, queue, tie, guide, stats, hints) -> None:
+def _expand(search: _Round, i: int) -> None:
     """Queue every successor of node ``i`` unchecked, keyed (f, -g, place rank, insertion);
     f = g + weight (h + blockers) plus a penalty of 1 for moving an object no goal atom
     plausibly involves and 1 for moving the object the last move moved (orderings only:
     nothing is pruned); h is `_Guide.estimate`. The ``hints`` places of (object, target)
     where they are free rank before `candidate_places`'."""
-    node = nodes[i]
+    config, stats, hints, guide = (
+        search.run.config,
+        search.run.stats,
+        search.run.hints,
+        search.guide,
+    )
+    node = search.nodes[i]
     stats["nodes"] += 1
     scene, supports = node.scene, node.supports
     under = set(supports.values())
@@ -463,7 +506,8 @@ def _expand(i, nodes, goal, config, queue, tie, guide, stats, hints) -> None:
                 h = guide.estimate(child, after)
                 f = g + config.weight * h + penalty
                 stats["generated"] += 1
-                heapq.heappush(queue, (f, -g, rank, next(tie), i, GeoMove(x, place)))
+                entry = (f, -g, rank, next(search.tie), i, GeoMove(x, place))
+                heapq.heappush(search.queue, entry)
 
 
 def _regions(scene: Scene) -> tuple[str, ...]:

@@ -344,6 +344,78 @@ def failed_pick(done: ExecutionResult) -> bool:
     return not done.ok and top and isinstance(geo, dict) and geo.get("sides") == ["pick"]
 
 
+@dataclass
+class _Tally:
+    """One `execute_move`'s running totals and the result it ends with: ``times`` (collision
+    checks s, motion planner s, path run rad, planner runs, planner failures) and the
+    rerouted phases ``started``, from the simulator time ``sim0`` and the wall time
+    ``wall0``."""
+
+    sim: Simulator
+    move: Move
+    sim0: float
+    wall0: float = field(default_factory=time.perf_counter)
+    times: list = field(default_factory=lambda: [0.0, 0.0, 0.0, 0, 0])
+    started: list[str] = field(default_factory=list)
+
+    def result(
+        self, failure: Failure | None = None, ik_time: float = 0.0, **evidence
+    ) -> ExecutionResult:
+        times = self.times
+        return ExecutionResult(
+            self.move,
+            failure is None,
+            failure,
+            evidence,
+            sim_time_s=self.sim.time - self.sim0,
+            wall_time_s=time.perf_counter() - self.wall0,
+            ik_time_s=ik_time,
+            check_time_s=times[0],
+            path_time_s=times[1],
+            path_rad=times[2],
+            rerouted=tuple(self.started),
+            planner_runs=times[3],
+            planner_failures=times[4],
+        )
+
+
+def _after_top_down(first: ExecutionResult, again: ExecutionResult, moved: dict):
+    """The geometric fallback's result ``again`` after the top-down tries (``first``, their
+    times): its outcome and path, ``moved`` added to its evidence, the times of both."""
+    return replace(
+        again,
+        evidence={**again.evidence, **moved},
+        sim_time_s=first.sim_time_s,
+        wall_time_s=first.wall_time_s,
+        ik_time_s=first.ik_time_s,
+        check_time_s=first.check_time_s + again.check_time_s,
+        path_time_s=first.path_time_s,
+        planner_runs=first.planner_runs,
+        planner_failures=first.planner_failures,
+    )
+
+
+def _lost(sim: Simulator, phase: str, config, on_frame, handling) -> tuple[Failure, dict] | None:
+    """What went wrong with the block after phase ``phase``, with its evidence: GRASP_MISSED
+    when the closed gripper holds no block (a welded grasp: no one block between the
+    fingers), DROPPED when it left the hand in the lift or the transit (the hand then opens
+    and holds still for 0.5 s); else None."""
+    if phase == "close":
+        missed = holding(sim, config.motion.block_size, config, fresh=True)
+        if missed is None and sim.grasp == "weld" and not sim.attach():
+            r = sim.gripper()  # block-wide, but no one block touches both fingers
+            missed = {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
+        return None if missed is None else (Failure.GRASP_MISSED, missed)
+    if phase in ("lift", "transit"):
+        gone = holding(sim, config.motion.block_size, config, fresh=False)
+        if gone is not None:
+            sim.detach()
+            hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
+            sim.run(hold, "open", on_frame=on_frame, expected=handling)
+            return Failure.DROPPED, gone
+    return None
+
+
 def execute_move(
     sim: Simulator,
     move: Move,
@@ -360,31 +432,10 @@ def execute_move(
     ``harness``: the fault injected (``drop_at`` in [0, 1] opens the gripper at that fraction
     of the transit) and the recorders called as frames and phases pass (`Harness`).
     """
-    wall0, sim0 = time.perf_counter(), sim.time
     scene, fallback = tools.scene, tools.fallback
     drop_at, on_frame, on_phase = harness.drop_at, harness.on_frame, harness.on_phase
-
-    # collision checks (s), motion planner (s), path run (rad), planner runs, planner failures
-    times = [0.0, 0.0, 0.0, 0, 0]
-    started: list[str] = []  # rerouted phases started
-
-    def result(failure: Failure | None = None, ik_time: float = 0.0, **evidence) -> ExecutionResult:
-        return ExecutionResult(
-            move,
-            failure is None,
-            failure,
-            evidence,
-            sim_time_s=sim.time - sim0,
-            wall_time_s=time.perf_counter() - wall0,
-            ik_time_s=ik_time,
-            check_time_s=times[0],
-            path_time_s=times[1],
-            path_rad=times[2],
-            rerouted=tuple(started),
-            planner_runs=times[3],
-            planner_failures=times[4],
-        )
-
+    tally = _Tally(sim, move, sim.time)
+    times, started, result = tally.times, tally.started, tally.result
     try:
         poses = observe()
     except PerceptionError as err:
@@ -399,17 +450,7 @@ def execute_move(
                 if again.ok or again.path_rad > 0:  # it made the move, or it ran and failed
                     first = result(planned[0], planned[1])  # the top-down tries' times
                     moved = placed_elsewhere(move, target) if again.ok else {}
-                    return replace(
-                        again,
-                        evidence={**again.evidence, **moved},
-                        sim_time_s=first.sim_time_s,
-                        wall_time_s=first.wall_time_s,
-                        ik_time_s=first.ik_time_s,
-                        check_time_s=first.check_time_s + again.check_time_s,
-                        path_time_s=first.path_time_s,
-                        planner_runs=first.planner_runs,
-                        planner_failures=first.planner_failures,
-                    )
+                    return _after_top_down(first, again, moved)
                 planned[2]["geo"] = again.evidence
         return result(planned[0], planned[1], **planned[2])
     target, phases, ik, rerouted = planned
@@ -432,22 +473,13 @@ def execute_move(
         if worst > config.max_tracking:
             _back_off(sim, phases, on_frame, handling)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
-        if phase.name == "close":
-            missed = holding(sim, config.motion.block_size, config, fresh=True)
-            if missed is None and sim.grasp == "weld" and not sim.attach():
-                r = sim.gripper()  # block-wide, but no one block touches both fingers
-                missed = {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
-            if missed is not None:
-                _back_off(sim, phases, on_frame, handling)
-                return result(Failure.GRASP_MISSED, ik, **missed)
-        elif phase.name in ("lift", "transit"):
-            gone = holding(sim, config.motion.block_size, config, fresh=False)
-            if gone is not None:
-                sim.detach()
-                hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
-                sim.run(hold, "open", on_frame=on_frame, expected=handling)
-                injected = release is not None  # the fault injection opened the gripper
-                return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **gone)
+        lost = _lost(sim, phase.name, config, on_frame, handling)
+        if lost is not None and lost[0] is Failure.GRASP_MISSED:
+            _back_off(sim, phases, on_frame, handling)
+            return result(Failure.GRASP_MISSED, ik, **lost[1])
+        if lost is not None:
+            injected = release is not None  # the fault injection opened the gripper
+            return result(Failure.DROPPED, ik, after=phase.name, injected=injected, **lost[1])
     try:
         seen = observe()[move.entity]
     except PerceptionError as err:

@@ -283,16 +283,16 @@ class GivenPlanEpisode(Episode):
             outcome = "executed" if done.ok else done.failure.value
             self._record(
                 StepReport(
-                    step.number,
-                    step.label,
-                    valid,
-                    failed,
-                    reason,
-                    True,
-                    outcome,
-                    dict(done.evidence),
-                    moved,
-                    carried,
+                    number=step.number,
+                    label=step.label,
+                    valid=valid,
+                    failed=failed,
+                    reason=reason,
+                    attempted=True,
+                    outcome=outcome,
+                    evidence=dict(done.evidence),
+                    disturbed=moved,
+                    carried_to=carried,
                 )
             )
             if self.replan:  # the robot's own check: observe, and replan on a surprise

@@ -80,6 +80,39 @@ class MuJoCoSim(Simulator):
         if self.video:  # llvmpipe spends most of a frame on the 4096^2 default shadow map
             s.visual.quality.shadowsize = VIDEO_SHADOW_MAP
         world, scene = s.worldbody, self.scene
+        self._add_surroundings(world)
+        bodies = {name: scene.body(name) for name in self.entities}
+        if any(b.kind == "cylinder" for b in bodies.values()):  # matte like LatPlan's rubber
+            s.add_material(name="block", specular=0.1, shininess=0.1)
+        world.add_light(
+            name="sun",
+            type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+            pos=[0.5, 0.3, 2.0],
+            dir=[-0.2, -0.1, -1.0],
+            diffuse=[0.8, 0.8, 0.8],
+        )
+        world.add_camera(
+            name="scene",
+            pos=list(cam.eye),
+            quat=_look_at(cam.eye, cam.target, cam.up),
+            fovy=cam.fovy,
+        )
+        self._add_blocks(s, poses, bodies)
+        s.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
+        self.model = m = s.compile()
+        self.data = d = mujoco.MjData(m)
+        self._index(m)
+        d.qpos[self._arm_q] = PANDA.q_home
+        d.qpos[self._fingers] = PANDA.finger_open
+        self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
+        mujoco.mj_forward(m, d)
+        self._renderer: mujoco.Renderer | None = None
+        self._video: mujoco.Renderer | None = None  # render_video's, its own GL context
+        self.set_view(self.camera, self.lighting)
+
+    def _add_surroundings(self, world) -> None:
+        """The floor, the backdrop, the fixed boxes and the drawn regions of the scene."""
+        scene = self.scene
         world.add_geom(
             name="floor",
             type=mujoco.mjtGeom.mjGEOM_PLANE,
@@ -117,22 +150,11 @@ class MuJoCoSim(Simulator):
                 contype=0,
                 conaffinity=2,
             )
-        bodies = {name: scene.body(name) for name in self.entities}
-        if any(b.kind == "cylinder" for b in bodies.values()):  # matte like LatPlan's rubber
-            s.add_material(name="block", specular=0.1, shininess=0.1)
-        world.add_light(
-            name="sun",
-            type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
-            pos=[0.5, 0.3, 2.0],
-            dir=[-0.2, -0.1, -1.0],
-            diffuse=[0.8, 0.8, 0.8],
-        )
-        world.add_camera(
-            name="scene",
-            pos=list(cam.eye),
-            quat=_look_at(cam.eye, cam.target, cam.up),
-            fovy=cam.fovy,
-        )
+
+    def _add_blocks(self, s, poses, bodies) -> None:
+        """Each block at its pose, free to move, and its weld to the hand (off until a
+        welded grasp closes)."""
+        world, scene = s.worldbody, self.scene
         for i, name in enumerate(self.entities):
             pose = poses[name]
             body = world.add_body(name=f"block_{name}", pos=list(pose.xyz), quat=_quat(pose.yaw))
@@ -158,9 +180,12 @@ class MuJoCoSim(Simulator):
                 objtype=mujoco.mjtObj.mjOBJ_BODY,
                 active=False,
             )
-        s.option.enableflags |= mujoco.mjtEnableBit.mjENBL_SLEEP
-        self.model = m = s.compile()
-        self.data = d = mujoco.MjData(m)
+
+    def _index(self, m) -> None:
+        """The compiled model's addresses and ids the simulator reads and writes: the arm's
+        and the fingers' joints and actuators, the blocks' bodies, joints and welds, and each
+        geom's contact label."""
+        scene = self.scene
         self._arm_q = np.array([m.joint(j).qposadr[0] for j in PANDA.arm_joints])
         self._fingers = np.array([m.joint(j).qposadr[0] for j in PANDA.finger_joints])
         self._act = np.array([m.actuator(actuator_name(j)).id for j in PANDA.arm_joints])
@@ -191,13 +216,6 @@ class MuJoCoSim(Simulator):
             ]
         )
         self._geom_label[m.body_rootid[m.geom_bodyid] == m.body_rootid[self._hand]] = 0
-        d.qpos[self._arm_q] = PANDA.q_home
-        d.qpos[self._fingers] = PANDA.finger_open
-        self._command(np.asarray(PANDA.q_home), np.zeros(7), "open")
-        mujoco.mj_forward(m, d)
-        self._renderer: mujoco.Renderer | None = None
-        self._video: mujoco.Renderer | None = None  # render_video's, its own GL context
-        self.set_view(self.camera, self.lighting)
 
     def _command(self, q, qd, gripper) -> None:
         self.data.ctrl[self._act] = np.asarray(q) + self._lead * np.asarray(qd)

@@ -36,6 +36,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -174,8 +175,7 @@ def generate(problem: str, seed: int, **size) -> CanonicalProblem:
             break
     else:
         raise ProblemError(f"{problem}: no variant found for seed {seed} in {TRIES} draws")
-    objects, regions, obstacles, atoms, note, witness = made
-    return _finish(problem, seed, objects, regions, obstacles, atoms, note, witness)
+    return _finish(problem, seed, _Drawn(*made))
 
 
 def write_all(directory: str | Path = SCENES_DIR) -> tuple[Path, ...]:
@@ -298,9 +298,22 @@ def in_view(points, eye, target, camera: Camera = Camera(), margin: float = 1.0)
 NO_PARKING = frozenset({"hanoi"})
 
 
-def _finish(name, seed, objects, regions, obstacles, atoms, note, witness) -> CanonicalProblem:
-    """The variant as a checked scene: round-tripped through the file format and the loader's
-    checks (a failure here is a generator bug), its goal parsed and unmet."""
+class _Drawn(NamedTuple):
+    """What a generator (`GENERATORS`) draws: the scene's parts, the goal atoms, the note and
+    the witness plan."""
+
+    objects: Sequence
+    regions: Sequence
+    obstacles: Sequence
+    atoms: Sequence[tuple[str, ...]]
+    note: str
+    witness: Sequence
+
+
+def _finish(name, seed, drawn: _Drawn) -> CanonicalProblem:
+    """The ``drawn`` variant as a checked scene: round-tripped through the file format and the
+    loader's checks (a failure here is a generator bug), its goal parsed and unmet."""
+    objects, regions, obstacles, atoms, note, witness = drawn
     scene = Scene(
         f"{name}-{seed}",
         TABLE_TOP,

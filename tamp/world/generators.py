@@ -353,38 +353,8 @@ def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
     blocked: dict[str, int] = {}
     for i in range(n):
         for _ in range(TRIES):
-            r, theta = rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65)
-            x, y = _polar(r, theta)
-            yaw = rng.uniform(-math.pi / 4, math.pi / 4)
-            kind = str(rng.choice(("cube", "cuboid", "cylinder")))
-            if kind == "cube":
-                size = (rng.uniform(0.045, 0.05),)
-            elif kind == "cuboid":
-                size = (
-                    rng.uniform(0.045, 0.05),
-                    rng.uniform(0.05, 0.065),
-                    rng.uniform(0.045, 0.06),
-                )
-            else:
-                size = (rng.uniform(0.045, 0.05), rng.uniform(0.05, 0.06))
-            o = _movable(f"o{i + 1}", kind, size, of[i], (x, y, 0.0), yaw)
-            o = _at(o, (x, y, o.half[2]))
-            axis = int(rng.integers(2))
-            signs = (1.0, -1.0) if rng.random() < 0.3 else (float(rng.choice((1.0, -1.0))),)
-            mine = []
-            for s in signs:
-                d = rng.uniform(0.046, 0.056) + POST_HALF[0]
-                across = rng.uniform(-0.003, 0.003)
-                u, v = (s * d, across) if axis == 0 else (across, s * d)
-                px, py = _rot(yaw, u, v)
-                mine.append(
-                    Obstacle(
-                        f"post_{len(posts) + len(mine)}",
-                        (round_length(x + px), round_length(y + py), POST_HALF[2]),
-                        POST_HALF,
-                        round_length(yaw),
-                    )
-                )
+            o, drawn = _sorting_object(rng, f"o{i + 1}", of[i])
+            axis, mine = _posts_beside(rng, drawn, len(posts))
             solids = [of_movable(p) for p in objects] + [of_box(p) for p in posts]
             new = [of_movable(o)] + [of_box(p) for p in mine]
             if not all(_clear_of(s, solids, 0.03) for s in new):
@@ -401,25 +371,79 @@ def _sorting(rng: np.random.Generator, n: int, colours: int) -> _Made | None:
         else:
             return None
     for _ in range(n // 2):  # free posts between the objects
-        for _ in range(20):
-            x, y = _polar(rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65))
-            post = Obstacle(
-                f"post_{len(posts)}", (round_length(x), round_length(y), POST_HALF[2]), POST_HALF
-            )
-            solid = of_box(post)
-            if (
-                _clear_of(solid, [of_movable(o) for o in objects], 0.03)
-                and _clear_of(solid, [of_box(p) for p in posts], 0.04)
-                and _sorted_grasps(zones, [*posts, post], objects, blocked)
-            ):
-                posts.append(post)
-                break
+        post = _free_post(rng, zones, posts, objects, blocked)
+        if post is not None:
+            posts.append(post)
     note = (
         f"{n} objects of {colours} colours among {len(posts)} posts 10 cm tall: a post 4.5-6 cm "
         "from each object blocks one of its two top-down grasp axes"
     )
     atoms = [("in", o.name, f"{c}_zone") for o, c in zip(objects, of, strict=True)]
     return objects, tuple(zones), tuple(posts), atoms, note, ()
+
+
+def _sorting_object(rng: np.random.Generator, name: str, colour: str):
+    """An object of ``colour`` of a random kind and size, somewhere in the sector in front of
+    the robot, turned up to 45 degrees, standing on the table; and the (x, y, yaw) drawn for
+    it, before the object's own rounding."""
+    r, theta = rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65)
+    x, y = _polar(r, theta)
+    yaw = rng.uniform(-math.pi / 4, math.pi / 4)
+    kind = str(rng.choice(("cube", "cuboid", "cylinder")))
+    if kind == "cube":
+        size = (rng.uniform(0.045, 0.05),)
+    elif kind == "cuboid":
+        size = (
+            rng.uniform(0.045, 0.05),
+            rng.uniform(0.05, 0.065),
+            rng.uniform(0.045, 0.06),
+        )
+    else:
+        size = (rng.uniform(0.045, 0.05), rng.uniform(0.05, 0.06))
+    o = _movable(name, kind, size, colour, (x, y, 0.0), yaw)
+    return _at(o, (x, y, o.half[2])), (x, y, yaw)
+
+
+def _posts_beside(rng: np.random.Generator, at: tuple, first: int) -> tuple[int, list]:
+    """The grasp axis (0 or 1, in the frame of an object at ``at``, (x, y, yaw)) to block and
+    the posts, numbered from ``first``, that block it: one 4.5-6 cm from the object's centre
+    on a random side, or (three times in ten) one on each side."""
+    x, y, yaw = at
+    axis = int(rng.integers(2))
+    signs = (1.0, -1.0) if rng.random() < 0.3 else (float(rng.choice((1.0, -1.0))),)
+    mine = []
+    for s in signs:
+        d = rng.uniform(0.046, 0.056) + POST_HALF[0]
+        across = rng.uniform(-0.003, 0.003)
+        u, v = (s * d, across) if axis == 0 else (across, s * d)
+        px, py = _rot(yaw, u, v)
+        mine.append(
+            Obstacle(
+                f"post_{first + len(mine)}",
+                (round_length(x + px), round_length(y + py), POST_HALF[2]),
+                POST_HALF,
+                round_length(yaw),
+            )
+        )
+    return axis, mine
+
+
+def _free_post(rng: np.random.Generator, zones, posts: list, objects: list, blocked: dict):
+    """A post clear of the ``objects`` and the ``posts`` that leaves every object's grasps
+    as ``blocked`` says, in at most 20 draws in the sector; None when none fits."""
+    for _ in range(20):
+        x, y = _polar(rng.uniform(0.36, 0.66), rng.uniform(-0.65, 0.65))
+        post = Obstacle(
+            f"post_{len(posts)}", (round_length(x), round_length(y), POST_HALF[2]), POST_HALF
+        )
+        solid = of_box(post)
+        if (
+            _clear_of(solid, [of_movable(o) for o in objects], 0.03)
+            and _clear_of(solid, [of_box(p) for p in posts], 0.04)
+            and _sorted_grasps(zones, [*posts, post], objects, blocked)
+        ):
+            return post
+    return None
 
 
 def _sorted_grasps(zones, posts, objects, blocked: dict[str, int]) -> bool:

@@ -238,7 +238,16 @@ def _parse(data) -> Scene:
     parking = data.get("parking", True)
     if not isinstance(parking, bool):
         raise _Fault(f"parking: expected true or false, got {parking!r}")
-    return Scene(data["name"], table, regions, obstacles, objects, slots, camera, parking)
+    return Scene(
+        name=data["name"],
+        table=table,
+        regions=regions,
+        obstacles=obstacles,
+        objects=objects,
+        slots=slots,
+        camera=camera,
+        parking=parking,
+    )
 
 
 def _coordinates(value, where: str) -> tuple[float, ...]:
@@ -289,7 +298,17 @@ def _region(value, where: str, obstacles: tuple[Obstacle, ...]) -> Region:
         raise _Fault(f"{where}.wall_thickness: {thick} m walls leave no room inside the region")
     rgb = _colour(r.get("colour", list(BROWN)), f"{where}.colour")
     name = _name(r["name"], f"{where}.name")
-    return Region(name, lo, hi, base + floor, floor, on, height, thick, rgb)
+    return Region(
+        name=name,
+        lo=lo,
+        hi=hi,
+        surface=base + floor,
+        floor=floor,
+        on=on,
+        wall_height=height,
+        wall_thickness=thick,
+        rgb=rgb,
+    )
 
 
 def _object(value, where: str) -> Movable:

@@ -1,6 +1,7 @@
 """The interface a planning domain supplies, and the tensor encoding shared by relational domains.
 
-A domain is one file in ``task/domains/`` exposing an object that satisfies `Domain`: its soft
+A domain is one file in ``task/domains/`` exposing an object that satisfies `Domain` (its class
+inherits `DomainBase`, the defaults of the optional members): its soft
 transition (``step``, ``consistency``), its action columns and how a column decodes into a
 move, its crisp legality and apply, its goal terms, an admissible lower bound, its PDDL
 mapping and a sampler of small problems for the contract tests. The rollout, optimiser,
@@ -17,8 +18,9 @@ domains (Blocksworld, Logistics) use ``Y = N + K`` support targets and ``A = Y +
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Hashable, Iterator, Sequence
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Protocol
 
 import torch
@@ -129,13 +131,13 @@ def zero_cycle_loss(F: Tensor, batch: SoftBatch) -> Tensor:
 class Domain(Protocol):
     """What a domain file provides. Tensors are batch first; see the glossary in ``task``.
 
-    Optional: ``estimate(problem, state) -> float``, an inadmissible cost-to-go the decoder
-    ranks restarts by instead of ``lower_bound`` (which still marks dead ends);
-    ``planner_defaults``, a dict of `PlannerConfig` fields (`PlannerConfig.for_domain`); for
-    big problems (`PlannerConfig.safe_from`), ``safe_moves(problem, state)``, moves some
-    shortest plan starts with, taken without a window, and ``unfinished(problem, state,
-    depth)``, the part of the problem a window of at most ``depth`` moves plans
-    (`window_part`)."""
+    Optional, with defaults in `DomainBase` (which a domain's class inherits): ``estimate``,
+    an inadmissible cost-to-go the decoder ranks restarts by instead of ``lower_bound``
+    (which still marks dead ends), where ``has_estimate``; ``helpful`` moves the greedy search
+    tries first; ``planner_defaults``, `PlannerConfig` fields (`PlannerConfig.for_domain`);
+    for big problems (`PlannerConfig.safe_from`), ``safe_moves``, moves some shortest plan
+    starts with, taken without a window where ``has_safe_moves``, and ``unfinished``, the part
+    of the problem a window of at most ``depth`` moves plans (`window_part`)."""
 
     name: str
     size_name: str  # what `size` counts, a table's column head ("blocks", "packages", ...)
@@ -239,21 +241,67 @@ class Domain(Protocol):
         """Small random problems of this domain of several sizes, for the contract tests."""
         ...
 
+    # ----------------------------------------------------- optional (defaults: `DomainBase`)
+    planner_defaults: Mapping[str, object]
+    has_estimate: bool
+    has_safe_moves: bool
+
+    def estimate(self, problem: Problem, state: State) -> float: ...
+
+    def helpful(self, problem: Problem, state: State) -> frozenset: ...
+
+    def safe_moves(self, problem: Problem, state: State) -> Sequence[Move]: ...
+
+    def unfinished(
+        self, problem: Problem, state: State, depth: int | None
+    ) -> tuple[Problem, Sequence[int]] | None: ...
+
+
+class DomainBase:
+    """The defaults of a `Domain`'s optional members; every domain's class inherits it, so
+    the planner calls these members directly. A domain overrides what it has (with a
+    ``staticmethod``, as its other members) and sets the flag that says so."""
+
+    planner_defaults: Mapping[str, object] = MappingProxyType({})  # `PlannerConfig.for_domain`
+    has_estimate = False  # whether `estimate` is the domain's own (else the lower bound)
+    has_safe_moves = False  # whether `safe_moves` may name any (`PlannerConfig.safe_from`)
+
+    def estimate(self, problem: Problem, state: State) -> float:
+        """An inadmissible cost-to-go to rank by (the decoder's restarts, the greedy search);
+        by default the admissible ``lower_bound``."""
+        return self.lower_bound(problem, state)
+
+    def helpful(self, problem: Problem, state: State) -> frozenset:
+        """Moves the greedy search tries first from ``state`` (its preferred queue,
+        `task.symbolic.lazy_search.lazy_greedy`); by default none."""
+        return frozenset()
+
+    def safe_moves(self, problem: Problem, state: State) -> Sequence[Move]:
+        """Moves some shortest plan from ``state`` starts with, taken without a window
+        (`task.planner.windows.take_safe`, where ``has_safe_moves``); by default none."""
+        return ()
+
+    def unfinished(
+        self, problem: Problem, state: State, depth: int | None
+    ) -> tuple[Problem, Sequence[int]] | None:
+        """The part of ``problem`` a window of at most ``depth`` moves plans from ``state``,
+        with the kept entities' indices (`window_part`); by default None, the whole."""
+        return None
+
 
 def window_part(
     domain: Domain, problem: Problem, state: State, visited: set, depth: int | None = None
 ) -> tuple[Problem, State, set]:
     """The problem a window of at most ``depth`` moves plans from ``state``: the domain's part
-    still to be planned (its optional ``unfinished(problem, state, depth) -> (part, kept
-    indices) | None``; the part may have entities of its own after the kept ones, and keep
+    still to be planned (its ``unfinished(problem, state, depth) -> (part, kept indices) |
+    None``; the part may have entities of its own after the kept ones, and keep
     only what ``depth`` moves can change), the part's state and ``visited`` read in the part's
     blocks and supports. Of the visited states only those a window could reach again are
     read: the same as now in every block the part drops or stands elsewhere (the window moves
     neither), each then read in the part as it stands now. The window's moves are moves of the
     whole problem, and its goal is reached exactly when the whole one's is. ``problem``,
     ``state`` and ``visited`` as they are without such a part or when it has no goal left."""
-    shrink = getattr(domain, "unfinished", None)
-    part = None if shrink is None else shrink(problem, state, depth)
+    part = domain.unfinished(problem, state, depth)
     if part is None or not part[0].goal:
         return problem, state, visited
     part, keep = part

@@ -22,6 +22,7 @@ from torch import Tensor
 from task.domains import blocksworld_pddl as _pddl
 from task.domains.base import (
     STAY_PRIOR,
+    DomainBase,
     SoftBatch,
     encode_supports,
     relational_decode,
@@ -499,7 +500,7 @@ def samples(seed: int):
         yield with_slots(small, ("s0", "s1", "s2", "s3"))
 
 
-class Blocksworld:
+class Blocksworld(DomainBase):
     """The blocksworld domain object the shared planner drives (see task.domains.base.Domain)."""
 
     name = NAME
@@ -542,6 +543,7 @@ class Blocksworld:
     helpful = staticmethod(helpful)
     legal_moves = staticmethod(legal_moves)
     safe_moves = staticmethod(safe_moves)
+    has_safe_moves = True
     unfinished = staticmethod(unfinished)
     to_atoms = staticmethod(user_atoms(to_atoms))
     to_pddl = staticmethod(to_pddl)

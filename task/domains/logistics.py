@@ -34,7 +34,14 @@ from torch import Tensor
 
 from task.domains import logistics_map as lm
 from task.domains import logistics_pddl as lp
-from task.domains.base import INF, SoftBatch, encode_supports, relational_decode, zero_cycle_loss
+from task.domains.base import (
+    INF,
+    DomainBase,
+    SoftBatch,
+    encode_supports,
+    relational_decode,
+    zero_cycle_loss,
+)
 from task.domains.match.renaming import user_actions, user_atoms
 from task.errors import ProblemError, one_of
 from task.problem import Action, Move, Problem
@@ -303,7 +310,7 @@ def samples(seed: int):
         yield random_problem(cities, locations, packages, planes, seed)
 
 
-class Logistics:
+class Logistics(DomainBase):
     """The logistics domain object the shared planner drives (see task.domains.base.Domain)."""
 
     name, size_name, goal_losses, distributions = lp.NAME, "packages", GOAL_LOSSES, True

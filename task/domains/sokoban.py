@@ -36,7 +36,7 @@ import torch
 from torch import Tensor
 
 from task.domains import sokoban_grid as rules
-from task.domains.base import SoftBatch, zero_cycle_loss
+from task.domains.base import DomainBase, SoftBatch, zero_cycle_loss
 from task.domains.match.renaming import user_actions, user_atoms
 from task.domains.sokoban_grid import INF, ROBOT, State, grid
 from task.domains.sokoban_pddl import (
@@ -267,7 +267,7 @@ def decode(problem: Problem, row: int, col: int, n: int) -> Move | None:
     return Move(ROBOT, dirs[col]) if row == 0 and col < len(dirs) else None
 
 
-class Sokoban:
+class Sokoban(DomainBase):
     """The Sokoban domain object the shared planner drives (see task.domains.base.Domain)."""
 
     name = NAME
@@ -294,6 +294,7 @@ class Sokoban:
     matches = staticmethod(matches)
     pddl_domain_text = staticmethod(pddl_domain_text)
     estimate = staticmethod(estimate)
+    has_estimate = True
     # PlannerConfig.for_domain: pushes are irreversible and plans run to 65 actions, so
     # longer lookahead restarts (8 moves) and a larger window budget (see BENCHMARKS.md)
     planner_defaults = MappingProxyType({"lookahead": 8, "max_windows": 100})

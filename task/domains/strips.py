@@ -32,7 +32,7 @@ from pddl.core import Problem as PDDLProblem
 
 from task.deadline import NO_DEADLINE, Deadline
 from task.domains import strips_soft
-from task.domains.base import zero_cycle_loss
+from task.domains.base import DomainBase, zero_cycle_loss
 from task.errors import PDDLError, ProblemError
 from task.problem import Action, Problem
 from task.symbolic import relaxed, strips
@@ -278,7 +278,7 @@ def samples(seed: int) -> Iterator[Problem]:
         yield gripper_problem(n_balls, seed)
 
 
-class Strips:
+class Strips(DomainBase):
     """The generic STRIPS lift the shared planner drives (see task.domains.base.Domain)."""
 
     name = NAME
@@ -298,6 +298,7 @@ class Strips:
     is_goal = staticmethod(is_goal)
     lower_bound = staticmethod(lower_bound)
     estimate = staticmethod(estimate)
+    has_estimate = True
     helpful = staticmethod(helpful)
     from_pddl = staticmethod(from_pddl)
     to_actions = staticmethod(to_actions)

@@ -12,7 +12,7 @@ import torch
 
 from task.beliefs import BeliefSource
 from task.config import PlannerConfig
-from task.costs import CostSource
+from task.costs import CostSourceBase
 from task.domains.base import Domain, State
 from task.problem import Problem
 from task.symbolic.lazy_search import LazyResult
@@ -31,7 +31,7 @@ class PlanContext:
     config: PlannerConfig
     generator: torch.Generator  # CPU: the same draws on every device
     source: BeliefSource | None = None
-    costs: CostSource | None = None
+    costs: CostSourceBase | None = None  # `task.costs.cost_source`: its members all there
     indices: Sequence[int] = ()
     fallback: bool = False  # the complete fallback search runs after the windows
     windows_end: float | None = None

@@ -14,7 +14,7 @@ import torch
 
 from task.beliefs import BeliefSource
 from task.config import PlannerConfig
-from task.costs import IMPOSSIBLE, CostSource, WindowCosts, finite_costs
+from task.costs import IMPOSSIBLE, CostSource, CostSourceBase, WindowCosts, finite_costs
 from task.domains.base import Domain, State
 from task.errors import TampError
 from task.problem import Move, Problem
@@ -70,7 +70,7 @@ def fall_back(
     problem: Problem,
     state: State,
     config: PlannerConfig,
-    costs: CostSource | None = None,
+    costs: CostSourceBase | None = None,
     index: int = 0,
     deadline: float | None = None,
 ) -> LazyResult:
@@ -113,7 +113,7 @@ def fall_back(
     )
     search = lazy_greedy if config.fallback_search == "greedy" else lazy_best_first
     start = domain.initial_state(problem)
-    can_forget = costs is None or getattr(costs, "forget", None) is not None
+    can_forget = costs is None or costs.can_forget
     probing = config.restart_probe > 0 and search is lazy_best_first
     if probing and state != start and can_forget:
         probed = _probe(run, start)
@@ -145,7 +145,7 @@ class _Fallback:
     config: PlannerConfig
     feasible: Feasible | None  # the cost source's verdicts (None: every move is feasible)
     windows: dict  # the cost source's one-row windows, by the state they price
-    costs: CostSource | None
+    costs: CostSourceBase | None
     index: int
     deadline: float | None
 
@@ -163,9 +163,8 @@ class _Fallback:
 
     def forget(self) -> None:
         """Tell the cost source (one that can) to drop the moves committed to it."""
-        forget = getattr(self.costs, "forget", None)  # a cost source that can drop them
-        if forget is not None:
-            forget(self.index)
+        if self.costs is not None:
+            self.costs.forget(self.index)
 
 
 def _probe(run: _Fallback, start: State) -> LazyResult | None:

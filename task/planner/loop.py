@@ -32,9 +32,9 @@ from functools import partial
 
 import torch
 
-from task.beliefs import BeliefSource
+from task.beliefs import BeliefSource, belief_source
 from task.config import PlannerConfig, torch_device
-from task.costs import CostSource
+from task.costs import CostSource, cost_source
 from task.deadline import NO_DEADLINE, Deadline
 from task.decode import DecodedWindow
 from task.domains import get_domain
@@ -184,8 +184,7 @@ def _execute_window(
     planned = win.moves
     if costs is not None and context.source is None and context.config.own_state_costs:
         feasible, _ = cost_checks(domain, problem, costs, context.indices[i])
-        check_ahead = getattr(costs, "verify", None)  # the cost source's optional check ahead
-        verify = None if check_ahead is None else partial(check_ahead, context.indices[i])
+        verify = partial(costs.verify, context.indices[i])  # the cost source's check ahead
         planned = own_state_prefix(domain, problem, progress.states[i], planned, feasible, verify)
         progress.cut[i] += len(planned) < len(win.moves)
     tried, progress.states[i], progress.illegal[i], looped = execute(
@@ -339,7 +338,10 @@ def plan_batch(
         )
     torch_device(config.device)  # refused in one line where this machine lacks it
     generator = torch.Generator().manual_seed(seed)  # CPU: the same draws on every device
-    shared = PlanContext(domain, config, generator, source=beliefs, costs=costs)
+    # cost sources and window beliefs that do not inherit `CostSourceBase` and
+    # `WindowBeliefsBase` are wrapped here, once
+    source = belief_source(beliefs)
+    shared = PlanContext(domain, config, generator, source=source, costs=cost_source(costs))
     report = progress or (lambda k: None)
     final = on_result or (lambda i, result: None)
     if not config.batched:

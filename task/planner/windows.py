@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import torch
 
-from task.beliefs import WindowBeliefs
+from task.beliefs import WindowBeliefsBase
 from task.config import PlannerConfig
 from task.costs import WindowCosts
 from task.decode import DecodedWindow, DecodeRule, WindowStart, decode_best, proof_stop
@@ -33,7 +33,7 @@ PROOF_PROBLEMS = 1  # windows of at most this many problems are read early (`_pr
 def run_window(
     context: PlanContext,
     starts: Sequence[WindowStart],
-    beliefs: WindowBeliefs | None = None,
+    beliefs: WindowBeliefsBase | None = None,
     costs: WindowCosts | None = None,
 ) -> list[DecodedWindow]:
     """The decoded window of each problem from its start (`decode_best`), planned with the
@@ -72,18 +72,20 @@ def on_device(batch: SoftBatch, device: torch.device) -> SoftBatch:
 def _retry_frozen(
     context: PlanContext,
     starts: Sequence[WindowStart],
-    beliefs: WindowBeliefs | None,
+    beliefs: WindowBeliefsBase | None,
     decoded: list[DecodedWindow],
 ) -> set[int]:
     """Windows that decoded no move under adapted beliefs are planned again from their
     ``starts`` with the beliefs' frozen ``fallback`` (`task.beliefs`, without move costs); a
     retry that moves replaces the window in place. Returns the positions of the replaced
     windows."""
-    fallback = getattr(beliefs, "fallback", None)
     stuck = [k for k, w in enumerate(decoded) if not w.moves and not w.reached]
-    if fallback is None or not stuck:
+    if beliefs is None or not stuck:
         return set()
-    again = run_window(context, [starts[k] for k in stuck], fallback(stuck))
+    frozen = beliefs.fallback(stuck)
+    if frozen is None:
+        return set()
+    again = run_window(context, [starts[k] for k in stuck], frozen)
     replaced = set()
     for k, window in zip(stuck, again, strict=True):
         if window.moves or window.reached:
@@ -93,10 +95,10 @@ def _retry_frozen(
 
 
 def crisp_states(
-    beliefs: WindowBeliefs | None, world: Sequence[State]
+    beliefs: WindowBeliefsBase | None, world: Sequence[State]
 ) -> tuple[Sequence[State], bool]:
     """The states a window decodes against and whether they are perceived (not the world)."""
-    crisp = getattr(beliefs, "crisp_states", None)
+    crisp = None if beliefs is None else beliefs.crisp_states
     if crisp is None:
         return world, False
     if len(crisp) != len(world):
@@ -166,14 +168,13 @@ def take_safe(
     those still active (not at the goal). Only without beliefs and a cost source (the
     caller's check)."""
     domain, config = context.domain, context.config
-    take = getattr(domain, "safe_moves", None)
-    if take is None:
+    if not domain.has_safe_moves:
         return list(active)
     states, solved = progress.states, progress.solved
     still = []
     for i in active:
         if config.takes_safe(problems[i]):
-            for move in take(problems[i], states[i]):
+            for move in domain.safe_moves(problems[i], states[i]):
                 states[i] = domain.apply_move(problems[i], states[i], move)
                 progress.visited[i].add(states[i])
                 progress.moves[i].append(move)

@@ -211,9 +211,13 @@ def lazy_best_first(
 
 
 class GuidedDomain(CrispDomain, Protocol):
-    """A crisp domain with an optional inadmissible cost-to-go ``estimate`` (INF at a dead end;
-    without one the greedy search is guided by ``lower_bound``); an optional
-    ``helpful(problem, state)`` gives the moves worth trying first."""
+    """A crisp domain with a cost-to-go ``estimate`` (INF at a dead end; inadmissible where the
+    domain has its own, else its ``lower_bound``: `task.domains.base.DomainBase`) and the moves
+    worth trying first, ``helpful(problem, state)`` (none by default)."""
+
+    def estimate(self, problem: Problem, state: Hashable) -> float: ...
+
+    def helpful(self, problem: Problem, state: Hashable) -> frozenset: ...
 
 
 BOOST = 1000  # preferred-queue pops granted on each new best estimate (Fast Downward's boost)
@@ -231,15 +235,14 @@ def lazy_greedy(
     evaluation and preferred operators, as Fast Downward's lazy GBFS (Richter & Helmert 2009): a
     queue entry is a (state, move) pair ranked by its parent's estimate; the successor is made, and
     its estimate computed, only when the entry pops, and the move's feasibility is checked then (as
-    in `lazy_best_first`). The domain's optional ``helpful`` moves also enter a second queue; the
+    in `lazy_best_first`). The domain's ``helpful`` moves also enter a second queue; the
     two alternate, and every new best estimate grants the preferred queue ``BOOST`` pops.
 
     Complete over the same choices as `lazy_best_first` (every reachable state is closed once;
     states the estimate calls dead ends, INF, are cut), but the plan need not be shortest.
     Ends SOLVED, UNSOLVABLE or BUDGET (``max_nodes`` expansions or ``deadline``)."""
     checks = _Checks(feasible)
-    helpful = getattr(domain, "helpful", None)
-    guide = getattr(domain, "estimate", None) or domain.lower_bound
+    guide = domain.estimate  # the domain's own, else its lower bound (`DomainBase`)
 
     def done(status: SearchStatus, moves: tuple[Move, ...], reason: str) -> LazyResult:
         return checks.result(status, moves, expanded, reason)
@@ -263,7 +266,7 @@ def lazy_greedy(
                 why = "time" if late else "budget"
                 return done(SearchStatus.BUDGET, (), f"stopped after {expanded} expansions ({why})")
             expanded += 1
-            preferred = helpful(problem, state) if helpful is not None else ()
+            preferred = domain.helpful(problem, state)
             for move in domain.legal_moves(problem, state):
                 entry = (h, next(tie), state, move)
                 heapq.heappush(queues[0], entry)

@@ -61,20 +61,23 @@ class StripsTask:
         )
         goal = tuple(a for a in goal if a in col)
         return cls(
-            tuple(a for a, _ in ground),
-            effects,
-            tuple(fluent),
-            frozenset(static),
-            frozenset(init & set(fluent)),
-            goal,
-            _padded([[col[a] for a in sorted(e.pre_pos)] for e in effects], n),
-            _padded([[col[a] for a in sorted(e.add)] for e in effects], n + 1),
-            _padded([[col[a] for a in sorted(e.delete - e.add)] for e in effects], n + 1),
-            _padded([[a in e.delete - e.add for a in sorted(e.pre_pos)] for e in effects], 0) > 0,
-            max((len(e.add & set(goal)) for e in effects), default=1),
-            domain,
-            problem,
-            tuple(order),
+            actions=tuple(a for a, _ in ground),
+            effects=effects,
+            atoms=tuple(fluent),
+            static=frozenset(static),
+            init=frozenset(init & set(fluent)),
+            goal=goal,
+            pre=_padded([[col[a] for a in sorted(e.pre_pos)] for e in effects], n),
+            add=_padded([[col[a] for a in sorted(e.add)] for e in effects], n + 1),
+            delete=_padded([[col[a] for a in sorted(e.delete - e.add)] for e in effects], n + 1),
+            consumed=_padded(
+                [[a in e.delete - e.add for a in sorted(e.pre_pos)] for e in effects], 0
+            )
+            > 0,
+            goal_adds=max((len(e.add & set(goal)) for e in effects), default=1),
+            pddl_domain=domain,
+            pddl_problem=problem,
+            order=tuple(order),
         )
 
     @functools.cached_property

@@ -9,6 +9,7 @@ import torch
 
 from motion.cost import (
     Blocks,
+    Bodies,
     MoveCostConfig,
     block_depths,
     block_term,
@@ -107,9 +108,9 @@ def test_a_block_weight_of_zero_or_no_blocks_leave_the_costs_bit_identical(solve
     old = move_costs_batch(solver, PANDA.q_home, picks, places)
     for config, given in ((MoveCostConfig(), blocks), (ON, None)):
         assert torch.equal(
-            move_costs_batch(solver, PANDA.q_home, picks, places, config, blocks=given), old
+            move_costs_batch(solver, PANDA.q_home, picks, places, config, Bodies(blocks=given)), old
         )
-    on = move_costs_batch(solver, PANDA.q_home, picks, places, ON, blocks=blocks)
+    on = move_costs_batch(solver, PANDA.q_home, picks, places, ON, Bodies(blocks=blocks))
     assert on[0, 1, 0] > old[0, 1, 0] + 0.1
 
 
@@ -129,7 +130,7 @@ def test_gradient_of_the_block_term_matches_finite_differences(solver, monkeypat
     places = places.clone().requires_grad_()
 
     def cost(pl):
-        on = move_costs_batch(solver, PANDA.q_home, picks, pl, ON, blocks=blocks)
+        on = move_costs_batch(solver, PANDA.q_home, picks, pl, ON, Bodies(blocks=blocks))
         return on - move_costs_batch(solver, PANDA.q_home, picks, pl)  # the block term alone
 
     assert cost(places)[0, 1, 0] > 0.02
@@ -148,14 +149,17 @@ def test_gradient_of_the_block_term_matches_finite_differences(solver, monkeypat
 def test_misuse_names_the_bad_input(solver, change, message):
     picks, places, blocks = _scene(near=6)
     with pytest.raises(MotionError, match=message):
-        move_costs_batch(solver, PANDA.q_home, picks, places, ON, blocks=blocks._replace(**change))
+        move_costs_batch(
+            solver, PANDA.q_home, picks, places, ON, Bodies(blocks=blocks._replace(**change))
+        )
 
 
 def test_the_block_weight_scales_the_term(solver):
     picks, places, blocks = _scene(near=6)
     old = move_costs_batch(solver, PANDA.q_home, picks, places)
-    one = move_costs_batch(solver, PANDA.q_home, picks, places, ON, blocks=blocks) - old
+    one = move_costs_batch(solver, PANDA.q_home, picks, places, ON, Bodies(blocks=blocks)) - old
     five = replace(ON, block_weight=5.0)
     torch.testing.assert_close(
-        move_costs_batch(solver, PANDA.q_home, picks, places, five, blocks=blocks) - old, 5 * one
+        move_costs_batch(solver, PANDA.q_home, picks, places, five, Bodies(blocks=blocks)) - old,
+        5 * one,
     )

@@ -187,3 +187,29 @@ def test_a_window_stuck_under_adapted_beliefs_is_retried_frozen(with_fallback):
     result = plan(THREE, PlannerConfig(max_windows=4, restarts=4), seed=0, beliefs=source)
     assert result.solved == with_fallback
     assert sum(b.retried for b in made) == (len(made) if with_fallback else 0)
+
+
+def test_window_beliefs_of_their_own_are_wrapped_once_with_their_optional_members():
+    """Where a belief source enters the planner (`task.beliefs.belief_source`): each window's
+    beliefs that do not inherit `WindowBeliefsBase` are wrapped, their own ``crisp_states`` and
+    ``fallback`` kept; without them the defaults (the true states, no retry). Wrapping twice
+    changes nothing."""
+    from task.beliefs import WindowBeliefsBase, belief_source, window_beliefs
+
+    problem = Problem("p", "blocksworld", ("a", "b"), (TABLE, TABLE), (("a", "b"),))
+    assert belief_source(None) is None
+    plain = window_beliefs(_Blind(problem, with_fallback=False))
+    assert isinstance(plain, WindowBeliefsBase) and plain.crisp_states is None
+    assert plain.fallback([0]) is None and plain.lr == 0.05
+    assert window_beliefs(plain) is plain
+    blind = _Blind(problem, with_fallback=True)
+    blind.state = problem.init
+    blind.crisp_states = [problem.init]
+    source = belief_source(lambda indices, states: blind)
+    assert belief_source(source) is source
+    wrapped = source([0], [problem.init])
+    assert wrapped.crisp_states == [problem.init]
+    assert torch.equal(wrapped.compute()[0], blind.compute()[0])
+    frozen = wrapped.fallback([0])
+    assert isinstance(frozen, WindowBeliefsBase) and blind.retried == 1
+    assert frozen.crisp_states is None and frozen.parameters() == []

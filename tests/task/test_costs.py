@@ -227,8 +227,8 @@ def test_own_state_prefix_ends_before_the_first_move_its_check_ahead_fails():
 @dataclass
 class CheckedCosts(StateCosts):
     """a onto d looks best (a to the table is `EXPENSIVE`); the source's check ahead
-    (`task.costs.CostSource`'s optional ``verify``) fails a onto d, which it then prices out
-    in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
+    (``verify``: a source of its own, not a `task.costs.CostSourceBase`) fails a onto d, which
+    it then prices out in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
 
     refused: set = field(default_factory=set)
     checked: list = field(default_factory=list)
@@ -262,6 +262,40 @@ def test_a_move_that_fails_the_check_ahead_is_replaced_before_anything_runs():
     off = plan(UNSTACK, replace(config, own_state_costs=False), seed=0, costs=CheckedCosts())
     # the prices alone choose a onto d: the check ahead rides on own_state_costs
     assert off.plan.moves[0] == Move("a", "d")
+
+
+@dataclass
+class Forgets(FixedCosts):
+    """A cost source of its own (not a `CostSourceBase`) that can drop its committed moves."""
+
+    forgot: list = field(default_factory=list)
+
+    def forget(self, index) -> None:
+        self.forgot.append(index)
+
+
+def test_a_cost_source_of_its_own_is_wrapped_once_with_its_optional_members():
+    """Where a cost source enters the planner (`task.costs.cost_source`): one that inherits
+    `CostSourceBase` is kept as it is; one that does not is wrapped, its own ``verify`` and
+    ``forget`` called and ``can_forget`` telling whether it has the latter; without them the
+    defaults (every move passes, nothing forgotten, no start over)."""
+    from task.costs import CostSourceBase, cost_source
+
+    assert cost_source(None) is None
+    matrix = torch.ones((1, 4, 5))
+    plain = cost_source(FixedCosts(matrix))
+    assert isinstance(plain, CostSourceBase) and not plain.can_forget
+    assert plain.verify(0, BW.initial_state(UNSTACK), Move("a", "d"))
+    plain.forget(0)  # nothing to drop
+    assert plain([0], [BW.initial_state(UNSTACK)], 1).compute() is matrix
+    given = Forgets(matrix)
+    wrapped = cost_source(given)
+    assert wrapped.can_forget and cost_source(wrapped) is wrapped
+    wrapped.forget(3)
+    assert given.forgot == [3]
+    checked = CheckedCosts()
+    assert not cost_source(checked).verify(0, BW.initial_state(UNSTACK), Move("a", "d"))
+    assert checked.checked == [Move("a", "d")]
 
 
 @pytest.mark.parametrize("bad", [float("nan"), float("inf"), float("-inf")])

@@ -13,7 +13,7 @@ import pytest
 import torch
 
 from task.config import PlannerConfig
-from task.costs import IMPOSSIBLE
+from task.costs import IMPOSSIBLE, CostSourceBase
 from task.domains import get_domain, names
 from task.errors import TampError
 from task.planner import plan
@@ -41,7 +41,7 @@ def never_a_on_b(state, move) -> bool:
 
 
 @dataclass
-class RuleOut:
+class RuleOut(CostSourceBase):
     """A fake cost source: every move costs 1, the ones ``rule(state, move)`` names cost
     IMPOSSIBLE; records the moves committed to it."""
 
@@ -294,6 +294,7 @@ def test_a_star_out_of_budget_hands_over_to_a_greedy_search_from_the_same_state(
 class Forgetful(RuleOut):
     """`RuleOut` that can drop the moves committed to it (`ArmCosts.forget`)."""
 
+    can_forget = True
     forgot: list = field(default_factory=list)
 
     def forget(self, index):

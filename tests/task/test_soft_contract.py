@@ -21,7 +21,7 @@ import torch
 
 from task.config import PlannerConfig
 from task.domains import GENERIC, get_domain, names
-from task.domains.base import resolve_goal_loss
+from task.domains.base import DomainBase, resolve_goal_loss
 from task.problem import Action
 from task.rollout import rollout
 from task.soft import prod_others, transition
@@ -217,3 +217,25 @@ def test_prod_others_matches_loop():
     for i in range(5):
         others = torch.cat([v[:, :i], v[:, i + 1 :]], dim=1).prod(1)
         assert torch.allclose(out[:, i], others)
+
+
+@pytest.mark.parametrize("name", DOMAINS)
+def test_every_domain_inherits_the_optional_members_and_flags_its_own(name):
+    """Every registered domain inherits `DomainBase`, so the planner calls its optional
+    members directly; ``has_estimate`` and ``has_safe_moves`` say exactly whether the domain
+    has its own, and without its own the estimate is the lower bound and it takes no safe
+    or helpful moves."""
+    domain = get_domain(name)
+    own = vars(type(domain))
+    assert isinstance(domain, DomainBase)
+    assert domain.has_estimate == ("estimate" in own)
+    assert domain.has_safe_moves == ("safe_moves" in own)
+    problem = next(iter(domain.samples(0)))
+    state = domain.initial_state(problem)
+    if not domain.has_estimate:
+        assert domain.estimate(problem, state) == domain.lower_bound(problem, state)
+    if "helpful" not in own:
+        assert domain.helpful(problem, state) == frozenset()
+    if not domain.has_safe_moves:
+        assert tuple(domain.safe_moves(problem, state)) == ()
+    assert isinstance(dict(domain.planner_defaults), dict)

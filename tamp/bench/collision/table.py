@@ -19,7 +19,25 @@ def _cm(value: float | None) -> str:
 def checker_table(result: dict) -> str:
     """Three tables over the scenes of `tamp.bench.collision.run.run`'s result."""
     scenes = result["scenes"]
-    rates = table(
+    cpu = result["cpu"]
+    where = f"one core (pinned to CPU {cpu})" if cpu is not None else "one process (not pinned)"
+    return "\n".join(
+        [
+            f"sphere checker throughput, {where}:",
+            _rates(scenes),
+            "against the mesh model near obstacles (false free must be 0; excess: how much "
+            "farther than its margin the meshes were where the spheres refused):",
+            _checks(scenes),
+            "rerouted moves (planning time; mesh checks: calls to the mesh model per move):",
+            _moves(scenes),
+            BEFORE,
+        ]
+    )
+
+
+def _rates(scenes: list) -> str:
+    """Configurations checked per second, per scene, sample and batch size."""
+    return table(
         ("scene", "sample", "batch", "configs/s", "configs/CPU-s", "threads"),
         [
             (
@@ -34,7 +52,11 @@ def checker_table(result: dict) -> str:
             for r in s["throughput"]
         ],
     )
-    checks = table(
+
+
+def _checks(scenes: list) -> str:
+    """The spheres' verdicts against the meshes near obstacles, per scene."""
+    return table(
         (
             "scene",
             "near",
@@ -63,7 +85,11 @@ def checker_table(result: dict) -> str:
             for v in (s["validation"],)
         ],
     )
-    moves = table(
+
+
+def _moves(scenes: list) -> str:
+    """The rerouted moves' planning, per scene and planner."""
+    return table(
         (
             "scene",
             "planner",
@@ -88,18 +114,4 @@ def checker_table(result: dict) -> str:
             for s in scenes
             for name, m in s["moves"].items()
         ],
-    )
-    cpu = result["cpu"]
-    where = f"one core (pinned to CPU {cpu})" if cpu is not None else "one process (not pinned)"
-    return "\n".join(
-        [
-            f"sphere checker throughput, {where}:",
-            rates,
-            "against the mesh model near obstacles (false free must be 0; excess: how much "
-            "farther than its margin the meshes were where the spheres refused):",
-            checks,
-            "rerouted moves (planning time; mesh checks: calls to the mesh model per move):",
-            moves,
-            BEFORE,
-        ]
     )

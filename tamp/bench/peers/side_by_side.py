@@ -132,14 +132,14 @@ def summarise(
         shared = [got[n][0] for n in common]
         lines.append(
             Line(
-                domain,
-                planner,
-                len(names),
-                len(lengths),
-                sum(lengths) / len(lengths) if lengths else None,
-                sum(times) / len(times) if times else 0.0,
-                len(common),
-                sum(shared) / len(shared) if shared else None,
+                domain=domain,
+                planner=planner,
+                n=len(names),
+                solved=len(lengths),
+                mean_length=sum(lengths) / len(lengths) if lengths else None,
+                mean_s=sum(times) / len(times) if times else 0.0,
+                common=len(common),
+                common_length=sum(shared) / len(shared) if shared else None,
             )
         )
     return lines

@@ -197,9 +197,25 @@ def _plan(planned, keep, config, seed, beliefs) -> dict:
         return results
 
 
-def run_row(suite, chosen, mode: PerceptionMode, horizon: int, config, seed, perceiver, camera):
-    """Plan ``chosen`` once in one mode; returns per-instance rows and the row summary."""
-    config = replace(config, horizon=horizon)
+@dataclass(frozen=True)
+class RowInputs:
+    """What every row of one `run` shares: the ``suite`` and its ``chosen`` instances, the
+    planner settings, the layout ``seed``, the ``perceiver`` and the ``camera`` (`Renders`)."""
+
+    suite: object
+    chosen: Sequence
+    config: PlannerConfig
+    seed: int
+    perceiver: Perceiver
+    camera: Renders
+
+
+def run_row(inputs: RowInputs, mode: PerceptionMode, horizon: int):
+    """Plan ``inputs.chosen`` once in one mode; returns per-instance rows and the row
+    summary."""
+    suite, chosen, seed, camera = inputs.suite, inputs.chosen, inputs.seed, inputs.camera
+    perceiver = inputs.perceiver
+    config = replace(inputs.config, horizon=horizon)
     problems = [inst.problem for inst in chosen]
     render0, served0, t0 = camera.render_s, Counter(camera.served), time.perf_counter()
     beliefs = goal_images = None
@@ -293,9 +309,10 @@ def run(
     rows, summaries = [], []
     with StateRenderer(sim) as renderer:
         camera = Renders(renderer, [i.problem for i in chosen], seed, corruption)
+        inputs = RowInputs(suite, chosen, config, seed, perceiver, camera)
         for mode in modes:
             for horizon in horizons:
-                r, s = run_row(suite, chosen, mode, horizon, config, seed, perceiver, camera)
+                r, s = run_row(inputs, mode, horizon)
                 rows += r
                 summaries.append(s)
                 if progress is not None:

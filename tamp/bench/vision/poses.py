@@ -23,6 +23,7 @@ from tamp.camera.dataset import sample_scene
 from tamp.camera.poses import estimate_fits
 from tamp.camera.render import (
     StateRenderer,
+    View,
     ViewJitter,
     block_colours,
     jitter_camera,
@@ -122,9 +123,8 @@ def run(
                 names, colours, state = sample_scene(rng, min_blocks, max_blocks)
                 camera = jitter_camera(renderer.camera, view, rng) if jitter else renderer.camera
                 light = random_lighting(rng) if jitter else Lighting()
-                truth = renderer.place(
-                    names, state, int(rng.integers(2**31)), colours, camera, light, scene
-                )
+                view = View(camera, light, scene)
+                truth = renderer.place(names, state, int(rng.integers(2**31)), colours, view)
                 rgb, depth = renderer.sim.render_rgbd()
                 t0 = time.perf_counter()
                 fits = estimate_fits(
@@ -148,18 +148,18 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
         if isinstance(fit, str):
             out.append(
                 BlockRow(
-                    sim,
-                    scene,
-                    x,
-                    len(names),
-                    level[x],
-                    x in free,
-                    fit,
-                    None,
-                    None,
-                    None,
-                    None,
-                    None,
+                    sim=sim,
+                    scene=scene,
+                    block=x,
+                    blocks=len(names),
+                    level=level[x],
+                    top_free=x in free,
+                    reason=fit,
+                    error_mm=None,
+                    dx_mm=None,
+                    dy_mm=None,
+                    dz_mm=None,
+                    yaw_error_deg=None,
                 )
             )
             continue
@@ -168,18 +168,18 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
         yaw = yaw_error(fit.pose.yaw, true.yaw)
         out.append(
             BlockRow(
-                sim,
-                scene,
-                x,
-                len(names),
-                level[x],
-                x in free,
-                "",
-                error,
-                float(d[0]),
-                float(d[1]),
-                float(d[2]),
-                yaw,
+                sim=sim,
+                scene=scene,
+                block=x,
+                blocks=len(names),
+                level=level[x],
+                top_free=x in free,
+                reason="",
+                error_mm=error,
+                dx_mm=float(d[0]),
+                dy_mm=float(d[1]),
+                dz_mm=float(d[2]),
+                yaw_error_deg=yaw,
             )
         )
     return out

@@ -41,7 +41,14 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from tamp.geo.ours.pack import PackConfig, PackError, PackResult, pack_sampled, pack_tries
+from tamp.geo.ours.pack import (
+    Occupants,
+    PackConfig,
+    PackError,
+    PackResult,
+    pack_sampled,
+    pack_tries,
+)
 from tamp.geo.places import PACK_MARGIN, TABLE_CLEARANCE, candidate_places, placed_solid
 from tamp.geo.types import GeoMove, Place
 from tamp.scene import Pose
@@ -197,9 +204,49 @@ def bridge(
     if not scene.objects:
         raise SceneFileError(f"scene {scene.name}: objects: no movable object to plan for")
     support = dict(facts.supports)
-    regions = {r.name for r in scene.regions}
     names = [o.name for o in scene.objects]
-    wanted: dict[str, str] = {}  # object -> region / object / TABLE
+    wanted, clear = _wanted(goal)
+    sites: list[Site] = []
+    cells: list[tuple[str, str]] = []
+    packs: list[tuple[str, PackResult]] = []
+    for r in scene.regions:
+        inside = [x for x in names if support.get(x) == r.name]
+        movers = [x for x, t in wanted.items() if t == r.name and x not in inside]
+        if not movers:
+            continue
+        result = _pack_region(scene, r, movers, inside, config, seed, sampler)
+        packs.append((r.name, result))
+        sites += _cell_sites(r, result, len(movers))
+        cells += [(x, site.name) for x, site in zip(movers, sites[-len(movers) :], strict=True)]
+    if not scene.parking:  # no table spots: each region that has no cell offers its centre
+        taken = {s.target for s in sites}
+        for r in scene.regions:
+            if r.name not in taken and not any(support.get(x) == r.name for x in names):
+                (x0, y0), (x1, y1) = r.inner()
+                centre = ((x0 + x1) / 2, (y0 + y1) / 2)
+                sites.append(Site(f"{r.name}.centre", r.name, centre, r.surface))
+    table = _table_sites(scene, table_places, seed)
+    bases = _bases(scene, support, table, sites)  # appends the spots of those not on a table one
+    sites += table
+    goal_atoms, banned = _goal_atoms(scene, support, (wanted, clear), dict(cells), bases, sites)
+    plain = Problem(
+        name=scene.name,
+        domain="blocksworld",
+        entities=tuple(names),
+        init=tuple(TABLE if x in bases else support[x] for x in names),
+        goal=tuple(goal_atoms),
+    )
+    problem = with_slots(plain, tuple(s.name for s in sites), bases, hop=True)
+    return Bridged(
+        scene, goal, problem, tuple(sites), tuple(cells), frozenset(banned), tuple(packs)
+    )
+
+
+def _wanted(goal: Goal) -> tuple[dict[str, str], list[str]]:
+    """The support each object of ``goal`` must end on (object -> region / object / TABLE)
+    and the objects that must end clear; SceneFileError for a goal the domain cannot express
+    (two supports for one object, a clear object something must stand on)."""
+    wanted: dict[str, str] = {}
     clear: list[str] = []
     for atom in goal.atoms:
         if atom[0] == "clear":
@@ -216,71 +263,69 @@ def bridge(
         on_x = [o for o, t in wanted.items() if t == x]
         if on_x:
             raise SceneFileError(f"goal: (clear {x}) and (on {on_x[0]} {x}) contradict")
+    return wanted, clear
 
-    sites: list[Site] = []
-    cells: list[tuple[str, str]] = []
-    packs: list[tuple[str, PackResult]] = []
-    bases: dict[str, str] = {}  # object on the table or in a region -> its place now
-    for r in scene.regions:
-        inside = [x for x in names if support.get(x) == r.name]
-        movers = [x for x, t in wanted.items() if t == r.name and x not in inside]
-        if not movers:
-            continue
-        fixed = [scene.object(x) for x in inside]
-        # a few seeds (each R restart rows already), first with the footprints kept
-        # `PACK_MARGIN` inside the rectangle, then flush with it where nothing else fits; the
-        # first that packs wins, the gradient's tries `PACK_BATCH` at a time in one program
-        tries = [(PACK_MARGIN, attempt) for attempt in range(PACK_TRIES)]
-        tries += [(0.0, attempt) for attempt in range(FLUSH_TRIES)]
-        args = (
-            r.inner(),
-            [own_footprint(scene.object(x)) for x in movers],
-            [o.pose.xyz[:2] for o in fixed],
-            [footprint(o) for o in fixed],
-        )
-        step = 1 if sampler == "sampled" else PACK_BATCH
-        for k in range(0, len(tries), step):
-            batch = tries[k : k + step]
-            try:
-                if sampler == "sampled":
-                    margin, attempt = batch[0]
-                    budget = config.restarts * config.steps  # `pack`'s row-steps
-                    at = replace(config, margin=margin)
-                    results = [
-                        pack_sampled(*args, budget, seed + attempt, at, walled=r.wall_height > 0)
-                    ]
-                else:
-                    at = [(replace(config, margin=margin), seed + a) for margin, a in batch]
-                    results = pack_tries(*args, at, walled=r.wall_height > 0)
-            except PackError as exc:
-                if exc.index is None:
-                    raise
-                if batch[0][0] > 0:  # too wide for the margin: flush with the edges may fit
-                    continue
-                raise _too_small(scene, r, movers[exc.index]) from None
-            result = next((x for x in results if x.ok), results[-1])
-            if result.ok:
-                break
-        packs.append((r.name, result))
-        (x0, y0), (x1, y1) = r.inner()
-        for i, x in enumerate(movers):
-            # a failed sampled packing places only some: the rest at the centre (the planner
-            # refuses a packing that is not ok before it plans, `tamp.geo.ours.planner`)
-            xy, yaw = ((x0 + x1) / 2, (y0 + y1) / 2), 0.0
-            if i < len(result.positions):
-                xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))
-                yaw = float(result.yaws[i])
-            sites.append(Site(f"{r.name}.c{i}", r.name, xy, r.surface, yaw))
-            cells.append((x, sites[-1].name))
-    if not scene.parking:  # no table spots: each region that has no cell offers its centre
-        taken = {s.target for s in sites}
-        for r in scene.regions:
-            if r.name not in taken and not any(support.get(x) == r.name for x in names):
-                (x0, y0), (x1, y1) = r.inner()
-                centre = ((x0 + x1) / 2, (y0 + y1) / 2)
-                sites.append(Site(f"{r.name}.centre", r.name, centre, r.surface))
+
+def _pack_region(scene, r: Region, movers, inside, config: PackConfig, seed: int, sampler: str):
+    """The packing of the ``movers``' footprints in region ``r`` around the objects
+    ``inside`` it: a few seeds (each R restart rows already), first with the footprints kept
+    `PACK_MARGIN` inside the rectangle, then flush with it where nothing else fits; the
+    first that packs wins (else the last tried), the gradient's tries `PACK_BATCH` at a time
+    in one program."""
+    fixed = [scene.object(x) for x in inside]
+    tries = [(PACK_MARGIN, attempt) for attempt in range(PACK_TRIES)]
+    tries += [(0.0, attempt) for attempt in range(FLUSH_TRIES)]
+    args = (
+        r.inner(),
+        [own_footprint(scene.object(x)) for x in movers],
+        Occupants([o.pose.xyz[:2] for o in fixed], [footprint(o) for o in fixed]),
+    )
+    step = 1 if sampler == "sampled" else PACK_BATCH
+    for k in range(0, len(tries), step):
+        batch = tries[k : k + step]
+        try:
+            if sampler == "sampled":
+                margin, attempt = batch[0]
+                budget = config.restarts * config.steps  # `pack`'s row-steps
+                at = replace(config, margin=margin)
+                results = [
+                    pack_sampled(*args, budget, seed + attempt, at, walled=r.wall_height > 0)
+                ]
+            else:
+                at = [(replace(config, margin=margin), seed + a) for margin, a in batch]
+                results = pack_tries(*args, at, walled=r.wall_height > 0)
+        except PackError as exc:
+            if exc.index is None:
+                raise
+            if batch[0][0] > 0:  # too wide for the margin: flush with the edges may fit
+                continue
+            raise _too_small(scene, r, movers[exc.index]) from None
+        result = next((x for x in results if x.ok), results[-1])
+        if result.ok:
+            break
+    return result
+
+
+def _cell_sites(r: Region, result: PackResult, n: int) -> list[Site]:
+    """The ``n`` cells of region ``r`` where its packing ``result`` put them; a failed
+    sampled packing places only some: the rest at the centre (the planner refuses a packing
+    that is not ok before it plans, `tamp.geo.ours.planner`)."""
+    (x0, y0), (x1, y1) = r.inner()
+    out = []
+    for i in range(n):
+        xy, yaw = ((x0 + x1) / 2, (y0 + y1) / 2), 0.0
+        if i < len(result.positions):
+            xy = (float(result.positions[i, 0]), float(result.positions[i, 1]))
+            yaw = float(result.yaws[i])
+        out.append(Site(f"{r.name}.c{i}", r.name, xy, r.surface, yaw))
+    return out
+
+
+def _table_sites(scene: Scene, table_places: int | None, seed: int) -> list[Site]:
+    """The table spots (`bridge`'s ``table_places``; none where the scene has no parking),
+    placed for the widest object and kept off its own footprint."""
     probe = max(scene.objects, key=lambda o: max(footprint(o)))
-    n_table = len(names) + 2 if table_places is None else table_places
+    n_table = len(scene.objects) + 2 if table_places is None else table_places
     n_table = n_table if scene.parking else 0
     spots = candidate_places(scene, probe.name, TABLE, 3 * n_table, seed)
     me = of_movable(probe)  # the probe ignores itself: keep spots off its footprint too
@@ -290,12 +335,18 @@ def bridge(
         if math.dist(p.xyz[:2], probe.pose.xyz[:2]) <= ON_SPOT
         or footprint_gap(me, placed_solid(probe, p)) >= TABLE_CLEARANCE
     ][:n_table]
-    table = [Site(p.name, TABLE, p.xyz[:2], 0.0, p.yaw) for p in spots]
-    for x in names:
-        s = support.get(x)
+    return [Site(p.name, TABLE, p.xyz[:2], 0.0, p.yaw) for p in spots]
+
+
+def _bases(scene: Scene, support: dict, table: list[Site], sites: list[Site]) -> dict[str, str]:
+    """Object on the table or in a region -> the place it stands on now: a ``table`` spot
+    under it, else a spot of its own (appended to ``sites``)."""
+    regions = {r.name for r in scene.regions}
+    bases: dict[str, str] = {}
+    for o in scene.objects:
+        x, s = o.name, support.get(o.name)
         if s != TABLE and s not in regions:
             continue
-        o = scene.object(x)
         near = [
             t for t in table if math.dist(t.xy, o.pose.xyz[:2]) <= ON_SPOT and t.name not in bases
         ]
@@ -306,8 +357,17 @@ def bridge(
         surface = 0.0 if r is None else r.surface
         sites.append(Site(f"spot_{x}", s, tuple(o.pose.xyz[:2]), surface, o.pose.yaw))
         bases[x] = sites[-1].name
-    sites += table
-    cell = dict(cells)
+    return bases
+
+
+def _goal_atoms(scene: Scene, support: dict, wanted_clear, cell: dict, bases: dict, sites):
+    """The problem's goal supports and the banned (object, place) pairs: an object wanted
+    in a region goes to its cell (or stays on its base), one wanted on the table to no
+    region's place; nothing onto an object that must end clear, and what stands on it now
+    goes to the table."""
+    wanted, clear = wanted_clear
+    regions = {r.name for r in scene.regions}
+    names = [o.name for o in scene.objects]
     goal_atoms, banned = [], set()
     for x, t in wanted.items():
         if t in regions:
@@ -321,17 +381,7 @@ def bridge(
         for o in names:
             if support.get(o) == x and o not in wanted:
                 goal_atoms.append((o, TABLE))
-    plain = Problem(
-        name=scene.name,
-        domain="blocksworld",
-        entities=tuple(names),
-        init=tuple(TABLE if x in bases else support[x] for x in names),
-        goal=tuple(goal_atoms),
-    )
-    problem = with_slots(plain, tuple(s.name for s in sites), bases, hop=True)
-    return Bridged(
-        scene, goal, problem, tuple(sites), tuple(cells), frozenset(banned), tuple(packs)
-    )
+    return goal_atoms, banned
 
 
 def positions(bridged: Bridged) -> np.ndarray:

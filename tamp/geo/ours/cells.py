@@ -257,7 +257,18 @@ class CellWindow:
                 xy = torch.tensor([bridged.site(c).xy for c in region.cells], dtype=torch.float64)
                 fixed = tuple(torch.from_numpy(a) for a in _occupants(bridged, region))
                 columns = [problem.index(region.cells[k]) for k in free]
-                self.terms.append(_Term(i, region, free, columns, xy, fixed, picks, count))
+                self.terms.append(
+                    _Term(
+                        problem=i,
+                        region=region,
+                        free=free,
+                        columns=columns,
+                        xy=xy,
+                        fixed=fixed,
+                        picks=picks,
+                        first=count,
+                    )
+                )
                 count += len(free)
         self.u = torch.zeros(p * r, max(count, 1), 2, dtype=torch.float64, requires_grad=True)
 

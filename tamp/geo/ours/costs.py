@@ -60,7 +60,7 @@ from tamp.geo.ours.pack import PackConfig
 from tamp.geo.places import free, supported_on
 from tamp.world.geometry import Solid, fixed_solids, of_movable
 from tamp.world.schema import Scene
-from task.costs import IMPOSSIBLE
+from task.costs import IMPOSSIBLE, CostSourceBase
 from task.domains.base import State
 from task.domains.blocksworld import check_move as legal
 from task.problem import Move
@@ -208,10 +208,12 @@ class _Window:
         """Nothing to record: no cell of this window is empty (or cells are off)."""
 
 
-class GeoCosts:
+class GeoCosts(CostSourceBase):
     """`task.costs.CostSource` of one bridged problem (module docstring). ``solver`` and ``q``
     (J,): the IK solver and the arm configuration it is seeded from (None: no IK, the price is
     geometry only and the joint distance 0)."""
+
+    can_forget = True  # the fallback may start a plan over: nothing here goes stale (`forget`)
 
     def __init__(
         self,

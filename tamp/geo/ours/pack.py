@@ -42,6 +42,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -106,7 +107,19 @@ class PackResult:
     order: tuple[int, ...] = ()
 
 
-def _check(inner: Rect, half, fixed_xy, fixed_half) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class Occupants(NamedTuple):
+    """The fixed occupants of a region that a packing must keep clear of: centres ``xy``
+    (F, 2) and half extents ``half`` (F, 2), m."""
+
+    xy: Sequence = ()
+    half: Sequence = ()
+
+
+NO_OCCUPANTS = Occupants()
+
+
+def _check(inner: Rect, half, fixed: Occupants) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    fixed_xy, fixed_half = fixed
     half = np.asarray(half, dtype=np.float64).reshape(-1, 2)
     fxy = np.asarray(fixed_xy if fixed_xy is not None else (), dtype=np.float64).reshape(-1, 2)
     fh = np.asarray(fixed_half if fixed_half is not None else (), dtype=np.float64).reshape(-1, 2)
@@ -147,20 +160,21 @@ def overlap_loss(
     fixed_xy: torch.Tensor,
     fixed_half: torch.Tensor,
     beta: float,
-    eps: float,
-    gap: float,
-    ordered: bool = False,
+    config: PackConfig,
 ) -> torch.Tensor:
-    """(R,) the packing loss of each row (module docstring). ``xy`` (R, M, 2) centres, ``half``
-    (R, M, 2) grown half extents (finger room), ``body`` (R, M, 2) the bodies' own; fixed
-    occupants ``fixed_xy`` / ``fixed_half`` (F, 2). A grown footprint must clear the other
-    bodies: pairs count both ways (i's fingers against j's body and j's against i's), or with
-    ``ordered`` the lesser of the two (whichever is placed second needs the room)."""
+    """(R,) the packing loss of each row (module docstring) at softplus sharpness ``beta``.
+    ``xy`` (R, M, 2) centres, ``half`` (R, M, 2) grown half extents (finger room), ``body``
+    (R, M, 2) the bodies' own; fixed occupants ``fixed_xy`` / ``fixed_half`` (F, 2). Of
+    ``config``: the smoothing ``eps``, the clearance ``gap`` and ``ordered``. A grown footprint
+    must clear the other bodies: pairs count both ways (i's fingers against j's body and j's
+    against i's), or with ``ordered`` the lesser of the two (whichever is placed second needs
+    the room)."""
+    eps, gap = config.eps, config.gap
     m = xy.shape[1]
     d = xy[:, :, None] - xy[:, None]  # (R, M, M, 2)
     reach = half[:, :, None] + body[:, None] + gap  # (R, M, M, 2): i grown, j body
     pair = soft_area(d, reach, beta, eps)  # (R, M, M)
-    if ordered:
+    if config.ordered:
         pair = torch.minimum(pair, pair.transpose(1, 2))  # (R, M, M), symmetric
     off = ~torch.eye(m, dtype=torch.bool)
     loss = torch.where(off, pair, 0.0).sum((-1, -2))  # (R,)
@@ -206,21 +220,18 @@ def placing_order(xy, half, body, gap: float, tol: float) -> tuple[int, ...]:
 def pack(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     config: PackConfig = PackConfig(),
     seed: int = 0,
     turnable: Sequence[bool] | None = None,
     walled: bool = True,
 ) -> PackResult:
     """Place the M ``footprints`` (half extents (M, 2), m) inside ``inner`` free of each other
-    and of the fixed occupants (centres (F, 2), half extents (F, 2)); see the module docstring.
+    and of the ``fixed`` occupants (`Occupants`); see the module docstring.
     ``turnable[m]``: whether footprint m may turn a quarter turn (default: when it is not
     square); ``walled``: the hand must stay inside the region too (walls stand on its edges;
     a marked area lets the fingers reach beyond it)."""
-    (result,) = pack_tries(
-        inner, footprints, fixed_xy, fixed_half, ((config, seed),), turnable, walled
-    )
+    (result,) = pack_tries(inner, footprints, fixed, ((config, seed),), turnable, walled)
     return result
 
 
@@ -244,8 +255,7 @@ class _Try:
 def pack_tries(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     tries: Sequence[tuple[PackConfig, int]] = ((PackConfig(), 0),),
     turnable: Sequence[bool] | None = None,
     walled: bool = True,
@@ -268,26 +278,11 @@ def pack_tries(
             (x0 + config.margin, y0 + config.margin),
             (x1 - config.margin, y1 - config.margin),
         )
-        half_np, fxy_np, fh_np = _check(inside, footprints, fixed_xy, fixed_half)
-        m, r = len(half_np), config.restarts
-        gen = torch.Generator().manual_seed(seed)
-        square = np.isclose(half_np[:, 0], half_np[:, 1])
-        may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
-        turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
-        axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
-        h = torch.where(
-            turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np)
-        )
-        wide = 2 * h.gather(-1, axis[..., None])[..., 0] >= config.stroke - 1e-6  # (R, M)
-        axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
-        body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
-        lo = torch.tensor(inside[0], dtype=torch.float64)
-        span = torch.tensor(inside[1], dtype=torch.float64) - lo
-        edge = half if walled else body  # what must stay inside: the hand too where walls stand
-        room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
-        u0.append(torch.randn(r, m, 2, generator=gen, dtype=torch.float64))
-        made.append(_Try(config, lo, edge, room, turn, axis, half, body, slice(start, start + r)))
-        start += r
+        half_np, fxy_np, fh_np = _check(inside, footprints, fixed)
+        made_try, start_u = _try(inside, half_np, (config, seed), turnable, walled, start)
+        made.append(made_try)
+        u0.append(start_u)
+        start += config.restarts
     m = len(half_np)
     if m == 0:
         empty = np.zeros((0, 2))
@@ -307,9 +302,7 @@ def pack_tries(
 
     for k in range(steps):
         beta = first.beta * (first.beta_end / first.beta) ** (k / max(steps - 1, 1))
-        loss = overlap_loss(
-            centres(), half, body, fxy, fh, beta, first.eps, first.gap, first.ordered
-        )
+        loss = overlap_loss(centres(), half, body, fxy, fh, beta, first)
         opt.zero_grad()
         loss.sum().backward()
         opt.step()
@@ -317,6 +310,41 @@ def pack_tries(
         xy = centres().numpy()  # (sum R, M, 2)
     took = time.perf_counter() - t0
     return [_best(t, xy[t.rows], fxy_np, fh_np, took) for t in made]
+
+
+def _try(inside: Rect, half_np: np.ndarray, at: tuple, turnable, walled: bool, start: int):
+    """One try of `pack_tries`, ``at`` its (config, seed), in the ``inside`` rectangle (its
+    margin taken off), the footprints' half extents ``half_np`` (M, 2): its rows from
+    ``start`` (their turns and closing axes drawn, the grown and body footprints, the room
+    the centres may use) and their unbounded start values u (R, M, 2)."""
+    config, seed = at
+    m, r = len(half_np), config.restarts
+    gen = torch.Generator().manual_seed(seed)
+    square = np.isclose(half_np[:, 0], half_np[:, 1])
+    may = ~square if turnable is None else np.asarray(turnable, dtype=bool)
+    turn = (torch.rand(r, m, generator=gen) < 0.5) & torch.from_numpy(may)  # (R, M)
+    axis = torch.randint(0, 2, (r, m), generator=gen)  # (R, M) closing axis per row
+    h = torch.where(turn[..., None], torch.from_numpy(half_np).flip(-1), torch.from_numpy(half_np))
+    wide = 2 * h.gather(-1, axis[..., None])[..., 0] >= config.stroke - 1e-6  # (R, M)
+    axis = torch.where(wide, 1 - axis, axis)  # the fingers close across the other side
+    body, half = _grown(torch.from_numpy(half_np), turn, axis, config)  # (R, M, 2)
+    lo = torch.tensor(inside[0], dtype=torch.float64)
+    span = torch.tensor(inside[1], dtype=torch.float64) - lo
+    edge = half if walled else body  # what must stay inside: the hand too where walls stand
+    room = (span - 2 * edge).clamp_min(0.0)  # (R, M, 2)
+    u0 = torch.randn(r, m, 2, generator=gen, dtype=torch.float64)
+    made = _Try(
+        config=config,
+        lo=lo,
+        edge=edge,
+        room=room,
+        turn=turn,
+        axis=axis,
+        half=half,
+        body=body,
+        rows=slice(start, start + r),
+    )
+    return made, u0
 
 
 def _best(t: _Try, xy: np.ndarray, fxy_np, fh_np, took: float) -> PackResult:
@@ -356,8 +384,7 @@ def _best(t: _Try, xy: np.ndarray, fxy_np, fh_np, took: float) -> PackResult:
 def pack_sampled(
     inner: Rect,
     footprints: Sequence,
-    fixed_xy: Sequence = (),
-    fixed_half: Sequence = (),
+    fixed: Occupants = NO_OCCUPANTS,
     budget: int = 1000,
     seed: int = 0,
     config: PackConfig = PackConfig(),
@@ -371,7 +398,7 @@ def pack_sampled(
     t0 = time.perf_counter()
     (x0, y0), (x1, y1) = inner
     inner = ((x0 + config.margin, y0 + config.margin), (x1 - config.margin, y1 - config.margin))
-    half_np, fxy_np, fh_np = _check(inner, footprints, fixed_xy, fixed_half)
+    half_np, fxy_np, fh_np = _check(inner, footprints, fixed)
     m = len(half_np)
     rng = np.random.default_rng(seed)
     lo, hi = np.asarray(inner[0], float), np.asarray(inner[1], float)
@@ -398,9 +425,7 @@ def pack_sampled(
                     break
                 spent += 1
                 p = lo + edge + rng.random(2) * (hi - lo - 2 * edge)
-                if _free(
-                    p, grown[i], bodies[i], xy[:i], grown[:i], bodies[:i], fxy_np, fh_np, config
-                ):
+                if _free(p, i, xy, grown, bodies, (fxy_np, fh_np), config):
                     xy[i] = p
                     placed += 1
                     break
@@ -408,7 +433,16 @@ def pack_sampled(
                 break
         if placed == m:
             took = time.perf_counter() - t0
-            return PackResult(xy, yaws, axes, True, -math.inf, took, spent, tuple(range(m)))
+            return PackResult(
+                positions=xy,
+                yaws=yaws,
+                axes=axes,
+                ok=True,
+                overlap=-math.inf,
+                time=took,
+                tries=spent,
+                order=tuple(range(m)),
+            )
         if best is None or placed > len(best.positions):
             best = PackResult(xy[:placed], yaws[:placed], axes[:placed], False, math.inf, 0.0, 0)
     if best is None:
@@ -418,8 +452,12 @@ def pack_sampled(
     )
 
 
-def _free(p, grown, body, xy, others_grown, others_body, fxy, fh, config: PackConfig) -> bool:
-    """Whether a footprint at ``p`` clears the placed ones (both ways) and the fixed ones."""
+def _free(p, i: int, xy, grown, bodies, fixed, config: PackConfig) -> bool:
+    """Whether footprint ``i`` (grown and body half extents ``grown[i]``, ``bodies[i]``) at
+    ``p`` clears the ones placed before it (both ways: the first ``i`` of ``xy``, ``grown``,
+    ``bodies``) and the ``fixed`` ones (centres, half extents)."""
+    grown, body, xy, others_grown, others_body = grown[i], bodies[i], xy[:i], grown[:i], bodies[:i]
+    fxy, fh = fixed
     g, tol = config.gap, config.tol
     if len(xy):
         d = np.abs(xy - p)  # (k, 2)

@@ -193,7 +193,8 @@ def plan_motion_aware(
     bridged = first.stats.pop("bridged", None)
     if first.solved or config.search is None:
         return first
-    return _complete(scene, goal, tools, config, first, bound, t0, cell_hints(bridged))
+    attempt = _Attempt(first, bound, cell_hints(bridged))
+    return _complete(scene, goal, tools, config, attempt, t0)
 
 
 def plan_motion_aware_sampled(
@@ -220,15 +221,26 @@ def cell_hints(bridged: Bridged | None) -> dict:
     return {k: tuple(v) for k, v in out.items()}
 
 
-def _complete(
-    scene, goal, tools, config: OursConfig, first: GeoPlan, bound: tuple, t0: float, hints: dict
-):
-    """The complete geometric search from the world the first attempt's ``bound`` moves
-    reached, within what is left of the time budget, the packer's cells (``hints``) offered
-    first in their regions; its status is the answer (UNSOLVABLE from it is exhaustive over
-    the discretised grasps and places under the full check), the bound moves first."""
+@dataclass(frozen=True)
+class _Attempt:
+    """The differentiable planner's unsolved attempt: its ``plan``, the moves it ``bound``
+    (executable in order) and the places of the packer's cells (``hints``, per (object,
+    target), `cell_hints`)."""
+
+    plan: GeoPlan
+    bound: tuple
+    hints: dict
+
+
+def _complete(scene, goal, tools, config: OursConfig, attempt: _Attempt, t0: float):
+    """The complete geometric search from the world the first ``attempt``'s bound moves
+    reached, within what is left of the time budget, the packer's cells (its ``hints``)
+    offered first in their regions; its status is the answer (UNSOLVABLE from it is
+    exhaustive over the discretised grasps and places under the full check), the bound
+    moves first."""
     from tamp.geo.search import plan_search
 
+    first, bound, hints = attempt.plan, attempt.bound, attempt.hints
     world = scene
     for move in bound:
         world = moved(world, move.obj, move.place.pose)

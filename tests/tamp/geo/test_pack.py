@@ -12,6 +12,7 @@ import pytest
 import torch
 
 from tamp.geo.ours.pack import (
+    Occupants,
     PackConfig,
     PackError,
     overlap_loss,
@@ -46,10 +47,10 @@ def test_pack_places_five_squares_in_a_region_that_holds_them_only_tightly(seed)
 def test_tries_packed_together_give_each_the_packing_it_gets_alone():
     config = PackConfig(fingers=0.07, side=0.033)
     tries = [(replace(config, margin=margin), seed) for margin in (0.01, 0.0) for seed in (0, 3)]
-    fixed = ([(0.05, 0.05)], [(0.02, 0.02)])
-    together = pack_tries(TIGHT, SQUARES[:3], *fixed, tries, walled=False)
+    fixed = Occupants([(0.05, 0.05)], [(0.02, 0.02)])
+    together = pack_tries(TIGHT, SQUARES[:3], fixed, tries, walled=False)
     for (at, seed), got in zip(tries, together, strict=True):
-        alone = pack(TIGHT, SQUARES[:3], *fixed, at, seed, walled=False)
+        alone = pack(TIGHT, SQUARES[:3], fixed, at, seed, walled=False)
         assert np.array_equal(got.positions, alone.positions)
         assert (got.ok, got.overlap, got.order) == (alone.ok, alone.overlap, alone.order)
         assert np.array_equal(got.yaws, alone.yaws) and np.array_equal(got.axes, alone.axes)
@@ -66,7 +67,7 @@ def test_pack_says_when_the_region_cannot_hold_them():
 
 def test_pack_keeps_clear_of_fixed_occupants_and_leaves_finger_room():
     fixed = [(0.025, 0.0525)]  # a square in the left end of the region
-    result = pack(TIGHT, SQUARES[:3], fixed, [(0.025, 0.025)], seed=1)
+    result = pack(TIGHT, SQUARES[:3], Occupants(fixed, [(0.025, 0.025)]), seed=1)
     assert result.ok
     assert _free_and_inside(TIGHT, [(0.025, 0.025)] * 4, np.vstack([result.positions, fixed]))
     roomy = pack(((0.0, 0.0), (0.3, 0.3)), SQUARES[:2], config=PackConfig(fingers=0.07), seed=0)
@@ -86,7 +87,8 @@ def test_the_packing_loss_gradient_matches_finite_differences():
     fixed_half = torch.tensor([[0.01, 0.02]], dtype=torch.float64)
 
     def loss(p):
-        return overlap_loss(p, grown, body, fixed_xy, fixed_half, 300.0, 1e-3, 0.002)
+        smooth = PackConfig(eps=1e-3, gap=0.002, ordered=False)
+        return overlap_loss(p, grown, body, fixed_xy, fixed_half, 300.0, smooth)
 
     assert loss(xy).gt(0).all()  # overlapping, so the check sees a gradient
     assert torch.autograd.gradcheck(loss, (xy,), eps=1e-7, atol=1e-6)
