@@ -55,9 +55,10 @@ class WindowBeliefs(Protocol):
 
 class BeliefSource(Protocol):
     """Makes the beliefs of a window for the problems ``indices`` (positions in the list given
-    to `task.planner.plan_batch`) in their current crisp ``states``."""
+    to `task.planner.plan_batch`) in their current crisp ``states``; None: the planner's own
+    encoding of the true states."""
 
-    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefs: ...
+    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefs | None: ...
 
 
 class WindowBeliefsBase(ABC):
@@ -100,9 +101,12 @@ class _Given(WindowBeliefsBase):
         return None if self._fallback is None else window_beliefs(self._fallback(rows))
 
 
-def window_beliefs(beliefs: WindowBeliefs) -> WindowBeliefsBase:
-    """``beliefs`` as a `WindowBeliefsBase`: themselves when they inherit it, else wrapped."""
-    return beliefs if isinstance(beliefs, WindowBeliefsBase) else _Given(beliefs)
+def window_beliefs(beliefs: WindowBeliefs | None) -> WindowBeliefsBase | None:
+    """``beliefs`` as a `WindowBeliefsBase`: themselves when they inherit it, else wrapped;
+    None stays None (a source's answer for "plan from the true state")."""
+    if beliefs is None or isinstance(beliefs, WindowBeliefsBase):
+        return beliefs
+    return _Given(beliefs)
 
 
 class _Source:
@@ -111,7 +115,7 @@ class _Source:
     def __init__(self, source: BeliefSource) -> None:
         self.source = source
 
-    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefsBase:
+    def __call__(self, indices: Sequence[int], states: Sequence[State]) -> WindowBeliefsBase | None:
         return window_beliefs(self.source(indices, states))
 
 
