@@ -47,7 +47,10 @@ EDGE_HELPERS = {
 }
 
 # the parser's handlers: the namespace in, the edge's settings to the command
-PARSER = {"tamp/cli/parser.py:_at_edge.handler", "tamp/cli/parser.py:_lazy.handler"}
+PARSER = {
+    "tamp/cli/parsers/handlers.py:at_edge.handler",
+    "tamp/cli/parsers/handlers.py:lazy.handler",
+}
 
 # commands whose namespace still travels below their entry: a list that only shrinks
 NOT_YET = {
@@ -189,7 +192,7 @@ def _dotted(entry: str) -> tuple[str, str]:
 @pytest.mark.parametrize("command", sorted(EDGES))
 def test_a_converted_command_runs_on_its_edges_settings(command):
     """The parser binds each converted command's handler and recorded configuration through
-    its named edge (`tamp.cli.parser._at_edge`), so the handler receives typed settings."""
+    its named edge (`tamp.cli.parsers.handlers.at_edge`), so the handler receives typed settings."""
     parser = build_parser()
     for word in command.split():
         parser = next(a for a in parser._actions if isinstance(a.choices, dict)).choices[word]
