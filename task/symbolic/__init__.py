@@ -1,6 +1,7 @@
 """task.symbolic: the crisp side of planning, apart from the differentiable core.
 
-- ``pddl_io``: PDDL text in and out (parse domains, problems and plans; one-line errors);
+- ``pddl_io/``: PDDL text in and out (read files, parse domains and problems, check STRIPS,
+  read and write plans; one-line errors), its ``__init__`` the API;
 - ``strips``: grounded STRIPS semantics (applicable / apply) of a parsed PDDL domain;
 - ``ground``: grounding by relaxed reachability (the ground actions the relaxation reaches);
 - ``strips_task``: one grounded problem as padded index arrays;
