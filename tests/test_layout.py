@@ -113,9 +113,9 @@ def test_import_task_stays_light():
     assert out.stdout.strip() == "[]"
 
 
-CRISP = sorted(
-    f"task.symbolic.{p.stem}"
-    for p in (ROOT / "task" / "symbolic").glob("*.py")
+CRISP = sorted(  # every module of the crisp side, its sub-rooms' too (pddl_io/, proofs/, ...)
+    ".".join(p.relative_to(ROOT).with_suffix("").parts)
+    for p in (ROOT / "task" / "symbolic").rglob("*.py")
     if p.name != "__init__.py"
 )
 LOADED = """
