@@ -14,10 +14,10 @@ from pathlib import Path
 
 import pytest
 
-from tamp.bench import record
 from tamp.bench.executability import PlanRow
 from tamp.bench.motion import EPISODE_COLUMNS
 from tamp.bench.planning import INSTANCE_COLUMNS
+from tamp.bench.record import markdown
 from tamp.cli.options import GOAL_LOSSES
 from tamp.cli.reference import COMMAND, reference
 
@@ -82,7 +82,7 @@ def test_the_api_page_opens_with_the_readme_snippet():
 def test_the_readme_results_table_is_benchmarks_md_current_table():
     readme = README.read_text(encoding="utf-8")
     benchmarks = (ROOT / "BENCHMARKS.md").read_text(encoding="utf-8")
-    assert record.block_of(readme) == record.block_of(benchmarks), (
+    assert markdown.block_of(readme) == markdown.block_of(benchmarks), (
         "README.md's current-results table differs from BENCHMARKS.md's: run tamp bench record"
     )
 

@@ -10,7 +10,9 @@
 - ``fast_downward``: optimal plan lengths from Fast Downward (the ``bench`` extra,
   benchmark-only) for sets whose data lack them, cached by the PDDL texts' digest;
 - ``results``: the one results writer (output folder, machine record, JSON, CSV, plots);
-- ``tables``: the one table printer.
+- ``tables``: the one table printer;
+- ``record``: ``bench record``, the typed records of results (``records``) and BENCHMARKS.md
+  rendered from them (``markdown``).
 
 The command-line handlers that call these live in `tamp.cli.bench` (one module per kind).
 """

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from tamp.bench import record, results
+from tamp.bench import results
+from tamp.bench.record import markdown, records
 from tamp.bench.summary import Summary
 from tamp.cli import main
 from task.errors import DataError
@@ -104,7 +105,7 @@ def _results(folder: Path, *, seeds=(0,), commit=COMMIT, dirty=False, command="t
 
 
 def test_a_record_keeps_the_headline_figures_and_what_produced_them(tmp_path):
-    r = record.extract(_results(tmp_path / "blocks"))
+    r = records.extract(_results(tmp_path / "blocks"))
     assert (r.name, r.benchmark, r.instances, r.seeds) == ("blocks", "planbench", 4, (0,))
     assert (r.command, r.commit, r.dirty, r.date[:10]) == (
         "tamp bench x",
@@ -113,23 +114,23 @@ def test_a_record_keeps_the_headline_figures_and_what_produced_them(tmp_path):
         "2026-12-01",
     )
     assert [f["valid"] for f in r.figures] == [3] and r.machine["load_1min"] == 3.5
-    assert record.ours(r) == "3/4 valid (1 no plan), 66.7% optimal, 0.5 s/instance, 2 s in all"
-    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
-    several = record.extract(_results(tmp_path / "seeds", seeds=(0, 1, 2)))
+    assert markdown.ours(r) == "3/4 valid (1 no plan), 66.7% optimal, 0.5 s/instance, 2 s in all"
+    assert records.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+    several = records.extract(_results(tmp_path / "seeds", seeds=(0, 1, 2)))
     assert [f["valid"] for f in several.figures] == [3.5]  # the mean over seeds
-    assert record.ours(several).endswith("(mean of 3 seeds)") and "3.5/4 valid" in record.ours(
+    assert markdown.ours(several).endswith("(mean of 3 seeds)") and "3.5/4 valid" in markdown.ours(
         several
     )
 
 
 def test_a_dirty_run_is_marked_in_its_row_and_a_clean_one_is_not(tmp_path):
-    clean = record.extract(_results(tmp_path / "clean"))
-    dirty = record.extract(_results(tmp_path / "dirty", dirty=True))
-    table = record.render([clean, dirty])
+    clean = records.extract(_results(tmp_path / "clean"))
+    dirty = records.extract(_results(tmp_path / "dirty", dirty=True))
+    table = markdown.render([clean, dirty])
     lines = [line for line in table.splitlines() if line.startswith("| PlanBench")]
     assert ["uncommitted changes" in line for line in lines] == [False, True]
     assert "commit alone does not reproduce it" in table
-    assert "uncommitted" not in record.render([clean])
+    assert "uncommitted" not in markdown.render([clean])
 
 
 @pytest.mark.parametrize(
@@ -142,23 +143,23 @@ def test_a_dirty_run_is_marked_in_its_row_and_a_clean_one_is_not(tmp_path):
 def test_a_results_folder_that_names_no_commit_or_command_is_refused(tmp_path, change, message):
     folder = _results(tmp_path / "old", **change)
     with pytest.raises(DataError, match=message):
-        record.extract(folder)
+        records.extract(folder)
 
 
 def test_other_folders_are_refused_in_one_line(tmp_path):
     with pytest.raises(DataError, match=r"no results\.json"):
-        record.extract(tmp_path)
+        records.extract(tmp_path)
     (tmp_path / "motion").mkdir()
     (tmp_path / "motion" / "results.json").write_text(json.dumps({"summary": {}, "machine": {}}))
     with pytest.raises(DataError, match="records no command"):
-        record.extract(tmp_path / "motion")
+        records.extract(tmp_path / "motion")
     body = {"summary": {}, "machine": {"command": "tamp bench motion", "commit": COMMIT}}
     (tmp_path / "motion" / "results.json").write_text(json.dumps(body))
     with pytest.raises(DataError, match=r"not the results of a benchmark .*families: planning"):
-        record.extract(tmp_path / "motion")
+        records.extract(tmp_path / "motion")
     (tmp_path / "motion" / "results.json").write_bytes(b"\x89PNG\x00")
     with pytest.raises(DataError, match="not JSON"):
-        record.extract(tmp_path / "motion")
+        records.extract(tmp_path / "motion")
 
 
 def test_a_latplan_record_reads_true_states_and_images_apart(tmp_path):
@@ -194,17 +195,17 @@ def test_a_latplan_record_reads_true_states_and_images_apart(tmp_path):
         ],
     }
     (folder / "results.json").write_text(json.dumps(body))
-    r = record.extract(folder)
-    assert record.label(r) == "LatPlan-40"
-    assert record.ours(r) == (
+    r = records.extract(folder)
+    assert markdown.label(r) == "LatPlan-40"
+    assert markdown.ours(r) == (
         "true states: 40/40 valid, 40/40 optimal; images (frozen 150x100, frozen 45x30): "
         "38-40/40 valid, 38-39/40 optimal"
     )
-    assert "31/40 optimal" in record.render([r])  # the paper's figure beside ours
+    assert "31/40 optimal" in markdown.render([r])  # the paper's figure beside ours
 
 
 def _experiments(root: Path) -> None:
-    """An experiments index under ``root`` (what `record.page` lists last)."""
+    """An experiments index under ``root`` (what `markdown.page` lists last)."""
     (root / "docs" / "experiments").mkdir(parents=True)
     index = "# Experiments\n\nintro\n\n- [A study](a.md): what it measured.\n"
     (root / "docs" / "experiments" / "index.md").write_text(index)
@@ -216,20 +217,20 @@ def test_bench_record_writes_the_page_whole_and_only_the_readme_block(tmp_path, 
     _experiments(tmp_path)
     md, readme = tmp_path / "B.md", tmp_path / "R.md"
     md.write_text("stale, hand-typed\n")
-    readme.write_text(f"# Title\n\nbefore\n{record.START}\nstale\n{record.END}\nafter\n")
+    readme.write_text(f"# Title\n\nbefore\n{markdown.START}\nstale\n{markdown.END}\nafter\n")
     into = tmp_path / "current"
     argv = ["bench", "record", "--results", str(tmp_path / "runs"), "--into", str(into)]
     files = ["--markdown", str(md), "--readme", str(readme)]
     assert main([*argv, *files]) == 0  # a parent folder: each subfolder
     assert sorted(p.name for p in into.iterdir()) == ["blocks.json", "more.json"]
-    records = record.load_all(into)
+    loaded = records.load_all(into)
     page = md.read_text()
-    assert page == record.page(records, tmp_path) and "stale" not in page
-    assert record.block_of(page) == record.render(records)
+    assert page == markdown.page(loaded, tmp_path) and "stale" not in page
+    assert markdown.block_of(page) == markdown.render(loaded)
     assert "[A study](docs/experiments/a.md): what it measured." in page  # links from the root
     text = readme.read_text()
     assert text.startswith("# Title\n\nbefore\n") and text.endswith("\nafter\n")
-    assert "stale" not in text and record.block_of(text) == record.render(records)
+    assert "stale" not in text and markdown.block_of(text) == markdown.render(loaded)
     assert "wrote 2 record(s)" in capsys.readouterr().out
     assert main(["bench", "record", "--into", str(into), *files]) == 0
     assert (md.read_text(), readme.read_text()) == (page, text)  # same records, same text
@@ -258,28 +259,28 @@ def test_benchmarks_md_is_the_page_the_records_give():
     """BENCHMARKS.md, all of it, cannot drift from ``results/current`` and the experiments
     index: regenerate it with ``tamp bench record`` (from the repository root) after changing
     a record or a study."""
-    records = record.load_all(REPO / "results" / "current")
-    assert records, "results/current holds no records"
-    for r in records:
+    loaded = records.load_all(REPO / "results" / "current")
+    assert loaded, "results/current holds no records"
+    for r in loaded:
         assert r.command.startswith("tamp bench ") and len(r.commit) == 40, r.name
     text = (REPO / "BENCHMARKS.md").read_text(encoding="utf-8")
-    assert text == record.page(records, REPO), "BENCHMARKS.md differs: run tamp bench record"
+    assert text == markdown.page(loaded, REPO), "BENCHMARKS.md differs: run tamp bench record"
 
 
 def test_the_readme_results_block_is_the_one_the_records_give():
-    records = record.load_all(REPO / "results" / "current")
+    loaded = records.load_all(REPO / "results" / "current")
     text = (REPO / "README.md").read_text(encoding="utf-8")
-    assert record.block_of(text) == record.render(records), "run tamp bench record"
+    assert markdown.block_of(text) == markdown.render(loaded), "run tamp bench record"
 
 
 def test_every_study_is_indexed_and_every_family_without_a_record_names_studies_that_exist():
-    folder = REPO / record.EXPERIMENTS
+    folder = REPO / markdown.EXPERIMENTS
     studies = {p.name for p in folder.glob("*.md")} - {"index.md"}
-    listed = record.experiments_index(REPO)
+    listed = markdown.experiments_index(REPO)
     assert sorted(studies) == sorted(
         line.split("](docs/experiments/")[1].split(")")[0] for line in listed
     )
-    for s in record.STUDIED:
+    for s in markdown.STUDIED:
         assert s.command.startswith("tamp bench ") and f"--out results/{s.name}" in s.command
         assert set(s.studies) <= studies, s.name
     for path in folder.glob("*.md"):  # each study opens with a title and a header paragraph
@@ -294,23 +295,23 @@ def test_a_motion_run_is_recorded_with_its_figures_per_simulator(tmp_path):
     argv = ["bench", "motion", "--blocks", "3", "--n", "1", "--sim", "pybullet"]
     assert main([*argv, "--no-progress", "--out", str(out)]) == 0
     summary = json.loads((out / "results.json").read_text())["summary"]["pybullet"]
-    r = record.extract(out)
+    r = records.extract(out)
     assert (r.family, r.benchmark, r.instances, r.seeds) == (
-        record.Family.MOTION,
+        records.Family.MOTION,
         "motion",
         1,
         (0,),
     )
     (row,) = r.figures
-    assert row["sim"] == "pybullet" and set(row) == set(record.MOTION_FIGURES)
-    assert all(row[k] == summary[k] for k in record.MOTION_FIGURES if k != "sim")
+    assert row["sim"] == "pybullet" and set(row) == set(records.MOTION_FIGURES)
+    assert all(row[k] == summary[k] for k in records.MOTION_FIGURES if k != "sim")
     goal = f"pybullet: {summary['goal_reached']}/1 goal reached"
-    assert record.ours(r).startswith(goal) and f"{summary['moves_ok']}/{summary['moves']}" in (
-        record.ours(r)
+    assert markdown.ours(r).startswith(goal) and f"{summary['moves_ok']}/{summary['moves']}" in (
+        markdown.ours(r)
     )
-    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
-    table = record.render([r])
-    assert record.TITLES[record.Family.MOTION] in table and "Planning" not in table
+    assert records.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+    table = markdown.render([r])
+    assert markdown.TITLES[records.Family.MOTION] in table and "Planning" not in table
 
 
 @pytest.mark.sim
@@ -321,15 +322,15 @@ def test_a_tamp_run_is_recorded_with_its_figures_per_problem_planner_and_simulat
     argv += ["--planner", "motion-aware", "--workers", "1", "--no-progress", "--out", str(out)]
     assert main(argv) == 0
     (summary,) = json.loads((out / "results.json").read_text())["summary"]
-    r = record.extract(out)
-    assert (r.family, r.benchmark, r.instances, r.seeds) == (record.Family.TAMP, "tamp", 1, (0,))
-    assert r.figures == ({k: summary[k] for k in record.TAMP_FIGURES},)
+    r = records.extract(out)
+    assert (r.family, r.benchmark, r.instances, r.seeds) == (records.Family.TAMP, "tamp", 1, (0,))
+    assert r.figures == ({k: summary[k] for k in records.TAMP_FIGURES},)
     solved, collided = summary["solved"], summary["collided"]
-    assert record.ours(r) == (
+    assert markdown.ours(r) == (
         f"motion-aware, pybullet: {solved}/1 solved (blocked {solved}/1), {collided} collided"
     )
-    assert record.label(r) == "Canonical problems, 1 variants each"
-    assert record.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
+    assert markdown.label(r) == "Canonical problems, 1 variants each"
+    assert records.Record.from_json(json.loads(json.dumps(r.to_json()))) == r
 
 
 def test_a_partial_run_and_a_record_of_an_unknown_family_are_refused(tmp_path):
@@ -337,10 +338,10 @@ def test_a_partial_run_and_a_record_of_an_unknown_family_are_refused(tmp_path):
     body = json.loads((folder / "results.json").read_text()) | {"partial": {"done": 2, "of": 4}}
     (folder / "results.json").write_text(json.dumps(body))
     with pytest.raises(DataError, match=r"a partial run \(2 of 4 done"):
-        record.extract(folder)
+        records.extract(folder)
     into = tmp_path / "current"
-    record.write(record.extract(_results(tmp_path / "blocks")), into)
+    records.write(records.extract(_results(tmp_path / "blocks")), into)
     body = json.loads((into / "blocks.json").read_text()) | {"family": "dance"}
     (into / "blocks.json").write_text(json.dumps(body))
     with pytest.raises(DataError, match=r"blocks\.json: family 'dance' is not one of planning"):
-        record.load_all(into)
+        records.load_all(into)
