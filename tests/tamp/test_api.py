@@ -149,16 +149,25 @@ BENCHMARK_WRAPPERS |= {"benchmark_motion"}
 def test_only_the_benchmark_wrappers_import_tamp_bench():
     """The library's defaults live in its components' configs (the geometric episode's limits:
     `tamp.geo.types.GeoLimits`), never in a benchmark: outside the functions that wrap one,
-    `tamp.api` imports nothing from ``tamp.bench`` (type hints aside)."""
+    `tamp.api` (every module of the package) imports nothing from ``tamp.bench`` (type hints
+    aside)."""
     import ast
-    import inspect
 
-    tree = ast.parse(inspect.getsource(api))
     found = set()
-    for fn in (n for n in tree.body if isinstance(n, ast.FunctionDef)):
-        for node in ast.walk(fn):
-            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("tamp.bench"):
-                found.add(fn.name)
+    for path in sorted(Path(api.__file__).parent.glob("*.py")):
+        tree = ast.parse(path.read_text(), filename=str(path))
+        for node in tree.body:
+            top_level = isinstance(node, ast.Import | ast.ImportFrom)
+            if top_level:  # a module-level import of tamp.bench would load it with tamp.api
+                names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+                module = node.module if isinstance(node, ast.ImportFrom) else None
+                assert not any(n.startswith("tamp.bench") for n in [*names, module or ""]), path
+        for fn in (n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)):
+            for node in ast.walk(fn):
+                if isinstance(node, ast.ImportFrom) and (node.module or "").startswith(
+                    "tamp.bench"
+                ):
+                    found.add(fn.name)
     assert found and found <= BENCHMARK_WRAPPERS, sorted(found - BENCHMARK_WRAPPERS)
 
 
