@@ -326,8 +326,8 @@ def grasp_yaw(block_yaw: float, hand_yaw: float) -> float:
 
 def _kinematics(spec: PandaSpec) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The URDF chain for `_fk_jacobian`: joint-origin rotations (J, 3, 3) and offsets (J, 3)
-    from link i-1 to link i, and panda_link7 -> TCP (4, 4) (`motion.sphere_fk.chain`)."""
-    from motion.sphere_fk import chain
+    from link i-1 to link i, and panda_link7 -> TCP (4, 4) (`motion.sphere_check.fk.chain`)."""
+    from motion.sphere_check.fk import chain
 
     rot, off, hand, tcp = chain(spec)
     return rot, off, hand @ tcp

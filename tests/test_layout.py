@@ -65,7 +65,7 @@ ROOM_FORBIDDEN = {
     "task/domains": OPTIMISER,
 }
 ROOMS = {
-    "motion": ("pick_place",),
+    "motion": ("pick_place", "sphere_check"),
     "tamp": ("bench", "camera", "cli", "geo", "loop", "sim", "world"),
     "task": ("data", "domains", "planner", "symbolic"),
 }

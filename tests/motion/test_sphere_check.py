@@ -13,8 +13,11 @@ import numpy as np
 import pytest
 
 from motion.errors import MotionError
-from motion.sphere_bounds import dop_gap
-from motion.sphere_check import APART, APART_CLEARANCE, CHUNK, PARTS, Screened, SphereCollision
+from motion.sphere_check import Screened, SphereCollision
+from motion.sphere_check.bounds import dop_gap
+from motion.sphere_check.collision import CHUNK
+from motion.sphere_check.fk import PARTS
+from motion.sphere_check.model import APART, APART_CLEARANCE
 from robots.collision import Box
 from robots.panda import PANDA, data_dir
 from robots.panda_spheres import COVER, COVER_GAP, FINGERS, SPHERES
@@ -35,12 +38,12 @@ def near_arm_scenes(model: SphereCollision, n_scenes: int, per_scene: int, seed:
     rng = np.random.default_rng(seed)
     for s in range(n_scenes):
         q0 = np.clip(HOME + rng.normal(0.0, 0.8, 7), LO, HI)
-        rot, pos = model._links(q0[None], PANDA.finger_open)
+        rot, pos = model.model.links(q0[None], PANDA.finger_open)
         boxes = []
         for k in range(int(rng.integers(1, 3))):
             link = int(rng.integers(1, len(PARTS)))
-            i = model._start[link] + int(rng.integers(model._count[link]))
-            centre = rot[0, link] @ model._local[i] + pos[0, link]  # a sphere's world centre
+            i = model.model.start[link] + int(rng.integers(model.model.count[link]))
+            centre = rot[0, link] @ model.model.local[i] + pos[0, link]  # a sphere's world centre
             half = rng.uniform(0.01, 0.06, 3)
             yaw = float(rng.uniform(-math.pi, math.pi))
             direction = rng.normal(size=3)
@@ -51,7 +54,7 @@ def near_arm_scenes(model: SphereCollision, n_scenes: int, per_scene: int, seed:
             )  # the box's x and y axes
             support = abs(direction @ along[0]) * half[0] + abs(direction @ along[1]) * half[1]
             support += abs(direction[2]) * half[2]  # the box's extent towards the sphere
-            off = model._radii[i] + rng.uniform(-0.01, 0.1) + support
+            off = model.model.radii[i] + rng.uniform(-0.01, 0.1) + support
             at = centre + off * direction
             at[2] = max(at[2], half[2] + 0.001)  # stands on or above the table
             boxes.append(Box(f"box{k}", tuple(at), tuple(half), yaw))
@@ -99,7 +102,7 @@ def test_home_is_free_and_a_box_through_the_hand_is_not(spheres):
     spheres.set_boxes([])
     spheres.hold(None)
     assert spheres.valid(HOME) and spheres.contacts(HOME) == []
-    _, pos = spheres._links(HOME[None], PANDA.finger_open)
+    _, pos = spheres.model.links(HOME[None], PANDA.finger_open)
     hand = pos[0, PARTS.index("panda_hand")]
     spheres.set_boxes([Box("block", tuple(hand), (0.02, 0.02, 0.02))])
     assert not spheres.valid(HOME)
@@ -128,7 +131,7 @@ def test_the_held_block_hits_the_table_and_a_box_but_not_the_hand_holding_it(sph
     spheres.set_boxes([])
     spheres.hold(0.05)
     assert spheres.valid(HOME, 0.025)  # the fingers close on it: no hand contact
-    rot, pos = spheres._links(HOME[None], PANDA.finger_open)
+    rot, pos = spheres.model.links(HOME[None], PANDA.finger_open)
     tcp = pos[0, -1]
     assert rot[0, -1][2, 2] < -0.99  # the TCP's z points down at home
     below = np.eye(4)
@@ -323,14 +326,14 @@ def _reference_valid(model: SphereCollision, q: np.ndarray, fingers: float) -> n
     """`valid_batch` without any culling (no held box): every grown sphere against the table
     and every box (exact signed distance), and every checked link pair's spheres against the
     other link's box and 26-DOP, from the same forward kinematics."""
-    rot, pos = model._links(q.astype(np.float32), fingers)
+    rot, pos = model.model.links(q.astype(np.float32), fingers)
     m, gap = model.margin, model.gap
     free = np.ones(len(q), dtype=bool)
     spheres = []
     for link in range(len(PARTS)):
-        rows = slice(model._start[link], model._start[link] + model._count[link])
-        x = np.einsum("bij,sj->bsi", rot[:, link], model._local[rows]) + pos[:, link, None]
-        spheres.append((x, model._radii[rows] + gap))  # (B, S, 3), (S,)
+        rows = slice(model.model.start[link], model.model.start[link] + model.model.count[link])
+        x = np.einsum("bij,sj->bsi", rot[:, link], model.model.local[rows]) + pos[:, link, None]
+        spheres.append((x, model.model.radii[rows] + gap))  # (B, S, 3), (S,)
     for link, (x, r) in enumerate(spheres):
         if link > 0:  # link0 stands on the table
             free &= ((x[..., 2] - r) >= m).all(1)
@@ -342,17 +345,17 @@ def _reference_valid(model: SphereCollision, q: np.ndarray, fingers: float) -> n
             sdf = np.linalg.norm(np.maximum(np.abs(local) - model._halves[o], 0.0), axis=-1)
             sdf += np.minimum((np.abs(local) - model._halves[o]).max(-1), 0.0)
             free &= ((sdf - r) >= m).all(1)
-    for k, (c_link, a_link) in enumerate(model._pairs):
-        rule = model._apart_from[k]
+    for k, (c_link, a_link) in enumerate(model.model.pairs):
+        rule = model.model.apart_from[k]
         if model.self_margin < APART_CLEARANCE:
-            checked = q[:, model._apart_joint[k]] < rule  # (B,)
+            checked = q[:, model.model.apart_joint[k]] < rule  # (B,)
         else:
             checked = np.ones(len(q), dtype=bool)
         x, r = spheres[a_link]
         inner = np.einsum("bji,bsj->bsi", rot[:, c_link], x - pos[:, c_link, None])
-        d = np.abs(inner - model._aabb_c[c_link]) - model._aabb_h[c_link]
+        d = np.abs(inner - model.model.aabb_c[c_link]) - model.model.aabb_h[c_link]
         box = np.linalg.norm(np.maximum(d, 0.0), axis=-1) + np.minimum(d.max(-1), 0.0)
-        dop = (inner @ model._directions.T - model._dop[c_link]).max(-1)
+        dop = (inner @ model.model.directions.T - model.model.dop[c_link]).max(-1)
         hit = ((box - r) < model.self_margin) & ((dop - r) < model.self_margin)
         free &= ~(hit.any(1) & checked)
     return free
@@ -403,10 +406,10 @@ def test_a_batch_of_several_chunks_gets_the_reference_verdicts():
 
 
 def test_the_26_dop_bound_equals_the_matrix_product():
-    """`sphere_bounds.dop_gap` (three broadcast products, no BLAS) against the matrix product."""
+    """`bounds.dop_gap` (three broadcast products, no BLAS) against the matrix product."""
     rng = np.random.default_rng(3)
     model = SphereCollision()
     p = rng.normal(0.0, 0.2, (500, 3)).astype(np.float32)
-    support = model._dop_c[:, rng.integers(0, len(PARTS), 500)]  # (26, 500)
-    want = (p.astype(float) @ model._directions.T.astype(float) - support.T).max(-1)
-    assert np.allclose(dop_gap(p, model._directions, support), want, atol=1e-6)
+    support = model.model.dop_c[:, rng.integers(0, len(PARTS), 500)]  # (26, 500)
+    want = (p.astype(float) @ model.model.directions.T.astype(float) - support.T).max(-1)
+    assert np.allclose(dop_gap(p, model.model.directions, support), want, atol=1e-6)

@@ -11,7 +11,7 @@ import time
 import numpy as np
 import pytest
 
-from motion.sphere_check import CHUNK, SphereCollision
+from motion.sphere_check.collision import CHUNK, SphereCollision
 from tamp.bench.collision import scenes
 from tamp.bench.collision.threads import (
     blas_pools,

@@ -5,7 +5,7 @@ offsets), the link frames `PARTS` in the order `SphereCollision` uses, the spher
 `robots.panda_spheres` (cuRobo's SPHERES plus the COVER rows) per link in its own frame
 (`link_spheres`), and `links`: the world frames of every link and the TCP for B configurations at
 once (float32, `FLOAT`; `frames` batch-last, `batch_first` to gather them by configuration).
-The model's fixed bounding volumes and the checks' distance tests are `motion.sphere_bounds`.
+The model's fixed bounding volumes and the checks' distance tests are `motion.sphere_check.bounds`.
 """
 
 from __future__ import annotations

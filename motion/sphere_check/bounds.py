@@ -1,6 +1,6 @@
 """The sphere model's fixed bounding volumes and the distance tests of its checks.
 
-For `motion.sphere_check`, over the links of `motion.sphere_fk.PARTS`: bounding spheres
+For `motion.sphere_check`, over the links of `motion.sphere_check.fk.PARTS`: bounding spheres
 (`bound`), each link's 26-DOP from its collision mesh (`dops`), its spheres in clusters
 (`clusters`), turns about z (`turn`); and the checks' distance tests: the separating-axis test
 of two boxes (`obb_gap`), points against turned boxes (`box_gap`) and axis-aligned ones
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from motion.sphere_fk import PARTS
+from motion.sphere_check.fk import PARTS
 from robots.panda import data_dir
 from robots.panda_spheres import FINGERS
 
@@ -54,7 +54,7 @@ def bound(centres: np.ndarray, radii: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 def clusters(spheres, size: int):
-    """Each link's spheres (`motion.sphere_fk.link_spheres`) in clusters of at most ``size``
+    """Each link's spheres (`motion.sphere_check.fk.link_spheres`) in clusters of at most ``size``
     along the link's longest direction: per cluster its link (C,), centres (C, size, 3) padded
     by repeating its first, radii (C, size), count (C,) and bounding sphere (`bound`: (C, 3),
     (C,)); per link its first cluster (L,) and number of them (L,)."""

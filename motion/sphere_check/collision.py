@@ -12,7 +12,7 @@ panda_link0), each grown by ``COVER_GAP``, and against them
 - the table, a plane at z = 0 (panda_link0 stands on it: that pair is skipped, as the mesh
   model does);
 - the other links (self-collision, against ``self_margin``): the mesh model's link pairs (all
-  but `robots.collision.DISABLED_PAIRS`), less the pairs `APART` proves apart at the current
+  but `robots.collision.DISABLED_PAIRS`), less the pairs `model.APART` proves apart at the current
   angles; a pair is the distal link's grown spheres against the 26-DOP (26 support planes)
   that holds the other link's collision hull, a lower bound of the distance to it;
 - the held box (`hold`): riding in the TCP frame, against the boxes with the separating axis
@@ -25,76 +25,42 @@ spheres, so when a mesh comes within ``margin`` of a box, a grown sphere does to
 says "collision" a little earlier than the mesh model, never later. tests/motion/
 test_sphere_check.py compares the two on configurations beside boxes (no false "free" in 5,000
 at margins of 1 and 2 cm; about 9 % of all are false "collisions", mostly boxes 1-2.5 cm off).
-Its contacts' distances are lower bounds, so the mesh model stays the final word (`Screened`
-pairs the two: the mesh model answers ``valid`` and ``check_path``, the spheres
-``valid_batch``, which `motion.rrt.plan_path` uses to search).
+Its contacts' distances are lower bounds, so the mesh model stays the final word
+(`motion.sphere_check.screened.Screened` pairs the two: the mesh model answers ``valid`` and
+``check_path``, the spheres ``valid_batch``, which `motion.rrt.plan_path` uses to search).
 
 Speed. `CHUNK` configurations at a time; forward kinematics and the broad phases batch-last
-(`motion.sphere_fk`, `motion.sphere_bounds`). A bounding sphere per link (L = 11) is tested
-first: against the table, and against each box's world bounds axis by axis, (L, O, B); the
-flagged (configuration, link) pairs go to the narrow phase in three `BUCKETS` of links by sphere
-count (each link's spheres padded to its bucket's widest, placed in one batched product per
-bucket). Self pairs go through the bounding spheres (the pairs `APART` always keeps apart
-never), then the link's bounding sphere against the other link's box, then clusters of at most
-`CLUSTER` spheres of the link (their bounding spheres against that box first), then each sphere
-against the DOP's box and, where near, its 26 planes. A configuration with a contact found is
-not tested further (``valid_batch``). Without square roots where only the sign of a clearance
-matters, nor BLAS (numpy's OpenBLAS spreads a large product over a second thread): one thread.
-tests/motion/test_sphere_check.py checks the verdicts against a check that tests every sphere
-against everything.
+(`motion.sphere_check.fk`, `motion.sphere_check.bounds`); the fixed geometry of every phase is
+`motion.sphere_check.model.SphereModel`, built once (``model``). A bounding sphere per link
+(L = 11) is tested first: against the table, and against each box's world bounds axis by axis,
+(L, O, B); the flagged (configuration, link) pairs go to the narrow phase in three `model.BUCKETS`
+of links by sphere count (each link's spheres padded to its bucket's widest, placed in one batched
+product per bucket). Self pairs go through the bounding spheres (the pairs `model.APART` always
+keeps apart never), then the link's bounding sphere against the other link's box, then clusters of
+at most `model.CLUSTER` spheres of the link (their bounding spheres against that box first), then
+each sphere against the DOP's box and, where near, its 26 planes. A configuration with a contact
+found is not tested further (``valid_batch``). Without square roots where only the sign of a
+clearance matters, nor BLAS (numpy's OpenBLAS spreads a large product over a second thread): one
+thread. tests/motion/test_sphere_check.py checks the verdicts against a check that tests every
+sphere against everything.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Collection, Sequence
-from itertools import combinations
 
 import numpy as np
 
 from motion.errors import MotionError
-from motion.sphere_bounds import (
-    bound,
-    box_gap,
-    box_sdf,
-    clusters,
-    dop_gap,
-    dops,
-    near_box,
-    obb_gap,
-    turn,
-)
-from motion.sphere_fk import FLOAT, PARTS, batch_first, chain, frames, link_spheres, onehot
-from robots.collision import DISABLED_PAIRS, HAND, HELD, TABLE, Box, Contact, PathCheck, densify
+from motion.sphere_check.bounds import box_gap, box_sdf, dop_gap, near_box, obb_gap, turn
+from motion.sphere_check.fk import FLOAT, PARTS, batch_first
+from motion.sphere_check.model import APART_CLEARANCE, SphereModel
+from robots.collision import HAND, HELD, TABLE, Box, Contact, PathCheck, densify
 from robots.panda import PANDA, PandaSpec
-from robots.panda_spheres import COVER_GAP, FINGERS
+from robots.panda_spheres import COVER_GAP
 
 Ignore = Collection[tuple[str, str]]  # (part, other) pairs to skip, as in PandaCollision
-# Link pairs whose collision meshes stay at least APART_CLEARANCE apart while q[j] (0-based: 5
-# is panda_joint6) is at least the given angle (rad; -inf: always), within the datasheet limits
-# and for any finger opening: the least distance on a 0.02-0.03 rad grid of the two joints
-# between the links (PyBullet's closest points), less the most a point can move between grid
-# points (tests/motion/test_sphere_check.py re-derives them). They are skipped there while
-# self_margin < APART_CLEARANCE. The wrist's links are closer to each other than the spheres'
-# cover gap, so checking them with spheres would refuse most configurations.
-APART = (
-    ("panda_link0", "panda_link2", 0, -math.inf),  # >= 12 cm on a 0.03 rad grid of (q1, q2)
-    ("panda_link1", "panda_link3", 0, -math.inf),  # >= 12 cm, grid of (q2, q3)
-    ("panda_link2", "panda_link4", 0, -math.inf),  # >= 45 mm, grid of (q3, q4)
-    ("panda_link3", "panda_link5", 0, -math.inf),  # >= 48 mm, grid of (q4, q5)
-    ("panda_link5", "panda_link7", 5, 0.9),  # >= 9.8 mm for q6 >= 0.9, grid of (q6, q7)
-    ("panda_link5", "panda_hand", 5, 0.9),  # >= 12 mm for q6 >= 0.9, grid of (q6, q7)
-    ("panda_link6", "panda_hand", 0, -math.inf),  # >= 28 mm, grid of q7
-    ("panda_link6", FINGERS[0], 0, -math.inf),  # >= 10 cm, grid of q7
-    ("panda_link6", FINGERS[1], 0, -math.inf),
-    ("panda_link7", FINGERS[0], 0, -math.inf),  # >= 57 mm, fingers at 0 and 0.04 m
-    ("panda_link7", FINGERS[1], 0, -math.inf),
-)
-APART_CLEARANCE = 0.003  # m
-# the narrow phases test the links in buckets by sphere count (at most 10, 30, more: link0's
-# 46), each link's spheres padded to its bucket's widest: few groups, little padding
-BUCKETS = (10, 30)
-CLUSTER = 10  # spheres per cluster of a link in the self-collision narrow phase
 CHUNK = 2048  # configurations per pass of valid_batch: ~2x faster than 100,000 at once
 
 
@@ -114,30 +80,15 @@ class SphereCollision:
         self.margin, self.self_margin, self.spec = float(margin), float(self_margin), spec
         self.gap = COVER_GAP
         self.parts = (*PARTS, HELD)  # (P,) = L links + the held box, as PandaCollision.parts
-        self._rot, self._off, self._hand, self._tcp = chain(spec)
-        self._quarter_turns()
-        spheres = link_spheres()
-        # the G spheres, link by link: centres (G, 3) in their link's frame, radii (G,)
-        self._local = np.concatenate([spheres[link][0] for link in PARTS])
-        self._radii = np.concatenate([spheres[link][1] for link in PARTS])
-        self._count = np.array([len(spheres[link][1]) for link in PARTS])  # (L,)
-        self._start = np.cumsum(self._count) - self._count  # (L,) first sphere of each link
-        self._buckets(spheres)
-        self._clusters(spheres)
-        bounds = [bound(*spheres[link]) for link in PARTS]
-        self._bounds = np.array([c for c, _ in bounds])  # (L, 3) bounding-sphere centres
-        self._reach = np.array([r for _, r in bounds])  # (L,) bounding-sphere radii
+        self.model = SphereModel(spec)  # the fixed geometry, built once
         index = {name: k for k, name in enumerate(self.parts)}
         self._index = index
         self._groups = {n: [k] for n, k in index.items()} | {
             "robot": list(range(len(PARTS))),
             "hand": [index[n] for n in HAND],
         }
-        self._pair_rules()
-        self._directions, self._dop = dops()  # (26, 3), (L, 26)
         self._turns = np.zeros((0, 3, 3))  # (O, 3, 3) box frame -> world
         self._cos, self._sin = np.zeros(0, FLOAT), np.zeros(0, FLOAT)  # (O,) of the yaws
-        self._arm_vs_held = np.array([k for k, n in enumerate(PARTS) if n not in HAND])
         self._world_half = np.zeros((3, 0), FLOAT)  # (3, O): see set_boxes
         self._names: list[str] = [TABLE]  # (O + 1,) the table, then the boxes
         self._box_c = np.zeros((0, 3))  # (O, 3)
@@ -146,72 +97,6 @@ class SphereCollision:
         self._held_half: np.ndarray | None = None  # (3,)
         self._held_pose = np.eye(4)  # in the TCP frame
         self._masks: dict[frozenset, tuple[np.ndarray, np.ndarray]] = {}
-        for name in ("_rot", "_off", "_hand", "_tcp", "_local", "_radii", "_bounds", "_reach"):
-            setattr(self, name, getattr(self, name).astype(FLOAT))
-        self._directions, self._dop = self._directions.astype(FLOAT), self._dop.astype(FLOAT)
-        self._dop_boxes()
-
-    def _quarter_turns(self) -> None:
-        """Each joint origin's rotation as (source axis, sign) per axis (``_swaps``); the
-        URDF's are all quarter turns (MotionError otherwise)."""
-        self._swaps = []
-        for origin in self._rot:
-            k = np.abs(origin).argmax(0)  # (3,) the parent axis each new axis is
-            if not np.allclose(np.abs(origin), onehot(k), atol=1e-9):
-                raise MotionError(f"joint origin rotations must be quarter turns, got {origin}")
-            self._swaps.append([(int(k[a]), float(np.sign(origin[k[a], a]))) for a in range(3)])
-
-    def _buckets(self, spheres) -> None:
-        """The links by sphere count into BUCKETS; per bucket, every link's spheres padded to
-        the bucket's largest count by repeating its first (a repeat changes no minimum):
-        centres (L, S_k, 3) in the link's frame, radii (L, S_k); a link outside the bucket is
-        zeros."""
-        self._bucket = np.searchsorted(BUCKETS, self._count)  # (L,)
-        self._pad_local, self._pad_radii = [], []
-        for k in range(len(BUCKETS) + 1):
-            width = int(self._count[self._bucket == k].max(initial=1))
-            local, radii = np.zeros((len(PARTS), width, 3)), np.zeros((len(PARTS), width))
-            for link, name in enumerate(PARTS):
-                if self._bucket[link] == k:
-                    rows = np.arange(width)
-                    rows = np.where(rows < self._count[link], rows, 0)
-                    local[link], radii[link] = spheres[name][0][rows], spheres[name][1][rows]
-            self._pad_local.append(local.astype(FLOAT))
-            self._pad_radii.append(radii.astype(FLOAT))
-
-    def _pair_rules(self) -> None:
-        """The link pairs checked for self-collision (K, 2), and per pair the joint whose
-        angle, when at least its bound, keeps the pair apart (see APART)."""
-        pairs = [
-            (a, b)
-            for a, b in combinations(range(len(PARTS)), 2)
-            if frozenset((PARTS[a], PARTS[b])) not in DISABLED_PAIRS
-        ]
-        self._pairs = np.array(pairs)  # (K, 2) link pairs checked for self-collision
-        # (K,) the joint whose angle, when at least (K,), keeps the pair apart (see APART)
-        apart = {frozenset((a, b)): (j, lowest) for a, b, j, lowest in APART}
-        rule = [apart.get(frozenset((PARTS[a], PARTS[b])), (0, math.inf)) for a, b in pairs]
-        self._apart_joint = np.array([j for j, _ in rule])
-        self._apart_from = np.array([lowest for _, lowest in rule])
-
-    def _dop_boxes(self) -> None:
-        """The 26-DOP's first test: its axis-aligned box, centre (L, 3) and half extents
-        (L, 3), and the supports from the box's centre (26, L)."""
-        axes = [np.flatnonzero((self._directions == e).all(1))[0] for e in np.eye(3, dtype=FLOAT)]
-        minus = [np.flatnonzero((self._directions == -e).all(1))[0] for e in np.eye(3)]
-        high, low = self._dop[:, axes], -self._dop[:, minus]  # (L, 3) each
-        self._aabb_c, self._aabb_h = (high + low) / 2, (high - low) / 2
-        # (26, L) the supports from the box's centre: d . (p - c) - (s - d . c) = d . p - s
-        self._dop_c = np.ascontiguousarray((self._dop - self._aabb_c @ self._directions.T).T)
-
-    def _clusters(self, spheres) -> None:
-        """The self-collision narrow phase's clusters (`sphere_bounds.clusters`), as float32."""
-        link_of, local, radii, count, mids, reach, first, parts = clusters(spheres, CLUSTER)
-        self._cluster_link, self._cluster_count = link_of, count  # (C,) each
-        self._cluster_local = local.astype(FLOAT)  # (C, CLUSTER, 3)
-        self._cluster_radii = radii.astype(FLOAT)  # (C, CLUSTER)
-        self._cluster_mid, self._cluster_reach = mids.astype(FLOAT), reach.astype(FLOAT)
-        self._first_cluster, self._n_clusters = first, parts  # (L,) each
 
     # ---- the scene ---------------------------------------------------------------------------
 
@@ -277,7 +162,7 @@ class SphereCollision:
             return self._masks[key]
         scene = np.ones((len(self.parts), len(self._names)), dtype=bool)  # (P, O + 1)
         scene[self._index[self.spec.base_link], 0] = False  # link0 stands on the table
-        own = np.ones(len(self._pairs), dtype=bool)  # (K,)
+        own = np.ones(len(self.model.pairs), dtype=bool)  # (K,)
         held_arm = np.ones(len(PARTS), dtype=bool)  # (L,) held box vs link
         for pair in key:
             part, other = pair if isinstance(pair, tuple) and len(pair) == 2 else ("", "")
@@ -290,7 +175,7 @@ class SphereCollision:
             if col is None:
                 scene[rows, self._names.index(other)] = False
                 continue
-            for k, (a, b) in enumerate(self._pairs):
+            for k, (a, b) in enumerate(self.model.pairs):
                 own[k] &= not ((a in rows and b == col) or (b in rows and a == col))
             held = self._index[HELD]
             if held in rows and col < len(PARTS):
@@ -306,35 +191,6 @@ class SphereCollision:
         if isinstance(other, str):
             return other
         return self._names[other[k]] if other[k] >= 0 else self.parts[~other[k]]
-
-    # ---- kinematics --------------------------------------------------------------------------
-
-    def _links(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
-        """World rotations (B, L + 1, 3, 3) and origins (B, L + 1, 3): see `sphere_fk.links`."""
-        return batch_first(*self._frames(q, fingers))
-
-    def _frames(self, q: np.ndarray, fingers: float) -> tuple[np.ndarray, np.ndarray]:
-        """The same batch-last, (L + 1, 3, 3, B) and (L + 1, 3, B): see `sphere_fk.frames`."""
-        return frames(q, fingers, self._off, self._swaps, self._hand, self._tcp)
-
-    def _place(self, rot: np.ndarray, pos: np.ndarray, bucket: int, link: np.ndarray):
-        """World centres (M, S, 3) and grown radii (M, S) of the spheres of links ``link``
-        (M,), all in bucket ``bucket`` (padded to its S), in M frames: rotations (M, 3, 3) and
-        origins (M, 3) of those links (or of each relative to another link)."""
-        local = self._pad_local[bucket][link]  # (M, S, 3)
-        x = np.matmul(local, np.swapaxes(rot, 1, 2))  # (M, S, 3): R a for every sphere a
-        return x + pos[:, None], self._pad_radii[bucket][link] + self.gap
-
-    def _by_bucket(self, b: np.ndarray, link: np.ndarray):
-        """The (configuration, link) pairs ``b``, ``link`` (M,) grouped by the links' bucket:
-        yields the bucket, the positions (M_k,) of its pairs, their configurations and links."""
-        if not link.size:
-            return
-        bucket = self._bucket[link]  # (M,)
-        for k in range(len(BUCKETS) + 1):
-            group = np.flatnonzero(bucket == k)
-            if group.size:
-                yield k, group, b[group], link[group]
 
     # ---- queries -----------------------------------------------------------------------------
 
@@ -405,14 +261,15 @@ class SphereCollision:
     def _clearance(self, q: np.ndarray, fingers: float, ignore: Ignore, detail: bool):
         """(B,) bool validity, or (detail, B = 1) the list of contacts."""
         scene, own, held_arm = self._mask(ignore)
+        model = self.model
         n, links = q.shape[0], len(PARTS)
-        rot_t, pos_t = self._frames(q, float(fingers))  # (F, 3, 3, B), (F, 3, B)
-        b = self._bounds[:, :, None]  # (L, 3, 1) the bounding spheres' centres, link frames
+        rot_t, pos_t = model.frames(q, float(fingers))  # (F, 3, 3, B), (F, 3, B)
+        b = model.bounds[:, :, None]  # (L, 3, 1) the bounding spheres' centres, link frames
         mid_t = pos_t[:links] + rot_t[:links, :, 0] * b[:, None, 0]  # (L, 3, B)
         mid_t += rot_t[:links, :, 1] * b[:, None, 1]
         mid_t += rot_t[:links, :, 2] * b[:, None, 2]
         rot, pos = batch_first(rot_t, pos_t)  # (B, F, 3, 3), (B, F, 3)
-        reach = self._reach + self.gap  # (L,)
+        reach = model.reach + self.gap  # (L,)
         hit, found = np.zeros(n, dtype=bool), []  # found: [Contact]
 
         def record(b, part, other, clearance, limit: float) -> None:
@@ -440,8 +297,8 @@ class SphereCollision:
         # the table: a plane at z = 0
         low = mid_t[:, 2] < (reach + m)[:, None]  # (L, B)
         near_l, near_b = np.nonzero(low & scene[:links, 0, None])
-        for k, _, rows, link in self._by_bucket(near_b, near_l):
-            x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
+        for k, _, rows, link in model.by_bucket(near_b, near_l):
+            x, grown = model.place(rot[rows, link], pos[rows, link], k, link, self.gap)  # (M, S, 3)
             record(rows, link, np.zeros_like(rows), x[..., 2] - grown, m)
         # the boxes, each in its own frame (turned about z only)
         if len(self._names) > 1:  # the bounding spheres against the boxes' world bounds
@@ -454,28 +311,29 @@ class SphereCollision:
                 near &= np.less(np.abs(d, out=d), room[..., None], out=inside)
             near_l, near_o, near_b = np.nonzero(near)  # (M,) each
             near_b, near_l, near_o = pending(near_b, near_l, near_o)
-            for k, group, rows, link in self._by_bucket(near_b, near_l):
-                x, grown = self._place(rot[rows, link], pos[rows, link], k, link)  # (M, S, 3)
+            for k, group, rows, link in model.by_bucket(near_b, near_l):
+                rot_k, pos_k = rot[rows, link], pos[rows, link]  # (M, 3, 3), (M, 3)
+                x, grown = model.place(rot_k, pos_k, k, link, self.gap)  # (M, S, 3)
                 box = near_o[group]  # (M,)
                 gap = self._box_gap(x, box[:, None], grown + m, detail)  # (M, S)
                 record(rows, link, box + 1, gap + m, m)
         # the links against each other: the distal link's spheres against the other's 26-DOP
         if self.self_margin < APART_CLEARANCE:  # the pairs APART keeps apart at any angle
-            own = own & (self._apart_from > -math.inf)
-        a, c = self._pairs[own, 1], self._pairs[own, 0]  # (K',) sphere side, DOP side
+            own = own & (model.apart_from > -math.inf)
+        a, c = model.pairs[own, 1], model.pairs[own, 0]  # (K',) sphere side, DOP side
         apart = reach[a] + reach[c] + self.self_margin  # (K',)
         gap = mid_t[a]  # (K', 3, B)
         gap -= mid_t[c]
         gap *= gap
         close = gap.sum(1) < np.square(apart)[:, None]  # (K', B)
         if self.self_margin < APART_CLEARANCE:  # ... and those it keeps apart at these angles
-            close &= q.T[self._apart_joint[own]] < self._apart_from[own, None]
+            close &= q.T[model.apart_joint[own]] < model.apart_from[own, None]
         near_b, near_k = pending(*np.nonzero(close)[::-1])
         la, lc = a[near_k], c[near_k]
         if near_b.size:  # link a's bounding sphere against link c's box, in c's frame
             d = mid_t[la, :, near_b] - pos[near_b, lc]  # (M, 3)
-            d = np.einsum("mji,mj->mi", rot[near_b, lc], d) - self._aabb_c[lc]  # from its middle
-            keep = near_box(d, self._aabb_h[lc], reach[la] + self.self_margin)
+            d = np.einsum("mji,mj->mi", rot[near_b, lc], d) - model.aabb_c[lc]  # from its middle
+            keep = near_box(d, model.aabb_h[lc], reach[la] + self.self_margin)
             near_b, la, lc = near_b[keep], la[keep], lc[keep]
         if near_b.size:
             self._self_pairs(rot, pos, near_b, la, lc, record)
@@ -487,41 +345,42 @@ class SphereCollision:
         """The flagged link pairs (M,): configurations ``b``, sphere side ``link``, DOP side
         ``other``; each sphere-side cluster's bounding sphere against the other link's box,
         then its spheres against that box and, where near, against the 26-DOP."""
+        model = self.model
         r_c = rot[b, other]  # (M, 3, 3)
         r_rel = np.swapaxes(r_c, 1, 2) @ rot[b, link]  # (M, 3, 3) link -> the other's frame
         t_rel = np.einsum("mji,mj->mi", r_c, pos[b, link] - pos[b, other])  # (M, 3)
-        parts = self._n_clusters[link]  # (M,)
+        parts = model.n_clusters[link]  # (M,)
         pair = np.repeat(np.arange(b.size), parts)  # (N,) each pair's clusters
-        cluster = self._first_cluster[link][pair] + np.arange(pair.size)
+        cluster = model.first_cluster[link][pair] + np.arange(pair.size)
         cluster -= np.repeat(np.cumsum(parts) - parts, parts)  # (N,)
         frame = other[pair]  # (N,)
-        box_c, box_h = self._aabb_c[frame], self._aabb_h[frame]  # (N, 3) each
-        centre = np.einsum("nij,nj->ni", r_rel[pair], self._cluster_mid[cluster]) + t_rel[pair]
-        reach = self._cluster_reach[cluster] + (self.gap + self.self_margin)  # (N,)
+        box_c, box_h = model.aabb_c[frame], model.aabb_h[frame]  # (N, 3) each
+        centre = np.einsum("nij,nj->ni", r_rel[pair], model.cluster_mid[cluster]) + t_rel[pair]
+        reach = model.cluster_reach[cluster] + (self.gap + self.self_margin)  # (N,)
         keep = near_box(centre - box_c, box_h, reach)
         pair, cluster, frame = pair[keep], cluster[keep], frame[keep]
         box_c, box_h = box_c[keep, None], box_h[keep, None]  # (N', 1, 3) each
-        local = self._cluster_local[cluster]  # (N', S, 3), padded with repeats of the first
+        local = model.cluster_local[cluster]  # (N', S, 3), padded with repeats of the first
         # (N', S, 3) in the other link's frame, from the centre of its DOP's box
         inner = np.matmul(local, np.swapaxes(r_rel[pair], 1, 2)) + (t_rel[pair, None] - box_c)
-        grown = self._cluster_radii[cluster] + self.gap  # (N', S)
+        grown = model.cluster_radii[cluster] + self.gap  # (N', S)
         # the DOP's axis-aligned box first (a lower bound too), the 26 planes where it is near
         near_n, near_s = np.nonzero(near_box(inner, box_h, grown + self.self_margin))
-        gap = dop_gap(inner[near_n, near_s], self._directions, self._dop_c[:, frame[near_n]])
+        gap = dop_gap(inner[near_n, near_s], model.directions, model.dop_c[:, frame[near_n]])
         gap -= grown[near_n, near_s]  # (K,) the 26-DOP's bound
         least = np.full(b.size, np.inf, dtype=gap.dtype)  # (M,) per pair, over its spheres
         np.minimum.at(least, pair[near_n], gap)
         record(b, link, ~other, least, self.self_margin)
 
     def _box_gap(self, points: np.ndarray, box, reach, exact: bool) -> np.ndarray:
-        """`sphere_fk._box_gap` of points (..., 3) to the boxes ``box`` (indices broadcasting
+        """`bounds.box_gap` of points (..., 3) to the boxes ``box`` (indices broadcasting
         with the points' leading axes, or a slice) less ``reach`` (...)."""
         d = points - self._box_c[box]  # (..., 3)
         return box_gap(d, self._cos[box], self._sin[box], self._halves[box], reach, exact)
 
     def _check_held(self, rot, pos, mid, scene, held_arm, record) -> None:
         """The held box at the TCP against the table, the boxes and the arm's links."""
-        m, held = self.margin, self._index[HELD]
+        m, held, model = self.margin, self._index[HELD], self.model
         half = self._held_half  # (3,)
         r_tcp, t_tcp = rot[:, -1], pos[:, -1]  # (B, 3, 3), (B, 3)
         r_box = r_tcp @ self._held_pose[:3, :3]  # (B, 3, 3) held box -> world
@@ -540,70 +399,17 @@ class SphereCollision:
                 turns, centres, halves = self._turns[box], self._box_c[box], self._halves[box]
                 sep = obb_gap(r_box[near_b], t_box[near_b], half + m, turns, centres, halves)
                 record(near_b, HELD, box + 1, sep + m, m)
-        links = self._arm_vs_held[held_arm[self._arm_vs_held]]
+        links = model.arm_vs_held[held_arm[model.arm_vs_held]]
         if links.size:
-            reach = self._reach + self.gap
+            reach = model.reach + self.gap
             # (B, L', 3) link bounds in the held box's frame
             inner = np.einsum("bji,blj->bli", r_box, mid[:, links] - t_box[:, None])
             gap = box_sdf(inner, half) - reach[links]  # (B, L')
             near_b, near_l = np.nonzero(gap < m)
-            for k, _, rows, link in self._by_bucket(near_b, links[near_l]):
+            for k, _, rows, link in model.by_bucket(near_b, links[near_l]):
                 r_in = np.swapaxes(r_box[rows], 1, 2)  # (M, 3, 3) world -> held box
                 r_rel = r_in @ rot[rows, link]  # (M, 3, 3) link -> held box
                 t_rel = np.einsum("mij,mj->mi", r_in, pos[rows, link] - t_box[rows])  # (M, 3)
-                inner, grown = self._place(r_rel, t_rel, k, link)  # (M, S, 3) in its frame
+                # (M, S, 3) in its frame
+                inner, grown = model.place(r_rel, t_rel, k, link, self.gap)
                 record(rows, HELD, ~link, box_sdf(inner, half) - grown, m)
-
-
-class Screened:
-    """A mesh collision model (e.g. `robots.collision.PandaCollision`) with a `SphereCollision`
-    beside it that mirrors its scene: ``set_boxes``, ``hold`` and ``margin`` go to both;
-    ``valid``, ``contacts`` and ``check_path`` are the mesh model's (the final word);
-    ``valid_batch`` is the spheres' (conservative: False wherever the mesh model would find a
-    contact, and sometimes where it would not), for `motion.rrt.plan_path`'s ``valid_batch``.
-    """
-
-    def __init__(self, mesh, spheres: SphereCollision | None = None):
-        self.mesh = mesh
-        self.spheres = spheres if spheres is not None else SphereCollision(mesh.margin)
-        self.spheres.margin, self.spheres.self_margin = mesh.margin, mesh.self_margin
-
-    @property
-    def margin(self) -> float:
-        return self.mesh.margin
-
-    @margin.setter
-    def margin(self, value: float) -> None:
-        self.mesh.margin = self.spheres.margin = value
-
-    def set_boxes(self, boxes: Sequence[Box]) -> None:
-        self.mesh.set_boxes(boxes)
-        self.spheres.set_boxes(boxes)
-
-    def hold(self, size: float | None = None, half=None, pose=None) -> None:
-        self.mesh.hold(size, half, pose)
-        self.spheres.hold(size, half, pose)
-
-    def valid(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()) -> bool:
-        return self.mesh.valid(q, fingers, ignore)
-
-    def contacts(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()):
-        return self.mesh.contacts(q, fingers, ignore)
-
-    def check_path(self, path, fingers=PANDA.finger_open, ignore: Ignore = (), max_step=0.02):
-        return self.mesh.check_path(path, fingers, ignore, max_step)
-
-    def valid_batch(self, q, fingers: float = PANDA.finger_open, ignore: Ignore = ()):
-        return self.spheres.valid_batch(q, fingers, ignore)
-
-    def __getattr__(self, name: str):
-        """Anything else (``parts``, ``spec``, ``close``, ...) is the mesh model's."""
-        if name in ("mesh", "spheres"):  # not set yet: no recursion through the mesh
-            raise AttributeError(name)
-        return getattr(self.mesh, name)
-
-    def __enter__(self) -> Screened:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.mesh.close()
