@@ -4,7 +4,7 @@ A cost source prices every move ``x -> y`` in the state a planning window starts
 planner adds ``lambda_motion * sum_t sum_(x,y) g_t(x, y) c(x, y)`` to its loss (`task.costs`),
 so gradients flow from the costs into the action logits, and ranks equally short plans by the
 cost of their moves. Here the cost is the squared horizontal distance (m^2) a block travels
-from where it stands to where it lands, a stand-in for the arm's cost (`tamp.arm_costs`).
+from where it stands to where it lands, a stand-in for the arm's cost (`tamp.arm.costs`).
 ``torch.autograd.gradcheck`` compares its analytic gradient with finite differences in
 float64. Run: ``python examples/cost_gradient.py`` (about 3 s).
 """

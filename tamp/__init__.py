@@ -16,7 +16,7 @@ Its rooms:
   state and goals read from their geometry;
 - ``tamp.scene``: the table, its slots and block poses <-> symbolic states;
   ``tamp.obstacles``: the named scenes and the clearance they leave;
-  ``tamp.arm_costs``: the arm's cost of each move, for motion-aware planning;
+  ``tamp.arm``: the arm's cost of each move, for motion-aware planning, and what it failed;
   ``tamp.sweep``: independent items (episodes) in local processes or on a Ray cluster;
   ``tamp.video``: episode videos.
 """

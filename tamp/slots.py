@@ -1,6 +1,6 @@
 """The table as the planner's K base slots: a scene's places, each holding one tower.
 
-Motion-aware planning (`tamp.arm_costs`) plans on the table the arm really has: every table
+Motion-aware planning (`tamp.arm.costs`) plans on the table the arm really has: every table
 slot of the scene with room for a block (`tamp.scene.SceneConfig.slots`, not under a board too
 low for one) is a capacity-one target named ``slot<k>`` (`task.domains.blocksworld.with_slots`),
 so a plan never needs more free places than the table has and each move onto the table names
@@ -20,7 +20,8 @@ import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
-from tamp.arm_costs import Arm, ArmCosts
+from tamp.arm.arm import Arm
+from tamp.arm.costs import ArmCosts
 from tamp.scene import XY, Pose, SceneConfig, SceneError, layout, plain_move
 from task.config import PlannerConfig
 from task.domains.blocksworld import with_slots

@@ -2,7 +2,7 @@
 
 A `CostSource` gives every planning window a cost ``c(x, y)`` for each move of an entity ``x``
 onto a target ``y`` in the window's start state, for example the arm's joint-space motion and
-reach of each candidate pick-and-place (`tamp.arm_costs`, computed through pytorch-kinematics).
+reach of each candidate pick-and-place (`tamp.arm.costs`, computed through pytorch-kinematics).
 The planner adds the expected cost of the committed move mass to its loss,
 
     L_motion = lambda_motion * sum_t sum_(x, y) g_t(x, y) c(x, y)
@@ -21,7 +21,7 @@ window corrects, as it starts from the state the executed moves reached.
 
 A source may also check moves ahead: ``verify(index, state, move) -> bool`` says
 whether the move of problem ``index`` can be carried out where it starts (the arm's executor
-check on the poses the source predicts there, `tamp.arm_costs.ArmCosts.verify`). The receding
+check on the poses the source predicts there, `tamp.arm.costs.ArmCosts.verify`). The receding
 windows call it on each move they keep (`task.planner.windows.own_state_prefix`), ending the
 window before the first it fails; the source then rules that move out in that state, so the
 next window decodes another. A cheap matrix for every move, an exact check for the few the

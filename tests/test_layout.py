@@ -35,7 +35,7 @@ TAMP_LAYERS = (
     ("episode_report", "modes", "obstacles", "outcome", "rerun_log", "sweep"),
     ("scene",),
     ("sim",),
-    ("arm_costs", "slots", "video", "world"),
+    ("arm", "slots", "video", "world"),
     ("camera",),
     ("geo",),
     ("loop",),
@@ -66,7 +66,7 @@ ROOM_FORBIDDEN = {
 }
 ROOMS = {
     "motion": ("pick_place", "sphere_check"),
-    "tamp": ("bench", "camera", "cli", "geo", "loop", "sim", "world"),
+    "tamp": ("arm", "bench", "camera", "cli", "geo", "loop", "sim", "world"),
     "task": ("data", "domains", "planner", "symbolic"),
 }
 

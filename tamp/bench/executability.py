@@ -22,7 +22,7 @@ from pathlib import Path
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import Arm
+from tamp.arm.arm import Arm
 from tamp.bench.suites import Suite
 from tamp.loop import LoopConfig
 from tamp.loop.given import GivenPlanEpisode, StepReport, parse_given

@@ -85,7 +85,7 @@ def _plan_on_table(problem, config: PlannerConfig, settings: PlanSettings) -> Pl
         )
     from motion.ik import IKSolver
     from robots.panda import PANDA
-    from tamp.arm_costs import Arm
+    from tamp.arm.arm import Arm
     from tamp.obstacles import with_scene
     from tamp.scene import SceneConfig, layout
     from tamp.slots import plan_on_places

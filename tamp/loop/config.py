@@ -45,7 +45,7 @@ class LoopConfig:
     # centre, where the planner's Adam puts it (continuous placements; 0: the centre)
     # motion-aware, state, fixed places: the planner's windows check each move they keep with
     # the executor's own check on the poses they predict, before anything runs, and rule out
-    # where it starts a move that fails it (`tamp.arm_costs.ArmCosts.verify`). Off: on issue
+    # where it starts a move that fails it (`tamp.arm.costs.ArmCosts.verify`). Off: on issue
     # 13's cramped and shelf episodes it changed no outcome and cost planning time (BENCHMARKS)
     check_ahead: bool = False
 

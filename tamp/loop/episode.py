@@ -35,7 +35,9 @@ import numpy as np
 
 from motion.guard import guard_free_move
 from motion.ik import IKSolver
-from tamp.arm_costs import Arm, ArmCosts, FailedMove, failed_key
+from tamp.arm.arm import Arm
+from tamp.arm.costs import ArmCosts
+from tamp.arm.failures import FailedMove, failed_key
 from tamp.camera.from_images import ImageBeliefs
 from tamp.loop.config import LoopConfig
 from tamp.loop.execute import (

@@ -304,7 +304,7 @@ def motion_check(
     the arm at ``q_now``, nothing run: None when it finds the move's motion (top-down, each
     phase guarded, or with ``tools.fallback`` every other grasp), else the failure it would
     report. A planned move checked ahead, on the poses its plan predicts
-    (`tamp.arm_costs.ArmCosts.verify`)."""
+    (`tamp.arm.costs.ArmCosts.verify`)."""
     times = [0.0, 0.0, 0.0, 0, 0]
     planned = _plan(tools, move, poses, q_now, config, seed, times)
     if not (isinstance(planned, tuple) and isinstance(planned[0], Failure)):

@@ -1,4 +1,4 @@
-"""Motion-aware planning's move costs from the scene (`tamp.arm_costs`): predicted poses, the
+"""Motion-aware planning's move costs from the scene (`tamp.arm.costs`): predicted poses, the
 cost matrix's shape and meaning, blocked places under a shelf, and an episode planned with
 them."""
 
@@ -12,7 +12,9 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import ARM, BLOCKED, Arm, ArmCosts, predict_poses
+from tamp.arm.arm import Arm
+from tamp.arm.costs import ARM, BLOCKED, ArmCosts
+from tamp.arm.predict import predict_poses
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
 from tamp.scene import SceneConfig, layout
@@ -117,7 +119,7 @@ def test_the_planning_loss_differentiates_through_the_arm_into_logits_and_places
 
 
 def test_the_collision_proxy_prices_sweeps_past_the_scenes_obstacles_only(solver):
-    from tamp.arm_costs import obstacle_tensors
+    from tamp.arm.costs import obstacle_tensors
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
     costs = {}
@@ -212,21 +214,21 @@ def test_each_point_is_solved_once_per_source_with_the_batched_reach(solver, mon
     """A search prices many states whose blocks stand on the same spots: each point's IK is
     solved once per source. Whether it is reached is what a batched call says; a second state
     with the same points solves nothing."""
-    import tamp.arm_costs as arm_costs
+    import tamp.arm.sites as sites
     from motion.cost import site_solutions
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 4, 9])
     source = ArmCosts([FOUR], [poses], SCENE, Arm(solver, PANDA.q_home))
     picks = torch.tensor([[poses[x].xyz for x in FOUR.entities]], dtype=torch.float64)
     places = torch.tensor([[(0.5, 0.0, 0.025), (2.0, 0.0, 0.025)]], dtype=torch.float64)
-    q, ok = source._site_solutions(picks, places)
+    q, ok = source.sites.solve(picks, places)
     ok_all = site_solutions(solver, PANDA.q_home, picks, places)[1]
     assert torch.equal(ok, ok_all) and not ok[-1] and ok[:-1].all()  # 2 m away: out of reach
     reached = solver.fk(q[ok].numpy())[:, :3, 3]
     assert np.allclose(reached, torch.cat([picks, places], 1)[0][ok].numpy(), atol=2e-3)
     calls = []
-    monkeypatch.setattr(arm_costs, "site_solutions", lambda *a: calls.append(a) or (q, ok))
-    again = source._site_solutions(picks.flip(1), places)  # the same points, another order
+    monkeypatch.setattr(sites, "site_solutions", lambda *a: calls.append(a) or (q, ok))
+    again = source.sites.solve(picks.flip(1), places)  # the same points, another order
     assert calls == [] and torch.equal(again[0][:4], q[:4].flip(0))
 
 
@@ -236,7 +238,7 @@ def test_a_failed_move_is_ruled_out_wherever_it_would_be_the_same(solver):
     the blocks then around that still there; a pick that failed with every grasp rules out
     every move of its block there. Once a neighbour has gone, or the block stands elsewhere,
     it may be tried again."""
-    from tamp.arm_costs import FailedMove, Site
+    from tamp.arm.failures import FailedMove, Site
     from tamp.scene import Pose
 
     poses = layout(FOUR.entities, FOUR.init, SCENE, seed=0, slots=[0, 1, 9])  # a-b, c, d

@@ -1,4 +1,4 @@
-"""Continuous table placements (`tamp.arm_costs` with ``reach`` > 0, `tamp.slots`): each
+"""Continuous table placements (`tamp.arm.costs` with ``reach`` > 0, `tamp.slots`): each
 restart row optimises its own offsets, fresh in every window; a committed move keeps the
 position its row decided; a failed move at an offset position is priced out at its place."""
 
@@ -10,7 +10,9 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, Arm, ArmCosts, failed_key
+from tamp.arm.arm import Arm
+from tamp.arm.costs import BLOCKED, ArmCosts
+from tamp.arm.failures import failed_key
 from tamp.scene import PlacedMove, layout
 from tamp.slots import slotted
 from task.problem import TABLE, Move

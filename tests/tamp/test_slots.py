@@ -13,7 +13,9 @@ import torch
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, Arm, ArmCosts, failed_key
+from tamp.arm.arm import Arm
+from tamp.arm.costs import BLOCKED, ArmCosts
+from tamp.arm.failures import failed_key
 from tamp.loop import LoopConfig, run_episode
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout, place_pose, plain_move

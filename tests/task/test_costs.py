@@ -228,7 +228,7 @@ def test_own_state_prefix_ends_before_the_first_move_its_check_ahead_fails():
 class CheckedCosts(StateCosts):
     """a onto d looks best (a to the table is `EXPENSIVE`); the source's check ahead
     (``verify``: a source of its own, not a `task.costs.CostSourceBase`) fails a onto d, which
-    it then prices out in that state, as `tamp.arm_costs.ArmCosts.verify` does."""
+    it then prices out in that state, as `tamp.arm.costs.ArmCosts.verify` does."""
 
     refused: set = field(default_factory=set)
     checked: list = field(default_factory=list)

@@ -10,7 +10,7 @@ prices each legal move x -> y of that state:
   stand on, `tamp.geo.places.supported_on`), when no grasp of x is free both at the pick and at
   the place, or when the top-down grasp or release has no IK solution;
 - else the joint distance (rad) between the top-down grasp and release configurations, as
-  `tamp.arm_costs` prices Blocksworld moves (`motion.cost`'s c(x, y) without its sphere terms),
+  `tamp.arm.costs` prices Blocksworld moves (`motion.cost`'s c(x, y) without its sphere terms),
   plus, for a move into a goal region's cell, `GeoCostConfig.order` per cell of that region
   still empty whose hand room reaches this cell's body (filling this one first closes it: the
   packer's placing-order test, `tamp.geo.ours.cells.hand_reaches`).

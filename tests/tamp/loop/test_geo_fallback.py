@@ -1,7 +1,7 @@
 """The loop's world as a geometric scene (`tamp.loop.geo_fallback`), the executor's geometric
 fallback (`tamp.loop.execute`: a move top-down grasps over the highest stack cannot make, made with
 another grasp and a lower transit) and the motion-aware prices that agree with it
-(`tamp.arm_costs.ArmCosts`' ``grasps``)."""
+(`tamp.arm.costs.ArmCosts`' ``grasps``)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,8 @@ import pytest
 
 from motion.ik import IKSolver
 from robots.panda import PANDA
-from tamp.arm_costs import BLOCKED, DETOUR, Arm, ArmCosts
+from tamp.arm.arm import Arm
+from tamp.arm.costs import BLOCKED, DETOUR, ArmCosts
 from tamp.loop.geo_fallback import CHOICES, blocks_goal, geo_fallback, world_scene
 from tamp.obstacles import with_scene
 from tamp.scene import PlacedMove, Pose, SceneConfig, layout

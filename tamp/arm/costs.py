@@ -1,61 +1,47 @@
 """The arm's cost of every candidate move, for motion-aware task planning (`task.costs`).
 
-`ArmCosts` is a `task.costs.CostSource` for Blocksworld problems laid out on a table scene.
-For a window starting in a crisp state it predicts where every block stands (blocks keep their
-observed places; a tower moved to the table stands on a free slot, `predict_poses`), then prices
-each move x -> y with `motion.cost.move_costs`: the joint-space distance between the grasp
-configuration at x and the release configuration on y (through pytorch-kinematics, with
+`ArmCosts` is a `task.costs.CostSource` for Blocksworld problems laid out on a table scene. For
+a window starting in a crisp state it predicts where every block stands (blocks keep their
+observed places; a tower moved to the table stands on a free slot, `tamp.arm.predict`), then
+prices each move x -> y with `motion.cost.move_costs`: the joint-space distance between the
+grasp configuration at x and the release configuration on y (through pytorch-kinematics, with
 gradients to the targets), plus the reach residual, an infeasibility penalty and the sphere
 model's clearance to the scene's obstacles along the move and to the other blocks (boxes at
-their predicted places) at its grasp and release. A place onto a tower that its slot's
-clearance cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a move to a full
-table and a grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so
-does a move the arm failed in that state before (``avoid``, `failed_key`) or, in any state,
-where it failed (``failed``, `FailedMove`: picked and put among the same blocks). Each point's
-IK is solved once per source (`ArmCosts._site_solutions`). With ``grasps`` (the executor's
-geometric fallback, `tamp.loop.geo_fallback`: tilted and side grasps, corridor transits) the
-prices agree with what that executor can do: a pick or place out of top-down reach that one of
-those grasps reaches, and a top-down grasp or release into a neighbour, cost `DETOUR` instead.
-The matrix is computed once per state: the table placement is the scene's free slot, or with
-table places (`tamp.slots`) each place's centre. With ``reach`` > 0 the places move (continuous
-placements): every window optimises fresh offsets, one set per restart row, with the logits, and
-the source records, for each committed move, the position the chosen row decided it with
-(`ArmCosts.decided`).
+their predicted places) at its grasp and release. A place onto a tower that its slot's clearance
+cannot take (`tamp.scene.SceneConfig.capacity`: a shelf over it), a move to a full table and a
+grasp or release reaching `DEEP` into another block get ``blocked`` on top, and so does a move
+the arm failed in that state before (``avoid``, `tamp.arm.failures.failed_key`) or, in any
+state, where it failed (``failed``, `tamp.arm.failures.FailedMove`: picked and put among the
+same blocks). Each point's IK is solved once per source (`tamp.arm.sites`). With ``grasps`` (the
+executor's geometric fallback, `tamp.loop.geo_fallback`: tilted and side grasps, corridor
+transits) the prices agree with what that executor can do: a pick or place out of top-down reach
+that one of those grasps reaches, and a top-down grasp or release into a neighbour, cost
+`DETOUR` instead. The matrix is computed once per state: the table placement is the scene's free
+slot, or with table places (`tamp.slots`) each place's centre. With ``reach`` > 0 the places
+move (continuous placements): every window optimises fresh offsets, one set per restart row,
+with the logits, and the source records, for each committed move, the position the chosen row
+decided it with (`ArmCosts.decided`).
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import torch
 
-from motion.cost import (
-    Blocks,
-    Bodies,
-    MoveCostConfig,
-    block_depths,
-    move_costs_batch,
-    site_solutions,
-)
-from motion.ik import IKSolver
+from motion.cost import Blocks, Bodies, MoveCostConfig, block_depths, move_costs_batch
 from motion.pick_place import PickPlaceConfig
-from tamp.scene import (
-    XY,
-    PlacedMove,
-    Pose,
-    SceneConfig,
-    free_slot,
-    plain_move,
-    towers,
-)
-from tamp.world.convert.from_poses import read_state
+from tamp.arm.arm import Arm
+from tamp.arm.failures import column
+from tamp.arm.predict import predict_poses
+from tamp.arm.sites import SiteSolutions
+from tamp.scene import XY, Pose, SceneConfig, free_slot, plain_move
 from task.costs import IMPOSSIBLE, CostSourceBase
 from task.domains.base import State
-from task.problem import TABLE, Move, Problem
+from task.problem import TABLE, Problem
 
 # the move cost with the sphere model's clearance to the scene's obstacles (weight 5 per m of
 # CHOMP cost: 0.2-0.9 for a move sweeping past clutter's posts, next to about 1 per move of
@@ -72,51 +58,6 @@ BLOCKED = IMPOSSIBLE  # added to a move the scene cannot take: the planner refus
 # added instead to a move the top-down grasp cannot make but the executor's other grasps may
 # (`ArmCosts`' ``grasps``): about one move's joint distance, chosen, not tuned
 DETOUR = 1.0
-# m: the blocks around a pick or a place that a failed move's memory keeps (`Site`): within
-# reach of the hand and the forearm over it (the next slot, not the diagonal one); how far a
-# block may be from where it was recorded to still count as there (observation noise)
-AROUND, SAME = 0.2, 0.015
-
-
-def predict_poses(
-    entities: Sequence[str],
-    state: State,
-    poses: Mapping[str, Pose],
-    scene: SceneConfig,
-    bases: Mapping[str, tuple[float, float]] | None = None,
-) -> dict[str, Pose]:
-    """Block poses after the plan reached ``state`` from the observed ``poses``: a block with
-    the same blocks under it as observed keeps its observed pose; otherwise its tower keeps
-    the base block's observed table position when that base was on the table, else it stands
-    on a free slot, and the block stands exactly above the base. ``bases``: where each tower
-    base stands (a planned table place, `tamp.slots`) instead."""
-    s, out = scene.block_size, {}
-    stacks = towers(entities, state)
-    seen = read_state(entities, poses, scene).state
-    before = (
-        {}
-        if seen is None
-        else {x: tuple(t[:k]) for t in towers(entities, seen) for k, x in enumerate(t)}
-    )
-    grounded = [t for t in stacks if abs(poses[t[0]].xyz[2] - s / 2) <= scene.tol_z]
-    if bases is not None:
-        grounded = stacks
-    for tower in grounded:
-        base, stays = poses[tower[0]], True
-        if bases is not None:  # moved onto its planned place unless it stands there already
-            xy = bases[tower[0]]
-            if before.get(tower[0]) != () or math.dist(base.xy, xy) > scene.slot_radius:
-                base, stays = Pose((*xy, s / 2), 0.0), False
-        for level, x in enumerate(tower):
-            out[x] = Pose((base.xyz[0], base.xyz[1], s / 2 + level * s), base.yaw)
-            if stays and before.get(x) == tuple(tower[:level]):
-                out[x] = poses[x]  # nothing under it changed
-    for tower in (t for t in stacks if t not in grounded):
-        taken = {k: v for k, v in out.items()}
-        slot = free_slot(taken, poses[tower[0]].xyz, scene) or scene.slots[0]
-        for level, x in enumerate(tower):
-            out[x] = Pose((slot[0], slot[1], s / 2 + level * s), 0.0)
-    return out
 
 
 class _Fixed:
@@ -187,24 +128,6 @@ class _Placed:
             self.owner._record(i, done, None if row is None else shift[p * self.restarts + row])
 
 
-@dataclass(frozen=True)
-class Arm:
-    """The arm a plan is priced for, as its planner knows it now: the IK ``solver``, where it
-    stands (``q_now``, (J,)), what its executor can do besides the top-down grasp over the
-    highest stack (``grasps``: the grasp families of its geometric fallback, with which a pick
-    or place only those reach is not ruled out, `ArmCosts`; ``check``: the executor's own check
-    of a move among poses, `ArmCosts.verify`; None: none), and what it failed so far
-    (``avoid``: plain state -> `failed_key`s of the moves that failed there; ``failed``: the
-    moves it failed by where, ruled out wherever they would be the same, `FailedMove`)."""
-
-    solver: IKSolver
-    q_now: object
-    grasps: tuple[str, ...] = ()
-    check: Callable[[Mapping[str, Pose], Move], bool] | None = None
-    avoid: Mapping[State, set] | None = None
-    failed: Sequence[FailedMove] = ()
-
-
 class ArmCosts(CostSourceBase):
     """`task.costs.CostSource` of Blocksworld ``problems`` whose blocks were observed at
     ``poses[k]`` (block -> `Pose`), priced for ``arm`` (`Arm`: the arm now at ``arm.q_now``,
@@ -230,10 +153,10 @@ class ArmCosts(CostSourceBase):
         self.failed = tuple(arm.failed)  # moves the arm failed, by where (`FailedMove`)
         self.grasps = tuple(arm.grasps)  # grasp families the executor also has (`_hover`)
         self._reached: dict[tuple, bool] = {}  # (x, y, z mm, yaw) -> `_grasped`, per source
-        self._sites: dict[tuple, tuple[np.ndarray, bool]] = {}  # point -> `_site_solutions`
         self.places = places  # per problem: table place -> (x, y), for slotted problems
         self.avoid = arm.avoid or {}  # plain state -> `failed_key`s of moves that failed there
         self.solver, self.q_now = arm.solver, np.asarray(arm.q_now, float)
+        self.sites = SiteSolutions(self.solver, self.q_now)  # each point's IK, solved once
         self.config = config
         self.reach = reach  # m: how far a block may go from its place's centre (0: fixed)
         self.boxes = obstacle_tensors(scene)  # the collision proxy's obstacles, made once
@@ -305,14 +228,14 @@ class ArmCosts(CostSourceBase):
         logits."""
         *inputs, other = self._inputs(list(zip(indices, states, strict=True)))
         picks, places, extra, blocks = inputs
-        solved = self._site_solutions(picks, places)
+        solved = self.sites.solve(picks, places)
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return _Placed(self, indices, restarts, inputs, solved, extra)
 
     def _price(self, todo: list[tuple[int, State]]) -> list[torch.Tensor]:
         """(N, Y) cost matrices of the (problem index, state) pairs, one batched IK call."""
         picks, places, extra, blocks, other = self._inputs(todo)
-        solved = self._site_solutions(picks, places)
+        solved = self.sites.solve(picks, places)
         with torch.no_grad():
             bodies = Bodies(self.boxes, blocks)
             c = move_costs_batch(
@@ -320,26 +243,6 @@ class ArmCosts(CostSourceBase):
             )
         extra = extra + self._deep(solved, blocks) + self._detour(solved, other, picks.shape[1])
         return list(c + extra)  # (P, N, Y) each
-
-    def _site_solutions(self, picks, places) -> tuple[torch.Tensor, torch.Tensor]:
-        """`motion.cost.site_solutions` of picks (P, N, 3) then places (P, Y, 3) from
-        ``q_now``, each point solved once per source: a search prices thousands of states whose
-        blocks stand on the same few slots and heights, so most points repeat. One batched IK
-        call for the points (to the µm) not solved before. The batched solver stops once every
-        target of its batch has a solution, so a point's configuration can be another of its
-        seeds' than it would be in another batch; whether it is reached is the same."""
-        xyz = torch.cat([torch.as_tensor(picks), torch.as_tensor(places)], dim=1)
-        points = xyz.detach().reshape(-1, 3).to(torch.float64).numpy()  # (B, 3)
-        keys = [tuple(np.round(p, 6).tolist()) for p in points]
-        new = list(dict.fromkeys(k for k in keys if k not in self._sites))  # unseen, in order
-        if new:
-            at = torch.tensor(new, dtype=torch.float64)[None]  # (1, M, 3)
-            q, ok = site_solutions(self.solver, self.q_now, at, at[:, :0])
-            for k, qk, okk in zip(new, q.numpy(), ok.tolist(), strict=True):
-                self._sites[k] = (qk, bool(okk))
-        found = [self._sites[k] for k in keys]
-        q = torch.from_numpy(np.stack([f[0] for f in found]))  # (B, J)
-        return q, torch.tensor([f[1] for f in found], dtype=torch.bool)
 
     def _detour(self, solved, other: torch.Tensor, n: int) -> torch.Tensor:
         """(P, N, Y) ``DETOUR - config.infeasible`` per pick and per place whose top-down IK
@@ -411,7 +314,7 @@ class ArmCosts(CostSourceBase):
                 j = problem.targets.index(move.target)
                 extra[-1][problem.entities.index(move.entity), j] += BLOCKED
             for x, key in self.avoid.get(plain, ()):  # a move the arm failed in this state
-                j = _column(problem, key, at, self.reach)
+                j = column(problem, key, at, self.reach)
                 if j is not None:
                     extra[-1][problem.entities.index(x), j] += BLOCKED
         picks, places, extra = (torch.tensor(np.stack(a)) for a in (picks, places, extra))
@@ -432,7 +335,7 @@ class ArmCosts(CostSourceBase):
         points = np.vstack([picks, places])  # (N + Y, 3)
         points[:, 2] = np.maximum(points[:, 2], hover)
         n = picks.shape[0]
-        ok = self._site_solutions(points[None, :n], points[None, n:])[1]
+        ok = self.sites.solve(points[None, :n], points[None, n:])[1]
         ok = ok.numpy().copy()  # (N + Y,)
         other = np.zeros_like(ok)  # (N + Y,) out of that reach, in another grasp's
         if self.grasps and not ok.all():  # the executor's other grasps, at the block's height
@@ -492,109 +395,6 @@ class ArmCosts(CostSourceBase):
         if table_full:
             out[:, n:] = BLOCKED
         return out
-
-
-@dataclass(frozen=True)
-class Site:
-    """A point of a move (where the hand picks a block, or where it would put one) with the
-    blocks then within `AROUND` of it in (x, y): what a grasp or release there runs into."""
-
-    xyz: tuple[float, float, float]
-    around: tuple[tuple[str, tuple[float, float, float]], ...]  # (name, centre), by name
-
-    @classmethod
-    def at(cls, xyz, poses: Mapping[str, Pose], leave: str) -> Site:
-        """The site of point ``xyz`` among the blocks at ``poses`` (name -> `Pose`) but
-        ``leave`` (the block that moves)."""
-        point = tuple(float(v) for v in xyz)
-        around = tuple(
-            (name, tuple(float(v) for v in p.xyz))
-            for name, p in sorted(poses.items())
-            if name != leave and math.dist(p.xyz[:2], point[:2]) <= AROUND
-        )
-        return cls(point, around)
-
-    def matches(self, xyz, poses: Mapping[str, Pose], leave: str) -> bool:
-        """Whether point ``xyz`` among ``poses`` is this site again, or one at least as
-        crowded: the point and every block that was around it where they were (within
-        `SAME`); a block come near since only adds to what the hand runs into."""
-        if math.dist(xyz, self.xyz) > SAME:
-            return False
-        return all(
-            name in poses and math.dist(poses[name].xyz, at) <= SAME for name, at in self.around
-        )
-
-
-@dataclass(frozen=True)
-class FailedMove:
-    """A move the arm failed, kept by where it failed (`ArmCosts`' ``failed``): moving
-    ``entity`` from the ``pick`` site to the ``place`` site, or from the ``pick`` site to
-    anywhere (``place`` None: the pick itself failed with every grasp, whatever the place).
-    It is ruled out wherever both sites are the same again (or more crowded) and the stacks
-    as high, in any state: the memory of the move in the state it failed in (``avoid``) holds
-    in that state only."""
-
-    entity: str
-    pick: Site
-    place: Site | None
-    top: float  # m: the highest block's centre then (the top-down hand hovers over it)
-
-    @classmethod
-    def of(cls, entity: str, poses: Mapping[str, Pose], place, pick_only: bool) -> FailedMove:
-        """``entity`` (at ``poses[entity]``) failed to move to the point ``place`` (its
-        centre there), or to be picked at all (``pick_only``)."""
-        pick = Site.at(poses[entity].xyz, poses, entity)
-        place = None if pick_only else Site.at(place, poses, entity)
-        return cls(entity, pick, place, max(float(p.xyz[2]) for p in poses.values()))
-
-    def columns(self, entities: Sequence[str], now: Mapping[str, Pose], places) -> list[int]:
-        """The action columns this failure rules out in a state whose blocks stand at ``now``,
-        its targets' points ``places`` (Y, 3): none unless the block is picked where it
-        failed, with the highest stack as high or higher."""
-        at = now.get(self.entity)
-        if at is None or not self.pick.matches(at.xyz, now, self.entity):
-            return []
-        if max(float(p.xyz[2]) for p in now.values()) < self.top - SAME:
-            return []  # the hand hovers lower now
-        if self.place is None:
-            return list(range(len(places)))
-        e = entities.index(self.entity)
-        return [
-            j
-            for j, point in enumerate(places)
-            if j != e and self.place.matches(point, now, self.entity)
-        ]
-
-
-def failed_key(move) -> tuple[str, object]:
-    """``(entity, target)`` of a move for `ArmCosts`' ``avoid``: a block name, "table", or
-    ("at", place, x, y) for a move onto a planned table place (`tamp.scene.PlacedMove`: the
-    place's name and the position the block was to go to, to the mm)."""
-    if isinstance(move, PlacedMove) and move.at is not None:
-        at = move.at
-        return move.entity, ("at", move.place, round(at[0], 3), round(at[1], 3))
-    return move.entity, move.target
-
-
-def _column(problem: Problem, key, at, reach: float) -> int | None:
-    """The action column of a `failed_key` target in ``problem`` (None when the problem has no
-    such target). A place matches by name (any place when the key names none) and by
-    position: the failed position lies within the place's ``reach`` (each offset is at most
-    ``reach`` in x and y) of its centre, to the key's mm; the nearest such place."""
-    if isinstance(key, str) and key != TABLE:
-        return problem.entities.index(key)
-    if at is None:  # the one table column
-        return problem.n
-    if isinstance(key, str):
-        return None  # "somewhere on the table": no one place to blame
-    _, place, x, y = key
-    tol = reach * math.sqrt(2) + 1e-3
-    near = [
-        (math.dist(at[k], (x, y)), j)
-        for j, k in enumerate(problem.fixed)
-        if place in (None, k) and math.dist(at[k], (x, y)) <= tol
-    ]
-    return problem.n + min(near)[1] if near else None
 
 
 def obstacle_tensors(scene: SceneConfig) -> tuple[torch.Tensor, torch.Tensor]:
