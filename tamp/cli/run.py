@@ -159,24 +159,9 @@ def run_command(settings: RunSettings | Unsolvable) -> int:
                 written.append(video.path.name)
         except TampError as exc:  # the episode's outcome and report stand without the video
             print(f"warning: {exc}", file=sys.stderr)
-    body = report_json(report, recorded)
-    if out is not None:
-        (out / "report.json").write_text(body)
-        written.append("report.json")
-    if output.json:
-        print(body)
-    else:
-        print("\n".join(summary_lines(report)))
-        if written:
-            print(f"wrote {', '.join(written)} to {out}")
-        if recorder is not None:
-            print(
-                f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
-            )
-    if interrupted:
-        print("tamp: interrupted", file=sys.stderr)
-        return 130
-    return 0 if report.reached_goal else 1
+    lines = summary_lines(report)
+    _report(report, recorded, out, written, output.json, lines, recorder)
+    return _exit_code(report, interrupted)
 
 
 def unsolvable(found: Unsolvable) -> int:
@@ -223,23 +208,45 @@ def geo_run(settings: RunSettings, recorded: dict) -> int:
             )
         except EpisodeInterrupted as stop:  # Ctrl-C: the video and report of what was done
             report, interrupted = stop.report, True
-    body = report_json(report, recorded)
     written = []
     if video is not None and video.is_file():
         written.append(video.name)
+    lines = geo_lines(report)
+    _report(report, recorded, out, written, output.json, lines, recorder)
+    return _exit_code(report, interrupted)
+
+
+def _report(
+    report: EpisodeReport,
+    recorded: dict,
+    out: Path | None,
+    written: list[str],
+    as_json: bool,
+    lines: list[str],
+    recorder: RerunRecorder | None,
+) -> None:
+    """The end of either episode's command: ``report.json`` under ``out`` (added to
+    ``written``, the files already there), then the report (``--json``) or ``lines``, what was
+    written and the Rerun recording's path."""
+    body = report_json(report, recorded)
     if out is not None:
         (out / "report.json").write_text(body)
         written.append("report.json")
-    if output.json:
+    if as_json:
         print(body)
     else:
-        print("\n".join(geo_lines(report)))
+        print("\n".join(lines))
         if written:
             print(f"wrote {', '.join(written)} to {out}")
         if recorder is not None:
             print(
                 f"wrote the Rerun recording {recorder.path} (open it with: rerun {recorder.path})"
             )
+
+
+def _exit_code(report: EpisodeReport, interrupted: bool) -> int:
+    """Either episode's exit code: 130 when interrupted, else 0 when the goal is reached, 1
+    when not."""
     if interrupted:
         print("tamp: interrupted", file=sys.stderr)
         return 130

@@ -316,7 +316,7 @@ def run_geo_episode(
                 recorder.plan_made(sim, head, [m.text() for m in plan.moves], plan_times[-1])
             if not plan.solved:
                 status, reason = EpisodeStatus.NO_PLAN, f"{plan.status.value}: {plan.reason}"
-                limit = _time_limit_s(search)
+                limit = search.max_time_s
                 if plan.status is GeoStatus.BUDGET and limit and plan_times[-1] >= limit:
                     reason = f"{time_limit_reached(limit)}; {reason}"
                 break
@@ -426,12 +426,6 @@ def _truly_holds(sim: Simulator, scene: Scene, goal: Goal) -> bool:
     with sim.truth.scoring():
         truth = _with_poses(scene, sim.truth.block_poses())
     return goal.holds(read_facts(truth, OBSERVED))
-
-
-def _time_limit_s(config) -> float | None:
-    """The planner's wall-clock limit in seconds (a `SearchConfig`'s, or the search config a
-    planner's own config holds); None without one."""
-    return getattr(getattr(config, "search", config), "max_time_s", None)
 
 
 def _act(

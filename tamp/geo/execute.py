@@ -51,7 +51,7 @@ from robots.panda import PANDA
 from tamp.geo.check import MoveCheck, support_box
 from tamp.geo.types import GeoMove
 from tamp.outcome import Failure
-from tamp.sim.base import Expected, Simulator, holding
+from tamp.sim.base import Expected, Simulator, lost_hold
 from tamp.sim.harness import Harness
 
 if TYPE_CHECKING:
@@ -175,7 +175,7 @@ def run_move(
         if phase.name == "open":
             closing = expected_contacts("lower", move.obj, rests)
             evidence |= _release(sim, config, on_frame, closing, phase.trajectory.duration)
-        lost = _lost(sim, phase.name, width, config, on_frame, handling)
+        lost = lost_hold(sim, phase.name, width, config, on_frame, handling, _no_object)
         if lost is not None and lost[0] is Failure.GRASP_MISSED:
             freed = _back_off(sim, check.motion, on_frame, move.obj, rests, config)
             return done(Failure.GRASP_MISSED, **lost[1], **freed)
@@ -216,24 +216,9 @@ class _Looks:
         return fixed[0][0], list(fixed[0][1:])
 
 
-def _lost(sim, phase: str, width: float, config, on_frame, handling):
-    """What went wrong with the held object after phase ``phase``, with its evidence:
-    GRASP_MISSED when the closed gripper (``width`` apart) holds nothing (a welded grasp: no
-    object between the fingers), DROPPED when it left the hand in the lift or the transit
-    (the hand then opens and holds still for 0.5 s); else None."""
-    if phase == "close":
-        missed = holding(sim, width, config, fresh=True)
-        if missed is None and sim.grasp == "weld" and not sim.attach():
-            missed = {"weld": "no object between the fingers"}
-        return None if missed is None else (Failure.GRASP_MISSED, missed)
-    if phase in ("lift", "transit"):
-        gone = holding(sim, width, config, fresh=False)
-        if gone is not None:
-            sim.detach()
-            hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
-            sim.run(hold, "open", on_frame=on_frame, expected=handling)
-            return Failure.DROPPED, gone
-    return None
+def _no_object(sim: Simulator) -> dict:
+    """A welded grasp's miss: no object between the fingers (`lost_hold`'s evidence)."""
+    return {"weld": "no object between the fingers"}
 
 
 def rests_of(scene, move: GeoMove, support: str) -> tuple[str, str]:

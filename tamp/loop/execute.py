@@ -34,7 +34,7 @@ from perception.errors import PerceptionError
 from tamp.obstacles import ceiling
 from tamp.outcome import Failure
 from tamp.scene import PlacedMove, Pose, SceneConfig, place_pose, top_z
-from tamp.sim.base import Expected, Simulator, holding
+from tamp.sim.base import Expected, Simulator, lost_hold
 from tamp.sim.harness import Harness
 from task.errors import member
 from task.problem import TABLE, Move
@@ -395,25 +395,11 @@ def _after_top_down(first: ExecutionResult, again: ExecutionResult, moved: dict)
     )
 
 
-def _lost(sim: Simulator, phase: str, config, on_frame, handling) -> tuple[Failure, dict] | None:
-    """What went wrong with the block after phase ``phase``, with its evidence: GRASP_MISSED
-    when the closed gripper holds no block (a welded grasp: no one block between the
-    fingers), DROPPED when it left the hand in the lift or the transit (the hand then opens
-    and holds still for 0.5 s); else None."""
-    if phase == "close":
-        missed = holding(sim, config.motion.block_size, config, fresh=True)
-        if missed is None and sim.grasp == "weld" and not sim.attach():
-            r = sim.gripper()  # block-wide, but no one block touches both fingers
-            missed = {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
-        return None if missed is None else (Failure.GRASP_MISSED, missed)
-    if phase in ("lift", "transit"):
-        gone = holding(sim, config.motion.block_size, config, fresh=False)
-        if gone is not None:
-            sim.detach()
-            hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
-            sim.run(hold, "open", on_frame=on_frame, expected=handling)
-            return Failure.DROPPED, gone
-    return None
+def _no_block(sim: Simulator) -> dict:
+    """A welded grasp's miss: the gripper block-wide, but no one block touches both fingers
+    (`lost_hold`'s evidence)."""
+    r = sim.gripper()
+    return {"finger_width": round(r.width, 4), "weld": "no block between fingers"}
 
 
 def execute_move(
@@ -473,7 +459,8 @@ def execute_move(
         if worst > config.max_tracking:
             _back_off(sim, phases, on_frame, handling)
             return result(Failure.TRACKING, ik, phase=phase.name, error_rad=round(worst, 3))
-        lost = _lost(sim, phase.name, config, on_frame, handling)
+        width = config.motion.block_size
+        lost = lost_hold(sim, phase.name, width, config, on_frame, handling, _no_block)
         if lost is not None and lost[0] is Failure.GRASP_MISSED:
             _back_off(sim, phases, on_frame, handling)
             return result(Failure.GRASP_MISSED, ik, **lost[1])

@@ -28,6 +28,7 @@ import numpy as np
 
 if TYPE_CHECKING:
     from motion.trajectory import JointTrajectory
+from tamp.outcome import Failure
 from tamp.scene import Body, Pose, SceneConfig, cube_yaw
 from tamp.sim.truth import GroundTruth, Snapshot
 from task.errors import TampError, one_of
@@ -343,3 +344,35 @@ def holding(sim: Simulator, width: float, config, fresh: bool) -> dict | None:
         "left_force": round(r.left_force, 3),
         "right_force": round(r.right_force, 3),
     }
+
+
+def lost_hold(
+    sim: Simulator,
+    phase: str,
+    width: float,
+    config,
+    on_frame: Callable[[Simulator], None] | None,
+    handling: Expected,
+    weld_missed: Callable[[Simulator], dict],
+) -> tuple[Failure, dict] | None:
+    """What went wrong with the held object after phase ``phase``, with its evidence (both
+    executors': `tamp.loop.execute`, `tamp.geo.execute`): GRASP_MISSED when the closed gripper
+    (``width`` apart, `holding`) holds nothing, or, on a welded grasp, when no object lies
+    between the fingers (evidence ``weld_missed(sim)``); DROPPED when it left the hand in the
+    lift or the transit (the hand then opens and holds still for 0.5 s, ``handling`` the
+    contacts expected meanwhile); else None."""
+    from motion.trajectory import JointTrajectory  # ruckig: loaded only where a hand moves
+
+    if phase == "close":
+        missed = holding(sim, width, config, fresh=True)
+        if missed is None and sim.grasp == "weld" and not sim.attach():
+            missed = weld_missed(sim)
+        return None if missed is None else (Failure.GRASP_MISSED, missed)
+    if phase in ("lift", "transit"):
+        gone = holding(sim, width, config, fresh=False)
+        if gone is not None:
+            sim.detach()
+            hold = JointTrajectory.hold(sim.arm_q(), 0.5, sim.dt)
+            sim.run(hold, "open", on_frame=on_frame, expected=handling)
+            return Failure.DROPPED, gone
+    return None

@@ -48,6 +48,21 @@ def _quat(yaw: float) -> list[float]:
     return [math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)]
 
 
+def _add_box(world, name: str, box, **collision) -> None:
+    """``box`` (a `tamp.obstacles.Obstacle`: half extents, centre, yaw, colour) as a fixed box
+    geom of the MjSpec body ``world``; ``collision``: its contype/conaffinity, if not the
+    default's."""
+    world.add_geom(
+        name=name,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=list(box.half),
+        pos=list(box.centre),
+        quat=_quat(box.yaw),
+        rgba=[*box.rgb, 1],
+        **collision,
+    )
+
+
 def _look_at(eye, target, up) -> list[float]:
     """Quaternion of a MuJoCo camera at ``eye`` looking at ``target`` (camera looks along -z)."""
     back = np.asarray(eye, float) - np.asarray(target, float)
@@ -131,25 +146,9 @@ class MuJoCoSim(Simulator):
                 conaffinity=2,
             )
         for o in scene.obstacles:  # fixed boxes (tamp.obstacles)
-            world.add_geom(
-                name=f"obstacle_{o.name}",
-                type=mujoco.mjtGeom.mjGEOM_BOX,
-                size=list(o.half),
-                pos=list(o.centre),
-                quat=_quat(o.yaw),
-                rgba=[*o.rgb, 1],
-            )
+            _add_box(world, f"obstacle_{o.name}", o)
         for o in scene.marks:  # drawn regions: visual only, like the backdrop
-            world.add_geom(
-                name=f"mark_{o.name}",
-                type=mujoco.mjtGeom.mjGEOM_BOX,
-                size=list(o.half),
-                pos=list(o.centre),
-                quat=_quat(o.yaw),
-                rgba=[*o.rgb, 1],
-                contype=0,
-                conaffinity=2,
-            )
+            _add_box(world, f"mark_{o.name}", o, contype=0, conaffinity=2)
 
     def _add_blocks(self, s, poses, bodies) -> None:
         """Each block at its pose, free to move, and its weld to the hand (off until a

@@ -145,27 +145,6 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
     out = []
     for x in names:
         fit, true = fits[x], truth[x]
-        if isinstance(fit, str):
-            out.append(
-                BlockRow(
-                    sim=sim,
-                    scene=scene,
-                    block=x,
-                    blocks=len(names),
-                    level=level[x],
-                    top_free=x in free,
-                    reason=fit,
-                    error_mm=None,
-                    dx_mm=None,
-                    dy_mm=None,
-                    dz_mm=None,
-                    yaw_error_deg=None,
-                )
-            )
-            continue
-        d = 1000.0 * (np.asarray(fit.pose.xyz) - np.asarray(true.xyz))  # (3,) mm
-        error = float(np.linalg.norm(d))
-        yaw = yaw_error(fit.pose.yaw, true.yaw)
         out.append(
             BlockRow(
                 sim=sim,
@@ -174,15 +153,26 @@ def _rows(sim, scene, names, state, truth, fits) -> list[BlockRow]:
                 blocks=len(names),
                 level=level[x],
                 top_free=x in free,
-                reason="",
-                error_mm=error,
-                dx_mm=float(d[0]),
-                dy_mm=float(d[1]),
-                dz_mm=float(d[2]),
-                yaw_error_deg=yaw,
+                reason=fit if isinstance(fit, str) else "",
+                **_errors(fit, true),
             )
         )
     return out
+
+
+def _errors(fit, true) -> dict:
+    """A `BlockRow`'s error fields: the estimate ``fit`` against the true pose, or all None
+    when ``fit`` is the reason there is no estimate."""
+    if isinstance(fit, str):
+        return dict(error_mm=None, dx_mm=None, dy_mm=None, dz_mm=None, yaw_error_deg=None)
+    d = 1000.0 * (np.asarray(fit.pose.xyz) - np.asarray(true.xyz))  # (3,) mm
+    return dict(
+        error_mm=float(np.linalg.norm(d)),
+        dx_mm=float(d[0]),
+        dy_mm=float(d[1]),
+        dz_mm=float(d[2]),
+        yaw_error_deg=yaw_error(fit.pose.yaw, true.yaw),
+    )
 
 
 def block_rows(bench: PoseBench) -> list[dict]:
